@@ -1,0 +1,532 @@
+!> The input deck of Appendix B: read, validate and write.
+!>
+!>     line 1 : label (free text)
+!>     line 2 : NP  PIXEL  MAXCONT        integer, real (nm), integer
+!>     line 3 : E1  NU1                   lower surface (GPa, -)
+!>     line 4 : E2  NU2                   upper surface
+!>     line 5 : E3  NU3                   contact / interface elements
+!>     then NP*NP lower heights (nm), row by row, then NP*NP upper heights (nm)
+!>
+!> Lines 2 to 5 hold exactly the values named; the heights are free format from
+!> line 6 on (any number per line, separated by blanks, tabs or commas). CRLF line
+!> ends and Fortran `D` exponents are accepted. Every error names the file, the line
+!> and what was expected and found (doc/deck-format.md).
+module femcod_deck
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: ieee_exceptions, only: ieee_overflow, ieee_get_halting_mode, ieee_set_halting_mode, ieee_set_flag
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
+   use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, path_is_directory
+   implicit none
+   private
+   public :: deck_type, read_deck, write_deck, validate_deck, format_real, parse_real, parse_integer
+   public :: MAX_NP
+
+   !> Largest NP accepted: NP**2 must fit a default integer.
+   integer, parameter :: MAX_NP = 46340
+
+   !> A contact problem as the deck gives it.
+   type :: deck_type
+      !> Free-text label (line 1).
+      character(len=:), allocatable :: label
+      !> Pixels per side.
+      integer :: np = 0
+      !> Pixel side d (nm).
+      real(dp) :: pixel = 0
+      !> Maximum number of contacts.
+      integer :: maxcont = 0
+      !> Young's moduli (GPa): lower surface, upper surface, contact elements.
+      real(dp) :: young(3) = 0
+      !> Poisson's ratios: lower surface, upper surface, contact elements.
+      real(dp) :: poisson(3) = 0
+      !> Heights (nm), `lower(i, j)` is row i, column j as in the deck.
+      real(dp), allocatable :: lower(:, :), upper(:, :)
+   end type deck_type
+
+   character(len=*), parameter :: material_names(3) = [character(len=26) :: &
+      "lower surface", "upper surface", "contact/interface elements"]
+
+contains
+
+   !> Read and validate a deck. On error `status` holds `path:line: expected ..., found ...`
+   !> and `deck` is left unspecified.
+   subroutine read_deck(path, deck, status)
+      character(len=*), intent(in) :: path
+      type(deck_type), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      character(len=:), allocatable :: text
+      integer, allocatable :: tok_first(:), tok_last(:), tok_line(:)
+      integer :: ntok, k, first_line6, nvalues, i, j, last_line
+      integer :: ln_first(2:5), ln_count(2:5)
+
+      call read_whole_file(path, text, status)
+      if (status%code /= 0) return
+      call check_text(path, text, status)
+      if (status%code /= 0) return
+      call tokenize(text, ntok, tok_first, tok_last, tok_line, last_line)
+      deck%label = label_of(text)
+
+      ! Lines 2..5: exactly the named values.
+      ln_count = 0
+      ln_first = 0
+      first_line6 = ntok + 1
+      do k = 1, ntok
+         if (tok_line(k) >= 6) then
+            first_line6 = k
+            exit
+         end if
+         if (tok_line(k) >= 2) then
+            if (ln_count(tok_line(k)) == 0) ln_first(tok_line(k)) = k
+            ln_count(tok_line(k)) = ln_count(tok_line(k)) + 1
+         end if
+      end do
+      call expect_count(2, 3, "NP PIXEL MAXCONT")
+      if (status%code /= 0) return
+      call get_int(ln_first(2), "NP, a positive integer", deck%np)
+      if (status%code /= 0) return
+      if (deck%np <= 0 .or. deck%np > MAX_NP) then
+         call bad(2, "NP, an integer from 1 to "//int_str(MAX_NP), tok(ln_first(2)))
+         return
+      end if
+      call get_real(ln_first(2) + 1, "PIXEL, the pixel size in nm (> 0)", deck%pixel)
+      if (status%code /= 0) return
+      if (.not. deck%pixel > 0) then
+         call bad(2, "PIXEL, the pixel size in nm (> 0)", tok(ln_first(2) + 1))
+         return
+      end if
+      call get_int(ln_first(2) + 2, "MAXCONT, a positive integer", deck%maxcont)
+      if (status%code /= 0) return
+      if (deck%maxcont <= 0 .or. deck%maxcont > deck%np**2) then
+         call bad(2, "MAXCONT, an integer from 1 to NP**2 = "//int_str(deck%np**2), tok(ln_first(2) + 2))
+         return
+      end if
+      do i = 1, 3
+         call expect_count(2 + i, 2, "E"//int_str(i)//" NU"//int_str(i)//" of the "//trim(material_names(i)))
+         if (status%code /= 0) return
+         call get_real(ln_first(2 + i), "E"//int_str(i)//", Young's modulus in GPa (> 0)", deck%young(i))
+         if (status%code /= 0) return
+         if (.not. deck%young(i) > 0) then
+            call bad(2 + i, "E"//int_str(i)//", Young's modulus in GPa (> 0)", tok(ln_first(2 + i)))
+            return
+         end if
+         call get_real(ln_first(2 + i) + 1, "NU"//int_str(i)//", Poisson's ratio in (-1, 0.5)", deck%poisson(i))
+         if (status%code /= 0) return
+         if (.not. (deck%poisson(i) > -1 .and. deck%poisson(i) < 0.5_dp)) then
+            call bad(2 + i, "NU"//int_str(i)//", Poisson's ratio in (-1, 0.5)", tok(ln_first(2 + i) + 1))
+            return
+         end if
+      end do
+
+      ! Heights.
+      nvalues = 2*deck%np**2
+      if (ntok - first_line6 + 1 < nvalues) then
+         call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(last_line)//": expected "// &
+            int_str(nvalues)//" heights (NP**2 = "//int_str(deck%np**2)//" lower, then as many upper), found "// &
+            int_str(ntok - first_line6 + 1)//" before the end of the file")
+         return
+      end if
+      if (ntok - first_line6 + 1 > nvalues) then
+         k = first_line6 + nvalues
+         call bad(tok_line(k), "the end of the deck after the "//int_str(nvalues)//" heights", tok(k))
+         return
+      end if
+      allocate(deck%lower(deck%np, deck%np), deck%upper(deck%np, deck%np))
+      k = first_line6
+      do i = 1, deck%np
+         do j = 1, deck%np
+            call get_real(k, "a lower-surface height in nm (row "//int_str(i)//", column "//int_str(j)//")", &
+               deck%lower(i, j))
+            if (status%code /= 0) return
+            k = k + 1
+         end do
+      end do
+      do i = 1, deck%np
+         do j = 1, deck%np
+            call get_real(k, "an upper-surface height in nm (row "//int_str(i)//", column "//int_str(j)//")", &
+               deck%upper(i, j))
+            if (status%code /= 0) return
+            k = k + 1
+         end do
+      end do
+
+   contains
+
+      function tok(k) result(s)
+         integer, intent(in) :: k
+         character(len=:), allocatable :: s
+         s = "'"//text(tok_first(k):min(tok_last(k), tok_first(k) + 39))//"'"
+         if (tok_last(k) - tok_first(k) > 39) s = s//"..."
+      end function tok
+
+      subroutine bad(line, expected, found)
+         integer, intent(in) :: line
+         character(len=*), intent(in) :: expected, found
+         call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(line)//": expected "//expected// &
+            ", found "//found)
+      end subroutine bad
+
+      subroutine expect_count(line, n, what)
+         integer, intent(in) :: line, n
+         character(len=*), intent(in) :: what
+         if (ln_count(line) /= n) then
+            if (last_line < line) then
+               call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(line)//": expected "//int_str(n)// &
+                  " values ("//what//"), found the end of the file")
+            else
+               call bad(line, int_str(n)//" values ("//what//")", int_str(ln_count(line))//" values")
+            end if
+         end if
+      end subroutine expect_count
+
+      subroutine get_int(k, what, value)
+         integer, intent(in) :: k
+         character(len=*), intent(in) :: what
+         integer, intent(out) :: value
+         logical :: ok
+         call parse_integer(text(tok_first(k):tok_last(k)), value, ok)
+         if (.not. ok) call bad(tok_line(k), what, tok(k))
+      end subroutine get_int
+
+      subroutine get_real(k, what, value)
+         integer, intent(in) :: k
+         character(len=*), intent(in) :: what
+         real(dp), intent(out) :: value
+         logical :: ok
+         call parse_real(text(tok_first(k):tok_last(k)), value, ok)
+         if (.not. ok) call bad(tok_line(k), what//" (a finite number)", tok(k))
+      end subroutine get_real
+   end subroutine read_deck
+
+   !> Check the semantic limits of a deck built in memory (the reader checks the same).
+   subroutine validate_deck(deck, status)
+      type(deck_type), intent(in) :: deck
+      type(status_type), intent(inout) :: status
+      integer :: i
+      if (deck%np <= 0 .or. deck%np > MAX_NP) then
+         call set_error(status, STATUS_BAD_INPUT, "NP must be from 1 to "//int_str(MAX_NP))
+      else if (.not. (deck%pixel > 0 .and. ieee_is_finite(deck%pixel))) then
+         call set_error(status, STATUS_BAD_INPUT, "PIXEL must be a finite positive size in nm")
+      else if (deck%maxcont <= 0 .or. deck%maxcont > deck%np**2) then
+         call set_error(status, STATUS_BAD_INPUT, "MAXCONT must be from 1 to NP**2")
+      else if (index(deck%label, new_line("a")) > 0) then
+         call set_error(status, STATUS_BAD_INPUT, "the label must be a single line")
+      end if
+      if (status%code /= 0) return
+      do i = 1, 3
+         if (.not. (deck%young(i) > 0 .and. ieee_is_finite(deck%young(i)))) then
+            call set_error(status, STATUS_BAD_INPUT, "E"//int_str(i)//" must be a finite positive modulus in GPa")
+            return
+         end if
+         if (.not. (deck%poisson(i) > -1 .and. deck%poisson(i) < 0.5_dp)) then
+            call set_error(status, STATUS_BAD_INPUT, "NU"//int_str(i)//" must lie in (-1, 0.5)")
+            return
+         end if
+      end do
+      if (.not. allocated(deck%lower) .or. .not. allocated(deck%upper)) then
+         call set_error(status, STATUS_BAD_INPUT, "the deck has no heights")
+      else if (any(shape(deck%lower) /= deck%np) .or. any(shape(deck%upper) /= deck%np)) then
+         call set_error(status, STATUS_BAD_INPUT, "the height maps must be NP x NP")
+      else if (.not. (all(ieee_is_finite(deck%lower)) .and. all(ieee_is_finite(deck%upper)))) then
+         call set_error(status, STATUS_BAD_INPUT, "heights must be finite")
+      end if
+   end subroutine validate_deck
+
+   !> Write a deck: validated first, written under a temporary name, then renamed, so
+   !> that `path` is either untouched or complete. Each real is written with the fewest
+   !> digits that read back to the same double, one image row per line.
+   subroutine write_deck(path, deck, status)
+      character(len=*), intent(in) :: path
+      type(deck_type), intent(in) :: deck
+      type(status_type), intent(inout) :: status
+      character(len=:), allocatable :: tmp
+      integer :: unit, ios, i
+      call validate_deck(deck, status)
+      if (status%code /= 0) return
+      tmp = temporary_name(path)
+      open(newunit=unit, file=tmp, status="replace", action="write", form="formatted", iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot write (directory missing or not writable)")
+         return
+      end if
+      write(unit, '(a)', iostat=ios) deck%label
+      write(unit, '(a)', iostat=ios) int_str(deck%np)//" "//format_real(deck%pixel)//" "//int_str(deck%maxcont)
+      do i = 1, 3
+         write(unit, '(a)', iostat=ios) format_real(deck%young(i))//" "//format_real(deck%poisson(i))
+      end do
+      do i = 1, deck%np
+         call write_row(deck%lower(i, :))
+      end do
+      do i = 1, deck%np
+         call write_row(deck%upper(i, :))
+      end do
+      close(unit, iostat=ios)
+      if (ios /= 0) then
+         call remove_file(tmp)
+         call set_error(status, STATUS_IO, path//": writing failed")
+         return
+      end if
+      call atomic_rename(tmp, path, status)
+      if (status%code /= 0) call remove_file(tmp)
+   contains
+      subroutine write_row(row)
+         real(dp), intent(in) :: row(:)
+         character(len=:), allocatable :: line
+         integer :: j
+         line = format_real(row(1))
+         do j = 2, size(row)
+            line = line//" "//format_real(row(j))
+         end do
+         if (ios == 0) write(unit, '(a)', iostat=ios) line
+      end subroutine write_row
+   end subroutine write_deck
+
+   !> The shortest decimal form of `x` that reads back to the same double.
+   function format_real(x) result(s)
+      real(dp), intent(in) :: x
+      character(len=:), allocatable :: s
+      character(len=40) :: buf, fmt
+      real(dp) :: back
+      integer :: p, ios, e
+      if (x == 0) then
+         s = "0"
+         return
+      end if
+      do p = 0, 16
+         write(fmt, '("(es40.",i0,"e3)")') p
+         write(buf, fmt) x
+         read(buf, *, iostat=ios) back
+         if (ios == 0 .and. back == x) exit
+      end do
+      buf = adjustl(buf)
+      e = index(buf, "E")
+      s = buf(1:e - 1)
+      if (index(s, ".") > 0) then
+         do while (s(len(s):len(s)) == "0")
+            s = s(1:len(s) - 1)
+         end do
+         if (s(len(s):len(s)) == ".") s = s(1:len(s) - 1)
+      end if
+      read(buf(e + 1:), *) p
+      if (p /= 0) s = s//"e"//int_str(p)
+      ! Plain fixed notation when it reads back exactly and is not longer.
+      if (abs(x) >= 1.0e-4_dp .and. abs(x) < 1.0e15_dp) then
+         do p = 0, 20
+            write(fmt, '("(f0.",i0,")")') p
+            write(buf, fmt) x
+            read(buf, *, iostat=ios) back
+            if (ios == 0 .and. back == x) exit
+         end do
+         buf = adjustl(buf)
+         if (buf(1:1) == ".") buf = "0"//buf
+         if (buf(1:2) == "-.") buf = "-0"//buf(2:)
+         e = len_trim(buf)
+         if (buf(e:e) == ".") e = e - 1
+         if (e <= len(s)) s = buf(1:e)
+      end if
+   end function format_real
+
+   !> Parse a real token: [sign] digits [. digits] [(e|E|d|D) [sign] digits], at least
+   !> one mantissa digit. NaN, Inf, repeat counts and overflow are refused.
+   subroutine parse_real(token, value, ok)
+      character(len=*), intent(in) :: token
+      real(dp), intent(out) :: value
+      logical, intent(out) :: ok
+      character(len=len(token)) :: t
+      integer :: i, n, ndig, ios
+      logical :: halting
+      value = 0
+      ok = .false.
+      t = token
+      n = len(t)
+      i = 1
+      if (n == 0) return
+      if (t(i:i) == "+" .or. t(i:i) == "-") i = i + 1
+      ndig = 0
+      do while (i <= n)
+         if (.not. is_digit(t(i:i))) exit
+         i = i + 1
+         ndig = ndig + 1
+      end do
+      if (i <= n) then
+         if (t(i:i) == ".") then
+            i = i + 1
+            do while (i <= n)
+               if (.not. is_digit(t(i:i))) exit
+               i = i + 1
+               ndig = ndig + 1
+            end do
+         end if
+      end if
+      if (ndig == 0) return
+      if (i <= n) then
+         if (index("eEdD", t(i:i)) == 0) return
+         t(i:i) = "e"
+         i = i + 1
+         if (i <= n) then
+            if (t(i:i) == "+" .or. t(i:i) == "-") i = i + 1
+         end if
+         if (i > n) return
+         do while (i <= n)
+            if (.not. is_digit(t(i:i))) return
+            i = i + 1
+         end do
+      end if
+      ! An overflowing literal must give a message, not a trap under -ffpe-trap=overflow.
+      call ieee_get_halting_mode(ieee_overflow, halting)
+      if (halting) call ieee_set_halting_mode(ieee_overflow, .false.)
+      read(t, *, iostat=ios) value
+      call ieee_set_flag(ieee_overflow, .false.)
+      if (halting) call ieee_set_halting_mode(ieee_overflow, .true.)
+      ok = ios == 0 .and. ieee_is_finite(value)
+   end subroutine parse_real
+
+   !> Parse an integer token: [sign] digits, within the range of a default integer.
+   subroutine parse_integer(token, value, ok)
+      character(len=*), intent(in) :: token
+      integer, intent(out) :: value
+      logical, intent(out) :: ok
+      integer :: i, i0, ios
+      integer(i8) :: wide
+      value = 0
+      ok = .false.
+      if (len(token) == 0 .or. len(token) > 18) return
+      i0 = 1
+      if (token(1:1) == "+" .or. token(1:1) == "-") i0 = 2
+      if (i0 > len(token)) return
+      do i = i0, len(token)
+         if (.not. is_digit(token(i:i))) return
+      end do
+      read(token, *, iostat=ios) wide
+      if (ios /= 0 .or. abs(wide) > huge(value)) return
+      value = int(wide)
+      ok = .true.
+   end subroutine parse_integer
+
+   pure logical function is_digit(c)
+      character(len=1), intent(in) :: c
+      is_digit = c >= "0" .and. c <= "9"
+   end function is_digit
+
+   pure function int_str(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=12) :: buf
+      write(buf, '(i0)') i
+      s = trim(buf)
+   end function int_str
+
+   !> Read a whole file as bytes.
+   subroutine read_whole_file(path, text, status)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable, intent(out) :: text
+      type(status_type), intent(inout) :: status
+      integer :: unit, ios
+      integer(i8) :: nbytes
+      if (path_is_directory(path)) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected a deck file, found a directory")
+         return
+      end if
+      if (.not. path_exists(path)) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected a deck file, found no such file")
+         return
+      end if
+      open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected a readable deck file, cannot open it")
+         return
+      end if
+      inquire(unit=unit, size=nbytes)
+      if (nbytes <= 0) then
+         close(unit)
+         call set_error(status, STATUS_BAD_INPUT, path//":1: expected a label line, found an empty file")
+         return
+      end if
+      allocate(character(len=nbytes) :: text)
+      read(unit, iostat=ios) text
+      close(unit)
+      if (ios /= 0) call set_error(status, STATUS_BAD_INPUT, path//": expected a readable deck file, reading failed")
+   end subroutine read_whole_file
+
+   !> Refuse binary content: control bytes other than TAB, LF, CR and FF, or NUL.
+   subroutine check_text(path, text, status)
+      character(len=*), intent(in) :: path, text
+      type(status_type), intent(inout) :: status
+      integer :: i, line, c
+      line = 1
+      do i = 1, len(text)
+         c = iachar(text(i:i))
+         if (c == 10) then
+            line = line + 1
+         else if ((c < 32 .and. c /= 9 .and. c /= 13 .and. c /= 12) .or. c == 127) then
+            call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(line)// &
+               ": expected a text deck, found binary content (byte "//int_str(c)//")")
+            return
+         end if
+      end do
+   end subroutine check_text
+
+   !> The first line without its line end.
+   function label_of(text) result(label)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: label
+      integer :: e
+      e = index(text, new_line("a"))
+      if (e == 0) e = len(text) + 1
+      label = text(1:e - 1)
+      if (len(label) > 0) then
+         if (label(len(label):len(label)) == achar(13)) label = label(1:len(label) - 1)
+      end if
+      label = trim(label)
+   end function label_of
+
+   !> Split everything after line 1 into tokens separated by blanks, tabs, CR, FF or
+   !> commas, recording the line of each token and the number of the last line.
+   subroutine tokenize(text, ntok, first, last, line, last_line)
+      character(len=*), intent(in) :: text
+      integer, intent(out) :: ntok, last_line
+      integer, allocatable, intent(out) :: first(:), last(:), line(:)
+      integer :: pass, i, ln, start
+      logical :: in_tok
+      do pass = 1, 2
+         ntok = 0
+         ln = 1
+         in_tok = .false.
+         start = index(text, new_line("a"))
+         if (start == 0) start = len(text)
+         ln = 2
+         do i = start + 1, len(text) + 1
+            if (i <= len(text)) then
+               if (.not. is_separator(text(i:i))) then
+                  if (.not. in_tok) then
+                     in_tok = .true.
+                     ntok = ntok + 1
+                     if (pass == 2) then
+                        first(ntok) = i
+                        line(ntok) = ln
+                     end if
+                  end if
+                  cycle
+               end if
+            end if
+            if (in_tok .and. pass == 2) last(ntok) = i - 1
+            in_tok = .false.
+            if (i <= len(text)) then
+               if (text(i:i) == new_line("a")) ln = ln + 1
+            end if
+         end do
+         if (pass == 1) allocate(first(ntok), last(ntok), line(ntok))
+      end do
+      ! The number of the last line that holds anything.
+      last_line = ln
+      if (len(text) > 0) then
+         if (text(len(text):len(text)) == new_line("a")) last_line = ln - 1
+      end if
+      if (index(text, new_line("a")) == 0) last_line = 1
+   end subroutine tokenize
+
+   pure logical function is_separator(c)
+      character(len=1), intent(in) :: c
+      is_separator = c == " " .or. c == achar(9) .or. c == achar(10) .or. c == achar(13) .or. c == achar(12) &
+         .or. c == ","
+   end function is_separator
+end module femcod_deck

@@ -1,0 +1,66 @@
+!> Small file-system helpers used by the I/O modules (never by the numerical core):
+!> atomic replacement of a file by a temporary one, removal, existence and kind.
+module femcod_files
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+   use femcod_status, only: status_type, set_error, STATUS_IO
+   implicit none
+   private
+   public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name
+
+   interface
+      function c_rename(from, to) bind(c, name="rename") result(rc)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: rc
+      end function c_rename
+      function c_remove(path) bind(c, name="remove") result(rc)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: rc
+      end function c_remove
+      function c_getpid() bind(c, name="getpid") result(pid)
+         import :: c_int
+         integer(c_int) :: pid
+      end function c_getpid
+   end interface
+
+contains
+
+   !> Replace `target` by `source` in one step (POSIX rename): readers see the old
+   !> file or the complete new one, never a partial result.
+   subroutine atomic_rename(source, target, status)
+      character(len=*), intent(in) :: source, target
+      type(status_type), intent(inout) :: status
+      if (c_rename(source//c_null_char, target//c_null_char) /= 0) then
+         call set_error(status, STATUS_IO, target//": cannot rename the temporary file "//source//" onto it")
+      end if
+   end subroutine atomic_rename
+
+   !> Remove a file if it exists; errors are ignored (used to clean up temporaries).
+   subroutine remove_file(path)
+      character(len=*), intent(in) :: path
+      integer(c_int) :: rc
+      rc = c_remove(path//c_null_char)
+   end subroutine remove_file
+
+   !> True when a file or directory of that name exists.
+   logical function path_exists(path)
+      character(len=*), intent(in) :: path
+      inquire(file=path, exist=path_exists)
+   end function path_exists
+
+   !> True when `path` names a directory (it can be opened as `path/.`).
+   logical function path_is_directory(path)
+      character(len=*), intent(in) :: path
+      inquire(file=path//"/.", exist=path_is_directory)
+   end function path_is_directory
+
+   !> A temporary name beside `path`, unique to this process.
+   function temporary_name(path) result(tmp)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: tmp
+      character(len=16) :: buf
+      write(buf, '(i0)') c_getpid()
+      tmp = path//".tmp"//trim(buf)
+   end function temporary_name
+end module femcod_files

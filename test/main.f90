@@ -1,0 +1,52 @@
+!> femcod test driver: runs every suite serially and closes with "N passed, N failed".
+!> `fpm test -- SUITE [TEST]` runs one suite or one test.
+program tester
+   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+   use testdrive, only: run_testsuite, run_selected, new_testsuite, testsuite_type, select_suite, count_tests, &
+      tests_skipped
+   use test_deck, only: collect_deck
+   use test_workspace, only: collect_workspace
+   use test_sort, only: collect_sort
+   use test_surfaces, only: collect_surfaces
+   use femcod_exit, only: exit_program
+   implicit none
+   type(testsuite_type), allocatable :: suites(:)
+   integer :: stat, is, total, nargs
+   character(len=128) :: suite_name, test_name
+
+   suites = [ &
+      new_testsuite("deck", collect_deck), &
+      new_testsuite("workspace", collect_workspace), &
+      new_testsuite("sort", collect_sort), &
+      new_testsuite("surfaces", collect_surfaces) &
+      ]
+   stat = 0
+   total = 0
+   nargs = command_argument_count()
+   if (nargs >= 1) then
+      call get_command_argument(1, suite_name)
+      is = select_suite(suites, trim(suite_name))
+      if (is == 0) then
+         write(error_unit, '(a)') "no suite named "//trim(suite_name)
+         call exit_program(1)
+      end if
+      write(output_unit, '(a)') "# suite "//suites(is)%name
+      if (nargs >= 2) then
+         call get_command_argument(2, test_name)
+         call run_selected(suites(is)%collect, trim(test_name), output_unit, stat)
+         total = 1
+      else
+         call run_testsuite(suites(is)%collect, output_unit, stat)
+         total = count_tests(suites(is)%collect)
+      end if
+   else
+      do is = 1, size(suites)
+         write(output_unit, '(a)') "# suite "//suites(is)%name
+         call run_testsuite(suites(is)%collect, output_unit, stat, parallel=.false.)
+         total = total + count_tests(suites(is)%collect)
+      end do
+   end if
+   write(output_unit, '(i0,a,i0,a,i0,a)') total - stat - tests_skipped, " passed, ", stat, " failed, ", &
+      tests_skipped, " skipped"
+   if (stat > 0) call exit_program(1)
+end program tester

@@ -1,0 +1,242 @@
+!> Deck reading, writing and validation (issue: foundation, "Bad input").
+module test_deck
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type
+   use femcod_deck, only: deck_type, read_deck, write_deck, format_real
+   use femcod_strings, only: string_type
+   use femcod_cli, only: run_femcod
+   use test_support, only: write_text, scratch_path, contains_text, file_exists
+   use testdrive, only: new_unittest, unittest_type, error_type, check
+   implicit none
+   private
+   public :: collect_deck
+
+   character(len=*), parameter :: nl = new_line("a")
+   !> A valid 2x2 deck; the cases below break one thing at a time.
+   character(len=*), parameter :: header = "two by two"//nl//"2 1.5 3"//nl//"200 0.25"//nl// &
+      "2e7 0.25"//nl//"2e7 0.3"//nl
+   character(len=*), parameter :: heights = "0 0.5"//nl//"1 1.5"//nl//"2 2.5 3 3.5"//nl
+
+contains
+
+   subroutine collect_deck(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest("valid deck: values and layout", test_valid), &
+         new_unittest("CRLF, tabs, commas, D exponents, wrapped values", test_formats), &
+         new_unittest("write then read is exact", test_roundtrip), &
+         new_unittest("shortest round-trip number format", test_format_real), &
+         new_unittest("bad decks: file:line, expected, found; exit code 3", test_bad_decks), &
+         new_unittest("missing file, directory, empty file", test_bad_files), &
+         new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck) &
+         ]
+   end subroutine collect_deck
+
+   subroutine test_valid(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck
+      type(status_type) :: status
+      character(len=:), allocatable :: path
+      path = scratch_path("valid.deck")
+      call write_text(path, header//heights)
+      call read_deck(path, deck, status)
+      call check(error, status%code, 0, "a valid deck is accepted")
+      if (allocated(error)) return
+      call check(error, deck%label, "two by two")
+      if (allocated(error)) return
+      call check(error, deck%np, 2)
+      if (allocated(error)) return
+      call check(error, deck%maxcont, 3)
+      if (allocated(error)) return
+      call check(error, deck%pixel, 1.5_dp)
+      if (allocated(error)) return
+      call check(error, deck%young(3), 2.0e7_dp)
+      if (allocated(error)) return
+      call check(error, deck%poisson(3), 0.3_dp)
+      if (allocated(error)) return
+      ! Row by row: lower(1,2) is the second value, upper(2,1) the seventh.
+      call check(error, deck%lower(1, 2), 0.5_dp)
+      if (allocated(error)) return
+      call check(error, deck%lower(2, 1), 1.0_dp)
+      if (allocated(error)) return
+      call check(error, deck%upper(2, 1), 3.0_dp)
+   end subroutine test_valid
+
+   subroutine test_formats(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck
+      type(status_type) :: status
+      character(len=:), allocatable :: path
+      character(len=*), parameter :: cr = achar(13), tab = achar(9)
+      path = scratch_path("formats.deck")
+      call write_text(path, "crlf deck"//cr//nl//"2"//tab//"1.5D0 3"//cr//nl//"2.0d2 0.25"//cr//nl// &
+         "2E7,0.25"//cr//nl//"+2e+7 .3"//cr//nl//"0"//cr//nl//"0.5 1"//cr//nl//cr//nl//tab//"1.5 2 2.5"// &
+         cr//nl//"3"//nl//"3.5")
+      call read_deck(path, deck, status)
+      call check(error, status%code, 0, "CRLF, tabs, commas, D exponents and wrapped values are accepted")
+      if (allocated(error)) return
+      call check(error, deck%label, "crlf deck")
+      if (allocated(error)) return
+      call check(error, deck%pixel, 1.5_dp)
+      if (allocated(error)) return
+      call check(error, deck%young(1), 200.0_dp)
+      if (allocated(error)) return
+      call check(error, deck%poisson(3), 0.3_dp)
+      if (allocated(error)) return
+      call check(error, deck%upper(2, 2), 3.5_dp)
+   end subroutine test_formats
+
+   subroutine test_roundtrip(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck, back
+      type(status_type) :: status
+      character(len=:), allocatable :: path
+      integer :: i, j
+      deck%label = "round trip"
+      deck%np = 3
+      deck%pixel = 1.0_dp/3
+      deck%maxcont = 9
+      deck%young = [200.0_dp, 2.0e7_dp, 123.456_dp]
+      deck%poisson = [0.25_dp, -0.5_dp, 0.499_dp]
+      allocate(deck%lower(3, 3), deck%upper(3, 3))
+      do j = 1, 3
+         do i = 1, 3
+            deck%lower(i, j) = sqrt(real(i + 10*j, dp))*1.0e-7_dp
+            deck%upper(i, j) = -exp(real(i*j, dp))*1.0e5_dp
+         end do
+      end do
+      path = scratch_path("roundtrip.deck")
+      call write_deck(path, deck, status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      call read_deck(path, back, status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      call check(error, all(back%lower == deck%lower) .and. all(back%upper == deck%upper) .and. &
+         back%pixel == deck%pixel .and. all(back%young == deck%young) .and. all(back%poisson == deck%poisson), &
+         "every value reads back bit for bit")
+   end subroutine test_roundtrip
+
+   subroutine test_format_real(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, format_real(200.0_dp), "200")
+      if (allocated(error)) return
+      call check(error, format_real(0.25_dp), "0.25")
+      if (allocated(error)) return
+      call check(error, format_real(2.0e7_dp), "2e7")
+      if (allocated(error)) return
+      call check(error, format_real(-1.5e-9_dp), "-1.5e-9")
+      if (allocated(error)) return
+      call check(error, format_real(0.0_dp), "0")
+   end subroutine test_format_real
+
+   !> Each case: deck text, the line the error must name, and a word of what was expected.
+   subroutine test_bad_decks(error)
+      type(error_type), allocatable, intent(out) :: error
+      call bad("missing value line 2", "x"//nl//"2 1.5"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
+         ":2:", "NP PIXEL MAXCONT")
+      if (allocated(error)) return
+      call bad("extra value line 3", "x"//nl//"2 1.5 3"//nl//"200 0.25 9"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// &
+         heights, ":3:", "E1 NU1")
+      if (allocated(error)) return
+      call bad("non-numeric height", header//"0 0.5"//nl//"1 abc"//nl//"2 2.5 3 3.5"//nl, ":7:", "lower-surface height")
+      if (allocated(error)) return
+      call bad("NaN height", header//heights(1:len(heights) - 4)//"NaN"//nl, ":8:", "finite")
+      if (allocated(error)) return
+      call bad("Inf height", header//"Inf 0.5"//nl//"1 1.5"//nl//"2 2.5 3 3.5"//nl, ":6:", "finite")
+      if (allocated(error)) return
+      call bad("overflowing height", header//"0 0.5"//nl//"1 1.5"//nl//"2 1e999 3 3.5"//nl, ":8:", "finite")
+      if (allocated(error)) return
+      call bad("NP zero", "x"//nl//"0 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, ":2:", "NP")
+      if (allocated(error)) return
+      call bad("NP negative", "x"//nl//"-2 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
+         ":2:", "NP")
+      if (allocated(error)) return
+      call bad("NP not an integer", "x"//nl//"2.5 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// &
+         heights, ":2:", "NP")
+      if (allocated(error)) return
+      call bad("NP overflowing", "x"//nl//"99999999999 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// &
+         heights, ":2:", "NP")
+      if (allocated(error)) return
+      call bad("PIXEL zero", "x"//nl//"2 0 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, ":2:", &
+         "PIXEL")
+      if (allocated(error)) return
+      call bad("PIXEL negative", "x"//nl//"2 -1 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
+         ":2:", "PIXEL")
+      if (allocated(error)) return
+      call bad("MAXCONT zero", "x"//nl//"2 1.5 0"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
+         ":2:", "MAXCONT")
+      if (allocated(error)) return
+      call bad("MAXCONT above NP**2", "x"//nl//"2 1.5 5"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// &
+         heights, ":2:", "MAXCONT")
+      if (allocated(error)) return
+      call bad("E zero", "x"//nl//"2 1.5 3"//nl//"0 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, ":3:", "E1")
+      if (allocated(error)) return
+      call bad("E negative", "x"//nl//"2 1.5 3"//nl//"200 0.25"//nl//"-2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
+         ":4:", "E2")
+      if (allocated(error)) return
+      call bad("nu = 0.5", "x"//nl//"2 1.5 3"//nl//"200 0.5"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, ":3:", "NU1")
+      if (allocated(error)) return
+      call bad("nu = -1", "x"//nl//"2 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 -1"//nl//heights, ":5:", "NU3")
+      if (allocated(error)) return
+      call bad("truncated heights", header//"0 0.5"//nl//"1 1.5"//nl//"2 2.5 3"//nl, ":8:", "heights")
+      if (allocated(error)) return
+      call bad("trailing values", header//heights//"4"//nl, ":9:", "end of the deck")
+      if (allocated(error)) return
+      call bad("binary content", header//"0 0.5"//nl//achar(0)//achar(1)//"1 1.5"//nl//"2 2.5 3 3.5"//nl, ":7:", &
+         "binary")
+      if (allocated(error)) return
+      call bad("header cut short", "x"//nl//"2 1.5 3"//nl//"200 0.25", ":4:", "E2 NU2")
+   contains
+      subroutine bad(name, text, where, expected)
+         character(len=*), intent(in) :: name, text, where, expected
+         type(deck_type) :: deck
+         type(status_type) :: status
+         character(len=:), allocatable :: path
+         path = scratch_path("bad.deck")
+         call write_text(path, text)
+         call read_deck(path, deck, status)
+         call check(error, status%code, 3, name//": bad input is status 3")
+         if (allocated(error)) return
+         call check(error, contains_text(status%message, path//where), &
+            name//": message names file and line "//where//": "//status%message)
+         if (allocated(error)) return
+         call check(error, contains_text(status%message, expected) .and. contains_text(status%message, "found"), &
+            name//": message says what was expected and found: "//status%message)
+      end subroutine bad
+   end subroutine test_bad_decks
+
+   subroutine test_bad_files(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck
+      type(status_type) :: status
+      call read_deck(scratch_path("no-such.deck"), deck, status)
+      call check(error, status%code == 3 .and. contains_text(status%message, "no such file"), &
+         "missing file: "//status%message)
+      if (allocated(error)) return
+      status%code = 0
+      call read_deck(scratch_path(""), deck, status)
+      call check(error, status%code == 3 .and. contains_text(status%message, "directory"), &
+         "directory: "//status%message)
+      if (allocated(error)) return
+      status%code = 0
+      call write_text(scratch_path("empty.deck"), "")
+      call read_deck(scratch_path("empty.deck"), deck, status)
+      call check(error, status%code == 3 .and. contains_text(status%message, ":1:"), "empty file: "//status%message)
+   end subroutine test_bad_files
+
+   subroutine test_run_bad_deck(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: path, prefix
+      integer :: code
+      path = scratch_path("run-bad.deck")
+      prefix = scratch_path("run-bad-out")
+      call write_text(path, header//"0 0.5"//nl//"1 abc"//nl//"2 2.5 3 3.5"//nl)
+      call run_femcod([string_type("run"), string_type(path), string_type("-o"), string_type(prefix), &
+         string_type("--quiet")], code)
+      call check(error, code, 3, "femcod run on a bad deck exits with 3")
+      if (allocated(error)) return
+      call check(error, .not. (file_exists(prefix//".history.csv") .or. file_exists(prefix//".loads.csv") .or. &
+         file_exists(prefix//".contacts.csv")), "no result file is written")
+   end subroutine test_run_bad_deck
+end module test_deck

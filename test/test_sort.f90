@@ -1,0 +1,73 @@
+!> Stable merge sort of the gaps (Appendix B).
+module test_sort
+   use femcod_kinds, only: dp
+   use femcod_sort, only: merge_sort_index
+   use femcod_random, only: random_stream, seed_stream, uniform
+   use testdrive, only: new_unittest, unittest_type, error_type, check
+   implicit none
+   private
+   public :: collect_sort
+
+contains
+
+   subroutine collect_sort(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest("ties keep row-wise order", test_ties), &
+         new_unittest("sorted and reversed input", test_sorted_reversed), &
+         new_unittest("random input against insertion sort", test_random) &
+         ]
+   end subroutine collect_sort
+
+   subroutine test_ties(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: order(9)
+      call merge_sort_index([2.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 2.0_dp, 1.0_dp, 0.0_dp, 1.0_dp, 2.0_dp], order)
+      ! By hand: the zeros at 2, 4, 7, the ones at 3, 6, 8, the twos at 1, 5, 9.
+      call check(error, all(order == [2, 4, 7, 3, 6, 8, 1, 5, 9]), "stable order of ties")
+   end subroutine test_ties
+
+   subroutine test_sorted_reversed(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 1000
+      real(dp) :: v(n)
+      integer :: order(n), i
+      v = [(real(i, dp), i = 1, n)]
+      call merge_sort_index(v, order)
+      call check(error, all(order == [(i, i = 1, n)]), "sorted input keeps the identity")
+      if (allocated(error)) return
+      v = [(real(n - i, dp), i = 1, n)]
+      call merge_sort_index(v, order)
+      call check(error, all(order == [(n + 1 - i, i = 1, n)]), "reversed input is reversed")
+      if (allocated(error)) return
+      call merge_sort_index([5.0_dp], order(1:1))
+      call check(error, order(1), 1, "a single value")
+   end subroutine test_sorted_reversed
+
+   subroutine test_random(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 777
+      real(dp) :: v(n), u
+      integer :: order(n), ref(n), i, j, key
+      type(random_stream) :: stream
+      call seed_stream(stream, 7)
+      do i = 1, n
+         call uniform(stream, u)
+         v(i) = real(int(50*u), dp)   ! many ties
+      end do
+      call merge_sort_index(v, order)
+      ! Reference: stable insertion sort.
+      ref = [(i, i = 1, n)]
+      do i = 2, n
+         key = ref(i)
+         j = i - 1
+         do while (j >= 1)
+            if (v(ref(j)) <= v(key)) exit
+            ref(j + 1) = ref(j)
+            j = j - 1
+         end do
+         ref(j + 1) = key
+      end do
+      call check(error, all(order == ref), "merge sort equals a stable insertion sort")
+   end subroutine test_random
+end module test_sort
