@@ -1,27 +1,189 @@
-!> `femcod run` (placeholder until the solvers land: reads and validates the deck).
+!> `femcod run DECK [-o PREFIX] [--solver legacy] [--loads F1,F2,...] [--max-contacts N]
+!> [--hardness H] [--no-final-check] [--quiet]`: read the deck, run the solver, write
+!> PREFIX.history.csv, PREFIX.contacts.csv and (with --loads) PREFIX.loads.csv, and
+!> print a summary.
 module femcod_run
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck
-   use femcod_strings, only: string_type
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, STATUS_USAGE
+   use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real
+   use femcod_strings, only: string_type, int_str, real_str, split_list
+   use femcod_contact_result, only: contact_result, contact_options, stop_reason_text
+   use femcod_legacy, only: solve_legacy
+   use femcod_results, only: write_csv_results
    implicit none
    private
    public :: run_command
+
 contains
+
+   subroutine run_help()
+      write(output_unit, '(a)') &
+         "usage: femcod run DECK [-o PREFIX] [--solver legacy] [--loads F1,F2,...] [--max-contacts N]", &
+         "                  [--hardness H] [--no-final-check] [--quiet]", &
+         "", &
+         "Contact history of the deck, step by step (thesis chapter 4, Appendix B).", &
+         "  -o PREFIX          output prefix (default: the deck's name without .deck, here)", &
+         "  --solver legacy    the Appendix B program (skyline, COLHT, TRFACT, POSTP)", &
+         "  --loads F1,...     total loads in nN at which to report the state (PREFIX.loads.csv);", &
+         "                     the run stops once the largest is reached", &
+         "  --max-contacts N   stop after N contacts (default: the deck's MAXCONT)", &
+         "  --hardness H       GPa, for n_above_hardness (default 11, polysilicon)", &
+         "  --no-final-check   skip the final check of every pixel for missed contacts", &
+         "  --quiet            no summary on standard output", &
+         "", &
+         "outputs: PREFIX.history.csv (step,contacts,load_nN,approach_nm,area_nm2,area_fraction),", &
+         "         PREFIX.contacts.csv (i,j,step,force_nN,pressure_GPa) at the largest requested load", &
+         "         or the last step, PREFIX.loads.csv (load_nN,approach_nm,contacts,area_nm2,area_fraction,", &
+         "         max_pressure_GPa,n_above_hardness)", &
+         "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
+   end subroutine run_help
+
    subroutine run_command(args, code)
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(deck_type) :: deck
       type(status_type) :: status
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(string_type), allocatable :: parts(:)
+      character(len=:), allocatable :: deck_path, prefix, solver, key
+      logical :: quiet, ok
+      integer :: i, k
       code = 0
-      if (size(args) < 1) then
-         code = 2
+      quiet = .false.
+      deck_path = ""
+      prefix = ""
+      solver = "legacy"
+      allocate(options%loads(0))
+      i = 1
+      do while (i <= size(args))
+         key = args(i)%s
+         select case (key)
+         case ("-h", "--help")
+            call run_help()
+            return
+         case ("--quiet", "-q")
+            quiet = .true.
+            i = i + 1
+            cycle
+         case ("--no-final-check")
+            options%final_check = .false.
+            i = i + 1
+            cycle
+         end select
+         if (key(1:1) /= "-" .or. len(key) == 1) then
+            if (deck_path /= "") then
+               call usage("one deck per run (found '"//deck_path//"' and '"//key//"')")
+               return
+            end if
+            deck_path = key
+            i = i + 1
+            cycle
+         end if
+         if (i == size(args)) then
+            call usage("option "//key//" needs a value")
+            return
+         end if
+         associate(v => args(i + 1)%s)
+            select case (key)
+            case ("-o", "--output")
+               prefix = v
+            case ("--solver")
+               solver = v
+               if (solver /= "legacy") then
+                  call usage("unknown solver '"//v//"' (available: legacy)")
+                  return
+               end if
+            case ("--loads")
+               parts = split_list(v)
+               deallocate(options%loads)
+               allocate(options%loads(size(parts)))
+               do k = 1, size(parts)
+                  call parse_real(parts(k)%s, options%loads(k), ok)
+                  if (.not. ok .or. options%loads(k) < 0) then
+                     call usage("--loads expects non-negative numbers in nN, found '"//parts(k)%s//"'")
+                     return
+                  end if
+               end do
+            case ("--max-contacts")
+               call parse_integer(v, options%max_contacts, ok)
+               if (.not. ok .or. options%max_contacts <= 0) then
+                  call usage("--max-contacts expects a positive integer, found '"//v//"'")
+                  return
+               end if
+            case ("--hardness")
+               call parse_real(v, options%hardness, ok)
+               if (.not. ok .or. options%hardness <= 0) then
+                  call usage("--hardness expects a positive number in GPa, found '"//v//"'")
+                  return
+               end if
+            case default
+               call usage("unknown option "//key)
+               return
+            end select
+         end associate
+         i = i + 2
+      end do
+      if (deck_path == "") then
+         call usage("run needs a DECK")
          return
       end if
-      call read_deck(args(1)%s, deck, status)
+      if (prefix == "") prefix = default_prefix(deck_path)
+
+      call read_deck(deck_path, deck, status)
+      if (status%code == 0) call solve_legacy(deck, options, res, status)
+      if (status%code == 0) call write_csv_results(prefix, deck, res, status)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod: "//status%message
          code = status%code
+         return
       end if
+      do k = 1, size(res%states)
+         if (.not. res%states(k)%reached) write(error_unit, '(a)') "femcod: warning: load "// &
+            format_real(res%states(k)%load)//" nN not reached ("//stop_reason_text(res%stop_reason)//")"
+      end do
+      if (.not. quiet) call print_summary()
+   contains
+      subroutine usage(message)
+         character(len=*), intent(in) :: message
+         write(error_unit, '(a)') "femcod run: "//message//" (femcod run --help)"
+         code = STATUS_USAGE
+      end subroutine usage
+
+      subroutine print_summary()
+         integer :: last
+         last = res%nsteps
+         write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//solver//")"
+         write(output_unit, '(a)') "  scene     : "//deck%label
+         write(output_unit, '(a)') "              NP = "//int_str(deck%np)//", d = "//format_real(deck%pixel)// &
+            " nm, E = "//real_str(deck%young(1), 4)//" / "//real_str(deck%young(2), 4)//" / "// &
+            real_str(deck%young(3), 4)//" GPa (lower / upper / contact)"
+         write(output_unit, '(a)') "  steps     : "//int_str(last)//", stopped: "//stop_reason_text(res%stop_reason)
+         if (last > 0) then
+            write(output_unit, '(a)') "  final     : "//int_str(res%step_contacts(last))//" contacts, load "// &
+               real_str(res%step_load(last), 6)//" nN, approach "//real_str(res%step_approach(last), 6)//" nm"
+         end if
+         write(output_unit, '(a)') "  wall time : "//real_str(res%wall_seconds, 3)//" s in total, "// &
+            real_str(res%wall_seconds/max(last, 1), 3)//" s per step"
+         write(output_unit, '(a)') "  checked   : "//int_str(res%missed_during_run)// &
+            " contacts found late by the candidate search, "//int_str(res%missed_final_check)// &
+            " found by the final check of all pixels; exact re-solve differs by "// &
+            real_str(res%final_check_difference, 2)
+         write(output_unit, '(a)') "  written   : "//prefix//".history.csv, "//prefix//".contacts.csv"// &
+            merge(", "//prefix//".loads.csv", repeat(" ", len(prefix) + 12), size(res%states) > 0)
+      end subroutine print_summary
    end subroutine run_command
+
+   !> The deck's file name without directory and without `.deck`.
+   function default_prefix(path) result(prefix)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: prefix
+      integer :: slash
+      slash = index(path, "/", back=.true.)
+      prefix = path(slash + 1:)
+      if (len(prefix) > 5) then
+         if (prefix(len(prefix) - 4:) == ".deck") prefix = prefix(1:len(prefix) - 5)
+      end if
+   end function default_prefix
 end module femcod_run

@@ -8,6 +8,8 @@ program tester
    use test_workspace, only: collect_workspace
    use test_sort, only: collect_sort
    use test_surfaces, only: collect_surfaces
+   use test_boussinesq, only: collect_boussinesq
+   use test_legacy, only: collect_legacy
    use femcod_exit, only: exit_program
    implicit none
    type(testsuite_type), allocatable :: suites(:)
@@ -18,7 +20,9 @@ program tester
       new_testsuite("deck", collect_deck), &
       new_testsuite("workspace", collect_workspace), &
       new_testsuite("sort", collect_sort), &
-      new_testsuite("surfaces", collect_surfaces) &
+      new_testsuite("surfaces", collect_surfaces), &
+      new_testsuite("boussinesq", collect_boussinesq), &
+      new_testsuite("legacy", collect_legacy) &
       ]
    stat = 0
    total = 0

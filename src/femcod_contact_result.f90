@@ -1,0 +1,107 @@
+!> What a contact solver returns: the step history, the states at requested loads,
+!> the contact pixels with their forces, and what was checked.
+module femcod_contact_result
+   use femcod_kinds, only: dp
+   implicit none
+   private
+   public :: contact_result, load_state, contact_options, append_step, STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text
+
+   integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3
+
+   !> What the user asked of a run.
+   type :: contact_options
+      !> Stop after this many contacts (0: the deck's MAXCONT).
+      integer :: max_contacts = 0
+      !> Requested total loads (nN); empty: run to MAXCONT.
+      real(dp), allocatable :: loads(:)
+      !> Hardness (GPa) for the count of pixels above it (thesis polysilicon: 11 GPa).
+      real(dp) :: hardness = 11
+      !> Candidates whose closing load is within this fraction of the total load of the
+      !> smallest one join in the same step (ties).
+      real(dp) :: tie_tolerance = 1.0e-9_dp
+      !> Check every pixel for penetration at the end, and correct (Appendix B).
+      logical :: final_check = .true.
+   end type contact_options
+
+   !> The contact state at one requested load.
+   type :: load_state
+      real(dp) :: load = 0, approach = 0
+      integer :: contacts = 0
+      real(dp) :: max_pressure = 0
+      integer :: n_above_hardness = 0
+      logical :: reached = .false.
+   end type load_state
+
+   !> Results of a run. Units: nN, nm, GPa.
+   type :: contact_result
+      integer :: nsteps = 0
+      !> Per step: contacts carrying load, total load and approach at the end of the step.
+      integer, allocatable :: step_contacts(:)
+      real(dp), allocatable :: step_load(:), step_approach(:), step_seconds(:)
+      !> Requested loads, in the order given.
+      type(load_state), allocatable :: states(:)
+      !> Contact pixels (row, column, step joined) and their forces at the reported state.
+      integer, allocatable :: contact_i(:), contact_j(:), contact_step(:)
+      real(dp), allocatable :: contact_force(:)
+      !> Load at which `contact_force` is reported.
+      real(dp) :: reported_load = 0
+      integer :: stop_reason = 0
+      !> Contacts found late by the candidate search (joined with a penetration),
+      !> and by the final check over all pixels.
+      integer :: missed_during_run = 0, missed_final_check = 0
+      !> Largest relative difference between the accumulated state and an exact
+      !> active-set solve at the end (a consistency check of the step accumulation).
+      real(dp) :: final_check_difference = 0
+      real(dp) :: wall_seconds = 0
+   end type contact_result
+
+contains
+
+   !> Append one history row.
+   pure subroutine append_step(res, contacts, load, approach, seconds)
+      type(contact_result), intent(inout) :: res
+      integer, intent(in) :: contacts
+      real(dp), intent(in) :: load, approach, seconds
+      integer, allocatable :: itmp(:)
+      real(dp), allocatable :: rtmp(:)
+      integer :: cap
+      if (.not. allocated(res%step_contacts)) then
+         allocate(res%step_contacts(64), res%step_load(64), res%step_approach(64), res%step_seconds(64))
+      end if
+      cap = size(res%step_contacts)
+      if (res%nsteps == cap) then
+         allocate(itmp(2*cap))
+         itmp(1:cap) = res%step_contacts
+         call move_alloc(itmp, res%step_contacts)
+         allocate(rtmp(2*cap))
+         rtmp(1:cap) = res%step_load
+         call move_alloc(rtmp, res%step_load)
+         allocate(rtmp(2*cap))
+         rtmp(1:cap) = res%step_approach
+         call move_alloc(rtmp, res%step_approach)
+         allocate(rtmp(2*cap))
+         rtmp(1:cap) = res%step_seconds
+         call move_alloc(rtmp, res%step_seconds)
+      end if
+      res%nsteps = res%nsteps + 1
+      res%step_contacts(res%nsteps) = contacts
+      res%step_load(res%nsteps) = load
+      res%step_approach(res%nsteps) = approach
+      res%step_seconds(res%nsteps) = seconds
+   end subroutine append_step
+
+   pure function stop_reason_text(reason) result(text)
+      integer, intent(in) :: reason
+      character(len=:), allocatable :: text
+      select case (reason)
+      case (STOP_MAXCONT)
+         text = "maximum number of contacts reached"
+      case (STOP_LOADS)
+         text = "all requested loads reached"
+      case (STOP_NO_CONTACT)
+         text = "no further pixel can come into contact"
+      case default
+         text = "not run"
+      end select
+   end function stop_reason_text
+end module femcod_contact_result

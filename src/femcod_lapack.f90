@@ -1,0 +1,58 @@
+!> Explicit interfaces to the LAPACK and BLAS routines femcod calls
+!> (implicit-external is off in fpm.toml).
+module femcod_lapack
+   use femcod_kinds, only: dp
+   implicit none
+   private
+   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv
+
+   interface
+      pure subroutine dpotrf(uplo, n, a, lda, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(dp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotrf
+      pure subroutine dpotri(uplo, n, a, lda, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(dp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotri
+      pure subroutine dsysv(uplo, n, nrhs, a, lda, ipiv, b, ldb, work, lwork, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, nrhs, lda, ldb, lwork
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         integer, intent(out) :: ipiv(*), info
+         real(dp), intent(inout) :: work(*)
+      end subroutine dsysv
+      pure subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
+         import :: dp
+         integer, intent(in) :: n, nrhs, lda, ldb
+         real(dp), intent(inout) :: a(lda, *), b(ldb, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgesv
+      pure real(dp) function ddot(n, x, incx, y, incy)
+         import :: dp
+         integer, intent(in) :: n, incx, incy
+         real(dp), intent(in) :: x(*), y(*)
+      end function ddot
+      pure subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: trans
+         integer, intent(in) :: m, n, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta, a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine dgemv
+      pure subroutine dsymv(uplo, n, alpha, a, lda, x, incx, beta, y, incy)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n, lda, incx, incy
+         real(dp), intent(in) :: alpha, beta, a(lda, *), x(*)
+         real(dp), intent(inout) :: y(*)
+      end subroutine dsymv
+   end interface
+end module femcod_lapack

@@ -1,0 +1,209 @@
+!> The Appendix B program against the thesis' published numbers (Tables 4.1, 4.2,
+!> section 4.4.3) and against independent calculations of the same model.
+module test_legacy
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type
+   use femcod_deck, only: deck_type, read_deck
+   use femcod_contact_result, only: contact_result, contact_options
+   use femcod_legacy, only: solve_legacy
+   use femcod_richardson, only: convergence_rate, richardson_extrapolate
+   use femcod_strings, only: string_type
+   use femcod_cli, only: run_femcod
+   use test_support, only: scratch_path, read_text, file_exists, contains_text
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   implicit none
+   private
+   public :: collect_legacy, run_deck_at_load
+
+   real(dp), parameter :: pi = acos(-1.0_dp)
+
+contains
+
+   subroutine collect_legacy(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest("Table 4.1: circular punch, approach and centre pressure", test_table_4_1), &
+         new_unittest("Table 4.2: square punch, approach and centre/mean pressure; Richardson", test_table_4_2), &
+         new_unittest("sphere, 0.5 nm mesh: Hertz at 1000 nN, Segedin at 18000 nN", test_sphere), &
+         new_unittest("rough surface: history consistent with an exact active-set solve", test_rough), &
+         new_unittest("femcod run writes the three CSV files with their headers", test_run_outputs) &
+         ]
+   end subroutine collect_legacy
+
+   !> Run a deck of input/ to `load` and return the approach and the centre pixel's pressure.
+   subroutine run_deck_at_load(name, load, approach, centre_pressure, res, status)
+      character(len=*), intent(in) :: name
+      real(dp), intent(in) :: load
+      real(dp), intent(out) :: approach, centre_pressure
+      type(contact_result), intent(out) :: res
+      type(status_type), intent(inout) :: status
+      type(deck_type) :: deck
+      type(contact_options) :: options
+      integer :: k, c
+      call read_deck("input/"//name//".deck", deck, status)
+      if (status%code /= 0) return
+      options%loads = [load]
+      call solve_legacy(deck, options, res, status)
+      if (status%code /= 0) return
+      approach = res%states(1)%approach
+      c = (deck%np + 1)/2
+      centre_pressure = -1
+      do k = 1, size(res%contact_i)
+         if (res%contact_i(k) == c .and. res%contact_j(k) == c) centre_pressure = res%contact_force(k)/deck%pixel**2
+      end do
+   end subroutine run_deck_at_load
+
+   subroutine test_table_4_1(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: decks(3) = [character(len=15) :: "circle_punch_d1", "circle_punch_d3", &
+         "circle_punch_d9"]
+      ! Thesis Table 4.1 (1 nN): displacement (1e-3 nm) and centre pressure (nN/nm^2).
+      real(dp), parameter :: thesis_approach(3) = [0.955e-3_dp, 0.920e-3_dp, 0.911e-3_dp]
+      real(dp), parameter :: thesis_pressure(3) = [0.0261_dp, 0.0245_dp, 0.0240_dp]
+      real(dp) :: a, p
+      type(contact_result) :: res
+      type(status_type) :: status
+      integer :: k
+      do k = 1, 3
+         call run_deck_at_load(trim(decks(k)), 1.0_dp, a, p, res, status)
+         call check(error, status%code, 0)
+         if (allocated(error)) return
+         ! The thesis prints 3 digits; independent calculations agree within 0.16 %, so
+         ! more than 0.5 % is a bug.
+         call check(error, a, thesis_approach(k), rel=.true., thr=5.0e-3_dp, message=trim(decks(k))//" approach")
+         if (allocated(error)) return
+         call check(error, p, thesis_pressure(k), rel=.true., thr=5.0e-3_dp, message=trim(decks(k))//" pressure")
+         if (allocated(error)) return
+      end do
+   end subroutine test_table_4_1
+
+   subroutine test_table_4_2(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: decks(4) = [character(len=16) :: "square_punch_n1", "square_punch_n3", &
+         "square_punch_n9", "square_punch_n27"]
+      ! Thesis Table 4.2 (1 nN): displacement (1e-3 nm) and centre pressure / mean pressure.
+      real(dp), parameter :: thesis_approach(4) = [0.526e-3_dp, 0.451e-3_dp, 0.422e-3_dp, 0.412e-3_dp]
+      real(dp), parameter :: thesis_ratio(4) = [1.0_dp, 0.511_dp, 0.519_dp, 0.498_dp]
+      real(dp) :: a(4), p, ratio(4), p13, p24, extrapolated
+      type(contact_result) :: res
+      type(status_type) :: status
+      integer :: k
+      do k = 1, 4
+         call run_deck_at_load(trim(decks(k)), 1.0_dp, a(k), p, res, status)
+         call check(error, status%code, 0)
+         if (allocated(error)) return
+         ! Mean pressure: 1 nN over the 10 nm x 10 nm punch.
+         ratio(k) = p/(1.0_dp/100)
+         call check(error, a(k), thesis_approach(k), rel=.true., thr=5.0e-3_dp, message=trim(decks(k))//" approach")
+         if (allocated(error)) return
+         call check(error, ratio(k), thesis_ratio(k), rel=.true., thr=5.0e-3_dp, message=trim(decks(k))//" ratio")
+         if (allocated(error)) return
+      end do
+      ! Section 4.4.2: rates 0.874 (meshes 1-3) and 0.973 (meshes 2-4), extrapolated
+      ! approach 0.407e-3 nm; the thesis prints the rates to 3 decimals.
+      p13 = convergence_rate(a(1), a(2), a(3), 3.0_dp)
+      p24 = convergence_rate(a(2), a(3), a(4), 3.0_dp)
+      call check(error, p13, 0.874_dp, thr=0.005_dp, message="rate, meshes 1-3")
+      if (allocated(error)) return
+      call check(error, p24, 0.973_dp, thr=0.005_dp, message="rate, meshes 2-4")
+      if (allocated(error)) return
+      extrapolated = richardson_extrapolate(a(3), a(4), 3.0_dp, p24)
+      call check(error, extrapolated, 0.407e-3_dp, rel=.true., thr=2.0e-3_dp, message="extrapolated approach")
+      if (allocated(error)) return
+      ! The issue's converged value of the model, 0.4068e-3 nm and ratio 0.4855.
+      call check(error, extrapolated, 0.4068e-3_dp, rel=.true., thr=1.0e-3_dp, message="converged approach")
+      if (allocated(error)) return
+      call check(error, richardson_extrapolate(ratio(3), ratio(4), 3.0_dp, p24), 0.4855_dp, rel=.true., &
+         thr=2.0e-3_dp, message="converged centre/mean pressure")
+   end subroutine test_table_4_2
+
+   subroutine test_sphere(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status
+      real(dp) :: estar, r, hertz, a, lo, hi, segedin
+      integer :: it
+      call read_deck("input/sphere_d05.deck", deck, status)
+      options%loads = [1000.0_dp, 18000.0_dp]
+      call solve_legacy(deck, options, res, status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      estar = 200/(1 - 0.25_dp**2)
+      r = 15
+      ! Hertz, eq. 4.14: delta = (9 F**2/(16 R E*^2))**(1/3).
+      hertz = (9*1000.0_dp**2/(16*r*estar**2))**(1.0_dp/3)
+      call check(error, res%states(1)%approach, hertz, rel=.true., thr=0.01_dp, message="Hertz at 1000 nN")
+      if (allocated(error)) return
+      ! Segedin's rigid sphere: F = E*/2 [(a^2+R^2) ln((R+a)/(R-a)) - 2 a R], delta = a/2 ln((R+a)/(R-a)).
+      lo = 0
+      hi = r*(1 - 1.0e-12_dp)
+      do it = 1, 200
+         a = (lo + hi)/2
+         if (estar/2*((a*a + r*r)*log((r + a)/(r - a)) - 2*a*r) < 18000) then
+            lo = a
+         else
+            hi = a
+         end if
+      end do
+      segedin = a/2*log((r + a)/(r - a))
+      call check(error, res%states(2)%approach, segedin, rel=.true., thr=0.005_dp, message="Segedin at 18000 nN")
+   end subroutine test_sphere
+
+   subroutine test_rough(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status
+      integer :: k
+      call read_deck("input/rough_selfaffine_32.deck", deck, status)
+      allocate(options%loads(0))
+      call solve_legacy(deck, options, res, status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      call check(error, res%step_contacts(1), 1, "one contact at the first step")
+      if (allocated(error)) return
+      call check(error, all([(res%step_load(k) >= res%step_load(k - 1) .and. res%step_approach(k) >= &
+         res%step_approach(k - 1), k = 2, res%nsteps)]), "load and approach never decrease")
+      if (allocated(error)) return
+      call check(error, res%missed_final_check, 0, "the final check finds no missed contact")
+      if (allocated(error)) return
+      ! Independent calculation: the condensed active-set system solved densely (LAPACK
+      ! dsysv) at the final load, against the accumulated skyline/TRFACT steps. The
+      ! springs are 1e5 times stiffer than the substrate, which costs about 5 digits.
+      call check(error, res%final_check_difference < 1.0e-8_dp, "accumulated state equals the exact solve: "// &
+         to_string(res%final_check_difference))
+      if (allocated(error)) return
+      call check(error, all(res%contact_force >= 0), "no tensile contact force")
+   end subroutine test_rough
+
+   subroutine test_run_outputs(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, text
+      integer :: code
+      prefix = scratch_path("run-square")
+      call run_femcod([string_type("run"), string_type("input/square_punch_n3.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--loads"), string_type("1,2"), string_type("--quiet")], code)
+      call check(error, code, 0)
+      if (allocated(error)) return
+      text = read_text(prefix//".history.csv")
+      call check(error, text(1:index(text, new_line("a")) - 1), "step,contacts,load_nN,approach_nm,area_nm2,area_fraction")
+      if (allocated(error)) return
+      text = read_text(prefix//".loads.csv")
+      call check(error, text(1:index(text, new_line("a")) - 1), &
+         "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness")
+      if (allocated(error)) return
+      ! Two requested loads: a header and two rows.
+      call check(error, count([(text(code:code) == new_line("a"), code = 1, len(text))]), 3, "rows of loads.csv")
+      if (allocated(error)) return
+      text = read_text(prefix//".contacts.csv")
+      call check(error, text(1:index(text, new_line("a")) - 1), "i,j,step,force_nN,pressure_GPa")
+      if (allocated(error)) return
+      ! Nine punch pixels in contact.
+      call check(error, count([(text(code:code) == new_line("a"), code = 1, len(text))]), 10, "rows of contacts.csv")
+      if (allocated(error)) return
+      call check(error, .not. file_exists(prefix//".history.csv.tmp"), "no temporary file left")
+   end subroutine test_run_outputs
+end module test_legacy
