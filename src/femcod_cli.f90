@@ -9,6 +9,7 @@ module femcod_cli
    use femcod_workspace, only: workspace_type, workspace_layout, N_REAL_BLOCKS, N_INT_BLOCKS
    use femcod_generate, only: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, KINDS
    use femcod_run, only: run_command
+   use femcod_verification, only: write_verification_report
    use femcod_strings, only: string_type, int_str
    implicit none
    private
@@ -54,6 +55,8 @@ contains
          call mkdeck_command(args(2:), code)
       case ("run")
          call run_command(args(2:), code)
+      case ("verify")
+         call verify_command(args(2:), code)
       case default
          call usage_error("unknown command '"//args(1)%s//"'")
          code = STATUS_USAGE
@@ -70,6 +73,7 @@ contains
          "  run DECK [options]        contact history of a deck (femcod run --help)", &
          "  mkdeck KIND [options]     generate a deck (femcod mkdeck --help)", &
          "  workspace NP MAXCONT      print the Appendix B memory map (Tables B.1, B.2)", &
+         "  verify [-o FILE]          recompute the thesis checks, write doc/verification.md", &
          "  --help, --version", &
          "", &
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
@@ -345,6 +349,44 @@ contains
             int_str(deck%maxcont)//")"
       end subroutine one_verification
    end subroutine mkdeck_command
+
+   !> `femcod verify [-o FILE]`.
+   subroutine verify_command(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      type(status_type) :: status
+      character(len=:), allocatable :: output
+      code = 0
+      output = "doc/verification.md"
+      if (size(args) >= 1) then
+         select case (args(1)%s)
+         case ("-h", "--help")
+            write(output_unit, '(a)') "usage: femcod verify [-o FILE]", &
+               "Runs the legacy solver on the decks of input/ (run from the package root) and writes the", &
+               "comparison with the thesis (Tables 4.1, 4.2, section 4.4.3, Fig. 5.2) to FILE", &
+               "(default doc/verification.md). Takes about two minutes with the release build."
+            return
+         case ("-o")
+            if (size(args) < 2) then
+               call usage_error("verify: -o needs a file")
+               code = STATUS_USAGE
+               return
+            end if
+            output = args(2)%s
+         case default
+            call usage_error("verify: unknown argument "//args(1)%s)
+            code = STATUS_USAGE
+            return
+         end select
+      end if
+      call write_verification_report(output, status, .true.)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod: "//status%message
+         code = status%code
+         return
+      end if
+      write(output_unit, '(a)') "wrote "//output
+   end subroutine verify_command
 
    function kinds_list() result(s)
       character(len=:), allocatable :: s

@@ -1,10 +1,11 @@
 !> What a contact solver returns: the step history, the states at requested loads,
 !> the contact pixels with their forces, and what was checked.
 module femcod_contact_result
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, i8
    implicit none
    private
-   public :: contact_result, load_state, contact_options, append_step, STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text
+   public :: contact_result, load_state, contact_options, append_step, progress_interface
+   public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text
 
    integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3
 
@@ -49,11 +50,28 @@ module femcod_contact_result
       !> Contacts found late by the candidate search (joined with a penetration),
       !> and by the final check over all pixels.
       integer :: missed_during_run = 0, missed_final_check = 0
+      !> Contacts released (force reached zero) during the run.
+      integer :: releases = 0
+      !> Exact pixel evaluations made by the candidate search (incremental solver).
+      integer(i8) :: evaluations = 0
       !> Largest relative difference between the accumulated state and an exact
       !> active-set solve at the end (a consistency check of the step accumulation).
       real(dp) :: final_check_difference = 0
+      !> Deepest penetration of any pixel not in contact at the end (nm, >= 0), from the
+      !> full-field check.
+      real(dp) :: max_penetration = 0
       real(dp) :: wall_seconds = 0
    end type contact_result
+
+   abstract interface
+      !> Called by a solver after every step, so that a program can report progress
+      !> (the solver itself does no I/O): step, contacts, total load (nN), elapsed (s).
+      subroutine progress_interface(step, contacts, load, elapsed)
+         import :: dp
+         integer, intent(in) :: step, contacts
+         real(dp), intent(in) :: load, elapsed
+      end subroutine progress_interface
+   end interface
 
 contains
 

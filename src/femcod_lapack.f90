@@ -4,7 +4,7 @@ module femcod_lapack
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv
+   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf
 
    interface
       pure subroutine dpotrf(uplo, n, a, lda, info)
@@ -54,5 +54,19 @@ module femcod_lapack
          real(dp), intent(in) :: alpha, beta, a(lda, *), x(*)
          real(dp), intent(inout) :: y(*)
       end subroutine dsymv
+      pure subroutine dtpsv(uplo, trans, diag, n, ap, x, incx)
+         import :: dp
+         character(len=1), intent(in) :: uplo, trans, diag
+         integer, intent(in) :: n, incx
+         real(dp), intent(in) :: ap(*)
+         real(dp), intent(inout) :: x(*)
+      end subroutine dtpsv
+      pure subroutine dpptrf(uplo, n, ap, info)
+         import :: dp
+         character(len=1), intent(in) :: uplo
+         integer, intent(in) :: n
+         real(dp), intent(inout) :: ap(*)
+         integer, intent(out) :: info
+      end subroutine dpptrf
    end interface
 end module femcod_lapack

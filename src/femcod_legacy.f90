@@ -20,11 +20,11 @@ module femcod_legacy
    use femcod_boussinesq, only: offset_table, surface_compliance, boussinesq_flexibility, boussinesq_inverse, &
       boussinesq_element
    use femcod_spring, only: spring_stiffness, spring_element
-   use femcod_skyline, only: colht, diagonal_addresses, assemble_element
+   use femcod_skyline, only: colht, diagonal_addresses, assemble_element, skyline_matvec
    use femcod_trfact, only: trfact, TRFACT_FACTOR, TRFACT_SOLVE
    use femcod_postp, only: candidate_count, postp_search
    use femcod_condensed, only: solve_active_set, gap_at
-   use femcod_contact_result, only: contact_result, contact_options, append_step, STOP_MAXCONT, STOP_LOADS, &
+   use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, STOP_MAXCONT, STOP_LOADS, &
       STOP_NO_CONTACT
    implicit none
    private
@@ -33,11 +33,13 @@ module femcod_legacy
 contains
 
    !> Run the Appendix B algorithm on a deck.
-   subroutine solve_legacy(deck, options, res, status)
+   subroutine solve_legacy(deck, options, res, status, progress)
       type(deck_type), intent(in) :: deck
       type(contact_options), intent(in) :: options
       type(contact_result), intent(out) :: res
       type(status_type), intent(inout) :: status
+      !> Optional progress report after every step.
+      procedure(progress_interface), optional :: progress
       type(workspace_type) :: ws
       real(dp), allocatable :: table(:, :), g0(:), funit(:), ftot(:), loads(:)
       integer, allocatable :: ic(:), jc(:), joiners(:), cstep(:)
@@ -124,6 +126,7 @@ contains
          call advance(lambda)
          call wall_clock(t1)
          call append_step(res, n, total, approach, t1 - t0)
+         if (present(progress)) call progress(step, n, total, t1 - tstart)
          if (size(loads) > 0) then
             if (max_load <= total) then
                res%stop_reason = STOP_LOADS
@@ -226,7 +229,10 @@ contains
                call add_contact(extra(q), step)
             end do
          end if
-         g0c = [(g0((ic(q) - 1)*np + jc(q)), q = 1, n)]
+         allocate(g0c(n))
+         do q = 1, n
+            g0c(q) = g0((ic(q) - 1)*np + jc(q))
+         end do
          allocate(fex(n))
          call solve_active_set(ic(1:n), jc(1:n), g0c, csum, 3/kspring, table, total, fex, aex, status)
          if (status%code /= 0) return
@@ -252,15 +258,21 @@ contains
       type(workspace_type), intent(inout) :: ws
       real(dp), intent(out) :: delta, funit(:)
       type(status_type), intent(inout) :: status
-      real(dp), allocatable :: flex(:, :), kinv(:, :), element(:, :), b(:)
+      real(dp), allocatable :: flex(:, :), kinv(:, :), element(:, :), b(:), rhs(:), r(:), kcopy(:)
       integer, allocatable :: height(:), eqs1(:), eqs2(:), iadr(:)
       integer :: n, neq, k, istif, nstif, inod
       real(dp) :: spring(2, 2)
       n = size(ic)
       neq = 4*n + 1
       ! Element connectivity, element by element (IPNOD1..3), node 1 = fixed handle.
-      eqs1 = [(k, k = 1, n), 0]
-      eqs2 = [(3*n + k, k = 1, n), 4*n + 1]
+      ! (Explicit loops: gfortran builds implied-do constructors of run-time length slowly.)
+      allocate(eqs1(n + 1), eqs2(n + 1))
+      do k = 1, n
+         eqs1(k) = k
+         eqs2(k) = 3*n + k
+      end do
+      eqs1(n + 1) = 0
+      eqs2(n + 1) = 4*n + 1
       inod = ws%ifirst(IPNOD1)
       ws%ia(inod:inod + 2*n + 1) = [eqs1, eqs2] + 1
       inod = ws%ifirst(IPNOD2)
@@ -312,12 +324,21 @@ contains
             call assemble_element(spring, [n + 2*k - 1, n + 2*k], iadr, a)
          end do
          ! TRFACT twice: factorise, then solve for the negative unit load on the top handle.
-         allocate(b(neq))
-         b = 0
-         b(neq) = -1
+         ! The rigid body and the rigid springs make K stiff by five orders of magnitude
+         ! across its entries; one step of iterative refinement with the assembled K
+         ! (kept aside before the factorisation) restores the digits that costs.
+         allocate(b(neq), rhs(neq), r(neq))
+         rhs = 0
+         rhs(neq) = -1
+         b = rhs
+         kcopy = a
          call trfact(a, iadr, b, TRFACT_FACTOR, status)
          if (status%code /= 0) return
          call trfact(a, iadr, b, TRFACT_SOLVE, status)
+         call skyline_matvec(kcopy, iadr, b, r)
+         r = rhs - r
+         call trfact(a, iadr, r, TRFACT_SOLVE, status)
+         b = b + r
       end associate
       ws%ra(ws%rfirst(MPDISP):ws%rfirst(MPDISP) + neq - 1) = b
       delta = -b(neq)

@@ -10,6 +10,7 @@ module femcod_run
    use femcod_strings, only: string_type, int_str, real_str, split_list
    use femcod_contact_result, only: contact_result, contact_options, stop_reason_text
    use femcod_legacy, only: solve_legacy
+   use femcod_incremental, only: solve_incremental, scene_report
    use femcod_results, only: write_csv_results
    implicit none
    private
@@ -19,18 +20,20 @@ contains
 
    subroutine run_help()
       write(output_unit, '(a)') &
-         "usage: femcod run DECK [-o PREFIX] [--solver legacy] [--loads F1,F2,...] [--max-contacts N]", &
+         "usage: femcod run DECK [-o PREFIX] [--solver incremental|legacy] [--loads F1,F2,...] [--max-contacts N]", &
          "                  [--hardness H] [--no-final-check] [--quiet]", &
          "", &
          "Contact history of the deck, step by step (thesis chapter 4, Appendix B).", &
          "  -o PREFIX          output prefix (default: the deck's name without .deck, here)", &
-         "  --solver legacy    the Appendix B program (skyline, COLHT, TRFACT, POSTP)", &
+         "  --solver S         incremental (default): event-exact, condensed to the contacts, bordered", &
+         "                     Cholesky factor, exact candidate bound, full-field FFT check at the end;", &
+         "                     legacy: the Appendix B program (skyline, COLHT, TRFACT, POSTP)", &
          "  --loads F1,...     total loads in nN at which to report the state (PREFIX.loads.csv);", &
          "                     the run stops once the largest is reached", &
          "  --max-contacts N   stop after N contacts (default: the deck's MAXCONT)", &
          "  --hardness H       GPa, for n_above_hardness (default 11, polysilicon)", &
          "  --no-final-check   skip the final check of every pixel for missed contacts", &
-         "  --quiet            no summary on standard output", &
+         "  --quiet            no summary on standard output, no progress lines on standard error", &
          "", &
          "outputs: PREFIX.history.csv (step,contacts,load_nN,approach_nm,area_nm2,area_fraction),", &
          "         PREFIX.contacts.csv (i,j,step,force_nN,pressure_GPa) at the largest requested load", &
@@ -50,11 +53,12 @@ contains
       character(len=:), allocatable :: deck_path, prefix, solver, key
       logical :: quiet, ok
       integer :: i, k
+      real(dp) :: last_report
       code = 0
       quiet = .false.
       deck_path = ""
       prefix = ""
-      solver = "legacy"
+      solver = "incremental"
       allocate(options%loads(0))
       i = 1
       do while (i <= size(args))
@@ -91,8 +95,8 @@ contains
                prefix = v
             case ("--solver")
                solver = v
-               if (solver /= "legacy") then
-                  call usage("unknown solver '"//v//"' (available: legacy)")
+               if (solver /= "legacy" .and. solver /= "incremental") then
+                  call usage("unknown solver '"//v//"' (available: incremental, legacy)")
                   return
                end if
             case ("--loads")
@@ -132,7 +136,23 @@ contains
       if (prefix == "") prefix = default_prefix(deck_path)
 
       call read_deck(deck_path, deck, status)
-      if (status%code == 0) call solve_legacy(deck, options, res, status)
+      last_report = 0
+      if (status%code == 0) then
+         select case (solver)
+         case ("legacy")
+            if (quiet) then
+               call solve_legacy(deck, options, res, status)
+            else
+               call solve_legacy(deck, options, res, status, report_progress)
+            end if
+         case default
+            if (quiet) then
+               call solve_incremental(deck, options, res, status)
+            else
+               call solve_incremental(deck, options, res, status, report_progress)
+            end if
+         end select
+      end if
       if (status%code == 0) call write_csv_results(prefix, deck, res, status)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod: "//status%message
@@ -145,6 +165,17 @@ contains
       end do
       if (.not. quiet) call print_summary()
    contains
+      !> A progress line on standard error at most every 5 s.
+      subroutine report_progress(step, contacts, load, elapsed)
+         integer, intent(in) :: step, contacts
+         real(dp), intent(in) :: load, elapsed
+         if (elapsed - last_report < 5) return
+         last_report = elapsed
+         write(error_unit, '(a)') "femcod: step "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
+            real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s"
+         flush(error_unit)
+      end subroutine report_progress
+
       subroutine usage(message)
          character(len=*), intent(in) :: message
          write(error_unit, '(a)') "femcod run: "//message//" (femcod run --help)"
@@ -153,6 +184,7 @@ contains
 
       subroutine print_summary()
          integer :: last
+         character(len=160), allocatable :: lines(:)
          last = res%nsteps
          write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//solver//")"
          write(output_unit, '(a)') "  scene     : "//deck%label
@@ -161,15 +193,28 @@ contains
             real_str(deck%young(3), 4)//" GPa (lower / upper / contact)"
          write(output_unit, '(a)') "  steps     : "//int_str(last)//", stopped: "//stop_reason_text(res%stop_reason)
          if (last > 0) then
-            write(output_unit, '(a)') "  final     : "//int_str(res%step_contacts(last))//" contacts, load "// &
-               real_str(res%step_load(last), 6)//" nN, approach "//real_str(res%step_approach(last), 6)//" nm"
+            write(output_unit, '(a)') "  last step : "//int_str(res%step_contacts(last))//" contacts up to load "// &
+               real_str(res%step_load(last), 6)//" nN (where the next contact closes), approach "// &
+               real_str(res%step_approach(last), 6)//" nm"
          end if
          write(output_unit, '(a)') "  wall time : "//real_str(res%wall_seconds, 3)//" s in total, "// &
             real_str(res%wall_seconds/max(last, 1), 3)//" s per step"
-         write(output_unit, '(a)') "  checked   : "//int_str(res%missed_during_run)// &
-            " contacts found late by the candidate search, "//int_str(res%missed_final_check)// &
-            " found by the final check of all pixels; exact re-solve differs by "// &
-            real_str(res%final_check_difference, 2)
+         if (solver == "incremental") then
+            lines = scene_report(deck)
+            do k = 1, size(lines)
+               write(output_unit, '(a)') "  model     : "//trim(lines(k))
+            end do
+            write(output_unit, '(a)') "  checked   : every pixel by FFT convolution at the end: "// &
+               int_str(res%missed_final_check)//" penetrating (deepest "//real_str(res%max_penetration, 2)// &
+               " nm); "//int_str(res%releases)//" releases; "//real_str(real(res%evaluations, dp), 3)// &
+               " exact pixel evaluations; exact re-solve differs by "// &
+               real_str(res%final_check_difference, 2)
+         else
+            write(output_unit, '(a)') "  checked   : "//int_str(res%missed_during_run)// &
+               " contacts found late by the candidate search, "//int_str(res%missed_final_check)// &
+               " found by the final check of all pixels; exact re-solve differs by "// &
+               real_str(res%final_check_difference, 2)
+         end if
          write(output_unit, '(a)') "  written   : "//prefix//".history.csv, "//prefix//".contacts.csv"// &
             merge(", "//prefix//".loads.csv", repeat(" ", len(prefix) + 12), size(res%states) > 0)
       end subroutine print_summary

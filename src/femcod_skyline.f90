@@ -8,7 +8,7 @@ module femcod_skyline
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: colht, diagonal_addresses, assemble_element
+   public :: colht, diagonal_addresses, assemble_element, skyline_matvec
 
 contains
 
@@ -54,4 +54,27 @@ contains
          end do
       end do
    end subroutine assemble_element
+
+   !> y = K x for a symmetric matrix in skyline storage (upper triangle by columns).
+   pure subroutine skyline_matvec(a, iadr, x, y)
+      real(dp), intent(in) :: a(:), x(:)
+      integer, intent(in) :: iadr(:)
+      real(dp), intent(out) :: y(:)
+      integer :: j, top, len, first
+      y = 0
+      do j = 1, size(iadr)
+         if (j == 1) then
+            len = 0
+         else
+            len = iadr(j) - iadr(j - 1) - 1
+         end if
+         top = j - len
+         first = iadr(j) - len
+         y(j) = y(j) + a(iadr(j))*x(j)
+         if (len > 0) then
+            y(top:j - 1) = y(top:j - 1) + a(first:iadr(j) - 1)*x(j)
+            y(j) = y(j) + dot_product(a(first:iadr(j) - 1), x(top:j - 1))
+         end if
+      end do
+   end subroutine skyline_matvec
 end module femcod_skyline

@@ -16,7 +16,9 @@ contains
       integer, allocatable :: buffer(:)
       integer :: n, width, lo, mid, hi, i, j, k
       n = size(values)
-      order = [(i, i = 1, n)]
+      do i = 1, n
+         order(i) = i
+      end do
       allocate(buffer(n))
       width = 1
       do while (width < n)

@@ -1,0 +1,446 @@
+!> The event-exact incremental solver (`--solver incremental`): the Appendix B model
+!> condensed to the contact degrees of freedom.
+!>
+!> With both handles and the springs eliminated, the contacts C carry forces F with
+!>     M F - A 1 = -g0_C,   1'F = P,     M = c I_CC + s Id,
+!> c = c1 + c2 the composite surface compliance (one Love table serves both bodies), s
+!> the compliance of the springs in series at a contact (two interface springs and the
+!> penalty spring, 3/k). Under a unit load increment f = M^-1 1/(1'M^-1 1) and the
+!> approach rate is delta = 1/(1'M^-1 1). M = U'U is kept as a packed Cholesky factor;
+!> a new contact borders it with one row (a triangular solve, BLAS dtpsv), never a
+!> refactorisation, except when a contact is released.
+!>
+!> The next event is found exactly: every pixel not in contact sits in a heap keyed by
+!> a lower bound on its gap. Since F >= 0, a gap never shrinks faster than
+!>     delta_max = delta + c I(0,0) sum_k max(-f_k, 0)
+!> per unit load, so a pixel whose bound exceeds lambda_best * delta_max cannot close
+!> before the best candidate: only pixels that can are evaluated exactly (O(n) each).
+!> Releases (a contact force reaching zero) are events too. For monotonic loading the
+!> history is the exact piecewise-linear solution of the contact problem.
+module femcod_incremental
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
+   use femcod_deck, only: deck_type
+   use femcod_scene, only: initial_gaps
+   use femcod_boussinesq, only: offset_table, surface_compliance, love_influence
+   use femcod_spring, only: spring_stiffness
+   use femcod_lapack, only: dtpsv, dpptrf
+   use femcod_heap, only: min_heap, heap_build, heap_push, heap_pop, heap_top_key
+   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
+   use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, &
+      STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT
+   implicit none
+   private
+   public :: solve_incremental, scene_report
+
+contains
+
+   !> What the condensed model leaves out for this deck, one line each.
+   function scene_report(deck) result(lines)
+      type(deck_type), intent(in) :: deck
+      character(len=160), allocatable :: lines(:)
+      real(dp) :: c1, c2, s, cself
+      character(len=16) :: buf
+      c1 = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel)
+      c2 = surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
+      s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
+      cself = (c1 + c2)*love_influence(0, 0)
+      allocate(lines(0))
+      lines = [character(len=160) :: "handles, substrate and surface nodes condensed: unknowns are the contact "// &
+         "forces and the approach"]
+      if (c2 < c1*1.0e-3_dp) then
+         write(buf, '(es9.2)') c2/c1
+         lines = [character(len=160) :: lines, "upper body rigid (compliance "//trim(adjustl(buf))// &
+            " of the lower's): no element of its own, kept exactly in c = c1 + c2"]
+      else if (c1 < c2*1.0e-3_dp) then
+         write(buf, '(es9.2)') c1/c2
+         lines = [character(len=160) :: lines, "lower body rigid (compliance "//trim(adjustl(buf))// &
+            " of the upper's): no element of its own, kept exactly in c = c1 + c2"]
+      else if (deck%young(1) == deck%young(2) .and. deck%poisson(1) == deck%poisson(2)) then
+         lines = [character(len=160) :: lines, "identical materials: one Love table, c = 2 c1"]
+      else
+         lines = [character(len=160) :: lines, "two elastic bodies: one Love table, c = c1 + c2"]
+      end if
+      write(buf, '(es9.2)') s/cself
+      lines = [character(len=160) :: lines, "interface and penalty springs: an exact diagonal compliance 3/k = "// &
+         trim(adjustl(buf))//" of a pixel's self-compliance"]
+      if (all(deck%lower == deck%lower(1, 1))) lines = [character(len=160) :: lines, "lower surface flat"]
+      if (all(deck%upper == deck%upper(1, 1))) lines = [character(len=160) :: lines, "upper surface flat"]
+   end function scene_report
+
+   !> Run the event-exact algorithm on a deck (same outputs as the legacy solver).
+   subroutine solve_incremental(deck, options, res, status, progress)
+      type(deck_type), intent(in) :: deck
+      type(contact_options), intent(in) :: options
+      type(contact_result), intent(out) :: res
+      type(status_type), intent(inout) :: status
+      procedure(progress_interface), optional :: progress
+      real(dp), allocatable :: table(:, :), g0(:), ftot(:), funit(:), u(:), y(:), x(:), col(:), keys(:)
+      real(dp), allocatable :: lam_eval(:), gap_eval(:), loads(:)
+      integer, allocatable :: ic(:), jc(:), pix(:), cstep(:), slot(:), eval_pix(:), joiners(:), items(:)
+      type(min_heap) :: heap
+      real(dp) :: c, s, self, total, approach, phi, delta, delta_max, beta, lam_best, lam_release, bound
+      real(dp) :: tstart, t0, t1, max_load, g, rate, tie, key
+      integer :: np, npix, maxc, n, step, k, p, neval, njoin, krel, q, info
+      integer(i8) :: cap
+
+      call wall_clock(tstart)
+      np = deck%np
+      npix = np*np
+      maxc = deck%maxcont
+      if (options%max_contacts > 0) maxc = min(maxc, options%max_contacts)
+      allocate(table(0:np - 1, 0:np - 1))
+      table = offset_table(np)
+      g0 = initial_gaps(deck%lower, deck%upper)
+      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
+         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
+      s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
+      self = c*table(0, 0) + s
+      cap = int(maxc, i8)*int(maxc + 1, i8)/2
+      allocate(u(cap), stat=info)
+      if (info /= 0) then
+         call set_error(status, STATUS_NUMERICAL, "incremental: cannot allocate the factor ("// &
+            trim(i8str(8*cap))//" bytes)")
+         return
+      end if
+      allocate(ic(maxc), jc(maxc), pix(maxc), cstep(maxc), ftot(maxc), funit(maxc), y(maxc), x(maxc), col(maxc))
+      allocate(slot(npix), eval_pix(npix), lam_eval(npix), gap_eval(npix), joiners(npix))
+      slot = 0
+
+      ! Every pixel in the heap, keyed by its exact gap at zero load.
+      allocate(items(npix))
+      do p = 1, npix
+         items(p) = p
+      end do
+      keys = g0
+      call heap_build(heap, keys, items, npix)
+      phi = 0
+
+      max_load = -huge(1.0_dp)
+      if (allocated(options%loads)) then
+         loads = options%loads
+      else
+         allocate(loads(0))
+      end if
+      if (size(loads) > 0) max_load = maxval(loads)
+      allocate(res%states(size(loads)))
+      res%states%load = loads
+      total = 0
+      approach = 0
+      n = 0
+      step = 0
+      ! The first contact: the smallest gap (ties join at the next step with no load).
+      call pop_valid(p)
+      call add_contact(p, 1)
+      if (status%code /= 0) return
+
+      do
+         step = step + 1
+         call wall_clock(t0)
+         ! Unit-load solution from the factor: x = M^-1 1 = U^-1 y, beta = 1'x = y'y.
+         x(1:n) = y(1:n)
+         call dtpsv("U", "N", "N", n, u, x, 1)
+         beta = sum(y(1:n)**2)
+         delta = 1/beta
+         funit(1:n) = x(1:n)*delta
+         delta_max = delta + c*table(0, 0)*sum(max(-funit(1:n), 0.0_dp))
+
+         ! Releases: a contact force reaching zero.
+         lam_release = huge(1.0_dp)
+         krel = 0
+         do k = 1, n
+            if (funit(k) < 0) then
+               if (ftot(k)/(-funit(k)) < lam_release) then
+                  lam_release = ftot(k)/(-funit(k))
+                  krel = k
+               end if
+            end if
+         end do
+
+         ! Closing events: pop every pixel whose lower bound allows closing first.
+         lam_best = lam_release
+         neval = 0
+         do
+            tie = options%tie_tolerance*(total + max(lam_best, 0.0_dp))
+            if (lam_best < huge(1.0_dp)) then
+               bound = (lam_best + tie)*delta_max
+            else
+               bound = huge(1.0_dp)
+            end if
+            if (heap%size == 0) exit
+            if (heap_top_key(heap) - phi > bound) exit
+            call heap_pop(heap, key, p)
+            if (slot(p) /= 0) cycle
+            call evaluate(p, g, rate)
+            res%evaluations = res%evaluations + 1
+            neval = neval + 1
+            eval_pix(neval) = p
+            gap_eval(neval) = g
+            if (g <= 0) then
+               lam_eval(neval) = 0
+            else if (rate > 0) then
+               lam_eval(neval) = g/rate
+            else
+               lam_eval(neval) = huge(1.0_dp)
+            end if
+            lam_best = min(lam_best, lam_eval(neval))
+            if (neval == npix) exit
+         end do
+         tie = options%tie_tolerance*(total + max(lam_best, 0.0_dp))
+         njoin = 0
+         do q = 1, neval
+            if (lam_eval(q) <= lam_best + tie .and. lam_eval(q) < huge(1.0_dp)) then
+               njoin = njoin + 1
+               joiners(njoin) = eval_pix(q)
+            else
+               ! Back into the heap with its exact gap as the new bound.
+               call heap_push(heap, gap_eval(q) + phi, eval_pix(q))
+            end if
+         end do
+         res%missed_during_run = res%missed_during_run + count(gap_eval(1:neval) < -options%tie_tolerance*approach)
+
+         if (lam_best >= huge(1.0_dp)) then
+            ! Nothing can close and nothing is released: linear for ever.
+            call record_states(huge(1.0_dp), .true.)
+            res%stop_reason = STOP_NO_CONTACT
+            if (size(loads) > 0) then
+               if (max_load > total) call advance(max_load - total)
+            end if
+            call wall_clock(t1)
+            call append_step(res, n, total, approach, t1 - t0)
+            exit
+         end if
+         lam_best = max(lam_best, 0.0_dp)
+         call record_states(lam_best, .false.)
+         call advance(lam_best)
+         call wall_clock(t1)
+         call append_step(res, n, total, approach, t1 - t0)
+         if (present(progress)) call progress(step, n, total, t1 - tstart)
+         if (size(loads) > 0) then
+            if (max_load <= total) then
+               res%stop_reason = STOP_LOADS
+               do q = 1, njoin
+                  call heap_push(heap, phi, joiners(q))
+               end do
+               exit
+            end if
+         end if
+         if (njoin == 0 .and. krel > 0) then
+            ! A release: drop contact krel and refactor (rare).
+            call release_contact(krel)
+            if (status%code /= 0) return
+            cycle
+         end if
+         if (n + njoin > maxc) then
+            res%stop_reason = STOP_MAXCONT
+            do q = 1, njoin
+               call heap_push(heap, phi, joiners(q))
+            end do
+            exit
+         end if
+         do q = 1, njoin
+            call add_contact(joiners(q), step + 1)
+            if (status%code /= 0) return
+         end do
+      end do
+
+      if (options%final_check) call final_check()
+      if (status%code /= 0) return
+      if (.not. allocated(res%contact_force)) then
+         res%contact_force = ftot(1:n)
+         res%reported_load = total
+      end if
+      res%contact_i = ic(1:n)
+      res%contact_j = jc(1:n)
+      res%contact_step = cstep(1:n)
+      call wall_clock(t1)
+      res%wall_seconds = t1 - tstart
+
+   contains
+
+      !> Pop the heap until a pixel not in contact appears.
+      subroutine pop_valid(pixel)
+         integer, intent(out) :: pixel
+         real(dp) :: kk
+         do
+            call heap_pop(heap, kk, pixel)
+            if (slot(pixel) == 0) exit
+         end do
+      end subroutine pop_valid
+
+      !> Exact gap and closing rate of a pixel not in contact.
+      subroutine evaluate(pixel, gap, closing)
+         integer, intent(in) :: pixel
+         real(dp), intent(out) :: gap, closing
+         integer :: ip, jp, kk
+         real(dp) :: st, su, t
+         ip = (pixel - 1)/np + 1
+         jp = pixel - (ip - 1)*np
+         st = 0
+         su = 0
+         do kk = 1, n
+            t = table(abs(ip - ic(kk)), abs(jp - jc(kk)))
+            st = st + t*ftot(kk)
+            su = su + t*funit(kk)
+         end do
+         gap = g0(pixel) - approach + c*st
+         closing = delta - c*su
+      end subroutine evaluate
+
+      !> Border the factor with a new contact (zero force): U gains a column
+      !> (Uk = U^-T m, diagonal sqrt(mu - |Uk|^2)) and y = U^-T 1 one entry.
+      subroutine add_contact(pixel, joined)
+         integer, intent(in) :: pixel, joined
+         integer :: ip, jp, kk
+         integer(i8) :: base
+         real(dp) :: d2
+         ip = (pixel - 1)/np + 1
+         jp = pixel - (ip - 1)*np
+         do kk = 1, n
+            col(kk) = c*table(abs(ip - ic(kk)), abs(jp - jc(kk)))
+         end do
+         if (n > 0) call dtpsv("U", "T", "N", n, u, col, 1)
+         d2 = self - sum(col(1:n)**2)
+         if (.not. d2 > epsilon(1.0_dp)*self) then
+            call set_error(status, STATUS_NUMERICAL, "incremental: the contact compliance lost positive definiteness")
+            return
+         end if
+         base = int(n, i8)*int(n + 1, i8)/2
+         u(base + 1:base + n) = col(1:n)
+         u(base + n + 1) = sqrt(d2)
+         y(n + 1) = (1 - sum(col(1:n)*y(1:n)))/u(base + n + 1)
+         n = n + 1
+         ic(n) = ip
+         jc(n) = jp
+         pix(n) = pixel
+         cstep(n) = joined
+         ftot(n) = 0
+         slot(pixel) = n
+      end subroutine add_contact
+
+      !> Remove contact k (its force is zero) and refactor the rest (LAPACK dpptrf).
+      subroutine release_contact(krm)
+         integer, intent(in) :: krm
+         integer :: a, b, pos
+         ftot(krm) = 0
+         slot(pix(krm)) = 0
+         call heap_push(heap, phi, pix(krm))
+         ic(krm:n - 1) = ic(krm + 1:n)
+         jc(krm:n - 1) = jc(krm + 1:n)
+         pix(krm:n - 1) = pix(krm + 1:n)
+         cstep(krm:n - 1) = cstep(krm + 1:n)
+         ftot(krm:n - 1) = ftot(krm + 1:n)
+         n = n - 1
+         do a = 1, n
+            slot(pix(a)) = a
+         end do
+         pos = 0
+         do b = 1, n
+            do a = 1, b
+               pos = pos + 1
+               u(pos) = c*table(abs(ic(a) - ic(b)), abs(jc(a) - jc(b)))
+               if (a == b) u(pos) = u(pos) + s
+            end do
+         end do
+         call dpptrf("U", n, u, info)
+         if (info /= 0) then
+            call set_error(status, STATUS_NUMERICAL, "incremental: refactorisation after a release failed")
+            return
+         end if
+         y(1:n) = 1
+         call dtpsv("U", "T", "N", n, u, y, 1)
+         res%releases = res%releases + 1
+      end subroutine release_contact
+
+      subroutine advance(lam)
+         real(dp), intent(in) :: lam
+         total = total + lam
+         approach = approach + lam*delta
+         ftot(1:n) = ftot(1:n) + lam*funit(1:n)
+         phi = phi + lam*delta_max
+      end subroutine advance
+
+      subroutine record_states(lam, unbounded)
+         real(dp), intent(in) :: lam
+         logical, intent(in) :: unbounded
+         integer :: st
+         real(dp) :: dl
+         real(dp), allocatable :: f(:)
+         do st = 1, size(res%states)
+            if (res%states(st)%reached) cycle
+            if (.not. unbounded .and. res%states(st)%load > total + lam) cycle
+            dl = max(res%states(st)%load - total, 0.0_dp)
+            f = ftot(1:n) + dl*funit(1:n)
+            res%states(st)%approach = approach + dl*delta
+            res%states(st)%contacts = n
+            res%states(st)%max_pressure = maxval(f)/deck%pixel**2
+            res%states(st)%n_above_hardness = count(f/deck%pixel**2 > options%hardness)
+            res%states(st)%reached = .true.
+            if (res%states(st)%load == max_load) then
+               res%contact_force = f
+               res%reported_load = res%states(st)%load
+            end if
+         end do
+      end subroutine record_states
+
+      !> Full-field check by FFT convolution: no pixel may penetrate, no force be tensile.
+      subroutine final_check()
+         type(love_convolution) :: conv
+         real(dp), allocatable :: field(:, :), disp(:, :)
+         real(dp) :: gq, worst, allowance
+         integer :: qq, iq, jq
+         allocate(field(np, np), disp(np, np))
+         field = 0
+         do qq = 1, n
+            field(ic(qq), jc(qq)) = ftot(qq)
+         end do
+         call convolution_setup(conv, table)
+         call convolution_apply(conv, field, disp)
+         call convolution_free(conv)
+         worst = 0
+         res%missed_final_check = 0
+         ! Round-off allowance: the tie tolerance of the approach plus the FFT's
+         ! round-off on the height scale.
+         allowance = options%tie_tolerance*max(approach, tiny(1.0_dp)) + 1.0e-12_dp*maxval(abs(g0))
+         do qq = 1, npix
+            if (slot(qq) /= 0) cycle
+            iq = (qq - 1)/np + 1
+            jq = qq - (iq - 1)*np
+            gq = g0(qq) - approach + c*disp(iq, jq)
+            if (gq < -allowance) then
+               res%missed_final_check = res%missed_final_check + 1
+            end if
+            worst = min(worst, gq)
+         end do
+         res%max_penetration = max(0.0_dp, -worst)
+         ! Drift of the event accumulation against a fresh solve of the final active set
+         ! with the current factor: F = A M^-1 1 - M^-1 g0_C, A from 1'F = P (O(n^2)).
+         block
+            real(dp), allocatable :: w(:), fex(:)
+            real(dp) :: aex
+            w = g0(pix(1:n))
+            call dtpsv("U", "T", "N", n, u, w, 1)
+            call dtpsv("U", "N", "N", n, u, w, 1)
+            x(1:n) = y(1:n)
+            call dtpsv("U", "N", "N", n, u, x, 1)
+            aex = (total + sum(w))/sum(x(1:n))
+            fex = aex*x(1:n) - w
+            res%final_check_difference = max(abs(aex - approach)/max(abs(aex), tiny(1.0_dp)), &
+               maxval(abs(fex - ftot(1:n)))/max(maxval(abs(fex)), tiny(1.0_dp)))
+         end block
+      end subroutine final_check
+   end subroutine solve_incremental
+
+   function i8str(v) result(str)
+      integer(i8), intent(in) :: v
+      character(len=24) :: str
+      write(str, '(i0)') v
+   end function i8str
+
+   subroutine wall_clock(t)
+      real(dp), intent(out) :: t
+      integer(i8) :: count, rate
+      call system_clock(count, rate)
+      t = real(count, dp)/real(rate, dp)
+   end subroutine wall_clock
+end module femcod_incremental
