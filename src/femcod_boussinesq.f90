@@ -74,17 +74,19 @@ contains
    end function love_influence_far
 
    !> The translation-invariant table I(p, q), p, q = 0 .. np-1 (I is even in p and q,
-   !> so one quadrant serves every pair of pixels of an NP x NP grid).
-   pure function offset_table(np) result(table)
+   !> so one quadrant serves every pair of pixels of an NP x NP grid). Entries are
+   !> independent, so the OpenMP loop gives the same bits for any number of threads.
+   function offset_table(np) result(table)
       integer, intent(in) :: np
       real(dp) :: table(0:np - 1, 0:np - 1)
       integer :: p, q
+      !$omp parallel do schedule(dynamic, 8) private(p)
       do q = 0, np - 1
-         do p = 0, q
+         do p = 0, np - 1
             table(p, q) = love_influence(p, q)
-            table(q, p) = table(p, q)
          end do
       end do
+      !$omp end parallel do
    end function offset_table
 
    !> Dimensionless flexibility of the pixels (rows(k), cols(k)): F(k,l) = I(offset).

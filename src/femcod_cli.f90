@@ -13,7 +13,7 @@ module femcod_cli
    use femcod_strings, only: string_type, int_str
    implicit none
    private
-   public :: femcod_command, run_femcod, FEMCOD_VERSION
+   public :: femcod_command, run_femcod, command_arguments, FEMCOD_VERSION
 
    character(len=*), parameter :: FEMCOD_VERSION = "0.1.0"
 
@@ -22,6 +22,11 @@ contains
    !> Entry point for app/main.f90.
    subroutine femcod_command(code)
       integer, intent(out) :: code
+      call run_femcod(command_arguments(), code)
+   end subroutine femcod_command
+
+   !> The process arguments as a list.
+   function command_arguments() result(args)
       type(string_type), allocatable :: args(:)
       integer :: i, n, length
       n = command_argument_count()
@@ -31,8 +36,7 @@ contains
          allocate(character(len=length) :: args(i)%s)
          call get_command_argument(i, args(i)%s)
       end do
-      call run_femcod(args, code)
-   end subroutine femcod_command
+   end function command_arguments
 
    !> Dispatch on the first argument.
    subroutine run_femcod(args, code)
@@ -74,6 +78,7 @@ contains
          "  mkdeck KIND [options]     generate a deck (femcod mkdeck --help)", &
          "  workspace NP MAXCONT      print the Appendix B memory map (Tables B.1, B.2)", &
          "  verify [-o FILE]          recompute the thesis checks, write doc/verification.md", &
+         "  bench [--full]            speed against error, one table (use the release build)", &
          "  --help, --version", &
          "", &
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"

@@ -6,9 +6,10 @@
 !> c = c1 + c2 the composite surface compliance (one Love table serves both bodies), s
 !> the compliance of the springs in series at a contact (two interface springs and the
 !> penalty spring, 3/k). Under a unit load increment f = M^-1 1/(1'M^-1 1) and the
-!> approach rate is delta = 1/(1'M^-1 1). M = U'U is kept as a packed Cholesky factor;
-!> a new contact borders it with one row (a triangular solve, BLAS dtpsv), never a
-!> refactorisation, except when a contact is released.
+!> approach rate is delta = 1/(1'M^-1 1). M = U'U is kept as a Cholesky factor in full
+!> column storage that grows by doubling; a new contact borders it with one column (a
+!> triangular solve, BLAS dtrsv), never a refactorisation, except when a contact is
+!> released.
 !>
 !> The next event is found exactly: every pixel not in contact sits in a heap keyed by
 !> a lower bound on its gap. Since F >= 0, a gap never shrinks faster than
@@ -24,7 +25,7 @@ module femcod_incremental
    use femcod_scene, only: initial_gaps
    use femcod_boussinesq, only: offset_table, surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
-   use femcod_lapack, only: dtpsv, dpptrf
+   use femcod_lapack, only: dtrsv, dpotrf
    use femcod_heap, only: min_heap, heap_build, heap_push, heap_pop, heap_top_key
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, &
@@ -75,14 +76,13 @@ contains
       type(contact_result), intent(out) :: res
       type(status_type), intent(inout) :: status
       procedure(progress_interface), optional :: progress
-      real(dp), allocatable :: table(:, :), g0(:), ftot(:), funit(:), u(:), y(:), x(:), col(:), keys(:)
+      real(dp), allocatable :: table(:, :), g0(:), ftot(:), funit(:), u(:, :), y(:), x(:), col(:), keys(:)
       real(dp), allocatable :: lam_eval(:), gap_eval(:), loads(:)
       integer, allocatable :: ic(:), jc(:), pix(:), cstep(:), slot(:), eval_pix(:), joiners(:), items(:)
       type(min_heap) :: heap
       real(dp) :: c, s, self, total, approach, phi, delta, delta_max, beta, lam_best, lam_release, bound
       real(dp) :: tstart, t0, t1, max_load, g, rate, tie, key
-      integer :: np, npix, maxc, n, step, k, p, neval, njoin, krel, q, info
-      integer(i8) :: cap
+      integer :: np, npix, maxc, n, step, k, p, neval, njoin, krel, q, info, ld
 
       call wall_clock(tstart)
       np = deck%np
@@ -96,13 +96,8 @@ contains
          surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
       s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
       self = c*table(0, 0) + s
-      cap = int(maxc, i8)*int(maxc + 1, i8)/2
-      allocate(u(cap), stat=info)
-      if (info /= 0) then
-         call set_error(status, STATUS_NUMERICAL, "incremental: cannot allocate the factor ("// &
-            trim(i8str(8*cap))//" bytes)")
-         return
-      end if
+      ld = min(maxc, 256)
+      allocate(u(ld, ld))
       allocate(ic(maxc), jc(maxc), pix(maxc), cstep(maxc), ftot(maxc), funit(maxc), y(maxc), x(maxc), col(maxc))
       allocate(slot(npix), eval_pix(npix), lam_eval(npix), gap_eval(npix), joiners(npix))
       slot = 0
@@ -139,7 +134,7 @@ contains
          call wall_clock(t0)
          ! Unit-load solution from the factor: x = M^-1 1 = U^-1 y, beta = 1'x = y'y.
          x(1:n) = y(1:n)
-         call dtpsv("U", "N", "N", n, u, x, 1)
+         call dtrsv("U", "N", "N", n, u, ld, x, 1)
          beta = sum(y(1:n)**2)
          delta = 1/beta
          funit(1:n) = x(1:n)*delta
@@ -291,24 +286,36 @@ contains
       !> (Uk = U^-T m, diagonal sqrt(mu - |Uk|^2)) and y = U^-T 1 one entry.
       subroutine add_contact(pixel, joined)
          integer, intent(in) :: pixel, joined
-         integer :: ip, jp, kk
-         integer(i8) :: base
+         integer :: ip, jp, kk, stat
          real(dp) :: d2
+         real(dp), allocatable :: bigger(:, :)
          ip = (pixel - 1)/np + 1
          jp = pixel - (ip - 1)*np
+         if (n + 1 > ld) then
+            ! Grow the factor's storage by doubling (amortised O(n^2) copies).
+            allocate(bigger(min(2*ld, maxc), min(2*ld, maxc)), stat=stat)
+            if (stat /= 0) then
+               call set_error(status, STATUS_NUMERICAL, "incremental: cannot allocate the factor for "// &
+                  trim(i8str(int(min(2*ld, maxc), i8)))//" contacts ("// &
+                  trim(i8str(8*int(min(2*ld, maxc), i8)**2))//" bytes)")
+               return
+            end if
+            bigger(1:n, 1:n) = u(1:n, 1:n)
+            call move_alloc(bigger, u)
+            ld = size(u, 1)
+         end if
          do kk = 1, n
             col(kk) = c*table(abs(ip - ic(kk)), abs(jp - jc(kk)))
          end do
-         if (n > 0) call dtpsv("U", "T", "N", n, u, col, 1)
+         if (n > 0) call dtrsv("U", "T", "N", n, u, ld, col, 1)
          d2 = self - sum(col(1:n)**2)
          if (.not. d2 > epsilon(1.0_dp)*self) then
             call set_error(status, STATUS_NUMERICAL, "incremental: the contact compliance lost positive definiteness")
             return
          end if
-         base = int(n, i8)*int(n + 1, i8)/2
-         u(base + 1:base + n) = col(1:n)
-         u(base + n + 1) = sqrt(d2)
-         y(n + 1) = (1 - sum(col(1:n)*y(1:n)))/u(base + n + 1)
+         u(1:n, n + 1) = col(1:n)
+         u(n + 1, n + 1) = sqrt(d2)
+         y(n + 1) = (1 - sum(col(1:n)*y(1:n)))/u(n + 1, n + 1)
          n = n + 1
          ic(n) = ip
          jc(n) = jp
@@ -321,7 +328,7 @@ contains
       !> Remove contact k (its force is zero) and refactor the rest (LAPACK dpptrf).
       subroutine release_contact(krm)
          integer, intent(in) :: krm
-         integer :: a, b, pos
+         integer :: a, b
          ftot(krm) = 0
          slot(pix(krm)) = 0
          call heap_push(heap, phi, pix(krm))
@@ -334,21 +341,19 @@ contains
          do a = 1, n
             slot(pix(a)) = a
          end do
-         pos = 0
          do b = 1, n
             do a = 1, b
-               pos = pos + 1
-               u(pos) = c*table(abs(ic(a) - ic(b)), abs(jc(a) - jc(b)))
-               if (a == b) u(pos) = u(pos) + s
+               u(a, b) = c*table(abs(ic(a) - ic(b)), abs(jc(a) - jc(b)))
             end do
+            u(b, b) = u(b, b) + s
          end do
-         call dpptrf("U", n, u, info)
+         call dpotrf("U", n, u, ld, info)
          if (info /= 0) then
             call set_error(status, STATUS_NUMERICAL, "incremental: refactorisation after a release failed")
             return
          end if
          y(1:n) = 1
-         call dtpsv("U", "T", "N", n, u, y, 1)
+         call dtrsv("U", "T", "N", n, u, ld, y, 1)
          res%releases = res%releases + 1
       end subroutine release_contact
 
@@ -419,10 +424,10 @@ contains
             real(dp), allocatable :: w(:), fex(:)
             real(dp) :: aex
             w = g0(pix(1:n))
-            call dtpsv("U", "T", "N", n, u, w, 1)
-            call dtpsv("U", "N", "N", n, u, w, 1)
+            call dtrsv("U", "T", "N", n, u, ld, w, 1)
+            call dtrsv("U", "N", "N", n, u, ld, w, 1)
             x(1:n) = y(1:n)
-            call dtpsv("U", "N", "N", n, u, x, 1)
+            call dtrsv("U", "N", "N", n, u, ld, x, 1)
             aex = (total + sum(w))/sum(x(1:n))
             fex = aex*x(1:n) - w
             res%final_check_difference = max(abs(aex - approach)/max(abs(aex), tiny(1.0_dp)), &

@@ -4,7 +4,7 @@ module femcod_lapack
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf
+   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv
 
    interface
       pure subroutine dpotrf(uplo, n, a, lda, info)
@@ -61,6 +61,13 @@ module femcod_lapack
          real(dp), intent(in) :: ap(*)
          real(dp), intent(inout) :: x(*)
       end subroutine dtpsv
+      pure subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
+         import :: dp
+         character(len=1), intent(in) :: uplo, trans, diag
+         integer, intent(in) :: n, lda, incx
+         real(dp), intent(in) :: a(lda, *)
+         real(dp), intent(inout) :: x(*)
+      end subroutine dtrsv
       pure subroutine dpptrf(uplo, n, ap, info)
          import :: dp
          character(len=1), intent(in) :: uplo

@@ -16,6 +16,9 @@ module femcod_run
    private
    public :: run_command
 
+   !> Elapsed time (s) of the last progress line.
+   real(dp), save :: last_report = 0
+
 contains
 
    subroutine run_help()
@@ -53,7 +56,6 @@ contains
       character(len=:), allocatable :: deck_path, prefix, solver, key
       logical :: quiet, ok
       integer :: i, k
-      real(dp) :: last_report
       code = 0
       quiet = .false.
       deck_path = ""
@@ -165,17 +167,6 @@ contains
       end do
       if (.not. quiet) call print_summary()
    contains
-      !> A progress line on standard error at most every 5 s.
-      subroutine report_progress(step, contacts, load, elapsed)
-         integer, intent(in) :: step, contacts
-         real(dp), intent(in) :: load, elapsed
-         if (elapsed - last_report < 5) return
-         last_report = elapsed
-         write(error_unit, '(a)') "femcod: step "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
-            real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s"
-         flush(error_unit)
-      end subroutine report_progress
-
       subroutine usage(message)
          character(len=*), intent(in) :: message
          write(error_unit, '(a)') "femcod run: "//message//" (femcod run --help)"
@@ -197,6 +188,13 @@ contains
                real_str(res%step_load(last), 6)//" nN (where the next contact closes), approach "// &
                real_str(res%step_approach(last), 6)//" nm"
          end if
+         do k = 1, size(res%states)
+            if (.not. res%states(k)%reached) cycle
+            write(output_unit, '(a)') "  at load   : "//real_str(res%states(k)%load, 6)//" nN: approach "// &
+               real_str(res%states(k)%approach, 6)//" nm, "//int_str(res%states(k)%contacts)//" contacts ("// &
+               real_str(res%states(k)%contacts*deck%pixel**2, 4)//" nm^2), max pressure "// &
+               real_str(res%states(k)%max_pressure, 4)//" GPa"
+         end do
          write(output_unit, '(a)') "  wall time : "//real_str(res%wall_seconds, 3)//" s in total, "// &
             real_str(res%wall_seconds/max(last, 1), 3)//" s per step"
          if (solver == "incremental") then
@@ -219,6 +217,18 @@ contains
             merge(", "//prefix//".loads.csv", repeat(" ", len(prefix) + 12), size(res%states) > 0)
       end subroutine print_summary
    end subroutine run_command
+
+   !> A progress line on standard error at most every 5 s (a module procedure, not an
+   !> internal one, so that passing it needs no trampoline on the stack).
+   subroutine report_progress(step, contacts, load, elapsed)
+      integer, intent(in) :: step, contacts
+      real(dp), intent(in) :: load, elapsed
+      if (elapsed - last_report < 5) return
+      last_report = elapsed
+      write(error_unit, '(a)') "femcod: step "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
+         real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s"
+      flush(error_unit)
+   end subroutine report_progress
 
    !> The deck's file name without directory and without `.deck`.
    function default_prefix(path) result(prefix)

@@ -10,6 +10,7 @@ program tester
    use test_surfaces, only: collect_surfaces
    use test_boussinesq, only: collect_boussinesq
    use test_legacy, only: collect_legacy
+   use test_incremental, only: collect_incremental
    use femcod_exit, only: exit_program
    implicit none
    type(testsuite_type), allocatable :: suites(:)
@@ -22,7 +23,8 @@ program tester
       new_testsuite("sort", collect_sort), &
       new_testsuite("surfaces", collect_surfaces), &
       new_testsuite("boussinesq", collect_boussinesq), &
-      new_testsuite("legacy", collect_legacy) &
+      new_testsuite("legacy", collect_legacy), &
+      new_testsuite("incremental", collect_incremental) &
       ]
    stat = 0
    total = 0

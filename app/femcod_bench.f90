@@ -1,0 +1,199 @@
+!> `femcod bench`: speed against error, one table. Every number is measured in this run.
+module femcod_bench
+   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type
+   use femcod_deck, only: deck_type, read_deck, parse_integer
+   use femcod_generate, only: deck_spec, build_deck
+   use femcod_contact_result, only: contact_result, contact_options
+   use femcod_legacy, only: solve_legacy
+   use femcod_incremental, only: solve_incremental
+   use femcod_strings, only: string_type, int_str, real_str
+   implicit none
+   private
+   public :: bench_command
+
+   real(dp), parameter :: pi = acos(-1.0_dp)
+
+contains
+
+   subroutine bench_command(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      type(deck_type) :: rough, deck
+      type(deck_spec) :: spec
+      type(status_type) :: status
+      type(contact_result) :: inc, leg
+      type(contact_options) :: options
+      integer :: legacy_contacts, i, n, k
+      logical :: full, ok
+      real(dp) :: err, ref, peak
+      code = 0
+      legacy_contacts = 300
+      full = .false.
+      i = 1
+      do while (i <= size(args))
+         select case (args(i)%s)
+         case ("-h", "--help")
+            write(output_unit, '(a)') "usage: femcod bench [--full] [--legacy-contacts N]", &
+               "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
+               "event, peak memory (resident, per case), error against the reference. The rough surface is", &
+               "the one of issue 4: self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa,", &
+               "nu = 0.25, against a rigid flat (seed 1). --full adds the run to 5 % contact (minutes).", &
+               "--legacy-contacts N (default 300): how far the legacy solver runs on that surface.", &
+               "Run it with the release build: fpm run --profile release -- bench"
+            return
+         case ("--full")
+            full = .true.
+         case ("--legacy-contacts")
+            if (i < size(args)) then
+               call parse_integer(args(i + 1)%s, legacy_contacts, ok)
+               i = i + 1
+            end if
+         case default
+            write(error_unit, '(a)') "femcod bench: unknown argument "//args(i)%s
+            code = 2
+            return
+         end select
+         i = i + 1
+      end do
+
+      spec%kind = "self-affine"
+      spec%np = 512
+      spec%pixel = 5000.0_dp/512
+      spec%hurst = 0.8_dp
+      spec%rms = 3
+      spec%seed = 1
+      spec%shape_on = "lower"
+      spec%rigid = "upper"
+      spec%label = "bench"
+      spec%matrix_file = ""
+      spec%maxcont = 512*512/20
+      call build_deck(spec, rough, status)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench: "//status%message
+         code = status%code
+         return
+      end if
+
+      write(output_unit, '(a)') "| problem | NP | contacts | solver | wall (s) | per event (ms) | peak RSS (MB) "// &
+         "| error | reference |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|"
+
+      ! Rough surface: incremental against legacy over the first contacts. The legacy
+      ! candidate list (Appendix B) can miss a contact and take it late; the comparison
+      ! counts the events that agree before the first such difference.
+      options%max_contacts = legacy_contacts
+      allocate(options%loads(0))
+      call reset_peak()
+      call solve_incremental(rough, options, inc, status)
+      peak = peak_mb()
+      call reset_peak()
+      call solve_legacy(rough, options, leg, status)
+      n = 0
+      err = 0
+      do k = 1, min(inc%nsteps, leg%nsteps)
+         if (inc%step_contacts(k) /= leg%step_contacts(k)) exit
+         n = k
+         if (k > 1) err = max(err, abs(inc%step_load(k) - leg%step_load(k))/leg%step_load(k))
+      end do
+      call row("self-affine 5 um", 512, inc, "incremental", err, "legacy: first "//int_str(n)// &
+         " events equal (max rel. load diff.); legacy took "//int_str(leg%missed_during_run)// &
+         " contacts late, its final check found "//int_str(leg%missed_final_check), peak)
+      call row("self-affine 5 um", 512, leg, "legacy", err, "incremental, as above", peak_mb())
+
+      do k = 1, merge(2, 1, full)
+         options%max_contacts = 2621*merge(1, 5, k == 1)
+         call reset_peak()
+         call solve_incremental(rough, options, inc, status)
+         call row("self-affine 5 um, to "//int_str(merge(1, 5, k == 1))//" %", 512, inc, "incremental", &
+            max(inc%final_check_difference, inc%max_penetration), "fresh solve of the final active set", peak_mb())
+      end do
+
+      ! Verification decks against their analytic or thesis values.
+      deallocate(options%loads)
+      options%max_contacts = 0
+      call verification_row("circle_punch_d9", 1.0_dp, 0.911e-3_dp, "Table 4.1 approach 0.911e-3 nm")
+      call verification_row("square_punch_n27", 1.0_dp, 0.412e-3_dp, "Table 4.2 approach 0.412e-3 nm")
+      call verification_row("sphere_d05", 18000.0_dp, segedin(18000.0_dp), "Segedin approach at 18000 nN")
+   contains
+      subroutine verification_row(name, load, reference, what)
+         character(len=*), intent(in) :: name, what
+         real(dp), intent(in) :: load, reference
+         call read_deck("input/"//name//".deck", deck, status)
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod bench: "//status%message//" (run from the package root)"
+            return
+         end if
+         options%loads = [load]
+         call reset_peak()
+         call solve_incremental(deck, options, inc, status)
+         call row(name, deck%np, inc, "incremental", abs(inc%states(1)%approach/reference - 1), what, peak_mb())
+         call reset_peak()
+         call solve_legacy(deck, options, leg, status)
+         call row(name, deck%np, leg, "legacy", abs(leg%states(1)%approach/reference - 1), what, peak_mb())
+      end subroutine verification_row
+   end subroutine bench_command
+
+   subroutine row(problem, np, res, solver, error, reference, peak)
+      character(len=*), intent(in) :: problem, solver, reference
+      integer, intent(in) :: np
+      type(contact_result), intent(in) :: res
+      real(dp), intent(in) :: error, peak
+      integer :: contacts
+      contacts = size(res%contact_i)
+      write(output_unit, '(a)') "| "//problem//" | "//int_str(np)//" | "//int_str(contacts)//" | "//solver//" | "// &
+         real_str(res%wall_seconds, 3)//" | "//real_str(1000*res%wall_seconds/max(res%nsteps, 1), 3)//" | "// &
+         real_str(peak, 3)//" | "//real_str(error, 2)//" | "//reference//" |"
+      flush(output_unit)
+   end subroutine row
+
+   !> Segedin's rigid sphere R = 15 nm on E = 200 GPa, nu = 0.25: approach at load f.
+   real(dp) function segedin(f)
+      real(dp), intent(in) :: f
+      real(dp) :: estar, r, a, lo, hi
+      integer :: it
+      estar = 200/(1 - 0.25_dp**2)
+      r = 15
+      lo = 0
+      hi = r*(1 - 1.0e-12_dp)
+      do it = 1, 200
+         a = (lo + hi)/2
+         if (estar/2*((a*a + r*r)*log((r + a)/(r - a)) - 2*a*r) < f) then
+            lo = a
+         else
+            hi = a
+         end if
+      end do
+      segedin = a/2*log((r + a)/(r - a))
+   end function segedin
+
+   !> Reset the kernel's peak-RSS counter of this process (Linux /proc/self/clear_refs).
+   subroutine reset_peak()
+      integer :: unit, ios
+      open(newunit=unit, file="/proc/self/clear_refs", action="write", iostat=ios)
+      if (ios == 0) then
+         write(unit, '(a)', iostat=ios) "5"
+         close(unit, iostat=ios)
+      end if
+   end subroutine reset_peak
+
+   !> Peak resident memory (MB) since the last reset, from /proc/self/status (VmHWM).
+   real(dp) function peak_mb()
+      integer :: unit, ios, kb
+      character(len=256) :: line
+      peak_mb = -1
+      open(newunit=unit, file="/proc/self/status", action="read", iostat=ios)
+      if (ios /= 0) return
+      do
+         read(unit, '(a)', iostat=ios) line
+         if (ios /= 0) exit
+         if (line(1:6) == "VmHWM:") then
+            read(line(7:), *, iostat=ios) kb
+            if (ios == 0) peak_mb = kb/1024.0_dp
+            exit
+         end if
+      end do
+      close(unit)
+   end function peak_mb
+end module femcod_bench
