@@ -91,11 +91,10 @@ contains
       pc_thesis_three = convergence_rate(0.955_dp, 0.920_dp, 0.911_dp, 3.0_dp)
       write(u, '(a)') "", "Analytic displacement (eq. 4.10) with the radius of the discretised area, R = sqrt(21/pi) = "// &
          fmt(rc, 5)//" nm: "//fmt(delta0*1e3_dp, 5)//"e-3 nm (the thesis quotes 0.907e-3).", "", &
-         "Richardson rate for the circle, the thesis' 1.15 for displacements: from the two coarsest meshes and", &
-         "the analytic limit femcod gives "//fmt(pc_known, 3)//"; from three meshes femcod gives "// &
-         fmt(pc_three, 3)//", while the thesis' own rounded table gives "//fmt(pc_thesis_three, 3)// &
-         ". The thesis' 1.15 is reproduced only", "with the analytic limit; from three meshes its rounded values give "// &
-         fmt(pc_thesis_three, 3)//" (rounding to three digits moves this rate by several percent).", ""
+         "Richardson rate for the circle (the thesis gives 1.15 for displacements): with the analytic", &
+         "limit and the two coarsest meshes femcod gives "//fmt(pc_known, 3)//", which reproduces it. From three", &
+         "meshes femcod gives "//fmt(pc_three, 3)//"; the thesis' own rounded table gives "//fmt(pc_thesis_three, 3)// &
+         " the same way, because rounding", "to three digits moves a three-mesh rate by several percent.", ""
 
       write(u, '(a)') "## Table 4.2: rigid square punch (10 nm) in a 30 nm region, 1 nN", "", &
          "| NP | pixels | approach thesis (1e-3 nm) | femcod | diff | centre/mean thesis | femcod | diff |", &
@@ -132,7 +131,7 @@ contains
       call power_law_fit(load, area, expo, pref)
       write(u, '(a)') "", "Segedin: F = E*/2 [(a^2+R^2) ln((R+a)/(R-a)) - 2aR], delta = (a/2) ln((R+a)/(R-a)); at 18000 nN", &
          "the contact radius is a = "//fmt(aseg, 4)//" nm. Run: "//int_str(res%nsteps)//" steps, "// &
-         int_str(res%step_contacts(res%nsteps))//" contacts, "//fmt(res%wall_seconds, 3)//" s.", "", &
+         int_str(res%step_contacts(res%nsteps))//" contacts, "//secs(res%wall_seconds)//".", "", &
          "Power-law fit A = c F^m over every step of this run (0 to 18000 nN): m = "//fmt(expo, 4)// &
          ". The thesis reports 0.68 for", "its fit 'in the full range shown'; the exponent depends on the fitted range and on", &
          "how the staircase of Fig. 4.16b is sampled (femcod fits every step end), so 0.68 is not reproduced", &
@@ -158,9 +157,9 @@ contains
       end do
       write(u, '(a)') "", "## Summary", "", &
          "Largest relative difference from the 14 values of Tables 4.1 and 4.2: "//pct(1 + worst, 1.0_dp)//".", &
-         "Wall time of the legacy solver (release build): circle "//fmt(wcirc(1), 2)//", "//fmt(wcirc(2), 2)//", "// &
-         fmt(wcirc(3), 2)//" s; square "//fmt(wall(1), 2)//", "//fmt(wall(2), 2)//", "//fmt(wall(3), 2)//", "// &
-         fmt(wall(4), 2)//" s."
+         "Wall time of the legacy solver: circle "//secs(wcirc(1))//", "//secs(wcirc(2))//", "// &
+         secs(wcirc(3))//"; square "//secs(wall(1))//", "//secs(wall(2))//", "//secs(wall(3))//", "// &
+         secs(wall(4))//"."
       close(u, iostat=ios)
       if (ios /= 0) then
          call remove_file(tmp)
@@ -237,6 +236,15 @@ contains
       write(buf, f) x
       s = trim(adjustl(buf))
    end function fmt
+
+   !> Seconds in es form.
+   function secs(t) result(s)
+      real(dp), intent(in) :: t
+      character(len=:), allocatable :: s
+      character(len=20) :: buf
+      write(buf, '(es10.2e2)') t
+      s = trim(adjustl(buf))//" s"
+   end function secs
 
    !> Relative difference in percent, signed.
    function pct(value, reference) result(s)
