@@ -9,11 +9,11 @@ module femcod_bench
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental
    use femcod_strings, only: string_type, int_str, real_str
+   use femcod_analytic, only: segedin_sphere
    implicit none
    private
    public :: bench_command
 
-   real(dp), parameter :: pi = acos(-1.0_dp)
 
 contains
 
@@ -156,21 +156,8 @@ contains
    !> Segedin's rigid sphere R = 15 nm on E = 200 GPa, nu = 0.25: approach at load f.
    real(dp) function segedin(f)
       real(dp), intent(in) :: f
-      real(dp) :: estar, r, a, lo, hi
-      integer :: it
-      estar = 200/(1 - 0.25_dp**2)
-      r = 15
-      lo = 0
-      hi = r*(1 - 1.0e-12_dp)
-      do it = 1, 200
-         a = (lo + hi)/2
-         if (estar/2*((a*a + r*r)*log((r + a)/(r - a)) - 2*a*r) < f) then
-            lo = a
-         else
-            hi = a
-         end if
-      end do
-      segedin = a/2*log((r + a)/(r - a))
+      real(dp) :: a
+      call segedin_sphere(f, 15.0_dp, 200/(1 - 0.25_dp**2), a, segedin)
    end function segedin
 
    !> Reset the kernel's peak-RSS counter of this process (Linux /proc/self/clear_refs).

@@ -173,7 +173,8 @@ contains
          "  -o FILE               output deck (written atomically)", &
          "  --np N                pixels per side (not for matrix)", &
          "  --pixel D             pixel size in nm", &
-         "  --maxcont M           maximum contacts (default: punch pixels for punches, else NP^2)", &
+         "  --maxcont M           maximum contacts (default: the punch pixels for punches, NP^2 for flat,", &
+         "                        else 5 % of NP^2)", &
          "  --young E --poisson NU  the elastic body (default 200 GPa, 0.25)", &
          "  --shape-on upper|lower  surface that carries the shape (default upper)", &
          "  --rigid upper|lower|none  rigid body (default upper)", &

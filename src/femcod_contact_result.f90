@@ -5,7 +5,7 @@ module femcod_contact_result
    implicit none
    private
    public :: contact_result, load_state, contact_options, append_step, progress_interface
-   public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text
+   public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text, record_load_states, finish_contacts
 
    integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3
 
@@ -107,6 +107,48 @@ contains
       res%step_approach(res%nsteps) = approach
       res%step_seconds(res%nsteps) = seconds
    end subroutine append_step
+
+   !> Record the states at the requested loads that fall inside the current step, which
+   !> starts at `total` and ends `lam` later (`bounded` false: the step never ends).
+   !> Within a step the response is linear, so the interpolation is exact. At the largest
+   !> requested load the contact forces are kept for the contacts file.
+   pure subroutine record_load_states(res, lam, bounded, total, approach, delta, ftot, funit, pixel, hardness)
+      type(contact_result), intent(inout) :: res
+      real(dp), intent(in) :: lam, total, approach, delta, ftot(:), funit(:), pixel, hardness
+      logical, intent(in) :: bounded
+      integer :: s
+      real(dp) :: dl
+      real(dp), allocatable :: f(:)
+      do s = 1, size(res%states)
+         if (res%states(s)%reached) cycle
+         if (bounded .and. res%states(s)%load > total + lam) cycle
+         dl = max(res%states(s)%load - total, 0.0_dp)
+         f = ftot + dl*funit
+         res%states(s)%approach = approach + dl*delta
+         res%states(s)%contacts = size(ftot)
+         res%states(s)%max_pressure = maxval(f)/pixel**2
+         res%states(s)%n_above_hardness = count(f/pixel**2 > hardness)
+         res%states(s)%reached = .true.
+         if (res%states(s)%load == maxval(res%states%load)) then
+            res%contact_force = f
+            res%reported_load = res%states(s)%load
+         end if
+      end do
+   end subroutine record_load_states
+
+   !> Store the contact pixels; the forces at the end when no requested load set them.
+   pure subroutine finish_contacts(res, ic, jc, cstep, ftot, total)
+      type(contact_result), intent(inout) :: res
+      integer, intent(in) :: ic(:), jc(:), cstep(:)
+      real(dp), intent(in) :: ftot(:), total
+      if (.not. allocated(res%contact_force)) then
+         res%contact_force = ftot
+         res%reported_load = total
+      end if
+      res%contact_i = ic
+      res%contact_j = jc
+      res%contact_step = cstep
+   end subroutine finish_contacts
 
    pure function stop_reason_text(reason) result(text)
       integer, intent(in) :: reason

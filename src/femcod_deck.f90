@@ -17,6 +17,7 @@ module femcod_deck
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, path_is_directory
+   use femcod_strings, only: int_str
    implicit none
    private
    public :: deck_type, read_deck, write_deck, validate_deck, format_real, parse_real, parse_integer
@@ -406,14 +407,6 @@ contains
       character(len=1), intent(in) :: c
       is_digit = c >= "0" .and. c <= "9"
    end function is_digit
-
-   pure function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=12) :: buf
-      write(buf, '(i0)') i
-      s = trim(buf)
-   end function int_str
 
    !> Read a whole file as bytes.
    subroutine read_whole_file(path, text, status)

@@ -11,6 +11,7 @@ module femcod_generate
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
    use femcod_deck, only: deck_type, parse_real, validate_deck, format_real
    use femcod_files, only: path_exists, path_is_directory
+   use femcod_strings, only: int_str
    use femcod_surfaces, only: circle_punch, square_punch, sphere_cap, sinusoid_surface, weierstrass_mandelbrot, &
       self_affine_surface, remove_plane
    implicit none
@@ -49,8 +50,8 @@ module femcod_generate
 
 contains
 
-   !> Build a deck from a spec. MAXCONT 0 means "all pixels of the shape that can
-   !> touch": the punch pixels for punches, NP**2 otherwise.
+   !> Build a deck from a spec. MAXCONT 0 means a default: the punch pixels for
+   !> punches, NP**2 for a flat, 5 % of NP**2 otherwise.
    subroutine build_deck(spec, deck, status)
       type(deck_spec), intent(in) :: spec
       type(deck_type), intent(out) :: deck
@@ -117,8 +118,12 @@ contains
          deck%maxcont = spec%maxcont
       else if (npunch > 0) then
          deck%maxcont = npunch
-      else
+      else if (spec%kind == "flat") then
          deck%maxcont = np*np
+      else
+         ! 5 % of the pixels: rough contacts rarely go further, and the legacy solver's
+         ! skyline grows as MAXCONT**2.
+         deck%maxcont = max(1, np*np/20)
       end if
       deck%young = spec%young
       deck%poisson = spec%poisson
@@ -178,16 +183,16 @@ contains
          spec%pixel = 1.0_dp/m
          spec%radius = 2.5_dp
          spec%area = 21
-         spec%label = "circular rigid punch R=2.5 nm, 21 nm^2, d=1/"//trim(itoa(m))//" nm, NP="// &
-            trim(itoa(11*m))//", E=200 GPa nu=0.25 half-space: thesis Table 4.1, Fig. 4.10"
+         spec%label = "circular rigid punch R=2.5 nm, 21 nm^2, d=1/"//int_str(m)//" nm, NP="// &
+            int_str(11*m)//", E=200 GPa nu=0.25 half-space: thesis Table 4.1, Fig. 4.10"
       case ("square_punch_n1", "square_punch_n3", "square_punch_n9", "square_punch_n27")
          ! Table 4.2: 10 nm square punch in a 30 nm region, NP = 3, 9, 27, 81.
          read(name(15:), *) m
          spec%kind = "square-punch"
          spec%np = 3*m
          spec%pixel = 30.0_dp/(3*m)
-         spec%label = "square rigid punch 10 nm in a 30 nm region, "//trim(itoa(m*m))//" punch pixels, NP="// &
-            trim(itoa(3*m))//", E=200 GPa nu=0.25 half-space: thesis Table 4.2, Fig. 4.12"
+         spec%label = "square rigid punch 10 nm in a 30 nm region, "//int_str(m*m)//" punch pixels, NP="// &
+            int_str(3*m)//", E=200 GPa nu=0.25 half-space: thesis Table 4.2, Fig. 4.12"
       case ("sphere_d4", "sphere_d2", "sphere_d1", "sphere_d05")
          ! Figs. 4.14-4.16: rigid sphere R = 15 nm, 30 nm region, pixels 4, 2, 1, 0.5 nm.
          select case (name)
@@ -207,7 +212,7 @@ contains
          ! 9.3 nm at the thesis' largest load, 18000 nN).
          spec%maxcont = pixels_within(spec%np, spec%pixel, 10.0_dp)
          spec%label = "rigid sphere R=15 nm, 30 nm region, d="//format_real(spec%pixel)//" nm, NP="// &
-            trim(itoa(spec%np))//", E=200 GPa nu=0.25 half-space: thesis Figs. 4.14-4.16 (Hertz)"
+            int_str(spec%np)//", E=200 GPa nu=0.25 half-space: thesis Figs. 4.14-4.16 (Hertz)"
       case ("rough_selfaffine_32")
          spec%kind = "self-affine"
          spec%np = 32
@@ -223,12 +228,6 @@ contains
       case default
          call set_error(status, STATUS_BAD_INPUT, "mkdeck: unknown verification deck '"//name//"'")
       end select
-   contains
-      function itoa(i) result(s)
-         integer, intent(in) :: i
-         character(len=12) :: s
-         write(s, '(i0)') i
-      end function itoa
    end subroutine verification_spec
 
    !> Pixels whose centres lie within `radius` of the grid centre.
@@ -278,7 +277,7 @@ contains
          if (adjustl(line(1:1)) == "#" .or. line(1:1) == "#") cycle
          call split_reals(line, row, ok)
          if (.not. ok) then
-            call set_error(status, STATUS_BAD_INPUT, path//":"//trim(itoa(lineno))// &
+            call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(lineno)// &
                ": expected a row of finite numbers (nm), found '"//line(1:min(len(line), 40))//"'")
             close(unit)
             return
@@ -289,15 +288,15 @@ contains
             allocate(rows(ncol, ncol))
          end if
          if (size(row) /= ncol) then
-            call set_error(status, STATUS_BAD_INPUT, path//":"//trim(itoa(lineno))//": expected "// &
-               trim(itoa(ncol))//" values as in the first row, found "//trim(itoa(size(row))))
+            call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(lineno)//": expected "// &
+               int_str(ncol)//" values as in the first row, found "//(int_str(size(row))))
             close(unit)
             return
          end if
          nrow = nrow + 1
          if (nrow > ncol) then
-            call set_error(status, STATUS_BAD_INPUT, path//":"//trim(itoa(lineno))// &
-               ": expected a square matrix of "//trim(itoa(ncol))//" rows, found more rows")
+            call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(lineno)// &
+               ": expected a square matrix of "//int_str(ncol)//" rows, found more rows")
             close(unit)
             return
          end if
@@ -306,16 +305,10 @@ contains
       close(unit)
       if (nrow == 0 .or. nrow /= ncol) then
          call set_error(status, STATUS_BAD_INPUT, path//": expected a square matrix of heights, found "// &
-            trim(itoa(nrow))//" rows of "//trim(itoa(ncol))//" values")
+            int_str(nrow)//" rows of "//int_str(ncol)//" values")
          return
       end if
       z = transpose(rows)
-   contains
-      function itoa(i) result(s)
-         integer, intent(in) :: i
-         character(len=12) :: s
-         write(s, '(i0)') i
-      end function itoa
    end subroutine read_ascii_matrix
 
    !> Read one line of any length.

@@ -29,7 +29,8 @@ module femcod_incremental
    use femcod_heap, only: min_heap, heap_build, heap_push, heap_pop, heap_top_key
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, &
-      STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT
+      STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, record_load_states, finish_contacts
+   use femcod_clock, only: wall_clock
    implicit none
    private
    public :: solve_incremental, scene_report
@@ -196,7 +197,8 @@ contains
 
          if (lam_best >= huge(1.0_dp)) then
             ! Nothing can close and nothing is released: linear for ever.
-            call record_states(huge(1.0_dp), .true.)
+            call record_load_states(res, huge(1.0_dp), .false., total, approach, delta, ftot(1:n), funit(1:n), &
+               deck%pixel, options%hardness)
             res%stop_reason = STOP_NO_CONTACT
             if (size(loads) > 0) then
                if (max_load > total) call advance(max_load - total)
@@ -206,7 +208,8 @@ contains
             exit
          end if
          lam_best = max(lam_best, 0.0_dp)
-         call record_states(lam_best, .false.)
+         call record_load_states(res, lam_best, .true., total, approach, delta, ftot(1:n), funit(1:n), &
+            deck%pixel, options%hardness)
          call advance(lam_best)
          call wall_clock(t1)
          call append_step(res, n, total, approach, t1 - t0)
@@ -241,13 +244,7 @@ contains
 
       if (options%final_check) call final_check()
       if (status%code /= 0) return
-      if (.not. allocated(res%contact_force)) then
-         res%contact_force = ftot(1:n)
-         res%reported_load = total
-      end if
-      res%contact_i = ic(1:n)
-      res%contact_j = jc(1:n)
-      res%contact_step = cstep(1:n)
+      call finish_contacts(res, ic(1:n), jc(1:n), cstep(1:n), ftot(1:n), total)
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
 
@@ -365,29 +362,6 @@ contains
          phi = phi + lam*delta_max
       end subroutine advance
 
-      subroutine record_states(lam, unbounded)
-         real(dp), intent(in) :: lam
-         logical, intent(in) :: unbounded
-         integer :: st
-         real(dp) :: dl
-         real(dp), allocatable :: f(:)
-         do st = 1, size(res%states)
-            if (res%states(st)%reached) cycle
-            if (.not. unbounded .and. res%states(st)%load > total + lam) cycle
-            dl = max(res%states(st)%load - total, 0.0_dp)
-            f = ftot(1:n) + dl*funit(1:n)
-            res%states(st)%approach = approach + dl*delta
-            res%states(st)%contacts = n
-            res%states(st)%max_pressure = maxval(f)/deck%pixel**2
-            res%states(st)%n_above_hardness = count(f/deck%pixel**2 > options%hardness)
-            res%states(st)%reached = .true.
-            if (res%states(st)%load == max_load) then
-               res%contact_force = f
-               res%reported_load = res%states(st)%load
-            end if
-         end do
-      end subroutine record_states
-
       !> Full-field check by FFT convolution: no pixel may penetrate, no force be tensile.
       subroutine final_check()
          type(love_convolution) :: conv
@@ -442,10 +416,4 @@ contains
       write(str, '(i0)') v
    end function i8str
 
-   subroutine wall_clock(t)
-      real(dp), intent(out) :: t
-      integer(i8) :: count, rate
-      call system_clock(count, rate)
-      t = real(count, dp)/real(rate, dp)
-   end subroutine wall_clock
 end module femcod_incremental

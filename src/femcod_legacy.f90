@@ -24,8 +24,9 @@ module femcod_legacy
    use femcod_trfact, only: trfact, TRFACT_FACTOR, TRFACT_SOLVE
    use femcod_postp, only: candidate_count, postp_search
    use femcod_condensed, only: solve_active_set, gap_at
-   use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, STOP_MAXCONT, STOP_LOADS, &
-      STOP_NO_CONTACT
+   use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, STOP_MAXCONT, &
+      STOP_LOADS, STOP_NO_CONTACT, record_load_states, finish_contacts
+   use femcod_clock, only: wall_clock
    implicit none
    private
    public :: solve_legacy, legacy_unit_solution
@@ -113,7 +114,8 @@ contains
                njoin, nmissed, ws%ra(igaps:igaps + npix - 1))
          end if
          res%missed_during_run = res%missed_during_run + nmissed
-         call record_states(lambda)
+         call record_load_states(res, lambda, njoin > 0, total, approach, delta, ftot(1:n), funit(1:n), deck%pixel, &
+            options%hardness)
          if (njoin == 0) then
             res%stop_reason = STOP_NO_CONTACT
             if (size(loads) > 0) then
@@ -148,13 +150,7 @@ contains
       if (options%final_check) call final_check()
       if (status%code /= 0) return
 
-      if (.not. allocated(res%contact_force)) then
-         res%contact_force = ftot(1:n)
-         res%reported_load = total
-      end if
-      res%contact_i = ic(1:n)
-      res%contact_j = jc(1:n)
-      res%contact_step = cstep(1:n)
+      call finish_contacts(res, ic(1:n), jc(1:n), cstep(1:n), ftot(1:n), total)
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
 
@@ -176,31 +172,6 @@ contains
          approach = approach + lam*delta
          ftot(1:n) = ftot(1:n) + lam*funit(1:n)
       end subroutine advance
-
-      !> States at the requested loads that fall inside this step (within the step the
-      !> response is linear, so interpolation is exact).
-      subroutine record_states(lam)
-         real(dp), intent(in) :: lam
-         integer :: s
-         real(dp) :: dl
-         real(dp), allocatable :: f(:)
-         do s = 1, size(res%states)
-            if (res%states(s)%reached) cycle
-            if (res%states(s)%load > total + lam .and. njoin > 0) cycle
-            dl = res%states(s)%load - total
-            if (dl < 0) dl = 0
-            f = ftot(1:n) + dl*funit(1:n)
-            res%states(s)%approach = approach + dl*delta
-            res%states(s)%contacts = n
-            res%states(s)%max_pressure = maxval(f)/deck%pixel**2
-            res%states(s)%n_above_hardness = count(f/deck%pixel**2 > options%hardness)
-            res%states(s)%reached = .true.
-            if (res%states(s)%load == max_load) then
-               res%contact_force = f
-               res%reported_load = res%states(s)%load
-            end if
-         end do
-      end subroutine record_states
 
       !> Appendix B's final check over all pixels: any penetration is a missed contact;
       !> it is added and the state at the final load recomputed exactly. Without missed
@@ -347,11 +318,4 @@ contains
       end do
    end subroutine legacy_unit_solution
 
-   !> Wall-clock seconds.
-   subroutine wall_clock(t)
-      real(dp), intent(out) :: t
-      integer(i8) :: count, rate
-      call system_clock(count, rate)
-      t = real(count, dp)/real(rate, dp)
-   end subroutine wall_clock
 end module femcod_legacy

@@ -11,6 +11,7 @@ module femcod_verification
    use femcod_boussinesq, only: love_influence, love_influence_exact, love_influence_far, surface_compliance
    use femcod_richardson, only: convergence_rate, convergence_rate_known_limit, richardson_extrapolate, power_law_fit
    use femcod_files, only: atomic_rename, remove_file, temporary_name
+   use femcod_analytic, only: hertz_approach, segedin_sphere, flat_punch_approach
    implicit none
    private
    public :: write_verification_report
@@ -85,7 +86,7 @@ contains
       end do
       ! Analytic punch (eq. 4.10) with the radius of the discretised area, 21 nm^2.
       rc = sqrt(21/pi)
-      delta0 = (1 - 0.25_dp**2)/(2*rc*200)
+      delta0 = flat_punch_approach(1.0_dp, rc, 200.0_dp, 0.25_dp)
       pc_known = convergence_rate_known_limit(acirc(1), acirc(2), delta0, 3.0_dp)
       pc_three = convergence_rate(acirc(1), acirc(2), acirc(3), 3.0_dp)
       pc_thesis_three = convergence_rate(0.955_dp, 0.920_dp, 0.911_dp, 3.0_dp)
@@ -117,8 +118,8 @@ contains
          "| Borodachev's approximate solution | 0.400 / 0.456 | (an approximation, not the limit of this model) |", ""
 
       estar = 200/(1 - 0.25_dp**2)
-      hertz = (9*1000.0_dp**2/(16*15*estar**2))**(1.0_dp/3)
-      call segedin_approach(18000.0_dp, 15.0_dp, estar, aseg, segedin)
+      hertz = hertz_approach(1000.0_dp, 15.0_dp, estar)
+      call segedin_sphere(18000.0_dp, 15.0_dp, estar, aseg, segedin)
       write(u, '(a)') "## Section 4.4.3: rigid sphere R = 15 nm, 0.5 nm pixels (input/sphere_d05.deck)", "", &
          "| check | reference | femcod | diff |", "|---|---|---|---|", &
          "| approach at 1000 nN, Hertz eq. 4.14 (nm) | "//fmt(hertz, 5)//" | "//fmt(t(1), 5)//" | "// &
@@ -201,25 +202,6 @@ contains
          end do
       end function crossing
    end subroutine write_verification_report
-
-   !> Segedin's rigid sphere: contact radius and approach at load `f` (bisection).
-   subroutine segedin_approach(f, r, estar, a, delta)
-      real(dp), intent(in) :: f, r, estar
-      real(dp), intent(out) :: a, delta
-      real(dp) :: lo, hi
-      integer :: it
-      lo = 0
-      hi = r*(1 - 1.0e-12_dp)
-      do it = 1, 200
-         a = (lo + hi)/2
-         if (estar/2*((a*a + r*r)*log((r + a)/(r - a)) - 2*a*r) < f) then
-            lo = a
-         else
-            hi = a
-         end if
-      end do
-      delta = a/2*log((r + a)/(r - a))
-   end subroutine segedin_approach
 
    !> A number with `digits` significant digits.
    function fmt(x, digits) result(s)
