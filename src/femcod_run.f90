@@ -18,6 +18,11 @@ module femcod_run
 
    !> Elapsed time (s) of the last progress line.
    real(dp), save :: last_report = 0
+   !> What the run aims at, for the estimate of the time left: contacts, the largest
+   !> requested load (nN, 0 if none) and how the cost of a run grows with the contacts
+   !> (n^3 for the incremental solver, n^4 for the legacy one).
+   integer, save :: target_contacts = 0
+   real(dp), save :: target_load = 0, growth = 3
 
 contains
 
@@ -139,6 +144,11 @@ contains
 
       call read_deck(deck_path, deck, status)
       last_report = 0
+      target_contacts = deck%maxcont
+      if (options%max_contacts > 0) target_contacts = min(target_contacts, options%max_contacts)
+      target_load = 0
+      if (size(options%loads) > 0) target_load = maxval(options%loads)
+      growth = merge(4.0_dp, 3.0_dp, solver == "legacy")
       if (status%code == 0) then
          select case (solver)
          case ("legacy")
@@ -223,10 +233,21 @@ contains
    subroutine report_progress(step, contacts, load, elapsed)
       integer, intent(in) :: step, contacts
       real(dp), intent(in) :: load, elapsed
+      real(dp) :: fraction, left
+      character(len=:), allocatable :: estimate
       if (elapsed - last_report < 5) return
       last_report = elapsed
-      write(error_unit, '(a)') "femcod: step "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
-         real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s"
+      ! Time left from the cost model: a run to n contacts costs ~ n**growth; with a
+      ! load target, the fraction of the load reached bounds the fraction of contacts.
+      fraction = real(contacts, dp)/max(target_contacts, 1)
+      if (target_load > 0) fraction = max(fraction, min(load/target_load, 1.0_dp))
+      estimate = ""
+      if (fraction > 0 .and. fraction < 1) then
+         left = elapsed*(fraction**(-growth) - 1)
+         estimate = ", about "//real_str(left, 2)//" s left (cost ~ contacts^"//int_str(nint(growth))//")"
+      end if
+      write(error_unit, '(a)') "femcod: event "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
+         real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s elapsed"//estimate
       flush(error_unit)
    end subroutine report_progress
 
