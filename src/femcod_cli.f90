@@ -6,7 +6,7 @@ module femcod_cli
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, STATUS_USAGE, STATUS_BAD_INPUT
    use femcod_deck, only: deck_type, write_deck, parse_real, parse_integer, format_real
-   use femcod_workspace, only: workspace_type, workspace_layout, N_REAL_BLOCKS, N_INT_BLOCKS
+   use femcod_workspace, only: workspace_type, workspace_layout, workspace_table
    use femcod_generate, only: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, KINDS
    use femcod_run, only: run_command
    use femcod_verification, only: write_verification_report
@@ -97,6 +97,7 @@ contains
       type(status_type) :: status
       integer :: np, maxcont, k
       logical :: ok1, ok2
+      character(len=120), allocatable :: lines(:)
       code = 0
       if (size(args) >= 1) then
          if (args(1)%s == "--help" .or. args(1)%s == "-h") then
@@ -125,25 +126,10 @@ contains
          code = status%code
          return
       end if
-      write(output_unit, '(a,i0,a,i0,a,i0)') "# femcod workspace: NP = ", np, ", MAXCONT = ", maxcont, &
-         ", MAXNODE = ", ws%maxnode
-      write(output_unit, '(a)') "# integer array (Table B.2)"
-      write(output_unit, '(a8,2a14,2x,a)') "block", "first", "words", "holds"
-      do k = 1, N_INT_BLOCKS
-         write(output_unit, '(a8,2i14,2x,a)') ws%int_blocks(k)%name, ws%int_blocks(k)%first, &
-            ws%int_blocks(k)%size, trim(ws%int_blocks(k)%holds)
+      lines = workspace_table(ws)
+      do k = 1, size(lines)
+         write(output_unit, '(a)') trim(lines(k))
       end do
-      write(output_unit, '(a8,i14,14x,2x,a)') "IPEND   ", ws%ipend, "last address in use = integer words"
-      write(output_unit, '(a)') "# real array (Table B.1)"
-      write(output_unit, '(a8,2a14,2x,a)') "block", "first", "words", "holds"
-      do k = 1, N_REAL_BLOCKS
-         write(output_unit, '(a8,2i14,2x,a)') ws%real_blocks(k)%name, ws%real_blocks(k)%first, &
-            ws%real_blocks(k)%size, trim(ws%real_blocks(k)%holds)
-      end do
-      write(output_unit, '(a8,i14,14x,2x,a)') "MPEND   ", ws%mpend, "last address in use = real words"
-      write(output_unit, '(a,i0,a,i0,a)') "total integer: ", ws%ipend, " words, ", 4*ws%ipend, " bytes"
-      write(output_unit, '(a,i0,a,i0,a)') "total real: ", ws%mpend, " words, ", 8*ws%mpend, " bytes"
-      write(output_unit, '(a,i0,a)') "total: ", 4*ws%ipend + 8*ws%mpend, " bytes"
    end subroutine workspace_command
 
    subroutine mkdeck_help()

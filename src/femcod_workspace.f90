@@ -16,7 +16,7 @@ module femcod_workspace
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_BAD_INPUT
    implicit none
    private
-   public :: workspace_type, block_type, workspace_layout, allocate_workspace, skyline_words
+   public :: workspace_type, block_type, workspace_layout, allocate_workspace, skyline_words, workspace_table
    public :: MPSURF, MPGAPS, MPCORD, MPFEXT, MPDISP, MPDISP2, MPFORCE, MPWORK, MPSTIF, N_REAL_BLOCKS
    public :: IPSORT, IPKFIX, IPMAT, IPMAT2, IPMAT3, IPIADR, IPNOD1, IPNOD2, IPNOD3, IPCONT, IPSITU, N_INT_BLOCKS
 
@@ -120,6 +120,43 @@ contains
       end do
       ws%ipend = ws%int_blocks(N_INT_BLOCKS)%first + ws%int_blocks(N_INT_BLOCKS)%size - 1
    end subroutine workspace_layout
+
+   !> The memory map as printed by `femcod workspace`: a header, one line per block
+   !> (name, first address, words, contents), the end markers, the totals in words and bytes.
+   function workspace_table(ws) result(lines)
+      type(workspace_type), intent(in) :: ws
+      character(len=120), allocatable :: lines(:)
+      character(len=120) :: line
+      integer :: k
+      allocate(lines(0))
+      write(line, '(a,i0,a,i0,a,i0)') "# femcod workspace: NP = ", ws%np, ", MAXCONT = ", ws%maxcont, &
+         ", MAXNODE = ", ws%maxnode
+      lines = [character(len=120) :: lines, line, "# integer array (Table B.2)"]
+      write(line, '(a8,2a14,2x,a)') "block", "first", "words", "holds"
+      lines = [character(len=120) :: lines, line]
+      do k = 1, N_INT_BLOCKS
+         write(line, '(a8,2i14,2x,a)') ws%int_blocks(k)%name, ws%int_blocks(k)%first, ws%int_blocks(k)%size, &
+            trim(ws%int_blocks(k)%holds)
+         lines = [character(len=120) :: lines, line]
+      end do
+      write(line, '(a8,i14,14x,2x,a)') "IPEND   ", ws%ipend, "last address in use = integer words"
+      lines = [character(len=120) :: lines, line, "# real array (Table B.1)"]
+      write(line, '(a8,2a14,2x,a)') "block", "first", "words", "holds"
+      lines = [character(len=120) :: lines, line]
+      do k = 1, N_REAL_BLOCKS
+         write(line, '(a8,2i14,2x,a)') ws%real_blocks(k)%name, ws%real_blocks(k)%first, ws%real_blocks(k)%size, &
+            trim(ws%real_blocks(k)%holds)
+         lines = [character(len=120) :: lines, line]
+      end do
+      write(line, '(a8,i14,14x,2x,a)') "MPEND   ", ws%mpend, "last address in use = real words"
+      lines = [character(len=120) :: lines, line]
+      write(line, '(a,i0,a,i0,a)') "total integer: ", ws%ipend, " words, ", 4*ws%ipend, " bytes"
+      lines = [character(len=120) :: lines, line]
+      write(line, '(a,i0,a,i0,a)') "total real: ", ws%mpend, " words, ", 8*ws%mpend, " bytes"
+      lines = [character(len=120) :: lines, line]
+      write(line, '(a,i0,a)') "total: ", 4*ws%ipend + 8*ws%mpend, " bytes"
+      lines = [character(len=120) :: lines, line]
+   end function workspace_table
 
    !> Allocate both arrays (zeroed). A failed allocation is reported with the bytes
    !> needed, never a crash.

@@ -26,7 +26,28 @@ contains
          new_unittest("CRLF, tabs, commas, D exponents, wrapped values", test_formats), &
          new_unittest("write then read is exact", test_roundtrip), &
          new_unittest("shortest round-trip number format", test_format_real), &
-         new_unittest("bad decks: file:line, expected, found; exit code 3", test_bad_decks), &
+         new_unittest("bad deck: "//"missing value line 2", bad_01), &
+         new_unittest("bad deck: "//"extra value line 3", bad_02), &
+         new_unittest("bad deck: "//"non-numeric height", bad_03), &
+         new_unittest("bad deck: "//"NaN height", bad_04), &
+         new_unittest("bad deck: "//"Inf height", bad_05), &
+         new_unittest("bad deck: "//"overflowing height", bad_06), &
+         new_unittest("bad deck: "//"NP zero", bad_07), &
+         new_unittest("bad deck: "//"NP negative", bad_08), &
+         new_unittest("bad deck: "//"NP not an integer", bad_09), &
+         new_unittest("bad deck: "//"NP overflowing", bad_10), &
+         new_unittest("bad deck: "//"PIXEL zero", bad_11), &
+         new_unittest("bad deck: "//"PIXEL negative", bad_12), &
+         new_unittest("bad deck: "//"MAXCONT zero", bad_13), &
+         new_unittest("bad deck: "//"MAXCONT above NP**2", bad_14), &
+         new_unittest("bad deck: "//"E zero", bad_15), &
+         new_unittest("bad deck: "//"E negative", bad_16), &
+         new_unittest("bad deck: "//"nu = 0.5", bad_17), &
+         new_unittest("bad deck: "//"nu = -1", bad_18), &
+         new_unittest("bad deck: "//"truncated heights", bad_19), &
+         new_unittest("bad deck: "//"trailing values", bad_20), &
+         new_unittest("bad deck: "//"binary content", bad_21), &
+         new_unittest("bad deck: "//"header cut short", bad_22), &
          new_unittest("missing file, directory, empty file", test_bad_files), &
          new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck) &
          ]
@@ -130,81 +151,232 @@ contains
       call check(error, format_real(0.0_dp), "0")
    end subroutine test_format_real
 
-   !> Each case: deck text, the line the error must name, and a word of what was expected.
-   subroutine test_bad_decks(error)
+   !> The bad-deck cases, one test each: deck text, the line the error must name, and a
+   !> word of what was expected.
+   subroutine bad_case(k, name, text, where, expected)
+      integer, intent(in) :: k
+      character(len=:), allocatable, intent(out) :: name, text, where, expected
+      select case (k)
+      case (1)
+         name = "missing value line 2"
+         text = "x"//nl//"2 1.5"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":2:"
+         expected = "NP PIXEL MAXCONT"
+      case (2)
+         name = "extra value line 3"
+         text = "x"//nl//"2 1.5 3"//nl//"200 0.25 9"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// heights
+         where = ":3:"
+         expected = "E1 NU1"
+      case (3)
+         name = "non-numeric height"
+         text = header//"0 0.5"//nl//"1 abc"//nl//"2 2.5 3 3.5"//nl
+         where = ":7:"
+         expected = "lower-surface height"
+      case (4)
+         name = "NaN height"
+         text = header//heights(1:len(heights) - 4)//"NaN"//nl
+         where = ":8:"
+         expected = "finite"
+      case (5)
+         name = "Inf height"
+         text = header//"Inf 0.5"//nl//"1 1.5"//nl//"2 2.5 3 3.5"//nl
+         where = ":6:"
+         expected = "finite"
+      case (6)
+         name = "overflowing height"
+         text = header//"0 0.5"//nl//"1 1.5"//nl//"2 1e999 3 3.5"//nl
+         where = ":8:"
+         expected = "finite"
+      case (7)
+         name = "NP zero"
+         text = "x"//nl//"0 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":2:"
+         expected = "NP"
+      case (8)
+         name = "NP negative"
+         text = "x"//nl//"-2 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":2:"
+         expected = "NP"
+      case (9)
+         name = "NP not an integer"
+         text = "x"//nl//"2.5 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// heights
+         where = ":2:"
+         expected = "NP"
+      case (10)
+         name = "NP overflowing"
+         text = "x"//nl//"99999999999 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// heights
+         where = ":2:"
+         expected = "NP"
+      case (11)
+         name = "PIXEL zero"
+         text = "x"//nl//"2 0 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":2:"
+         expected = "PIXEL"
+      case (12)
+         name = "PIXEL negative"
+         text = "x"//nl//"2 -1 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":2:"
+         expected = "PIXEL"
+      case (13)
+         name = "MAXCONT zero"
+         text = "x"//nl//"2 1.5 0"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":2:"
+         expected = "MAXCONT"
+      case (14)
+         name = "MAXCONT above NP**2"
+         text = "x"//nl//"2 1.5 5"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// heights
+         where = ":2:"
+         expected = "MAXCONT"
+      case (15)
+         name = "E zero"
+         text = "x"//nl//"2 1.5 3"//nl//"0 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":3:"
+         expected = "E1"
+      case (16)
+         name = "E negative"
+         text = "x"//nl//"2 1.5 3"//nl//"200 0.25"//nl//"-2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":4:"
+         expected = "E2"
+      case (17)
+         name = "nu = 0.5"
+         text = "x"//nl//"2 1.5 3"//nl//"200 0.5"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights
+         where = ":3:"
+         expected = "NU1"
+      case (18)
+         name = "nu = -1"
+         text = "x"//nl//"2 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 -1"//nl//heights
+         where = ":5:"
+         expected = "NU3"
+      case (19)
+         name = "truncated heights"
+         text = header//"0 0.5"//nl//"1 1.5"//nl//"2 2.5 3"//nl
+         where = ":8:"
+         expected = "heights"
+      case (20)
+         name = "trailing values"
+         text = header//heights//"4"//nl
+         where = ":9:"
+         expected = "end of the deck"
+      case (21)
+         name = "binary content"
+         text = header//"0 0.5"//nl//achar(0)//achar(1)//"1 1.5"//nl//"2 2.5 3 3.5"//nl
+         where = ":7:"
+         expected = "binary"
+      case (22)
+         name = "header cut short"
+         text = "x"//nl//"2 1.5 3"//nl//"200 0.25"
+         where = ":4:"
+         expected = "E2 NU2"
+      end select
+   end subroutine bad_case
+
+   subroutine run_bad(error, k)
       type(error_type), allocatable, intent(out) :: error
-      call bad("missing value line 2", "x"//nl//"2 1.5"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
-         ":2:", "NP PIXEL MAXCONT")
+      integer, intent(in) :: k
+      type(deck_type) :: deck
+      type(status_type) :: status
+      character(len=:), allocatable :: path, name, text, where, expected
+      call bad_case(k, name, text, where, expected)
+      path = scratch_path("bad.deck")
+      call write_text(path, text)
+      call read_deck(path, deck, status)
+      call check(error, status%code, 3, name//": bad input is status 3")
       if (allocated(error)) return
-      call bad("extra value line 3", "x"//nl//"2 1.5 3"//nl//"200 0.25 9"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// &
-         heights, ":3:", "E1 NU1")
+      call check(error, contains_text(status%message, path//where), &
+         name//": message names file and line "//where//": "//status%message)
       if (allocated(error)) return
-      call bad("non-numeric height", header//"0 0.5"//nl//"1 abc"//nl//"2 2.5 3 3.5"//nl, ":7:", "lower-surface height")
-      if (allocated(error)) return
-      call bad("NaN height", header//heights(1:len(heights) - 4)//"NaN"//nl, ":8:", "finite")
-      if (allocated(error)) return
-      call bad("Inf height", header//"Inf 0.5"//nl//"1 1.5"//nl//"2 2.5 3 3.5"//nl, ":6:", "finite")
-      if (allocated(error)) return
-      call bad("overflowing height", header//"0 0.5"//nl//"1 1.5"//nl//"2 1e999 3 3.5"//nl, ":8:", "finite")
-      if (allocated(error)) return
-      call bad("NP zero", "x"//nl//"0 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, ":2:", "NP")
-      if (allocated(error)) return
-      call bad("NP negative", "x"//nl//"-2 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
-         ":2:", "NP")
-      if (allocated(error)) return
-      call bad("NP not an integer", "x"//nl//"2.5 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// &
-         heights, ":2:", "NP")
-      if (allocated(error)) return
-      call bad("NP overflowing", "x"//nl//"99999999999 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// &
-         heights, ":2:", "NP")
-      if (allocated(error)) return
-      call bad("PIXEL zero", "x"//nl//"2 0 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, ":2:", &
-         "PIXEL")
-      if (allocated(error)) return
-      call bad("PIXEL negative", "x"//nl//"2 -1 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
-         ":2:", "PIXEL")
-      if (allocated(error)) return
-      call bad("MAXCONT zero", "x"//nl//"2 1.5 0"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
-         ":2:", "MAXCONT")
-      if (allocated(error)) return
-      call bad("MAXCONT above NP**2", "x"//nl//"2 1.5 5"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl// &
-         heights, ":2:", "MAXCONT")
-      if (allocated(error)) return
-      call bad("E zero", "x"//nl//"2 1.5 3"//nl//"0 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, ":3:", "E1")
-      if (allocated(error)) return
-      call bad("E negative", "x"//nl//"2 1.5 3"//nl//"200 0.25"//nl//"-2e7 0.25"//nl//"2e7 0.3"//nl//heights, &
-         ":4:", "E2")
-      if (allocated(error)) return
-      call bad("nu = 0.5", "x"//nl//"2 1.5 3"//nl//"200 0.5"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl//heights, ":3:", "NU1")
-      if (allocated(error)) return
-      call bad("nu = -1", "x"//nl//"2 1.5 3"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 -1"//nl//heights, ":5:", "NU3")
-      if (allocated(error)) return
-      call bad("truncated heights", header//"0 0.5"//nl//"1 1.5"//nl//"2 2.5 3"//nl, ":8:", "heights")
-      if (allocated(error)) return
-      call bad("trailing values", header//heights//"4"//nl, ":9:", "end of the deck")
-      if (allocated(error)) return
-      call bad("binary content", header//"0 0.5"//nl//achar(0)//achar(1)//"1 1.5"//nl//"2 2.5 3 3.5"//nl, ":7:", &
-         "binary")
-      if (allocated(error)) return
-      call bad("header cut short", "x"//nl//"2 1.5 3"//nl//"200 0.25", ":4:", "E2 NU2")
-   contains
-      subroutine bad(name, text, where, expected)
-         character(len=*), intent(in) :: name, text, where, expected
-         type(deck_type) :: deck
-         type(status_type) :: status
-         character(len=:), allocatable :: path
-         path = scratch_path("bad.deck")
-         call write_text(path, text)
-         call read_deck(path, deck, status)
-         call check(error, status%code, 3, name//": bad input is status 3")
-         if (allocated(error)) return
-         call check(error, contains_text(status%message, path//where), &
-            name//": message names file and line "//where//": "//status%message)
-         if (allocated(error)) return
-         call check(error, contains_text(status%message, expected) .and. contains_text(status%message, "found"), &
-            name//": message says what was expected and found: "//status%message)
-      end subroutine bad
-   end subroutine test_bad_decks
+      call check(error, contains_text(status%message, expected) .and. contains_text(status%message, "found"), &
+         name//": message says what was expected and found: "//status%message)
+   end subroutine run_bad
+
+   subroutine bad_01(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 1)
+   end subroutine bad_01
+   subroutine bad_02(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 2)
+   end subroutine bad_02
+   subroutine bad_03(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 3)
+   end subroutine bad_03
+   subroutine bad_04(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 4)
+   end subroutine bad_04
+   subroutine bad_05(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 5)
+   end subroutine bad_05
+   subroutine bad_06(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 6)
+   end subroutine bad_06
+   subroutine bad_07(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 7)
+   end subroutine bad_07
+   subroutine bad_08(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 8)
+   end subroutine bad_08
+   subroutine bad_09(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 9)
+   end subroutine bad_09
+   subroutine bad_10(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 10)
+   end subroutine bad_10
+   subroutine bad_11(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 11)
+   end subroutine bad_11
+   subroutine bad_12(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 12)
+   end subroutine bad_12
+   subroutine bad_13(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 13)
+   end subroutine bad_13
+   subroutine bad_14(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 14)
+   end subroutine bad_14
+   subroutine bad_15(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 15)
+   end subroutine bad_15
+   subroutine bad_16(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 16)
+   end subroutine bad_16
+   subroutine bad_17(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 17)
+   end subroutine bad_17
+   subroutine bad_18(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 18)
+   end subroutine bad_18
+   subroutine bad_19(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 19)
+   end subroutine bad_19
+   subroutine bad_20(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 20)
+   end subroutine bad_20
+   subroutine bad_21(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 21)
+   end subroutine bad_21
+   subroutine bad_22(error)
+      type(error_type), allocatable, intent(out) :: error
+      call run_bad(error, 22)
+   end subroutine bad_22
 
    subroutine test_bad_files(error)
       type(error_type), allocatable, intent(out) :: error

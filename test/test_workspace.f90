@@ -2,7 +2,7 @@
 module test_workspace
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type
-   use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, skyline_words, &
+   use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, skyline_words, workspace_table, &
       MPSURF, MPGAPS, MPCORD, MPFEXT, MPDISP, MPDISP2, MPFORCE, MPWORK, MPSTIF, IPSORT, IPSITU, IPCONT
    use test_support, only: contains_text
    use testdrive, only: new_unittest, unittest_type, error_type, check
@@ -19,7 +19,8 @@ contains
          new_unittest("Table B.1: real block sizes and MPEND = 3981268", test_real_blocks), &
          new_unittest("blocks are contiguous and bounds are checked", test_contiguous), &
          new_unittest("skyline size rule: (7n+2)(n+1)/2", test_skyline_rule), &
-         new_unittest("too large a workspace: bytes needed, no crash", test_too_large) &
+         new_unittest("too large a workspace: bytes needed, no crash", test_too_large), &
+         new_unittest("the printed table (femcod workspace 512 1000)", test_printed_table) &
          ]
    end subroutine collect_workspace
 
@@ -109,4 +110,27 @@ contains
       call check(error, status%code == 4 .and. contains_text(status%message, "bytes"), &
          "refused with the bytes needed: "//status%message)
    end subroutine test_too_large
+
+   subroutine test_printed_table(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(workspace_type) :: ws
+      type(status_type) :: status
+      character(len=120), allocatable :: lines(:)
+      integer :: k
+      logical :: found(4)
+      call workspace_layout(512, 1000, ws, status)
+      lines = workspace_table(ws)
+      found = .false.
+      do k = 1, size(lines)
+         ! Table B.2: IPSORT first at 1 with NP^2 = 262144 words; IPEND = 284156.
+         if (index(lines(k), "IPSORT") == 1 .and. index(lines(k), " 1 ") > 0 .and. index(lines(k), "262144") > 0) &
+            found(1) = .true.
+         if (index(lines(k), "IPEND") == 1 .and. index(lines(k), "284156") > 0) found(2) = .true.
+         ! 284156 default integers of 4 bytes, by hand: 1136624 bytes.
+         if (index(lines(k), "total integer: 284156 words, 1136624 bytes") == 1) found(3) = .true.
+         ! MPCORD as the thesis prints it: 12008 words.
+         if (index(lines(k), "MPCORD") == 1 .and. index(lines(k), "12008") > 0) found(4) = .true.
+      end do
+      call check(error, all(found), "IPSORT, IPEND, integer total and MPCORD lines as expected")
+   end subroutine test_printed_table
 end module test_workspace
