@@ -28,10 +28,12 @@ contains
 
    subroutine run_help()
       write(output_unit, '(a)') &
-         "usage: femcod run DECK [-o PREFIX] [--solver incremental|legacy] [--loads F1,F2,...] [--max-contacts N]", &
-         "                  [--hardness H] [--no-final-check] [--quiet]", &
+         "usage: femcod run DECK [DECK ...] [-o PREFIX] [--solver incremental|legacy] [--loads F1,F2,...]", &
+         "                  [--max-contacts N] [--hardness H] [--no-final-check] [--quiet]", &
          "", &
-         "Contact history of the deck, step by step (thesis chapter 4, Appendix B).", &
+         "Contact history of each deck, step by step (thesis chapter 4, Appendix B). With several decks", &
+         "(batch) each gets its own outputs named after it; a bad deck is reported and the others still", &
+         "run; the exit code is that of the first failure, and a final summary lists the failures.", &
          "  -o PREFIX          output prefix (default: the deck's name without .deck, here)", &
          "  --solver S         incremental (default): event-exact, condensed to the contacts, bordered", &
          "                     Cholesky factor, exact candidate bound, full-field FFT check at the end;", &
@@ -57,13 +59,14 @@ contains
       type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: res
-      type(string_type), allocatable :: parts(:)
-      character(len=:), allocatable :: deck_path, prefix, solver, key
+      type(string_type), allocatable :: parts(:), decks(:), failed(:)
+      character(len=:), allocatable :: deck_path, prefix, solver, key, current_prefix
       logical :: quiet, ok
-      integer :: i, k
+      integer :: i, k, d, rc
       code = 0
       quiet = .false.
       deck_path = ""
+      allocate(decks(0), failed(0))
       prefix = ""
       solver = "incremental"
       allocate(options%loads(0))
@@ -84,11 +87,13 @@ contains
             cycle
          end select
          if (key(1:1) /= "-" .or. len(key) == 1) then
-            if (deck_path /= "") then
-               call usage("one deck per run (found '"//deck_path//"' and '"//key//"')")
-               return
-            end if
-            deck_path = key
+            do d = 1, size(decks)
+               if (decks(d)%s == key) then
+                  call usage("the deck '"//key//"' is given twice (its results would overwrite each other)")
+                  return
+               end if
+            end do
+            decks = [decks, string_type(key)]
             i = i + 1
             cycle
          end if
@@ -136,47 +141,78 @@ contains
          end associate
          i = i + 2
       end do
-      if (deck_path == "") then
+      if (size(decks) == 0) then
          call usage("run needs a DECK")
          return
       end if
-      if (prefix == "") prefix = default_prefix(deck_path)
-
-      call read_deck(deck_path, deck, status)
-      last_report = 0
-      target_contacts = deck%maxcont
-      if (options%max_contacts > 0) target_contacts = min(target_contacts, options%max_contacts)
-      target_load = 0
-      if (size(options%loads) > 0) target_load = maxval(options%loads)
-      growth = merge(4.0_dp, 3.0_dp, solver == "legacy")
-      if (status%code == 0) then
-         select case (solver)
-         case ("legacy")
-            if (quiet) then
-               call solve_legacy(deck, options, res, status)
-            else
-               call solve_legacy(deck, options, res, status, report_progress)
-            end if
-         case default
-            if (quiet) then
-               call solve_incremental(deck, options, res, status)
-            else
-               call solve_incremental(deck, options, res, status, report_progress)
-            end if
-         end select
-      end if
-      if (status%code == 0) call write_csv_results(prefix, deck, res, status)
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod: "//status%message
-         code = status%code
+      if (size(decks) > 1 .and. prefix /= "") then
+         call usage("-o PREFIX names the outputs of one deck; with several decks each deck's outputs are "// &
+            "named after it, in the current directory")
          return
       end if
-      do k = 1, size(res%states)
-         if (.not. res%states(k)%reached) write(error_unit, '(a)') "femcod: warning: load "// &
-            format_real(res%states(k)%load)//" nN not reached ("//stop_reason_text(res%stop_reason)//")"
+      ! Batch: every deck runs; a failed deck is reported and the others go on.
+      do d = 1, size(decks)
+         deck_path = decks(d)%s
+         if (prefix /= "") then
+            call run_one(prefix, rc)
+         else
+            call run_one(default_prefix(deck_path), rc)
+         end if
+         if (rc /= 0) then
+            failed = [failed, string_type(deck_path)]
+            if (code == 0) code = rc
+         end if
       end do
-      if (.not. quiet) call print_summary()
+      if (size(decks) > 1) then
+         write(output_unit, '(a)') "femcod run: "//int_str(size(decks))//" decks, "//int_str(size(failed))//" failed"
+         do d = 1, size(failed)
+            write(output_unit, '(a)') "  failed: "//failed(d)%s
+         end do
+      end if
    contains
+      !> One deck: read, solve, write, report. `rc` is its exit code.
+      subroutine run_one(out_prefix, rc)
+         character(len=*), intent(in) :: out_prefix
+         integer, intent(out) :: rc
+         type(status_type) :: st
+         rc = 0
+         current_prefix = out_prefix
+         call read_deck(deck_path, deck, st)
+         last_report = 0
+         target_contacts = deck%maxcont
+         if (options%max_contacts > 0) target_contacts = min(target_contacts, options%max_contacts)
+         target_load = 0
+         if (size(options%loads) > 0) target_load = maxval(options%loads)
+         growth = merge(4.0_dp, 3.0_dp, solver == "legacy")
+         if (st%code == 0) then
+            select case (solver)
+            case ("legacy")
+               if (quiet) then
+                  call solve_legacy(deck, options, res, st)
+               else
+                  call solve_legacy(deck, options, res, st, report_progress)
+               end if
+            case default
+               if (quiet) then
+                  call solve_incremental(deck, options, res, st)
+               else
+                  call solve_incremental(deck, options, res, st, report_progress)
+               end if
+            end select
+         end if
+         if (st%code == 0) call write_csv_results(current_prefix, deck, res, st)
+         if (st%code /= 0) then
+            write(error_unit, '(a)') "femcod: "//st%message
+            rc = st%code
+            return
+         end if
+         do k = 1, size(res%states)
+            if (.not. res%states(k)%reached) write(error_unit, '(a)') "femcod: warning: load "// &
+               format_real(res%states(k)%load)//" nN not reached ("//stop_reason_text(res%stop_reason)//")"
+         end do
+         if (.not. quiet) call print_summary()
+      end subroutine run_one
+
       subroutine usage(message)
          character(len=*), intent(in) :: message
          write(error_unit, '(a)') "femcod run: "//message//" (femcod run --help)"
@@ -223,8 +259,8 @@ contains
                " found by the final check of all pixels; exact re-solve differs by "// &
                real_str(res%final_check_difference, 2)
          end if
-         write(output_unit, '(a)') "  written   : "//prefix//".history.csv, "//prefix//".contacts.csv"// &
-            merge(", "//prefix//".loads.csv", repeat(" ", len(prefix) + 12), size(res%states) > 0)
+         write(output_unit, '(a)') "  written   : "//current_prefix//".history.csv, "//current_prefix//".contacts.csv"// &
+            merge(", "//current_prefix//".loads.csv", repeat(" ", len(current_prefix) + 12), size(res%states) > 0)
       end subroutine print_summary
    end subroutine run_command
 

@@ -26,7 +26,8 @@ contains
          new_unittest("Table 4.2: square punch, approach and centre/mean pressure; Richardson", test_table_4_2), &
          new_unittest("sphere, 0.5 nm mesh: Hertz at 1000 nN, Segedin at 18000 nN", test_sphere), &
          new_unittest("rough surface: history consistent with an exact active-set solve", test_rough), &
-         new_unittest("femcod run writes the three CSV files with their headers", test_run_outputs) &
+         new_unittest("femcod run writes the three CSV files with their headers", test_run_outputs), &
+         new_unittest("batch: a bad deck is reported, the others still run", test_batch) &
          ]
    end subroutine collect_legacy
 
@@ -206,4 +207,49 @@ contains
       if (allocated(error)) return
       call check(error, .not. file_exists(prefix//".history.csv.tmp"), "no temporary file left")
    end subroutine test_run_outputs
+
+   !> Several decks in one run: each gets its outputs (named after it, in the current
+   !> directory, here the scratch directory), a bad one does not stop the others, the
+   !> exit code is non-zero; the same deck twice is a usage error.
+   subroutine test_batch(error)
+      use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_size_t, c_ptr
+      type(error_type), allocatable, intent(out) :: error
+      interface
+         function c_chdir(path) bind(c, name="chdir") result(rc)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: rc
+         end function c_chdir
+         function c_getcwd(buf, size) bind(c, name="getcwd") result(p)
+            import :: c_char, c_size_t, c_ptr
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_size_t), value :: size
+            type(c_ptr) :: p
+         end function c_getcwd
+      end interface
+      character(kind=c_char, len=4096) :: home
+      type(c_ptr) :: p
+      character(len=:), allocatable :: dir
+      integer :: code, ios
+      home = repeat(c_null_char, len(home))
+      p = c_getcwd(home, int(len(home), c_size_t))
+      home = home(1:index(home, c_null_char) - 1)
+      dir = scratch_path("batch")
+      call execute_command_line("mkdir -p "//dir//" && cp input/square_punch_n3.deck input/circle_punch_d1.deck "// &
+         dir//"/ && printf 'bad\n' > "//dir//"/bad.deck && rm -f "//dir//"/*.csv", exitstat=ios)
+      call check(error, c_chdir(dir//c_null_char) == 0, "cd into the scratch directory")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("square_punch_n3.deck"), string_type("bad.deck"), &
+         string_type("circle_punch_d1.deck"), string_type("--loads"), string_type("1"), string_type("--quiet")], code)
+      ios = c_chdir(trim(home)//c_null_char)
+      call check(error, code, 3, "the bad deck's exit code")
+      if (allocated(error)) return
+      call check(error, file_exists(dir//"/square_punch_n3.loads.csv") .and. &
+         file_exists(dir//"/circle_punch_d1.loads.csv") .and. .not. file_exists(dir//"/bad.history.csv"), &
+         "both good decks ran, the bad one wrote nothing")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("input/square_punch_n3.deck"), &
+         string_type("input/square_punch_n3.deck"), string_type("--quiet")], code)
+      call check(error, code, 2, "the same deck twice is a usage error")
+   end subroutine test_batch
 end module test_legacy
