@@ -18,7 +18,7 @@ module femcod_condensed
    use femcod_lapack, only: dsysv
    implicit none
    private
-   public :: solve_active_set, gap_at
+   public :: solve_active_set, gap_at, gap_and_rate
 
 contains
 
@@ -34,6 +34,26 @@ contains
       end do
       gap_at = g0 - approach + csum*s
    end function gap_at
+
+   !> Current gap (nm) of pixel (ip, jp) under total forces `ftot` and approach `atot`,
+   !> and its closing rate (nm/nN) under the unit-load forces `funit` and approach rate
+   !> `delta`: gap = g0 - atot + c sum I ftot, rate = delta - c sum I funit (one pass).
+   pure subroutine gap_and_rate(g0, atot, delta, csum, table, ip, jp, ic, jc, ftot, funit, gap, rate)
+      real(dp), intent(in) :: g0, atot, delta, csum, table(0:, 0:), ftot(:), funit(:)
+      integer, intent(in) :: ip, jp, ic(:), jc(:)
+      real(dp), intent(out) :: gap, rate
+      integer :: k
+      real(dp) :: s_tot, s_unit, t
+      s_tot = 0
+      s_unit = 0
+      do k = 1, size(ftot)
+         t = table(abs(ip - ic(k)), abs(jp - jc(k)))
+         s_tot = s_tot + t*ftot(k)
+         s_unit = s_unit + t*funit(k)
+      end do
+      gap = g0 - atot + csum*s_tot
+      rate = delta - csum*s_unit
+   end subroutine gap_and_rate
 
    !> Exact forces and approach for the active set (ic, jc) at total load `load`.
    subroutine solve_active_set(ic, jc, g0, csum, spring_compliance, table, load, forces, approach, status)

@@ -16,7 +16,7 @@ module femcod_deck
    use, intrinsic :: ieee_exceptions, only: ieee_overflow, ieee_get_halting_mode, ieee_set_halting_mode, ieee_set_flag
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
-   use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, path_is_directory
+   use femcod_files, only: commit_file, temporary_name, path_exists, path_is_directory
    use femcod_strings, only: int_str
    implicit none
    private
@@ -260,14 +260,7 @@ contains
       do i = 1, deck%np
          call write_row(deck%upper(i, :))
       end do
-      close(unit, iostat=ios)
-      if (ios /= 0) then
-         call remove_file(tmp)
-         call set_error(status, STATUS_IO, path//": writing failed")
-         return
-      end if
-      call atomic_rename(tmp, path, status)
-      if (status%code /= 0) call remove_file(tmp)
+      call commit_file(unit, tmp, path, status)
    contains
       subroutine write_row(row)
          real(dp), intent(in) :: row(:)

@@ -5,7 +5,7 @@ module femcod_files
    use femcod_status, only: status_type, set_error, STATUS_IO
    implicit none
    private
-   public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name
+   public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, commit_file
 
    interface
       function c_rename(from, to) bind(c, name="rename") result(rc)
@@ -35,6 +35,23 @@ contains
          call set_error(status, STATUS_IO, target//": cannot rename the temporary file "//source//" onto it")
       end if
    end subroutine atomic_rename
+
+   !> Close `unit` (open on the temporary file `tmp`) and move it onto `path`; on any
+   !> failure the temporary file is removed and `path` is left as it was.
+   subroutine commit_file(unit, tmp, path, status)
+      integer, intent(in) :: unit
+      character(len=*), intent(in) :: tmp, path
+      type(status_type), intent(inout) :: status
+      integer :: ios
+      close(unit, iostat=ios)
+      if (ios /= 0) then
+         call remove_file(tmp)
+         call set_error(status, STATUS_IO, path//": writing failed")
+         return
+      end if
+      call atomic_rename(tmp, path, status)
+      if (status%code /= 0) call remove_file(tmp)
+   end subroutine commit_file
 
    !> Remove a file if it exists; errors are ignored (used to clean up temporaries).
    subroutine remove_file(path)

@@ -26,6 +26,7 @@ module femcod_incremental
    use femcod_boussinesq, only: offset_table, surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_lapack, only: dtrsv, dpotrf
+   use femcod_condensed, only: gap_and_rate
    use femcod_heap, only: min_heap, heap_build, heap_push, heap_pop, heap_top_key
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, &
@@ -264,19 +265,11 @@ contains
       subroutine evaluate(pixel, gap, closing)
          integer, intent(in) :: pixel
          real(dp), intent(out) :: gap, closing
-         integer :: ip, jp, kk
-         real(dp) :: st, su, t
+         integer :: ip, jp
          ip = (pixel - 1)/np + 1
          jp = pixel - (ip - 1)*np
-         st = 0
-         su = 0
-         do kk = 1, n
-            t = table(abs(ip - ic(kk)), abs(jp - jc(kk)))
-            st = st + t*ftot(kk)
-            su = su + t*funit(kk)
-         end do
-         gap = g0(pixel) - approach + c*st
-         closing = delta - c*su
+         call gap_and_rate(g0(pixel), approach, delta, c, table, ip, jp, ic(1:n), jc(1:n), ftot(1:n), funit(1:n), &
+            gap, closing)
       end subroutine evaluate
 
       !> Border the factor with a new contact (zero force): U gains a column

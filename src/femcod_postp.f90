@@ -11,6 +11,7 @@
 !> (lambda = 0), as the thesis corrects late-found contacts.
 module femcod_postp
    use femcod_kinds, only: dp
+   use femcod_condensed, only: gap_and_rate
    implicit none
    private
    public :: candidate_count, postp_search
@@ -40,9 +41,8 @@ contains
       real(dp), intent(out) :: lambda
       integer, intent(out) :: joiners(:), njoin, nmissed
       real(dp), intent(inout) :: gaps(:)
-      real(dp) :: lam(ncand), s_tot, s_unit, t, rate, bound
-      integer :: pos, p, ip, jp, k, n
-      n = size(ftot)
+      real(dp) :: lam(ncand), rate, bound
+      integer :: pos, p, ip, jp
       lambda = huge(1.0_dp)
       lam = huge(1.0_dp)
       do pos = 1, ncand
@@ -50,15 +50,7 @@ contains
          if (in_contact(p)) cycle
          ip = (p - 1)/np + 1
          jp = p - (ip - 1)*np
-         s_tot = 0
-         s_unit = 0
-         do k = 1, n
-            t = table(abs(ip - ic(k)), abs(jp - jc(k)))
-            s_tot = s_tot + t*ftot(k)
-            s_unit = s_unit + t*funit(k)
-         end do
-         gaps(p) = g0(p) - atot + csum*s_tot
-         rate = delta - csum*s_unit
+         call gap_and_rate(g0(p), atot, delta, csum, table, ip, jp, ic, jc, ftot, funit, gaps(p), rate)
          if (gaps(p) <= 0) then
             lam(pos) = min(0.0_dp, gaps(p))
          else if (rate > 0) then

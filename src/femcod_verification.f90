@@ -10,7 +10,7 @@ module femcod_verification
    use femcod_legacy, only: solve_legacy
    use femcod_boussinesq, only: love_influence, love_influence_exact, love_influence_far, surface_compliance
    use femcod_richardson, only: convergence_rate, convergence_rate_known_limit, richardson_extrapolate, power_law_fit
-   use femcod_files, only: atomic_rename, remove_file, temporary_name
+   use femcod_files, only: commit_file, temporary_name
    use femcod_analytic, only: hertz_approach, segedin_sphere, flat_punch_approach
    implicit none
    private
@@ -161,13 +161,7 @@ contains
          "Wall time of the legacy solver: circle "//secs(wcirc(1))//", "//secs(wcirc(2))//", "// &
          secs(wcirc(3))//"; square "//secs(wall(1))//", "//secs(wall(2))//", "//secs(wall(3))//", "// &
          secs(wall(4))//"."
-      close(u, iostat=ios)
-      if (ios /= 0) then
-         call remove_file(tmp)
-         call set_error(status, STATUS_IO, path//": writing failed")
-         return
-      end if
-      call atomic_rename(tmp, path, status)
+      call commit_file(u, tmp, path, status)
    contains
       subroutine at_load(name, loads, first, second, res)
          character(len=*), intent(in) :: name
