@@ -57,7 +57,9 @@ contains
       type(status_type), intent(inout) :: status
       character(len=:), allocatable :: text
       integer, allocatable :: tok_first(:), tok_last(:), tok_line(:)
-      integer :: ntok, k, first_line6, nvalues, i, j, last_line
+      integer :: ntok, k, first_line6, i, j, last_line
+      integer(i8) :: nvalues
+      character(len=24) :: count_text
       integer :: ln_first(2:5), ln_count(2:5)
 
       call read_whole_file(path, text, status)
@@ -119,16 +121,18 @@ contains
       end do
 
       ! Heights.
-      nvalues = 2*deck%np**2
+      ! In 64 bits: 2 NP**2 overflows a default integer for NP > 32767.
+      nvalues = 2*int(deck%np, i8)**2
+      write(count_text, '(i0)') nvalues
       if (ntok - first_line6 + 1 < nvalues) then
          call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(last_line)//": expected "// &
-            int_str(nvalues)//" heights (NP**2 = "//int_str(deck%np**2)//" lower, then as many upper), found "// &
+            trim(count_text)//" heights (NP**2 = "//int_str(deck%np**2)//" lower, then as many upper), found "// &
             int_str(ntok - first_line6 + 1)//" before the end of the file")
          return
       end if
       if (ntok - first_line6 + 1 > nvalues) then
-         k = first_line6 + nvalues
-         call bad(tok_line(k), "the end of the deck after the "//int_str(nvalues)//" heights", tok(k))
+         k = first_line6 + int(nvalues)
+         call bad(tok_line(k), "the end of the deck after the "//trim(count_text)//" heights", tok(k))
          return
       end if
       allocate(deck%lower(deck%np, deck%np), deck%upper(deck%np, deck%np))
