@@ -13,7 +13,7 @@ run_main=1
 
 sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 
-debian_packages=(gfortran liblapack-dev libopenblas-dev libhdf5-dev libfftw3-dev pkg-config)
+debian_packages=(gfortran liblapack-dev libopenblas-dev libhdf5-dev libfftw3-dev pkg-config hdf5-tools)
 missing=()
 for p in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -36,5 +36,5 @@ fpm build --profile release >/dev/null 2>build.log || { cat build.log >&2; exit 
 rm -f build.log
 if [ "$run_main" -eq 1 ]; then
   mkdir -p out
-  fpm run --profile release femcod -- run input/sphere_d1.deck -o out/sphere_d1 --loads 100,1000,5000
+  fpm run --profile release femcod -- run input/sphere_d1.deck -o out/sphere_d1 --loads 100,1000,5000 --force
 fi

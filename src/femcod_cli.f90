@@ -9,13 +9,14 @@ module femcod_cli
    use femcod_workspace, only: workspace_type, workspace_layout, workspace_table
    use femcod_generate, only: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, KINDS
    use femcod_run, only: run_command
+   use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
    use femcod_strings, only: string_type, int_str
    implicit none
    private
    public :: femcod_command, run_femcod, command_arguments, FEMCOD_VERSION
 
-   character(len=*), parameter :: FEMCOD_VERSION = "0.1.0"
+
 
 contains
 

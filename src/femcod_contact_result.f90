@@ -6,6 +6,7 @@ module femcod_contact_result
    private
    public :: contact_result, load_state, contact_options, append_step, progress_interface
    public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text, record_load_states, finish_contacts
+   public :: solver_state, checkpoint_interface
 
    integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3
 
@@ -22,6 +23,9 @@ module femcod_contact_result
       real(dp) :: tie_tolerance = 1.0e-9_dp
       !> Check every pixel for penetration at the end, and correct (Appendix B).
       logical :: final_check = .true.
+      !> Hand the solver state to the checkpoint procedure every this many seconds of
+      !> wall time (0: after every step; negative: never).
+      real(dp) :: checkpoint_interval = -1
    end type contact_options
 
    !> The contact state at one requested load.
@@ -31,6 +35,9 @@ module femcod_contact_result
       real(dp) :: max_pressure = 0
       integer :: n_above_hardness = 0
       logical :: reached = .false.
+      !> The contact pixels (row, column) and their forces (nN) at this load.
+      integer, allocatable :: i(:), j(:)
+      real(dp), allocatable :: force(:)
    end type load_state
 
    !> Results of a run. Units: nN, nm, GPa.
@@ -63,6 +70,21 @@ module femcod_contact_result
       real(dp) :: wall_seconds = 0
    end type contact_result
 
+   !> Everything the incremental solver needs to continue a run exactly where it was:
+   !> the contacts are rebuilt by replaying `operations` in order (the same bordered
+   !> updates, so the factor is the same to the last bit), the rest is stored.
+   type :: solver_state
+      integer :: step = 0, n = 0
+      real(dp) :: total = 0, approach = 0
+      !> +p: pixel p joined; -k: contact k was released.
+      integer, allocatable :: operations(:)
+      !> The current contacts: step joined and force (nN).
+      integer, allocatable :: cstep(:)
+      real(dp), allocatable :: ftot(:)
+      !> The results so far (history, states reached, counters).
+      type(contact_result) :: res
+   end type solver_state
+
    abstract interface
       !> Called by a solver after every step, so that a program can report progress
       !> (the solver itself does no I/O): step, contacts, total load (nN), elapsed (s).
@@ -71,6 +93,12 @@ module femcod_contact_result
          integer, intent(in) :: step, contacts
          real(dp), intent(in) :: load, elapsed
       end subroutine progress_interface
+      !> Called by a solver every `checkpoint_interval` seconds with its complete state
+      !> at the end of a step; the program stores it (the solver does no I/O).
+      subroutine checkpoint_interface(state)
+         import :: solver_state
+         type(solver_state), intent(in) :: state
+      end subroutine checkpoint_interface
    end interface
 
 contains
@@ -110,11 +138,13 @@ contains
 
    !> Record the states at the requested loads that fall inside the current step, which
    !> starts at `total` and ends `lam` later (`bounded` false: the step never ends).
-   !> Within a step the response is linear, so the interpolation is exact. At the largest
-   !> requested load the contact forces are kept for the contacts file.
-   pure subroutine record_load_states(res, lam, bounded, total, approach, delta, ftot, funit, pixel, hardness)
+   !> Within a step the response is linear, so the interpolation is exact. The contacts
+   !> (ic, jc) and their forces are kept for the maps; at the largest requested load
+   !> also for the contacts file.
+   pure subroutine record_load_states(res, lam, bounded, total, approach, delta, ftot, funit, pixel, hardness, ic, jc)
       type(contact_result), intent(inout) :: res
       real(dp), intent(in) :: lam, total, approach, delta, ftot(:), funit(:), pixel, hardness
+      integer, intent(in) :: ic(:), jc(:)
       logical, intent(in) :: bounded
       integer :: s
       real(dp) :: dl
@@ -129,6 +159,9 @@ contains
          res%states(s)%max_pressure = maxval(f)/pixel**2
          res%states(s)%n_above_hardness = count(f/pixel**2 > hardness)
          res%states(s)%reached = .true.
+         res%states(s)%i = ic
+         res%states(s)%j = jc
+         res%states(s)%force = f
          if (res%states(s)%load == maxval(res%states%load)) then
             res%contact_force = f
             res%reported_load = res%states(s)%load

@@ -18,10 +18,6 @@ module femcod_files
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int) :: rc
       end function c_remove
-      function c_getpid() bind(c, name="getpid") result(pid)
-         import :: c_int
-         integer(c_int) :: pid
-      end function c_getpid
    end interface
 
 contains
@@ -72,12 +68,12 @@ contains
       inquire(file=path//"/.", exist=path_is_directory)
    end function path_is_directory
 
-   !> A temporary name beside `path`, unique to this process.
+   !> The temporary name beside `path` (`path.part`). It is the same for every run, so
+   !> the leftovers of a run killed while writing are replaced by the next one instead
+   !> of piling up (two runs writing the same result at once would clash anyway).
    function temporary_name(path) result(tmp)
       character(len=*), intent(in) :: path
       character(len=:), allocatable :: tmp
-      character(len=16) :: buf
-      write(buf, '(i0)') c_getpid()
-      tmp = path//".tmp"//trim(buf)
+      tmp = path//".part"
    end function temporary_name
 end module femcod_files

@@ -11,12 +11,13 @@ module femcod_generate
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
    use femcod_deck, only: deck_type, parse_real, validate_deck, format_real
    use femcod_files, only: path_exists, path_is_directory
+   use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close
    use femcod_strings, only: int_str
    use femcod_surfaces, only: circle_punch, square_punch, sphere_cap, sinusoid_surface, weierstrass_mandelbrot, &
       self_affine_surface, remove_plane
    implicit none
    private
-   public :: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, read_ascii_matrix, RIGID_FACTOR, KINDS
+   public :: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, read_ascii_matrix, read_heights, RIGID_FACTOR, KINDS
 
    !> Modulus ratio of a rigid body to the elastic one (thesis section 4.4).
    real(dp), parameter :: RIGID_FACTOR = 1.0e5_dp
@@ -33,6 +34,8 @@ module femcod_generate
    !> What to generate. Lengths in nm, moduli in GPa.
    type :: deck_spec
       character(len=:), allocatable :: kind, label, matrix_file
+      !> With kind "matrix": heights of the other surface from a second file ("": flat).
+      character(len=:), allocatable :: second_file
       integer :: np = 0, maxcont = 0, seed = 1, ridges = 10
       real(dp) :: pixel = 0
       real(dp) :: young = 200, poisson = 0.25_dp
@@ -98,7 +101,7 @@ contains
          allocate(shape(np, np))
          call self_affine_surface(np, spec%pixel, spec%hurst, spec%rms, spec%seed, shape)
       case ("matrix")
-         call read_ascii_matrix(spec%matrix_file, shape, status)
+         call read_heights(spec%matrix_file, shape, status)
          if (status%code /= 0) return
          np = size(shape, 1)
       case default
@@ -152,6 +155,25 @@ contains
          call set_error(status, STATUS_BAD_INPUT, "mkdeck: --shape-on must be upper or lower")
          return
       end select
+      if (spec%kind == "matrix" .and. allocated(spec%second_file)) then
+         if (spec%second_file /= "") then
+            call read_heights(spec%second_file, shape, status)
+            if (status%code /= 0) return
+            if (size(shape, 1) /= np) then
+               call set_error(status, STATUS_BAD_INPUT, spec%second_file//": expected "//int_str(np)//" x "// &
+                  int_str(np)//" heights as in "//spec%matrix_file//", found "//int_str(size(shape, 1))//" x "// &
+                  int_str(size(shape, 2)))
+               return
+            end if
+            if (spec%plane) call remove_plane(shape)
+            shape = shape - minval(shape)
+            if (spec%shape_on == "upper") then
+               deck%lower = shape
+            else
+               deck%upper = shape
+            end if
+         end if
+      end if
       call validate_deck(deck, status)
    contains
       pure real(dp) function pick(value, default)
@@ -244,6 +266,40 @@ contains
          end do
       end do
    end function pixels_within
+
+   !> Heights (nm) from `FILE` (an ASCII matrix) or `FILE.h5:/path` (a square 2-D HDF5
+   !> dataset, C order: data[i, j] is row i, column j; any numeric type).
+   subroutine read_heights(path, z, status)
+      character(len=*), intent(in) :: path
+      real(dp), allocatable, intent(out) :: z(:, :)
+      type(status_type), intent(inout) :: status
+      type(h5_file) :: file
+      integer :: colon
+      colon = index(path, ":/", back=.true.)
+      if (colon == 0) then
+         call read_ascii_matrix(path, z, status)
+         return
+      end if
+      associate(fname => path(1:colon - 1), dataset => path(colon + 1:))
+         if (path_is_directory(fname) .or. .not. path_exists(fname)) then
+            call set_error(status, STATUS_BAD_INPUT, fname//": expected an HDF5 file of heights, found none")
+            return
+         end if
+         call h5_open(fname, file, status, STATUS_BAD_INPUT)
+         call h5_read(file, dataset, z, status, STATUS_BAD_INPUT)
+         call h5_close(file, status)
+         if (status%code /= 0) return
+         if (size(z, 1) /= size(z, 2) .or. size(z) == 0) then
+            call set_error(status, STATUS_BAD_INPUT, path//": expected a square matrix of heights, found "// &
+               int_str(size(z, 1))//" x "//int_str(size(z, 2)))
+            return
+         end if
+         if (.not. all(abs(z) <= huge(1.0_dp))) then
+            call set_error(status, STATUS_BAD_INPUT, path//": expected finite heights (nm), found NaN or Inf")
+            return
+         end if
+      end associate
+   end subroutine read_heights
 
    !> Read an ASCII height matrix (nm), one image row per line, values separated by
    !> blanks, tabs or commas, lines starting with '#' ignored (Gwyddion export). The

@@ -30,8 +30,11 @@ module femcod_incremental
    use femcod_heap, only: min_heap, heap_build, heap_push, heap_pop, heap_top_key
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, &
-      STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, record_load_states, finish_contacts
+      STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, record_load_states, finish_contacts, solver_state, &
+      checkpoint_interface
+   use femcod_sort, only: merge_sort_index
    use femcod_clock, only: wall_clock
+   use femcod_memory, only: physical_memory, memory_text
    implicit none
    private
    public :: solve_incremental, scene_report
@@ -72,12 +75,20 @@ contains
    end function scene_report
 
    !> Run the event-exact algorithm on a deck (same outputs as the legacy solver).
-   subroutine solve_incremental(deck, options, res, status, progress)
+   !> With `checkpoint`, the state is handed over every options%checkpoint_interval
+   !> seconds; with `resume`, the run continues from such a state and ends exactly as
+   !> the uninterrupted run would (the caller checks that deck and options match).
+   subroutine solve_incremental(deck, options, res, status, progress, checkpoint, resume)
       type(deck_type), intent(in) :: deck
       type(contact_options), intent(in) :: options
       type(contact_result), intent(out) :: res
       type(status_type), intent(inout) :: status
       procedure(progress_interface), optional :: progress
+      procedure(checkpoint_interface), optional :: checkpoint
+      type(solver_state), intent(in), optional :: resume
+      integer, allocatable :: ops(:), order(:)
+      integer :: nops
+      real(dp) :: last_checkpoint
       real(dp), allocatable :: table(:, :), g0(:), ftot(:), funit(:), u(:, :), y(:), x(:), col(:), keys(:)
       real(dp), allocatable :: lam_eval(:), gap_eval(:), loads(:)
       integer, allocatable :: ic(:), jc(:), pix(:), cstep(:), slot(:), eval_pix(:), joiners(:), items(:)
@@ -126,12 +137,21 @@ contains
       approach = 0
       n = 0
       step = 0
-      ! The first contact: the smallest gap (ties join at the next step with no load).
-      call pop_valid(p)
-      call add_contact(p, 1)
-      if (status%code /= 0) return
+      allocate(ops(64))
+      nops = 0
+      if (present(resume)) then
+         call restore(resume)
+         if (status%code /= 0) return
+      else
+         ! The first contact: the smallest gap (ties join at the next step with no load).
+         call pop_valid(p)
+         call add_contact(p, 1)
+         if (status%code /= 0) return
+      end if
+      call wall_clock(last_checkpoint)
 
       do
+         if (present(checkpoint)) call maybe_checkpoint()
          step = step + 1
          call wall_clock(t0)
          ! Unit-load solution from the factor: x = M^-1 1 = U^-1 y, beta = 1'x = y'y.
@@ -194,12 +214,20 @@ contains
                call heap_push(heap, gap_eval(q) + phi, eval_pix(q))
             end if
          end do
+         if (njoin > 1) then
+            ! Tied contacts join in pixel order, so that the factor (and every result
+            ! bit) does not depend on the order the heap handed them out.
+            if (allocated(order)) deallocate(order)
+            allocate(order(njoin))
+            call merge_sort_index(real(joiners(1:njoin), dp), order)
+            joiners(1:njoin) = joiners(order)
+         end if
          res%missed_during_run = res%missed_during_run + count(gap_eval(1:neval) < -options%tie_tolerance*approach)
 
          if (lam_best >= huge(1.0_dp)) then
             ! Nothing can close and nothing is released: linear for ever.
             call record_load_states(res, huge(1.0_dp), .false., total, approach, delta, ftot(1:n), funit(1:n), &
-               deck%pixel, options%hardness)
+               deck%pixel, options%hardness, ic(1:n), jc(1:n))
             res%stop_reason = STOP_NO_CONTACT
             if (size(loads) > 0) then
                if (max_load > total) call advance(max_load - total)
@@ -210,7 +238,7 @@ contains
          end if
          lam_best = max(lam_best, 0.0_dp)
          call record_load_states(res, lam_best, .true., total, approach, delta, ftot(1:n), funit(1:n), &
-            deck%pixel, options%hardness)
+            deck%pixel, options%hardness, ic(1:n), jc(1:n))
          call advance(lam_best)
          call wall_clock(t1)
          call append_step(res, n, total, approach, t1 - t0)
@@ -251,6 +279,88 @@ contains
 
    contains
 
+      !> Hand the state to the checkpoint procedure when the interval has passed.
+      subroutine maybe_checkpoint()
+         type(solver_state) :: state
+         real(dp) :: now
+         if (options%checkpoint_interval < 0 .or. step == 0) return
+         call wall_clock(now)
+         if (now - last_checkpoint < options%checkpoint_interval) return
+         state%step = step
+         state%n = n
+         state%total = total
+         state%approach = approach
+         state%operations = ops(1:nops)
+         state%cstep = cstep(1:n)
+         state%ftot = ftot(1:n)
+         state%res = res
+         call checkpoint(state)
+         call wall_clock(last_checkpoint)
+      end subroutine maybe_checkpoint
+
+      !> Continue from a stored state: replay the contact operations (the same bordered
+      !> updates in the same order give the same factor), restore the accumulated
+      !> quantities, and key the heap by the current gaps from one FFT convolution
+      !> (less a margin, so the keys stay lower bounds).
+      subroutine restore(state)
+         type(solver_state), intent(in) :: state
+         type(love_convolution) :: conv
+         real(dp), allocatable :: field(:, :), disp(:, :)
+         real(dp) :: margin
+         integer :: qq, iq, jq, m
+         do qq = 1, size(state%operations)
+            if (state%operations(qq) > 0) then
+               call add_contact(state%operations(qq), 0)
+            else
+               call release_contact(-state%operations(qq))
+            end if
+            if (status%code /= 0) return
+         end do
+         if (n /= state%n) then
+            call set_error(status, STATUS_NUMERICAL, "incremental: the checkpoint's contact list is inconsistent")
+            return
+         end if
+         cstep(1:n) = state%cstep
+         ftot(1:n) = state%ftot
+         total = state%total
+         approach = state%approach
+         step = state%step
+         res = state%res
+         allocate(field(np, np), disp(np, np))
+         field = 0
+         do qq = 1, n
+            field(ic(qq), jc(qq)) = ftot(qq)
+         end do
+         call convolution_setup(conv, table)
+         call convolution_apply(conv, field, disp)
+         call convolution_free(conv)
+         margin = 1.0e-9_dp*(abs(approach) + maxval(abs(g0)))
+         m = 0
+         do qq = 1, npix
+            if (slot(qq) /= 0) cycle
+            iq = (qq - 1)/np + 1
+            jq = qq - (iq - 1)*np
+            m = m + 1
+            keys(m) = g0(qq) - approach + c*disp(iq, jq) - margin
+            items(m) = qq
+         end do
+         call heap_build(heap, keys(1:m), items(1:m), npix)
+         phi = 0
+      end subroutine restore
+
+      !> Record a contact operation for checkpoints (+pixel joined, -k released).
+      subroutine log_operation(op)
+         integer, intent(in) :: op
+         integer, allocatable :: longer(:)
+         if (nops == size(ops)) then
+            allocate(longer(2*size(ops)))
+            longer(1:nops) = ops(1:nops)
+            call move_alloc(longer, ops)
+         end if
+         nops = nops + 1
+         ops(nops) = op
+      end subroutine log_operation
+
       !> Pop the heap until a pixel not in contact appears.
       subroutine pop_valid(pixel)
          integer, intent(out) :: pixel
@@ -282,7 +392,15 @@ contains
          ip = (pixel - 1)/np + 1
          jp = pixel - (ip - 1)*np
          if (n + 1 > ld) then
-            ! Grow the factor's storage by doubling (amortised O(n^2) copies).
+            ! Grow the factor's storage by doubling (amortised O(n^2) copies), within
+            ! the machine's memory (Linux would over-commit and kill the run later).
+            if (physical_memory() > 0 .and. 8*int(min(2*ld, maxc), i8)**2 > physical_memory()) then
+               call set_error(status, STATUS_NUMERICAL, "incremental: the factor for "// &
+                  trim(i8str(int(min(2*ld, maxc), i8)))//" contacts needs "// &
+                  memory_text(8*int(min(2*ld, maxc), i8)**2)//", this machine has "// &
+                  memory_text(physical_memory())//"; lower MAXCONT or --max-contacts")
+               return
+            end if
             allocate(bigger(min(2*ld, maxc), min(2*ld, maxc)), stat=stat)
             if (stat /= 0) then
                call set_error(status, STATUS_NUMERICAL, "incremental: cannot allocate the factor for "// &
@@ -313,12 +431,14 @@ contains
          cstep(n) = joined
          ftot(n) = 0
          slot(pixel) = n
+         call log_operation(pixel)
       end subroutine add_contact
 
       !> Remove contact k (its force is zero) and refactor the rest (LAPACK dpptrf).
       subroutine release_contact(krm)
          integer, intent(in) :: krm
          integer :: a, b
+         call log_operation(-krm)
          ftot(krm) = 0
          slot(pix(krm)) = 0
          call heap_push(heap, phi, pix(krm))

@@ -115,7 +115,7 @@ contains
          end if
          res%missed_during_run = res%missed_during_run + nmissed
          call record_load_states(res, lambda, njoin > 0, total, approach, delta, ftot(1:n), funit(1:n), deck%pixel, &
-            options%hardness)
+            options%hardness, ic(1:n), jc(1:n))
          if (njoin == 0) then
             res%stop_reason = STOP_NO_CONTACT
             if (size(loads) > 0) then

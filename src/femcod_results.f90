@@ -1,121 +1,404 @@
-!> Result files of a run (CSV), written under temporary names and renamed only when
-!> all of them are complete, so a failed run leaves no partial result.
+!> Result files of a run, written under temporary names and renamed only when all of
+!> them are complete, so a failed run leaves no partial result (doc/results.md):
 !>   PREFIX.history.csv   step,contacts,load_nN,approach_nm,area_nm2,area_fraction
 !>   PREFIX.loads.csv     load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness
 !>   PREFIX.contacts.csv  i,j,step,force_nN,pressure_GPa
+!>   PREFIX.h5            /deck /surfaces /history /contacts /loads/<k> /run
+!>   PREFIX.xdmf          the maps of PREFIX.h5 for ParaView
+!>   PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg
 module femcod_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_deck, only: deck_type, format_real
-   use femcod_strings, only: int_str
-   use femcod_files, only: atomic_rename, remove_file, temporary_name
-   use femcod_contact_result, only: contact_result
+   use femcod_strings, only: string_type, int_str
+   use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists
+   use femcod_contact_result, only: contact_result, stop_reason_text
+   use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_write, h5_attribute
+   use femcod_maps, only: load_maps
+   use femcod_svg, only: svg_plot, svg_pressure_map, fmt_sig
+   use femcod_richardson, only: power_law_fit
    implicit none
    private
-   public :: write_csv_results
+   public :: write_results, run_info, result_files
+
+   !> What the run was, for /run in the HDF5 file.
+   type :: run_info
+      character(len=:), allocatable :: version, solver, options
+      !> What the scene left out, one line each.
+      type(string_type), allocatable :: scene(:)
+   end type run_info
+
+   !> The maps of one requested load.
+   type :: maps_type
+      real(dp), allocatable :: pressure(:, :), gap(:, :)
+   end type maps_type
 
 contains
 
-   !> Write the three CSV files for `prefix`. The loads file is written only when loads
-   !> were requested.
-   subroutine write_csv_results(prefix, deck, res, status)
+   !> The names of every file a run writes for `prefix` (with `nloads` requested loads).
+   function result_files(prefix, nloads) result(names)
+      character(len=*), intent(in) :: prefix
+      integer, intent(in) :: nloads
+      type(string_type), allocatable :: names(:)
+      integer :: k
+      allocate(names(0))
+      names = [string_type(prefix//".history.csv"), string_type(prefix//".contacts.csv"), &
+         string_type(prefix//".h5"), string_type(prefix//".xdmf"), string_type(prefix//".load_approach.svg"), &
+         string_type(prefix//".area_load.svg")]
+      if (nloads > 0) names = [names, string_type(prefix//".loads.csv")]
+      do k = 1, nloads
+         names = [names, string_type(prefix//".pressure_"//int_str(k)//".svg")]
+      end do
+   end function result_files
+
+   !> Write every result file for `prefix`; on failure none is left behind and
+   !> existing files of that name are untouched. Each file is renamed into place when
+   !> all are written, PREFIX.h5 last, so its presence marks a complete set.
+   subroutine write_results(prefix, deck, res, info, status)
       character(len=*), intent(in) :: prefix
       type(deck_type), intent(in) :: deck
       type(contact_result), intent(in) :: res
+      type(run_info), intent(in) :: info
       type(status_type), intent(inout) :: status
-      character(len=:), allocatable :: names(:), temps(:)
-      integer :: unit, ios, k, nfiles
-      real(dp) :: area_pixel, region
-      logical :: with_loads
-      area_pixel = deck%pixel**2
-      region = deck%np**2*area_pixel
-      with_loads = size(res%states) > 0
-      nfiles = merge(3, 2, with_loads)
-      allocate(character(len=len(prefix) + 14) :: names(3), temps(3))
-      names(1) = prefix//".history.csv"
-      names(2) = prefix//".contacts.csv"
-      names(3) = prefix//".loads.csv"
-      do k = 1, 3
-         temps(k) = temporary_name(trim(names(k)))
+      type(string_type), allocatable :: names(:), temps(:)
+      type(maps_type), allocatable :: maps(:)
+      integer :: k, m
+      if (status%code /= 0) return
+      allocate(names(0), temps(0), maps(size(res%states)))
+      do k = 1, size(res%states)
+         if (res%states(k)%reached) call load_maps(deck, res%states(k), maps(k)%pressure, maps(k)%gap)
       end do
-
-      ios = 0
-      open(newunit=unit, file=trim(temps(1)), status="replace", action="write", iostat=ios)
-      if (ios /= 0) then
-         call fail(1)
-         return
+      call add(".history.csv")
+      call write_history_csv(temps(size(temps))%s, deck, res, status)
+      call add(".contacts.csv")
+      call write_contacts_csv(temps(size(temps))%s, deck, res, status)
+      if (size(res%states) > 0) then
+         call add(".loads.csv")
+         call write_loads_csv(temps(size(temps))%s, deck, res, status)
       end if
-      write(unit, '(a)', iostat=ios) "step,contacts,load_nN,approach_nm,area_nm2,area_fraction"
-      do k = 1, res%nsteps
-         write(unit, '(a)', iostat=ios) int_str(k)//","//int_str(res%step_contacts(k))//","// &
-            format_real(res%step_load(k))//","//format_real(res%step_approach(k))//","// &
-            format_real(res%step_contacts(k)*area_pixel)//","//format_real(res%step_contacts(k)*area_pixel/region)
+      call add(".xdmf")
+      call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res), status)
+      call add(".load_approach.svg")
+      call write_text(temps(size(temps))%s, svg_plot("femcod: "//deck%label, "approach (nm)", "total load (nN)", &
+         res%step_approach(1:res%nsteps), res%step_load(1:res%nsteps), .false., .false.), status)
+      call add(".area_load.svg")
+      call write_text(temps(size(temps))%s, area_load_svg(deck, res), status)
+      do k = 1, size(res%states)
+         if (.not. res%states(k)%reached) cycle
+         call add(".pressure_"//int_str(k)//".svg")
+         call write_text(temps(size(temps))%s, svg_pressure_map("contact pressure at "// &
+            fmt_sig(res%states(k)%load, 6)//" nN (approach "//fmt_sig(res%states(k)%approach, 4)//" nm, "// &
+            int_str(res%states(k)%contacts)//" contacts)", &
+            maps(k)%pressure, deck%np*deck%pixel), status)
       end do
-      close(unit, iostat=ios)
-      if (ios /= 0) then
-         call fail(1)
-         return
-      end if
-
-      open(newunit=unit, file=trim(temps(2)), status="replace", action="write", iostat=ios)
-      if (ios /= 0) then
-         call fail(2)
-         return
-      end if
-      write(unit, '(a)', iostat=ios) "i,j,step,force_nN,pressure_GPa"
-      do k = 1, size(res%contact_i)
-         write(unit, '(a)', iostat=ios) int_str(res%contact_i(k))//","//int_str(res%contact_j(k))//","// &
-            int_str(res%contact_step(k))//","//format_real(res%contact_force(k))//","// &
-            format_real(res%contact_force(k)/area_pixel)
-      end do
-      close(unit, iostat=ios)
-      if (ios /= 0) then
-         call fail(2)
-         return
-      end if
-
-      if (with_loads) then
-         open(newunit=unit, file=trim(temps(3)), status="replace", action="write", iostat=ios)
-         if (ios /= 0) then
-            call fail(3)
-            return
-         end if
-         write(unit, '(a)', iostat=ios) &
-            "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness"
-         do k = 1, size(res%states)
-            if (.not. res%states(k)%reached) cycle
-            associate(s => res%states(k))
-               write(unit, '(a)', iostat=ios) format_real(s%load)//","//format_real(s%approach)//","// &
-                  int_str(s%contacts)//","//format_real(s%contacts*area_pixel)//","// &
-                  format_real(s%contacts*area_pixel/region)//","//format_real(s%max_pressure)//","// &
-                  int_str(s%n_above_hardness)
-            end associate
+      ! PREFIX.h5 is renamed last: when it exists, the whole set is complete.
+      call add(".h5")
+      call write_hdf5(temps(size(temps))%s, deck, res, info, maps, status)
+      if (status%code /= 0) then
+         do m = 1, size(temps)
+            call remove_file(temps(m)%s)
          end do
-         close(unit, iostat=ios)
-         if (ios /= 0) then
-            call fail(3)
-            return
-         end if
+         return
       end if
-
-      do k = 1, nfiles
-         call atomic_rename(trim(temps(k)), trim(names(k)), status)
+      do k = 1, size(names)
+         call atomic_rename(temps(k)%s, names(k)%s, status)
          if (status%code /= 0) then
-            call cleanup()
+            ! No partial set: drop the files of this set already in place too.
+            do m = 1, size(temps)
+               call remove_file(temps(m)%s)
+               if (m < k) call remove_file(names(m)%s)
+            end do
             return
          end if
       end do
    contains
-      subroutine fail(which)
-         integer, intent(in) :: which
-         call set_error(status, STATUS_IO, trim(names(which))//": cannot write (directory missing or not writable)")
-         call cleanup()
-      end subroutine fail
-      subroutine cleanup()
-         integer :: m
-         do m = 1, 3
-            call remove_file(trim(temps(m)))
+      subroutine add(suffix)
+         character(len=*), intent(in) :: suffix
+         names = [names, string_type(prefix//suffix)]
+         temps = [temps, string_type(temporary_name(prefix//suffix))]
+      end subroutine add
+   end subroutine write_results
+
+
+   !> Open a temporary file for writing; on failure `status` names the result file.
+   subroutine open_for_writing(tmp, unit, status)
+      character(len=*), intent(in) :: tmp
+      integer, intent(out) :: unit
+      type(status_type), intent(inout) :: status
+      integer :: ios
+      unit = -1
+      if (status%code /= 0) return
+      open(newunit=unit, file=tmp, status="replace", action="write", iostat=ios)
+      if (ios /= 0) then
+         unit = -1
+         call set_error(status, STATUS_IO, result_name(tmp)//": cannot write (directory missing or not writable)")
+      end if
+   end subroutine open_for_writing
+
+   subroutine close_written(unit, tmp, ios, status)
+      integer, intent(in) :: unit, ios
+      character(len=*), intent(in) :: tmp
+      type(status_type), intent(inout) :: status
+      integer :: ios2
+      close(unit, iostat=ios2)
+      if ((ios /= 0 .or. ios2 /= 0) .and. status%code == 0) &
+         call set_error(status, STATUS_IO, result_name(tmp)//": writing failed (disk full?)")
+   end subroutine close_written
+
+   !> The result file a temporary name stands for (temporary_name appends ".part").
+   function result_name(tmp) result(name)
+      character(len=*), intent(in) :: tmp
+      character(len=:), allocatable :: name
+      integer :: k
+      k = index(tmp, ".part", back=.true.)
+      name = tmp
+      if (k > 1) name = tmp(1:k - 1)
+   end function result_name
+
+   subroutine write_text(tmp, text, status)
+      character(len=*), intent(in) :: tmp, text
+      type(status_type), intent(inout) :: status
+      integer :: unit, ios
+      if (status%code /= 0) return
+      ! Unformatted stream: the bytes of `text`, no record marks or added line end.
+      open(newunit=unit, file=tmp, access="stream", form="unformatted", status="replace", action="write", iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_IO, result_name(tmp)//": cannot write (directory missing or not writable)")
+         return
+      end if
+      write(unit, iostat=ios) text
+      call close_written(unit, tmp, ios, status)
+   end subroutine write_text
+
+   subroutine write_history_csv(tmp, deck, res, status)
+      character(len=*), intent(in) :: tmp
+      type(deck_type), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      type(status_type), intent(inout) :: status
+      integer :: unit, ios, k
+      real(dp) :: area_pixel, region
+      call open_for_writing(tmp, unit, status)
+      if (status%code /= 0) return
+      area_pixel = deck%pixel**2
+      region = deck%np**2*area_pixel
+      write(unit, '(a)', iostat=ios) "step,contacts,load_nN,approach_nm,area_nm2,area_fraction"
+      do k = 1, res%nsteps
+         if (ios /= 0) exit
+         write(unit, '(a)', iostat=ios) int_str(k)//","//int_str(res%step_contacts(k))//","// &
+            format_real(res%step_load(k))//","//format_real(res%step_approach(k))//","// &
+            format_real(res%step_contacts(k)*area_pixel)//","//format_real(res%step_contacts(k)*area_pixel/region)
+      end do
+      call close_written(unit, tmp, ios, status)
+   end subroutine write_history_csv
+
+   subroutine write_contacts_csv(tmp, deck, res, status)
+      character(len=*), intent(in) :: tmp
+      type(deck_type), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      type(status_type), intent(inout) :: status
+      integer :: unit, ios, k
+      call open_for_writing(tmp, unit, status)
+      if (status%code /= 0) return
+      write(unit, '(a)', iostat=ios) "i,j,step,force_nN,pressure_GPa"
+      do k = 1, size(res%contact_i)
+         if (ios /= 0) exit
+         write(unit, '(a)', iostat=ios) int_str(res%contact_i(k))//","//int_str(res%contact_j(k))//","// &
+            int_str(res%contact_step(k))//","//format_real(res%contact_force(k))//","// &
+            format_real(res%contact_force(k)/deck%pixel**2)
+      end do
+      call close_written(unit, tmp, ios, status)
+   end subroutine write_contacts_csv
+
+   subroutine write_loads_csv(tmp, deck, res, status)
+      character(len=*), intent(in) :: tmp
+      type(deck_type), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      type(status_type), intent(inout) :: status
+      integer :: unit, ios, k
+      real(dp) :: area_pixel, region
+      call open_for_writing(tmp, unit, status)
+      if (status%code /= 0) return
+      area_pixel = deck%pixel**2
+      region = deck%np**2*area_pixel
+      write(unit, '(a)', iostat=ios) "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness"
+      do k = 1, size(res%states)
+         if (.not. res%states(k)%reached .or. ios /= 0) cycle
+         associate(s => res%states(k))
+            write(unit, '(a)', iostat=ios) format_real(s%load)//","//format_real(s%approach)//","// &
+               int_str(s%contacts)//","//format_real(s%contacts*area_pixel)//","// &
+               format_real(s%contacts*area_pixel/region)//","//format_real(s%max_pressure)//","// &
+               int_str(s%n_above_hardness)
+         end associate
+      end do
+      call close_written(unit, tmp, ios, status)
+   end subroutine write_loads_csv
+
+   !> The HDF5 file (schema in doc/results.md).
+   subroutine write_hdf5(tmp, deck, res, info, maps, status)
+      character(len=*), intent(in) :: tmp
+      type(deck_type), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      type(run_info), intent(in) :: info
+      type(maps_type), intent(in) :: maps(:)
+      type(status_type), intent(inout) :: status
+      type(h5_file) :: file
+      type(status_type) :: local
+      character(len=:), allocatable :: g, scene
+      real(dp) :: area_pixel, region, exponent, prefactor
+      integer :: k, n
+      if (status%code /= 0) return
+      n = res%nsteps
+      area_pixel = deck%pixel**2
+      region = deck%np**2*area_pixel
+      call h5_create(tmp, file, local)
+      file%path = result_name(tmp)
+      call h5_group(file, "/deck", local)
+      call h5_attribute(file, "/deck", "label", deck%label, local)
+      call h5_attribute(file, "/deck", "NP", deck%np, local)
+      call h5_attribute(file, "/deck", "pixel_nm", deck%pixel, local)
+      call h5_attribute(file, "/deck", "MAXCONT", deck%maxcont, local)
+      call h5_attribute(file, "/deck", "young_lower_GPa", deck%young(1), local)
+      call h5_attribute(file, "/deck", "young_upper_GPa", deck%young(2), local)
+      call h5_attribute(file, "/deck", "young_contact_GPa", deck%young(3), local)
+      call h5_attribute(file, "/deck", "poisson_lower", deck%poisson(1), local)
+      call h5_attribute(file, "/deck", "poisson_upper", deck%poisson(2), local)
+      call h5_attribute(file, "/deck", "poisson_contact", deck%poisson(3), local)
+      call h5_group(file, "/surfaces", local)
+      call h5_write(file, "/surfaces/lower", deck%lower, "nm", local)
+      call h5_write(file, "/surfaces/upper", deck%upper, "nm", local)
+      call h5_group(file, "/history", local)
+      call h5_write(file, "/history/step", [(k, k = 1, n)], "1", local)
+      call h5_write(file, "/history/contacts", res%step_contacts(1:n), "1", local)
+      call h5_write(file, "/history/load", res%step_load(1:n), "nN", local)
+      call h5_write(file, "/history/approach", res%step_approach(1:n), "nm", local)
+      call h5_write(file, "/history/area", res%step_contacts(1:n)*area_pixel, "nm^2", local)
+      call h5_write(file, "/history/area_fraction", res%step_contacts(1:n)*area_pixel/region, "1", local)
+      call h5_group(file, "/contacts", local)
+      call h5_attribute(file, "/contacts", "load_nN", res%reported_load, local)
+      call h5_write(file, "/contacts/i", res%contact_i, "1", local)
+      call h5_write(file, "/contacts/j", res%contact_j, "1", local)
+      call h5_write(file, "/contacts/step", res%contact_step, "1", local)
+      call h5_write(file, "/contacts/force", res%contact_force, "nN", local)
+      call h5_group(file, "/loads", local)
+      do k = 1, size(res%states)
+         if (.not. res%states(k)%reached) cycle
+         g = "/loads/"//int_str(k)
+         associate(s => res%states(k))
+            call h5_group(file, g, local)
+            call h5_attribute(file, g, "load_nN", s%load, local)
+            call h5_attribute(file, g, "approach_nm", s%approach, local)
+            call h5_attribute(file, g, "contacts", s%contacts, local)
+            call h5_attribute(file, g, "area_nm2", s%contacts*area_pixel, local)
+            call h5_attribute(file, g, "max_pressure_GPa", s%max_pressure, local)
+            call h5_attribute(file, g, "n_above_hardness", s%n_above_hardness, local)
+            call h5_write(file, g//"/pressure", maps(k)%pressure, "GPa", local)
+            call h5_write(file, g//"/gap", maps(k)%gap, "nm", local)
+         end associate
+      end do
+      call h5_group(file, "/run", local)
+      call h5_attribute(file, "/run", "femcod_version", info%version, local)
+      call h5_attribute(file, "/run", "solver", info%solver, local)
+      call h5_attribute(file, "/run", "options", info%options, local)
+      call h5_attribute(file, "/run", "wall_time_s", res%wall_seconds, local)
+      call h5_attribute(file, "/run", "stop_reason", stop_reason_text(res%stop_reason), local)
+      scene = ""
+      do k = 1, size(info%scene)
+         scene = scene//info%scene(k)%s
+         if (k < size(info%scene)) scene = scene//"; "
+      end do
+      call h5_attribute(file, "/run", "scene_left_out", scene, local)
+      call h5_write(file, "/run/missed_during_run", res%missed_during_run, "1", local)
+      call h5_write(file, "/run/missed_final_check", res%missed_final_check, "1", local)
+      call h5_write(file, "/run/max_penetration", res%max_penetration, "nm", local)
+      call h5_write(file, "/run/final_resolve_difference", res%final_check_difference, "1", local)
+      call h5_write(file, "/run/releases", res%releases, "1", local)
+      call h5_write(file, "/run/exact_evaluations", real(res%evaluations, dp), "1", local)
+      call area_fit(deck, res, exponent, prefactor)
+      call h5_write(file, "/run/area_load_exponent", exponent, "1", local)
+      call h5_write(file, "/run/area_load_prefactor", prefactor, "nm^2/nN^exponent", local)
+      call h5_close(file, local)
+      if (local%code /= 0) call set_error(status, STATUS_IO, local%message)
+   end subroutine write_hdf5
+
+   !> area = prefactor * load^exponent, least squares in log-log over the steps with
+   !> positive load (0, 0 when fewer than two).
+   subroutine area_fit(deck, res, exponent, prefactor)
+      type(deck_type), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      real(dp), intent(out) :: exponent, prefactor
+      logical, allocatable :: keep(:)
+      exponent = 0
+      prefactor = 0
+      if (res%nsteps < 2) return
+      keep = res%step_load(1:res%nsteps) > 0
+      if (count(keep) < 2) return
+      call power_law_fit(pack(res%step_load(1:res%nsteps), keep), &
+         pack(res%step_contacts(1:res%nsteps)*deck%pixel**2, keep), exponent, prefactor)
+   end subroutine area_fit
+
+   function area_load_svg(deck, res) result(svg)
+      type(deck_type), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      character(len=:), allocatable :: svg
+      real(dp) :: exponent, prefactor
+      real(dp), allocatable :: area(:)
+      call area_fit(deck, res, exponent, prefactor)
+      area = res%step_contacts(1:res%nsteps)*deck%pixel**2
+      if (prefactor > 0) then
+         svg = svg_plot("contact area against load: "//deck%label, "total load (nN)", "contact area (nm^2)", &
+            res%step_load(1:res%nsteps), area, .true., .true., exponent, prefactor)
+      else
+         svg = svg_plot("contact area against load: "//deck%label, "total load (nN)", "contact area (nm^2)", &
+            res%step_load(1:res%nsteps), area, .true., .true.)
+      end if
+   end function area_load_svg
+
+   !> XDMF 3 description of the maps: the surfaces, then one grid per reached load in
+   !> a temporal collection (time = load in nN), cell-centred on a 2DCoRectMesh.
+   function xdmf_text(h5name, deck, res) result(x)
+      character(len=*), intent(in) :: h5name
+      type(deck_type), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      character(len=:), allocatable :: x
+      character(len=1), parameter :: nl = new_line("a")
+      character(len=:), allocatable :: dims, nodes, geometry
+      integer :: k
+      dims = int_str(deck%np)//" "//int_str(deck%np)
+      nodes = int_str(deck%np + 1)//" "//int_str(deck%np + 1)
+      geometry = '    <Topology TopologyType="2DCoRectMesh" Dimensions="'//nodes//'"/>'//nl// &
+         '    <Geometry GeometryType="ORIGIN_DXDY">'//nl// &
+         '     <DataItem Format="XML" Dimensions="2">0 0</DataItem>'//nl// &
+         '     <DataItem Format="XML" Dimensions="2">'//format_real(deck%pixel)//" "//format_real(deck%pixel)// &
+         '</DataItem>'//nl//'    </Geometry>'//nl
+      x = '<?xml version="1.0" ?>'//nl//'<Xdmf Version="3.0">'//nl//' <Domain>'//nl// &
+         '  <Grid Name="surfaces" GridType="Uniform">'//nl//geometry// &
+         attribute("lower_nm", "/surfaces/lower")//attribute("upper_nm", "/surfaces/upper")//'  </Grid>'//nl
+      if (any(res%states%reached)) then
+         x = x//'  <Grid Name="loads" GridType="Collection" CollectionType="Temporal">'//nl
+         do k = 1, size(res%states)
+            if (.not. res%states(k)%reached) cycle
+            x = x//'   <Grid Name="load_'//int_str(k)//'" GridType="Uniform">'//nl// &
+               '    <Time Value="'//format_real(res%states(k)%load)//'"/>'//nl//geometry// &
+               attribute("pressure_GPa", "/loads/"//int_str(k)//"/pressure")// &
+               attribute("gap_nm", "/loads/"//int_str(k)//"/gap")//'   </Grid>'//nl
          end do
-      end subroutine cleanup
-   end subroutine write_csv_results
+         x = x//'  </Grid>'//nl
+      end if
+      x = x//' </Domain>'//nl//'</Xdmf>'//nl
+   contains
+      function attribute(name, path) result(a)
+         character(len=*), intent(in) :: name, path
+         character(len=:), allocatable :: a
+         a = '    <Attribute Name="'//name//'" AttributeType="Scalar" Center="Cell">'//nl// &
+            '     <DataItem Format="HDF" NumberType="Float" Precision="8" Dimensions="'//dims//'">'// &
+            h5name//':'//path//'</DataItem>'//nl//'    </Attribute>'//nl
+      end function attribute
+   end function xdmf_text
+
+   !> The file name without its directory.
+   function base_name(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      name = path(index(path, "/", back=.true.) + 1:)
+   end function base_name
 end module femcod_results

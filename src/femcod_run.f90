@@ -8,10 +8,16 @@ module femcod_run
    use femcod_status, only: status_type, STATUS_USAGE
    use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real
    use femcod_strings, only: string_type, int_str, real_str, split_list
-   use femcod_contact_result, only: contact_result, contact_options, stop_reason_text
+   use femcod_contact_result, only: contact_result, contact_options, stop_reason_text, solver_state
+   use femcod_checkpoint, only: write_checkpoint, read_checkpoint
+   use femcod_files, only: remove_file
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental, scene_report
-   use femcod_results, only: write_csv_results
+   use femcod_results, only: write_results, run_info, result_files
+   use femcod_generate, only: deck_spec, build_deck
+   use femcod_files, only: path_exists
+   use femcod_about, only: FEMCOD_VERSION
+   use femcod_status, only: STATUS_IO
    implicit none
    private
    public :: run_command
@@ -23,13 +29,20 @@ module femcod_run
    !> (n^3 for the incremental solver, n^4 for the legacy one).
    integer, save :: target_contacts = 0
    real(dp), save :: target_load = 0, growth = 3
+   !> Where and for what the checkpoint procedure writes (set before each solve).
+   character(len=:), allocatable, save :: checkpoint_path
+   type(deck_type), save :: checkpoint_deck
+   type(contact_options), save :: checkpoint_options
+   logical, save :: checkpoint_warned = .false.
 
 contains
 
    subroutine run_help()
       write(output_unit, '(a)') &
          "usage: femcod run DECK [DECK ...] [-o PREFIX] [--solver incremental|legacy] [--loads F1,F2,...]", &
-         "                  [--max-contacts N] [--hardness H] [--no-final-check] [--quiet]", &
+         "                  [--max-contacts N] [--hardness H] [--no-final-check] [--quiet] [--force]", &
+         "       femcod run --lower FILE [--upper FILE] --pixel D [--young E] [--poisson NU]", &
+         "                  [--rigid upper|lower|none] [--maxcont M] [--remove-plane] [options as above]", &
          "", &
          "Contact history of each deck, step by step (thesis chapter 4, Appendix B). With several decks", &
          "(batch) each gets its own outputs named after it; a bad deck is reported and the others still", &
@@ -44,11 +57,29 @@ contains
          "  --hardness H       GPa, for n_above_hardness (default 11, polysilicon)", &
          "  --no-final-check   skip the final check of every pixel for missed contacts", &
          "  --quiet            no summary on standard output, no progress lines on standard error", &
+         "  --checkpoint-interval S  write PREFIX.ckpt.h5 (atomically) every S seconds of wall time", &
+         "                     (default 300; 0: after every step; incremental solver); removed at the end", &
+         "  --restart          continue from PREFIX.ckpt.h5 if it exists (refused if it belongs to another", &
+         "                     deck or other options); the run ends exactly as an uninterrupted one", &
+         "  --force            overwrite existing result files (otherwise a deck whose results exist fails", &
+         "                     with exit code 5 before it is solved)", &
+         "", &
+         "heights straight from files, without a deck (one scene; -o defaults to the first file's name):", &
+         "  --lower FILE       lower surface heights (nm): an ASCII matrix, or FILE.h5:/dataset (square,", &
+         "                     C order: data[i, j] is row i, column j)", &
+         "  --upper FILE       upper surface heights, the same formats (missing: flat)", &
+         "  --pixel D          pixel size in nm (required)", &
+         "  --young E, --poisson NU   the elastic body (default 200 GPa, 0.25)", &
+         "  --rigid upper|lower|none  rigid body (default upper), as femcod mkdeck", &
+         "  --maxcont M        maximum contacts (default 5 % of the pixels)", &
+         "  --remove-plane     subtract each surface's least-squares plane", &
          "", &
          "outputs: PREFIX.history.csv (step,contacts,load_nN,approach_nm,area_nm2,area_fraction),", &
          "         PREFIX.contacts.csv (i,j,step,force_nN,pressure_GPa) at the largest requested load", &
          "         or the last step, PREFIX.loads.csv (load_nN,approach_nm,contacts,area_nm2,area_fraction,", &
-         "         max_pressure_GPa,n_above_hardness)", &
+         "         max_pressure_GPa,n_above_hardness), PREFIX.h5 (everything, with the pressure and gap", &
+         "         maps at each requested load; doc/results.md), PREFIX.xdmf (the maps for ParaView),", &
+         "         PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg", &
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
    end subroutine run_help
 
@@ -61,10 +92,25 @@ contains
       type(contact_result) :: res
       type(string_type), allocatable :: parts(:), decks(:), failed(:)
       character(len=:), allocatable :: deck_path, prefix, solver, key, current_prefix
-      logical :: quiet, ok
+      type(deck_spec) :: spec
+      type(run_info) :: info
+      type(solver_state) :: resume
+      logical :: quiet, ok, force, restart
       integer :: i, k, d, rc
       code = 0
       quiet = .false.
+      force = .false.
+      restart = .false.
+      options%checkpoint_interval = 300
+      spec%kind = "matrix"
+      spec%label = ""
+      spec%matrix_file = ""
+      spec%second_file = ""
+      info%options = ""
+      do k = 1, size(args)
+         info%options = info%options//args(k)%s
+         if (k < size(args)) info%options = info%options//" "
+      end do
       deck_path = ""
       allocate(decks(0), failed(0))
       prefix = ""
@@ -83,6 +129,18 @@ contains
             cycle
          case ("--no-final-check")
             options%final_check = .false.
+            i = i + 1
+            cycle
+         case ("--force")
+            force = .true.
+            i = i + 1
+            cycle
+         case ("--restart")
+            restart = .true.
+            i = i + 1
+            cycle
+         case ("--remove-plane")
+            spec%plane = .true.
             i = i + 1
             cycle
          end select
@@ -134,6 +192,34 @@ contains
                   call usage("--hardness expects a positive number in GPa, found '"//v//"'")
                   return
                end if
+            case ("--checkpoint-interval")
+               call parse_real(v, options%checkpoint_interval, ok)
+               if (.not. ok .or. options%checkpoint_interval < 0) then
+                  call usage("--checkpoint-interval expects seconds >= 0, found '"//v//"'")
+                  return
+               end if
+            case ("--lower")
+               spec%second_file = v
+            case ("--upper")
+               spec%matrix_file = v
+            case ("--label")
+               spec%label = v
+            case ("--rigid")
+               spec%rigid = v
+            case ("--pixel", "--young", "--poisson")
+               if (key == "--pixel") call parse_real(v, spec%pixel, ok)
+               if (key == "--young") call parse_real(v, spec%young, ok)
+               if (key == "--poisson") call parse_real(v, spec%poisson, ok)
+               if (.not. ok) then
+                  call usage(key//" expects a number, found '"//v//"'")
+                  return
+               end if
+            case ("--maxcont")
+               call parse_integer(v, spec%maxcont, ok)
+               if (.not. ok .or. spec%maxcont <= 0) then
+                  call usage("--maxcont expects a positive integer, found '"//v//"'")
+                  return
+               end if
             case default
                call usage("unknown option "//key)
                return
@@ -141,8 +227,35 @@ contains
          end associate
          i = i + 2
       end do
+      if (spec%matrix_file /= "" .or. spec%second_file /= "") then
+         ! Heights from files: one scene. The surface given alone carries the shape; with
+         ! both, the lower file is the matrix and the upper the second file.
+         if (size(decks) > 0) then
+            call usage("give either DECK files or --lower/--upper height files, not both")
+            return
+         end if
+         if (.not. spec%pixel > 0) then
+            call usage("--lower/--upper need --pixel D, the pixel size in nm")
+            return
+         end if
+         if (spec%matrix_file == "") then
+            spec%matrix_file = spec%second_file
+            spec%second_file = ""
+            spec%shape_on = "lower"
+         else if (spec%second_file /= "") then
+            ! Both: read the upper as the matrix and the lower as the second surface.
+            spec%shape_on = "upper"
+         end if
+         if (spec%label == "") spec%label = "femcod run "//info%options
+         decks = [string_type("")]
+         if (prefix == "") prefix = default_prefix(file_part(spec%matrix_file))
+      end if
       if (size(decks) == 0) then
          call usage("run needs a DECK")
+         return
+      end if
+      if (restart .and. solver == "legacy") then
+         call usage("--restart: checkpoints are written by the incremental solver only")
          return
       end if
       if (size(decks) > 1 .and. prefix /= "") then
@@ -175,9 +288,29 @@ contains
          character(len=*), intent(in) :: out_prefix
          integer, intent(out) :: rc
          type(status_type) :: st
+         character(len=160), allocatable :: lines(:)
          rc = 0
          current_prefix = out_prefix
-         call read_deck(deck_path, deck, st)
+         if (deck_path == "") then
+            call build_deck(spec, deck, st)
+         else
+            call read_deck(deck_path, deck, st)
+         end if
+         ! With --restart, result files are leftovers of the interrupted run while its
+         ! checkpoint exists, or while PREFIX.h5 (renamed last) does not; a complete set
+         ! without a checkpoint means the run had finished: nothing to do.
+         if (st%code == 0 .and. restart .and. .not. force .and. solver == "incremental") then
+            if (path_exists(out_prefix//".h5") .and. .not. path_exists(out_prefix//".ckpt.h5")) then
+               if (.not. quiet) write(error_unit, '(a)') "femcod: "//out_prefix//".h5: the run of "// &
+                  deck_label(deck_path)//" is complete; nothing to restart"
+               return
+            end if
+         end if
+         if (st%code == 0) call check_writable(out_prefix, st)
+         if (st%code == 0 .and. .not. force) then
+            if (.not. (restart .and. (path_exists(out_prefix//".ckpt.h5") .or. &
+               .not. path_exists(out_prefix//".h5")))) call refuse_overwrite(out_prefix, st)
+         end if
          last_report = 0
          target_contacts = deck%maxcont
          if (options%max_contacts > 0) target_contacts = min(target_contacts, options%max_contacts)
@@ -193,25 +326,92 @@ contains
                   call solve_legacy(deck, options, res, st, report_progress)
                end if
             case default
-               if (quiet) then
-                  call solve_incremental(deck, options, res, st)
+               checkpoint_path = out_prefix//".ckpt.h5"
+               checkpoint_deck = deck
+               checkpoint_options = options
+               checkpoint_warned = .false.
+               if (restart .and. path_exists(checkpoint_path)) then
+                  call read_checkpoint(checkpoint_path, deck, options, resume, st)
+                  if (st%code == 0) then
+                     if (.not. quiet) write(error_unit, '(a)') "femcod: resuming "//deck_label(deck_path)// &
+                        " from "//checkpoint_path//" at step "//int_str(resume%step)//" ("//int_str(resume%n)// &
+                        " contacts)"
+                     if (quiet) then
+                        call solve_incremental(deck, options, res, st, checkpoint=write_state, resume=resume)
+                     else
+                        call solve_incremental(deck, options, res, st, report_progress, write_state, resume)
+                     end if
+                  end if
                else
-                  call solve_incremental(deck, options, res, st, report_progress)
+                  if (restart .and. .not. quiet) write(error_unit, '(a)') "femcod: no checkpoint "// &
+                     checkpoint_path//": starting "//deck_label(deck_path)//" from the beginning"
+                  if (quiet) then
+                     call solve_incremental(deck, options, res, st, checkpoint=write_state)
+                  else
+                     call solve_incremental(deck, options, res, st, report_progress, write_state)
+                  end if
                end if
             end select
          end if
-         if (st%code == 0) call write_csv_results(current_prefix, deck, res, st)
+         if (st%code == 0) then
+            info%version = FEMCOD_VERSION
+            info%solver = solver
+            if (solver == "incremental") then
+               lines = scene_report(deck)
+               allocate(info%scene(size(lines)))
+               do k = 1, size(lines)
+                  info%scene(k)%s = trim(lines(k))
+               end do
+            else
+               allocate(info%scene(1))
+               info%scene(1)%s = "nothing: the legacy solver models every node and spring of Appendix B"
+            end if
+            call write_results(current_prefix, deck, res, info, st)
+            deallocate(info%scene)
+         end if
          if (st%code /= 0) then
             write(error_unit, '(a)') "femcod: "//st%message
             rc = st%code
             return
          end if
+         ! The results are safe: the checkpoint has served its purpose.
+         if (solver == "incremental") call remove_file(out_prefix//".ckpt.h5")
          do k = 1, size(res%states)
             if (.not. res%states(k)%reached) write(error_unit, '(a)') "femcod: warning: load "// &
                format_real(res%states(k)%load)//" nN not reached ("//stop_reason_text(res%stop_reason)//")"
          end do
          if (.not. quiet) call print_summary()
       end subroutine run_one
+
+      !> Before a long solve: can the results be written there at all?
+      subroutine check_writable(out_prefix, st)
+         character(len=*), intent(in) :: out_prefix
+         type(status_type), intent(inout) :: st
+         integer :: unit, ios
+         open(newunit=unit, file=out_prefix//".history.csv.part", status="replace", action="write", iostat=ios)
+         if (ios /= 0) then
+            st%code = STATUS_IO
+            st%message = out_prefix//".history.csv: cannot write (directory missing or not writable); nothing was run"
+            return
+         end if
+         close(unit, status="delete")
+      end subroutine check_writable
+
+      !> A deck whose result files exist fails unless --force.
+      subroutine refuse_overwrite(out_prefix, st)
+         character(len=*), intent(in) :: out_prefix
+         type(status_type), intent(inout) :: st
+         type(string_type), allocatable :: names(:)
+         integer :: m
+         names = result_files(out_prefix, size(options%loads))
+         do m = 1, size(names)
+            if (path_exists(names(m)%s)) then
+               st%code = STATUS_IO
+               st%message = names(m)%s//": exists; not overwritten (use --force to replace the results)"
+               return
+            end if
+         end do
+      end subroutine refuse_overwrite
 
       subroutine usage(message)
          character(len=*), intent(in) :: message
@@ -259,8 +459,9 @@ contains
                " found by the final check of all pixels; exact re-solve differs by "// &
                real_str(res%final_check_difference, 2)
          end if
-         write(output_unit, '(a)') "  written   : "//current_prefix//".history.csv, "//current_prefix//".contacts.csv"// &
-            merge(", "//current_prefix//".loads.csv", repeat(" ", len(current_prefix) + 12), size(res%states) > 0)
+         write(output_unit, '(a)') "  written   : "//current_prefix//".h5, .xdmf, .history.csv, .contacts.csv, "// &
+            ".load_approach.svg, .area_load.svg"//trim(merge(", .loads.csv, .pressure_<k>.svg", &
+            repeat(" ", 31), size(res%states) > 0))
       end subroutine print_summary
    end subroutine run_command
 
@@ -287,6 +488,37 @@ contains
       flush(error_unit)
    end subroutine report_progress
 
+   !> The checkpoint procedure handed to the incremental solver: store its state; a
+   !> failure to write is reported once and the run goes on.
+   subroutine write_state(state)
+      type(solver_state), intent(in) :: state
+      type(status_type) :: st
+      call write_checkpoint(checkpoint_path, checkpoint_deck, checkpoint_options, state, st)
+      if (st%code /= 0 .and. .not. checkpoint_warned) then
+         write(error_unit, '(a)') "femcod: warning: checkpoint not written: "//st%message
+         flush(error_unit)
+         checkpoint_warned = .true.
+      end if
+   end subroutine write_state
+
+   !> How a deck is named in messages.
+   function deck_label(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      name = path
+      if (path == "") name = "the height files"
+   end function deck_label
+
+   !> The file part of `FILE.h5:/dataset`.
+   function file_part(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      integer :: colon
+      colon = index(path, ":/", back=.true.)
+      name = path
+      if (colon > 0) name = path(1:colon - 1)
+   end function file_part
+
    !> The deck's file name without directory and without `.deck`.
    function default_prefix(path) result(prefix)
       character(len=*), intent(in) :: path
@@ -294,8 +526,12 @@ contains
       integer :: slash
       slash = index(path, "/", back=.true.)
       prefix = path(slash + 1:)
-      if (len(prefix) > 5) then
-         if (prefix(len(prefix) - 4:) == ".deck") prefix = prefix(1:len(prefix) - 5)
+      slash = index(prefix, ".", back=.true.)
+      if (slash > 1) then
+         select case (prefix(slash:))
+         case (".deck", ".txt", ".dat", ".asc", ".h5", ".hdf5", ".csv")
+            prefix = prefix(1:slash - 1)
+         end select
       end if
    end function default_prefix
 end module femcod_run

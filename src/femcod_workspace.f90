@@ -12,6 +12,7 @@
 !>  - MPSTIF is the skyline size of femcod's equation numbering at MAXCONT
 !>    contacts, (7*MAXCONT + 2)*(MAXCONT + 1)/2 words (see `skyline_words`).
 module femcod_workspace
+   use femcod_memory, only: physical_memory, memory_text
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_BAD_INPUT
    implicit none
@@ -169,6 +170,11 @@ contains
          write(buf, '(i0)') 8*ws%mpend + 4*ws%ipend
          call set_error(status, STATUS_NUMERICAL, "workspace: needs "//trim(buf)// &
             " bytes, more words than one array can address")
+         return
+      end if
+      if (physical_memory() > 0 .and. 8*ws%mpend + 4*ws%ipend > physical_memory()) then
+         call set_error(status, STATUS_NUMERICAL, "workspace: needs "//memory_text(8*ws%mpend + 4*ws%ipend)// &
+            ", this machine has "//memory_text(physical_memory()))
          return
       end if
       allocate(ws%ra(ws%mpend), ws%ia(ws%ipend), stat=stat)

@@ -11,7 +11,11 @@ program tester
    use test_boussinesq, only: collect_boussinesq
    use test_legacy, only: collect_legacy
    use test_incremental, only: collect_incremental
+   use test_results, only: collect_results
+   use test_hostile, only: collect_hostile
    use femcod_exit, only: exit_program
+   use femcod_cli, only: run_femcod, command_arguments
+   use femcod_strings, only: string_type
    implicit none
    type(testsuite_type), allocatable :: suites(:)
    integer :: stat, is, total, nargs
@@ -24,13 +28,26 @@ program tester
       new_testsuite("surfaces", collect_surfaces), &
       new_testsuite("boussinesq", collect_boussinesq), &
       new_testsuite("legacy", collect_legacy), &
-      new_testsuite("incremental", collect_incremental) &
+      new_testsuite("incremental", collect_incremental), &
+      new_testsuite("results", collect_results), &
+      new_testsuite("hostile", collect_hostile) &
       ]
    stat = 0
    total = 0
    nargs = command_argument_count()
    if (nargs >= 1) then
       call get_command_argument(1, suite_name)
+      if (suite_name == "--femcod") then
+         ! The tests that need a separate process (killed runs, captured messages) run
+         ! this executable as femcod: `tester --femcod ARGS` is `femcod ARGS`.
+         block
+            type(string_type), allocatable :: args(:)
+            integer :: code
+            args = command_arguments()
+            call run_femcod(args(2:), code)
+            call exit_program(code)
+         end block
+      end if
       is = select_suite(suites, trim(suite_name))
       if (is == 0) then
          write(error_unit, '(a)') "no suite named "//trim(suite_name)

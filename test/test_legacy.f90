@@ -185,6 +185,7 @@ contains
       character(len=:), allocatable :: prefix, text
       integer :: code
       prefix = scratch_path("run-square")
+      call execute_command_line("rm -f "//prefix//".*")
       call run_femcod([string_type("run"), string_type("input/square_punch_n3.deck"), string_type("-o"), &
          string_type(prefix), string_type("--loads"), string_type("1,2"), string_type("--quiet")], code)
       call check(error, code, 0)
@@ -205,7 +206,7 @@ contains
       ! Nine punch pixels in contact.
       call check(error, count([(text(code:code) == new_line("a"), code = 1, len(text))]), 10, "rows of contacts.csv")
       if (allocated(error)) return
-      call check(error, .not. file_exists(prefix//".history.csv.tmp"), "no temporary file left")
+      call check(error, .not. file_exists(prefix//".history.csv.part"), "no temporary file left")
    end subroutine test_run_outputs
 
    !> Several decks in one run: each gets its outputs (named after it, in the current
@@ -236,7 +237,8 @@ contains
       home = home(1:index(home, c_null_char) - 1)
       dir = scratch_path("batch")
       call execute_command_line("mkdir -p "//dir//" && cp input/square_punch_n3.deck input/circle_punch_d1.deck "// &
-         dir//"/ && printf 'bad\n' > "//dir//"/bad.deck && rm -f "//dir//"/*.csv", exitstat=ios)
+         dir//"/ && printf 'bad\n' > "//dir//"/bad.deck && rm -f "//dir//"/*.csv "//dir//"/*.h5 "// &
+         dir//"/*.xdmf "//dir//"/*.svg", exitstat=ios)
       call check(error, c_chdir(dir//c_null_char) == 0, "cd into the scratch directory")
       if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("square_punch_n3.deck"), string_type("bad.deck"), &

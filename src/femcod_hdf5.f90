@@ -1,0 +1,585 @@
+!> A small, status-returning layer over the HDF5 Fortran API (HDF5 1.10, serial).
+!>
+!> Every routine first returns if `status` already holds an error, so a writer can
+!> chain calls and test once. HDF5's own error stack printing is switched off; a
+!> failure becomes `file:object: what failed` with code STATUS_IO (or STATUS_BAD_INPUT
+!> when reading a file the user gave).
+!>
+!> Two-dimensional maps are stored so that C-order readers (h5py, h5dump) see
+!> `data[i, j]` with i the row and j the column, as in the deck: the Fortran array
+!> `map(i, j)` is written transposed.
+module femcod_hdf5
+   use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, h5fcreate_f, h5fopen_f, h5fclose_f, &
+      h5gcreate_f, h5gclose_f, h5screate_simple_f, h5screate_f, h5sclose_f, h5dcreate_f, h5dopen_f, h5dclose_f, &
+      h5dwrite_f, h5dread_f, h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
+      h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, h5oopen_f, h5oclose_f, h5tcopy_f, h5tset_size_f, &
+      h5tclose_f, h5lexists_f, h5aexists_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5S_SCALAR_F, H5T_NATIVE_DOUBLE, &
+      H5T_NATIVE_INTEGER, H5T_FORTRAN_S1
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_IO
+   implicit none
+   private
+   public :: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, h5_read, h5_exists
+   public :: h5_read_string_attribute, h5_rank_and_dims
+
+   !> An open HDF5 file and the name it was opened under (for messages).
+   type :: h5_file
+      integer(hid_t) :: id = -1
+      character(len=:), allocatable :: path
+   end type h5_file
+
+   !> Write a dataset (scalar, 1-D or 2-D, real or integer) with a `units` attribute.
+   interface h5_write
+      module procedure write_real0, write_real1, write_real2, write_int0, write_int1, write_int2
+   end interface h5_write
+
+   !> Attach an attribute (string, real or integer scalar) to an existing object.
+   interface h5_attribute
+      module procedure attribute_string, attribute_real, attribute_int
+   end interface h5_attribute
+
+   !> Read a whole dataset (converted to double or integer by HDF5).
+   interface h5_read
+      module procedure read_real0, read_real1, read_real2, read_int0, read_int1
+   end interface h5_read
+
+contains
+
+   subroutine initialise()
+      integer :: error
+      call h5open_f(error)
+      call h5eset_auto_f(0, error)
+   end subroutine initialise
+
+   !> Create (truncate) a file for writing.
+   subroutine h5_create(path, file, status)
+      character(len=*), intent(in) :: path
+      type(h5_file), intent(out) :: file
+      type(status_type), intent(inout) :: status
+      integer :: error
+      if (status%code /= 0) return
+      call initialise()
+      file%path = path
+      call h5fcreate_f(path, H5F_ACC_TRUNC_F, file%id, error)
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot create the HDF5 file (directory missing or not writable)")
+         file%id = -1
+      end if
+   end subroutine h5_create
+
+   !> Open an existing file read-only. `code` is the status code of a failure
+   !> (STATUS_BAD_INPUT for a file the user gave).
+   subroutine h5_open(path, file, status, code)
+      character(len=*), intent(in) :: path
+      type(h5_file), intent(out) :: file
+      type(status_type), intent(inout) :: status
+      integer, intent(in) :: code
+      integer :: error
+      if (status%code /= 0) return
+      call initialise()
+      file%path = path
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, file%id, error)
+      if (error /= 0) then
+         call set_error(status, code, path//": not a readable HDF5 file (missing, truncated or corrupted)")
+         file%id = -1
+      end if
+   end subroutine h5_open
+
+   !> Close the file (also after an error; then nothing is reported).
+   subroutine h5_close(file, status)
+      type(h5_file), intent(inout) :: file
+      type(status_type), intent(inout) :: status
+      integer :: error
+      if (file%id < 0) return
+      call h5fclose_f(file%id, error)
+      file%id = -1
+      if (error /= 0 .and. status%code == 0) call set_error(status, STATUS_IO, file%path//": error closing the file")
+   end subroutine h5_close
+
+   !> Create a group (its parent must exist).
+   subroutine h5_group(file, name, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: group
+      integer :: error
+      if (status%code /= 0) return
+      call h5gcreate_f(file%id, name, group, error)
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the group")
+         return
+      end if
+      call h5gclose_f(group, error)
+   end subroutine h5_group
+
+   !> Whether a link (group or dataset) exists; every parent of `name` must exist.
+   logical function h5_exists(file, name)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer :: error
+      h5_exists = .false.
+      if (file%id < 0) return
+      call h5lexists_f(file%id, name, h5_exists, error)
+      if (error /= 0) h5_exists = .false.
+   end function h5_exists
+
+   ! ---- writing ------------------------------------------------------------------
+
+   !> Create the dataset `name` of the given type and shape (`dims` in Fortran order;
+   !> empty: scalar) and return it open.
+   subroutine create_dataset(file, name, dtype, dims, dset, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(in) :: dtype
+      integer(hsize_t), intent(in) :: dims(:)
+      integer(hid_t), intent(out) :: dset
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: space
+      integer :: error
+      dset = -1
+      if (size(dims) == 0) then
+         call h5screate_f(H5S_SCALAR_F, space, error)
+      else
+         call h5screate_simple_f(size(dims), dims, space, error)
+      end if
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataspace")
+         return
+      end if
+      call h5dcreate_f(file%id, name, dtype, space, dset, error)
+      call h5sclose_f(space, error)
+      if (dset < 0) then
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataset")
+      end if
+   end subroutine create_dataset
+
+   !> Close a dataset after writing; attach its units.
+   subroutine finish_dataset(file, name, dset, error, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, units
+      integer(hid_t), intent(inout) :: dset
+      integer, intent(in) :: error
+      type(status_type), intent(inout) :: status
+      integer :: e
+      call h5dclose_f(dset, e)
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot write the dataset")
+         return
+      end if
+      call h5_attribute(file, name, "units", units, status)
+   end subroutine finish_dataset
+
+   subroutine write_real0(file, name, value, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, units
+      real(dp), intent(in) :: value
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset
+      integer(hsize_t) :: none(0)
+      integer :: error
+      if (status%code /= 0) return
+      call create_dataset(file, name, H5T_NATIVE_DOUBLE, none, dset, status)
+      if (status%code /= 0) return
+      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, value, none, error)
+      call finish_dataset(file, name, dset, error, units, status)
+   end subroutine write_real0
+
+   subroutine write_real1(file, name, values, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, units
+      real(dp), intent(in) :: values(:)
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset
+      integer(hsize_t) :: dims(1)
+      integer :: error
+      if (status%code /= 0) return
+      dims = size(values, kind=hsize_t)
+      call create_dataset(file, name, H5T_NATIVE_DOUBLE, dims, dset, status)
+      if (status%code /= 0) return
+      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, error)
+      call finish_dataset(file, name, dset, error, units, status)
+   end subroutine write_real1
+
+   !> A map(i, j) (row i, column j), stored so that C-order readers see [i, j].
+   subroutine write_real2(file, name, map, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, units
+      real(dp), intent(in) :: map(:, :)
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset
+      integer(hsize_t) :: dims(2)
+      real(dp), allocatable :: stored(:, :)
+      integer :: error
+      if (status%code /= 0) return
+      dims = [size(map, 2, kind=hsize_t), size(map, 1, kind=hsize_t)]
+      stored = transpose(map)
+      call create_dataset(file, name, H5T_NATIVE_DOUBLE, dims, dset, status)
+      if (status%code /= 0) return
+      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored, dims, error)
+      call finish_dataset(file, name, dset, error, units, status)
+   end subroutine write_real2
+
+   subroutine write_int0(file, name, value, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, units
+      integer, intent(in) :: value
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset
+      integer(hsize_t) :: none(0)
+      integer :: error
+      if (status%code /= 0) return
+      call create_dataset(file, name, H5T_NATIVE_INTEGER, none, dset, status)
+      if (status%code /= 0) return
+      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, value, none, error)
+      call finish_dataset(file, name, dset, error, units, status)
+   end subroutine write_int0
+
+   subroutine write_int1(file, name, values, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, units
+      integer, intent(in) :: values(:)
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset
+      integer(hsize_t) :: dims(1)
+      integer :: error
+      if (status%code /= 0) return
+      dims = size(values, kind=hsize_t)
+      call create_dataset(file, name, H5T_NATIVE_INTEGER, dims, dset, status)
+      if (status%code /= 0) return
+      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, error)
+      call finish_dataset(file, name, dset, error, units, status)
+   end subroutine write_int1
+
+   subroutine write_int2(file, name, map, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, units
+      integer, intent(in) :: map(:, :)
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset
+      integer(hsize_t) :: dims(2)
+      integer, allocatable :: stored(:, :)
+      integer :: error
+      if (status%code /= 0) return
+      dims = [size(map, 2, kind=hsize_t), size(map, 1, kind=hsize_t)]
+      stored = transpose(map)
+      call create_dataset(file, name, H5T_NATIVE_INTEGER, dims, dset, status)
+      if (status%code /= 0) return
+      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, stored, dims, error)
+      call finish_dataset(file, name, dset, error, units, status)
+   end subroutine write_int2
+
+   ! ---- attributes ---------------------------------------------------------------
+
+   !> Open object `name` and create attribute `key` of type `dtype` (scalar).
+   subroutine create_attribute(file, name, key, dtype, object, attr, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, key
+      integer(hid_t), intent(in) :: dtype
+      integer(hid_t), intent(out) :: object, attr
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: space
+      integer :: error
+      attr = -1
+      call h5oopen_f(file%id, name, object, error)
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, file%path//":"//name//": no such object for attribute "//key)
+         return
+      end if
+      call h5screate_f(H5S_SCALAR_F, space, error)
+      call h5acreate_f(object, key, dtype, space, attr, error)
+      call h5sclose_f(space, error)
+      if (error /= 0) then
+         call h5oclose_f(object, error)
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create attribute "//key)
+      end if
+   end subroutine create_attribute
+
+   subroutine close_attribute(file, name, key, object, attr, error, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, key
+      integer(hid_t), intent(inout) :: object, attr
+      integer, intent(in) :: error
+      type(status_type), intent(inout) :: status
+      integer :: e
+      call h5aclose_f(attr, e)
+      call h5oclose_f(object, e)
+      if (error /= 0) call set_error(status, STATUS_IO, file%path//":"//name//": cannot write attribute "//key)
+   end subroutine close_attribute
+
+   subroutine attribute_string(file, name, key, value, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, key, value
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: object, attr, stype
+      integer(hsize_t) :: none(0)
+      integer :: error
+      if (status%code /= 0) return
+      call h5tcopy_f(H5T_FORTRAN_S1, stype, error)
+      call h5tset_size_f(stype, int(max(len(value), 1), size_t), error)
+      call create_attribute(file, name, key, stype, object, attr, status)
+      if (status%code /= 0) then
+         call h5tclose_f(stype, error)
+         return
+      end if
+      if (len(value) == 0) then
+         call h5awrite_f(attr, stype, " ", none, error)
+      else
+         call h5awrite_f(attr, stype, value, none, error)
+      end if
+      call h5tclose_f(stype, error)
+      call close_attribute(file, name, key, object, attr, error, status)
+   end subroutine attribute_string
+
+   subroutine attribute_real(file, name, key, value, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, key
+      real(dp), intent(in) :: value
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: object, attr
+      integer(hsize_t) :: none(0)
+      integer :: error
+      if (status%code /= 0) return
+      call create_attribute(file, name, key, H5T_NATIVE_DOUBLE, object, attr, status)
+      if (status%code /= 0) return
+      call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, none, error)
+      call close_attribute(file, name, key, object, attr, error, status)
+   end subroutine attribute_real
+
+   subroutine attribute_int(file, name, key, value, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, key
+      integer, intent(in) :: value
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: object, attr
+      integer(hsize_t) :: none(0)
+      integer :: error
+      if (status%code /= 0) return
+      call create_attribute(file, name, key, H5T_NATIVE_INTEGER, object, attr, status)
+      if (status%code /= 0) return
+      call h5awrite_f(attr, H5T_NATIVE_INTEGER, value, none, error)
+      call close_attribute(file, name, key, object, attr, error, status)
+   end subroutine attribute_int
+
+   !> Read a string attribute of at most `length` characters.
+   subroutine h5_read_string_attribute(file, name, key, length, value, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, key
+      integer, intent(in) :: length, code
+      character(len=:), allocatable, intent(out) :: value
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: object, attr, stype
+      integer(hsize_t) :: none(0)
+      integer :: error
+      logical :: exists
+      value = ""
+      if (status%code /= 0) return
+      call h5oopen_f(file%id, name, object, error)
+      if (error /= 0) then
+         call set_error(status, code, file%path//":"//name//": missing")
+         return
+      end if
+      call h5aexists_f(object, key, exists, error)
+      if (.not. exists .or. error /= 0) then
+         call h5oclose_f(object, error)
+         call set_error(status, code, file%path//":"//name//": attribute "//key//" missing")
+         return
+      end if
+      call h5aopen_f(object, key, attr, error)
+      call h5tcopy_f(H5T_FORTRAN_S1, stype, error)
+      call h5tset_size_f(stype, int(length, size_t), error)
+      deallocate(value)
+      allocate(character(len=length) :: value)
+      call h5aread_f(attr, stype, value, none, error)
+      call h5tclose_f(stype, error)
+      call h5aclose_f(attr, error)
+      call h5oclose_f(object, error)
+      if (error /= 0) then
+         call set_error(status, code, file%path//":"//name//": cannot read attribute "//key)
+         return
+      end if
+      value = trim(value)
+   end subroutine h5_read_string_attribute
+
+   ! ---- reading ------------------------------------------------------------------
+
+   !> Rank and dimensions of a dataset, in C order (dims(1) the slowest index: rows).
+   subroutine h5_rank_and_dims(file, name, rank, dims, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer, intent(out) :: rank
+      integer(hsize_t), intent(out) :: dims(7)
+      type(status_type), intent(inout) :: status
+      integer, intent(in) :: code
+      integer(hid_t) :: dset, space
+      integer(hsize_t) :: fdims(7), maxdims(7)
+      integer :: error
+      rank = -1
+      dims = 0
+      if (status%code /= 0) return
+      call open_dataset(file, name, dset, status, code)
+      if (status%code /= 0) return
+      call h5dget_space_f(dset, space, error)
+      call h5sget_simple_extent_ndims_f(space, rank, error)
+      if (rank >= 0 .and. rank <= 7) then
+         call h5sget_simple_extent_dims_f(space, fdims(1:rank), maxdims(1:rank), error)
+         dims(1:rank) = fdims(rank:1:-1)
+      end if
+      call h5sclose_f(space, error)
+      call h5dclose_f(dset, error)
+   end subroutine h5_rank_and_dims
+
+   subroutine open_dataset(file, name, dset, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(out) :: dset
+      type(status_type), intent(inout) :: status
+      integer, intent(in) :: code
+      integer :: error
+      dset = -1
+      if (.not. dataset_path_exists(file, name)) then
+         call set_error(status, code, file%path//":"//name//": no such dataset")
+         return
+      end if
+      call h5dopen_f(file%id, name, dset, error)
+      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot open the dataset")
+   end subroutine open_dataset
+
+   !> Whether every component of an absolute or relative path exists.
+   logical function dataset_path_exists(file, name)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer :: k
+      dataset_path_exists = .false.
+      if (len_trim(name) == 0) return
+      do k = 2, len(name)
+         if (name(k:k) == "/") then
+            if (.not. h5_exists(file, name(1:k - 1))) return
+         end if
+      end do
+      dataset_path_exists = h5_exists(file, name)
+   end function dataset_path_exists
+
+   !> Check rank and size, then read.
+   subroutine read_checked(file, name, rank_wanted, dset, fdims, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: rank_wanted, code
+      integer(hid_t), intent(out) :: dset
+      integer(hsize_t), intent(out) :: fdims(7)
+      type(status_type), intent(inout) :: status
+      integer :: rank
+      integer(hsize_t) :: dims(7)
+      dset = -1
+      call h5_rank_and_dims(file, name, rank, dims, status, code)
+      if (status%code /= 0) return
+      if (rank /= rank_wanted) then
+         call set_error(status, code, file%path//":"//name//": expected a dataset of rank "// &
+            char(48 + rank_wanted)//", found rank "//char(48 + max(0, min(rank, 9))))
+         return
+      end if
+      fdims = 0
+      fdims(1:rank) = dims(rank:1:-1)
+      call open_dataset(file, name, dset, status, code)
+   end subroutine read_checked
+
+   subroutine read_real0(file, name, value, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      real(dp), intent(out) :: value
+      type(status_type), intent(inout) :: status
+      integer, intent(in) :: code
+      integer(hid_t) :: dset
+      integer(hsize_t) :: fdims(7)
+      integer :: error
+      value = 0
+      if (status%code /= 0) return
+      call read_checked(file, name, 0, dset, fdims, status, code)
+      if (status%code /= 0) return
+      call h5dread_f(dset, H5T_NATIVE_DOUBLE, value, fdims(1:0), error)
+      call h5dclose_f(dset, error)
+      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+   end subroutine read_real0
+
+   subroutine read_int0(file, name, value, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer, intent(out) :: value
+      type(status_type), intent(inout) :: status
+      integer, intent(in) :: code
+      integer(hid_t) :: dset
+      integer(hsize_t) :: fdims(7)
+      integer :: error
+      value = 0
+      if (status%code /= 0) return
+      call read_checked(file, name, 0, dset, fdims, status, code)
+      if (status%code /= 0) return
+      call h5dread_f(dset, H5T_NATIVE_INTEGER, value, fdims(1:0), error)
+      call h5dclose_f(dset, error)
+      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+   end subroutine read_int0
+
+   subroutine read_real1(file, name, values, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      real(dp), allocatable, intent(out) :: values(:)
+      type(status_type), intent(inout) :: status
+      integer, intent(in) :: code
+      integer(hid_t) :: dset
+      integer(hsize_t) :: fdims(7)
+      integer :: error
+      allocate(values(0))
+      if (status%code /= 0) return
+      call read_checked(file, name, 1, dset, fdims, status, code)
+      if (status%code /= 0) return
+      deallocate(values)
+      allocate(values(fdims(1)))
+      call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, fdims(1:1), error)
+      call h5dclose_f(dset, error)
+      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+   end subroutine read_real1
+
+   subroutine read_int1(file, name, values, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer, allocatable, intent(out) :: values(:)
+      type(status_type), intent(inout) :: status
+      integer, intent(in) :: code
+      integer(hid_t) :: dset
+      integer(hsize_t) :: fdims(7)
+      integer :: error
+      allocate(values(0))
+      if (status%code /= 0) return
+      call read_checked(file, name, 1, dset, fdims, status, code)
+      if (status%code /= 0) return
+      deallocate(values)
+      allocate(values(fdims(1)))
+      call h5dread_f(dset, H5T_NATIVE_INTEGER, values, fdims(1:1), error)
+      call h5dclose_f(dset, error)
+      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+   end subroutine read_int1
+
+   !> A 2-D dataset as map(i, j) with i the C-order first index (the row).
+   subroutine read_real2(file, name, map, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      real(dp), allocatable, intent(out) :: map(:, :)
+      type(status_type), intent(inout) :: status
+      integer, intent(in) :: code
+      integer(hid_t) :: dset
+      integer(hsize_t) :: fdims(7)
+      real(dp), allocatable :: stored(:, :)
+      integer :: error
+      allocate(map(0, 0))
+      if (status%code /= 0) return
+      call read_checked(file, name, 2, dset, fdims, status, code)
+      if (status%code /= 0) return
+      allocate(stored(fdims(1), fdims(2)))
+      call h5dread_f(dset, H5T_NATIVE_DOUBLE, stored, fdims(1:2), error)
+      call h5dclose_f(dset, error)
+      if (error /= 0) then
+         call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+         return
+      end if
+      map = transpose(stored)
+   end subroutine read_real2
+end module femcod_hdf5

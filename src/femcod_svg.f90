@@ -1,0 +1,354 @@
+!> SVG figures written by femcod itself (no plotting dependency): x-y plots on linear
+!> or logarithmic axes with an optional fitted power law, and a pressure map with a
+!> colour bar, in the manner of the thesis' figures 4.16-4.19. Each function returns
+!> the whole document as a string; writing it is the caller's business.
+module femcod_svg
+   use femcod_kinds, only: dp
+   use femcod_strings, only: int_str
+   implicit none
+   private
+   public :: svg_plot, svg_pressure_map, nice_ticks, fmt_sig
+
+   character(len=1), parameter :: nl = new_line("a")
+   !> Plot frame (px): width, height and margins left, right, top, bottom.
+   real(dp), parameter :: w = 640, h = 480, ml = 90, mr = 30, mt = 50, mb = 70
+
+contains
+
+   !> A line plot of y against x with markers. `logx`/`logy` use decades (values <= 0
+   !> are left out). With `exponent` and `prefactor` the power law y = prefactor x^exponent
+   !> is drawn dashed and its exponent written in the legend.
+   function svg_plot(title, xlabel, ylabel, x, y, logx, logy, exponent, prefactor) result(svg)
+      character(len=*), intent(in) :: title, xlabel, ylabel
+      real(dp), intent(in) :: x(:), y(:)
+      logical, intent(in) :: logx, logy
+      real(dp), intent(in), optional :: exponent, prefactor
+      character(len=:), allocatable :: svg
+      real(dp), allocatable :: tx(:), ty(:), xt(:), yt(:)
+      logical, allocatable :: keep(:)
+      real(dp) :: x0, x1, y0, y1, px, py, xf
+      integer :: k, m
+      character(len=:), allocatable :: path
+      allocate(keep(size(x)))
+      keep = .true.
+      if (logx) keep = keep .and. x > 0
+      if (logy) keep = keep .and. y > 0
+      tx = pack(x, keep)
+      ty = pack(y, keep)
+      if (logx) tx = log10(tx)
+      if (logy) ty = log10(ty)
+      svg = header(title)
+      if (size(tx) == 0) then
+         svg = svg//text(w/2, h/2, "no data", "middle", 14)//"</svg>"//nl
+         return
+      end if
+      call axis_range(minval(tx), maxval(tx), logx, x0, x1, xt)
+      call axis_range(minval(ty), maxval(ty), logy, y0, y1, yt)
+      svg = svg//axes(x0, x1, y0, y1, xt, yt, logx, logy, xlabel, ylabel)
+      ! Data: a polyline and markers.
+      path = ""
+      do k = 1, size(tx)
+         call to_px(tx(k), ty(k), px, py)
+         path = path//fmt(px)//","//fmt(py)//" "
+      end do
+      svg = svg//'<polyline fill="none" stroke="#1f4e9c" stroke-width="1.5" points="'//path//'"/>'//nl
+      m = max(1, size(tx)/200)
+      do k = 1, size(tx), m
+         call to_px(tx(k), ty(k), px, py)
+         svg = svg//'<circle cx="'//fmt(px)//'" cy="'//fmt(py)//'" r="2.5" fill="#1f4e9c"/>'//nl
+      end do
+      svg = svg//'<line x1="'//fmt(w - mr - 190)//'" y1="'//fmt(mt + 18)//'" x2="'//fmt(w - mr - 160)//'" y2="'// &
+         fmt(mt + 18)//'" stroke="#1f4e9c" stroke-width="1.5"/>'//text(w - mr - 154, mt + 22.0_dp, "femcod", "start", 12)
+      if (present(exponent) .and. present(prefactor)) then
+         path = ""
+         do k = 0, 50
+            xf = x0 + (x1 - x0)*k/50
+            if (logx .and. logy) then
+               py = log10(prefactor) + exponent*xf
+            else
+               py = prefactor*xf**exponent
+            end if
+            if (py < y0 .or. py > y1) cycle
+            call to_px(xf, py, px, py)
+            path = path//fmt(px)//","//fmt(py)//" "
+         end do
+         svg = svg//'<polyline fill="none" stroke="#c0392b" stroke-width="1.5" stroke-dasharray="6,4" points="'// &
+            path//'"/>'//nl
+         svg = svg//'<line x1="'//fmt(w - mr - 190)//'" y1="'//fmt(mt + 38)//'" x2="'//fmt(w - mr - 160)//'" y2="'// &
+            fmt(mt + 38)//'" stroke="#c0392b" stroke-width="1.5" stroke-dasharray="6,4"/>'// &
+            text(w - mr - 154, mt + 42, "fit: exponent "//fmt_sig(exponent, 4), "start", 12)
+      end if
+      svg = svg//"</svg>"//nl
+   contains
+      subroutine to_px(xv, yv, pxv, pyv)
+         real(dp), intent(in) :: xv, yv
+         real(dp), intent(out) :: pxv, pyv
+         pxv = ml + (xv - x0)/(x1 - x0)*(w - ml - mr)
+         pyv = h - mb - (yv - y0)/(y1 - y0)*(h - mt - mb)
+      end subroutine to_px
+   end function svg_plot
+
+   !> A map (GPa) of `values(i, j)` (row i drawn downwards, column j to the right) over
+   !> a square of side `side` nm: zero pixels are white, the others coloured on a
+   !> perceptual scale from 0 to the maximum, with a colour bar. Runs of equal colour
+   !> along a row become one rectangle, so the file grows with the contact area.
+   function svg_pressure_map(title, values, side) result(svg)
+      character(len=*), intent(in) :: title
+      real(dp), intent(in) :: values(:, :)
+      real(dp), intent(in) :: side
+      character(len=:), allocatable :: svg
+      integer, parameter :: levels = 64
+      integer :: np, i, j, j0, lev, k
+      real(dp) :: vmax, cell, size_px, x0, y0
+      real(dp), allocatable :: ticks(:)
+      integer, allocatable :: bin(:, :)
+      np = size(values, 1)
+      vmax = maxval(values)
+      size_px = h - mt - mb
+      cell = size_px/np
+      x0 = ml
+      y0 = mt
+      allocate(bin(np, np))
+      bin = 0
+      if (vmax > 0) then
+         where (values > 0) bin = 1 + min(levels - 1, int(values/vmax*levels))
+      end if
+      svg = header(title)
+      svg = svg//'<rect x="'//fmt(x0)//'" y="'//fmt(y0)//'" width="'//fmt(size_px)//'" height="'//fmt(size_px)// &
+         '" fill="white" stroke="black"/>'//nl
+      do i = 1, np
+         j = 1
+         do while (j <= np)
+            lev = bin(i, j)
+            j0 = j
+            do while (j < np)
+               if (bin(i, j + 1) /= lev) exit
+               j = j + 1
+            end do
+            if (lev > 0) then
+               svg = svg//'<rect x="'//fmt(x0 + (j0 - 1)*cell)//'" y="'//fmt(y0 + (i - 1)*cell)//'" width="'// &
+                  fmt((j - j0 + 1)*cell)//'" height="'//fmt(cell)//'" fill="'//colour((lev - 0.5_dp)/levels)//'"/>'//nl
+            end if
+            j = j + 1
+         end do
+      end do
+      ! Axes in nm and a colour bar in GPa.
+      svg = svg//text(x0 + size_px/2, h - mb + 40, "x (nm), column j", "middle", 13)
+      svg = svg//'<text x="'//fmt(x0 - 55)//'" y="'//fmt(y0 + size_px/2)//'" font-family="sans-serif" '// &
+         'font-size="13" text-anchor="middle" transform="rotate(-90 '//fmt(x0 - 55)//' '//fmt(y0 + size_px/2)// &
+         ')">y (nm), row i</text>'//nl
+      svg = svg//text(x0, h - mb + 18, "0", "middle", 11)//text(x0 + size_px, h - mb + 18, fmt_sig(side, 4), "middle", 11)
+      svg = svg//text(x0 - 6, y0 + 4, "0", "end", 11)//text(x0 - 6, y0 + size_px + 4, fmt_sig(side, 4), "end", 11)
+      do k = 0, levels - 1
+         svg = svg//'<rect x="'//fmt(x0 + size_px + 40)//'" y="'//fmt(y0 + size_px*(1 - real(k + 1, dp)/levels))// &
+            '" width="20" height="'//fmt(size_px/levels + 0.5_dp)//'" fill="'//colour((k + 0.5_dp)/levels)//'"/>'//nl
+      end do
+      svg = svg//'<rect x="'//fmt(x0 + size_px + 40)//'" y="'//fmt(y0)//'" width="20" height="'//fmt(size_px)// &
+         '" fill="none" stroke="black"/>'//nl
+      if (vmax > 0) then
+         ticks = nice_ticks(0.0_dp, vmax)
+         do k = 1, size(ticks)
+            if (ticks(k) < 0 .or. ticks(k) > vmax) cycle
+            svg = svg//text(x0 + size_px + 66, y0 + size_px*(1 - ticks(k)/vmax) + 4, fmt_sig(ticks(k), 4), "start", 11)
+         end do
+      end if
+      svg = svg//text(x0 + size_px + 50, y0 - 10, "GPa", "middle", 12)
+      svg = svg//text(x0 + size_px + 50, h - mb + 18, "max "//fmt_sig(vmax, 4), "middle", 11)
+      svg = svg//"</svg>"//nl
+   end function svg_pressure_map
+
+   function header(title) result(svg)
+      character(len=*), intent(in) :: title
+      character(len=:), allocatable :: svg
+      svg = '<?xml version="1.0" encoding="UTF-8"?>'//nl// &
+         '<svg xmlns="http://www.w3.org/2000/svg" width="'//fmt(w)//'" height="'//fmt(h)//'" viewBox="0 0 '// &
+         fmt(w)//' '//fmt(h)//'">'//nl//'<rect width="100%" height="100%" fill="white"/>'//nl// &
+         text(w/2, 28.0_dp, escape(shortened(title, 80)), "middle", 14)
+   end function header
+
+   !> Frame, ticks, grid and labels.
+   function axes(x0, x1, y0, y1, xt, yt, logx, logy, xlabel, ylabel) result(svg)
+      real(dp), intent(in) :: x0, x1, y0, y1, xt(:), yt(:)
+      logical, intent(in) :: logx, logy
+      character(len=*), intent(in) :: xlabel, ylabel
+      character(len=:), allocatable :: svg
+      real(dp) :: p
+      integer :: k
+      svg = '<rect x="'//fmt(ml)//'" y="'//fmt(mt)//'" width="'//fmt(w - ml - mr)//'" height="'//fmt(h - mt - mb)// &
+         '" fill="none" stroke="black"/>'//nl
+      do k = 1, size(xt)
+         p = ml + (xt(k) - x0)/(x1 - x0)*(w - ml - mr)
+         svg = svg//'<line x1="'//fmt(p)//'" y1="'//fmt(mt)//'" x2="'//fmt(p)//'" y2="'//fmt(h - mb)// &
+            '" stroke="#dddddd"/>'//nl//text(p, h - mb + 18, tick_label(xt(k), logx), "middle", 11)
+      end do
+      do k = 1, size(yt)
+         p = h - mb - (yt(k) - y0)/(y1 - y0)*(h - mt - mb)
+         svg = svg//'<line x1="'//fmt(ml)//'" y1="'//fmt(p)//'" x2="'//fmt(w - mr)//'" y2="'//fmt(p)// &
+            '" stroke="#dddddd"/>'//nl//text(ml - 6, p + 4, tick_label(yt(k), logy), "end", 11)
+      end do
+      svg = svg//text((ml + w - mr)/2, h - mb + 45, escape(xlabel), "middle", 13)
+      svg = svg//'<text x="22" y="'//fmt((mt + h - mb)/2)//'" font-family="sans-serif" font-size="13" '// &
+         'text-anchor="middle" transform="rotate(-90 22 '//fmt((mt + h - mb)/2)//')">'//escape(ylabel)//'</text>'//nl
+   end function axes
+
+   function tick_label(v, logscale) result(s)
+      real(dp), intent(in) :: v
+      logical, intent(in) :: logscale
+      character(len=:), allocatable :: s
+      if (logscale) then
+         s = "1e"//int_str(nint(v))
+      else
+         s = fmt_sig(v, 4)
+      end if
+   end function tick_label
+
+   !> Axis limits and ticks: whole decades on a log axis, "nice" steps on a linear one.
+   subroutine axis_range(lo, hi, logscale, a0, a1, ticks)
+      real(dp), intent(in) :: lo, hi
+      logical, intent(in) :: logscale
+      real(dp), intent(out) :: a0, a1
+      real(dp), allocatable, intent(out) :: ticks(:)
+      integer :: k, d0, d1
+      if (logscale) then
+         d0 = floor(lo)
+         d1 = ceiling(hi)
+         if (d1 == d0) d1 = d0 + 1
+         a0 = d0
+         a1 = d1
+         allocate(ticks(d1 - d0 + 1))
+         do k = d0, d1
+            ticks(k - d0 + 1) = k
+         end do
+      else
+         ticks = nice_ticks(lo, hi)
+         a0 = min(lo, ticks(1))
+         a1 = max(hi, ticks(size(ticks)))
+         if (a1 == a0) a1 = a0 + 1
+      end if
+   end subroutine axis_range
+
+   !> About five round tick values covering [lo, hi] (steps 1, 2 or 5 times a power of 10).
+   pure function nice_ticks(lo, hi) result(ticks)
+      real(dp), intent(in) :: lo, hi
+      real(dp), allocatable :: ticks(:)
+      real(dp) :: span, step, mag, f
+      integer :: k0, k1, k
+      span = hi - lo
+      if (.not. span > 0) span = max(abs(hi), 1.0_dp)
+      mag = 10.0_dp**floor(log10(span/5))
+      f = span/5/mag
+      if (f < 1.5_dp) then
+         step = mag
+      else if (f < 3.5_dp) then
+         step = 2*mag
+      else if (f < 7.5_dp) then
+         step = 5*mag
+      else
+         step = 10*mag
+      end if
+      k0 = floor(lo/step)
+      k1 = ceiling(hi/step)
+      if (k1 == k0) k1 = k0 + 1
+      allocate(ticks(k1 - k0 + 1))
+      do k = k0, k1
+         ticks(k - k0 + 1) = k*step
+      end do
+   end function nice_ticks
+
+   !> A colour on a viridis-like scale, t in [0, 1].
+   function colour(t) result(hex)
+      real(dp), intent(in) :: t
+      character(len=7) :: hex
+      real(dp), parameter :: anchors(3, 5) = reshape([ &
+         68, 1, 84, 59, 82, 139, 33, 145, 140, 94, 201, 98, 253, 231, 37], [3, 5])
+      real(dp) :: s, f
+      integer :: k, rgb(3)
+      s = max(0.0_dp, min(1.0_dp, t))*4
+      k = min(3, int(s))
+      f = s - k
+      rgb = nint(anchors(:, k + 1)*(1 - f) + anchors(:, k + 2)*f)
+      write(hex, '("#", 3z2.2)') rgb
+   end function colour
+
+   function text(x, y, s, anchor, size) result(svg)
+      real(dp), intent(in) :: x, y
+      character(len=*), intent(in) :: s, anchor
+      integer, intent(in) :: size
+      character(len=:), allocatable :: svg
+      svg = '<text x="'//fmt(x)//'" y="'//fmt(y)//'" font-family="sans-serif" font-size="'//int_str(size)// &
+         '" text-anchor="'//anchor//'">'//s//'</text>'//nl
+   end function text
+
+   !> At most `n` characters, with an ellipsis when cut.
+   function shortened(s, n) result(t)
+      character(len=*), intent(in) :: s
+      integer, intent(in) :: n
+      character(len=:), allocatable :: t
+      t = s
+      if (len(s) > n) t = s(1:n - 3)//"..."
+   end function shortened
+
+   !> XML-escape &, < and >.
+   function escape(s) result(e)
+      character(len=*), intent(in) :: s
+      character(len=:), allocatable :: e
+      integer :: k
+      e = ""
+      do k = 1, len(s)
+         select case (s(k:k))
+         case ("&")
+            e = e//"&amp;"
+         case ("<")
+            e = e//"&lt;"
+         case (">")
+            e = e//"&gt;"
+         case default
+            e = e//s(k:k)
+         end select
+      end do
+   end function escape
+
+   !> A coordinate with two decimals.
+   function fmt(v) result(s)
+      real(dp), intent(in) :: v
+      character(len=:), allocatable :: s
+      character(len=32) :: buf
+      write(buf, '(f0.2)') v
+      s = trim(adjustl(buf))
+      if (s(1:1) == ".") s = "0"//s
+      if (len(s) > 1) then
+         if (s(1:2) == "-.") s = "-0"//s(2:)
+      end if
+   end function fmt
+
+   !> A value with `digits` significant digits, without trailing zeros.
+   function fmt_sig(v, digits) result(s)
+      real(dp), intent(in) :: v
+      integer, intent(in) :: digits
+      character(len=:), allocatable :: s
+      character(len=40) :: buf
+      integer :: e
+      if (v == 0) then
+         s = "0"
+         return
+      end if
+      e = floor(log10(abs(v)))
+      if (e >= -3 .and. e < 6) then
+         write(buf, '(f0.'//int_str(max(0, digits - 1 - e))//')') v
+         s = trim(adjustl(buf))
+         if (index(s, ".") > 0) then
+            do while (s(len(s):len(s)) == "0")
+               s = s(1:len(s) - 1)
+            end do
+            if (s(len(s):len(s)) == ".") s = s(1:len(s) - 1)
+         end if
+         if (s(1:1) == ".") s = "0"//s
+         if (len(s) > 1) then
+            if (s(1:2) == "-.") s = "-0"//s(2:)
+         end if
+      else
+         write(buf, '(es16.'//int_str(digits - 1)//')') v
+         s = trim(adjustl(buf))
+      end if
+   end function fmt_sig
+end module femcod_svg

@@ -1,0 +1,133 @@
+!> Hostile input: every case of test/corpus/MANIFEST runs femcod in its own process
+!> (this executable with --femcod) and must end with the documented exit code, a
+!> message naming the problem, and no file written under its output prefix.
+module test_hostile
+   use femcod_strings, only: string_type
+   use femcod_cli, only: run_femcod
+   use test_support, only: scratch_path, read_text, file_exists, contains_text
+   use test_results, only: self_command
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   implicit none
+   private
+   public :: collect_hostile
+
+   character(len=*), parameter :: corpus = "test/corpus"
+
+contains
+
+   subroutine collect_hostile(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest("the corpus (test/corpus/MANIFEST): exit code, message, no output", test_corpus), &
+         new_unittest("paths with spaces work", test_spaces) &
+         ]
+   end subroutine collect_hostile
+
+   subroutine test_corpus(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: manifest, line, name, setup, args, fragment, dir, out, message, listing
+      integer :: a, b, code, expected, ncases, ios
+      manifest = read_text(corpus//"/MANIFEST")
+      call check(error, len(manifest) > 0, "reading "//corpus//"/MANIFEST")
+      if (allocated(error)) return
+      ncases = 0
+      a = 1
+      do while (a <= len(manifest))
+         b = index(manifest(a:), new_line("a"))
+         if (b == 0) b = len(manifest) - a + 2
+         line = manifest(a:a + b - 2)
+         a = a + b
+         if (len_trim(line) == 0) cycle
+         if (line(1:1) == "#") cycle
+         name = field(line, 1)
+         setup = field(line, 2)
+         read(setup, *, iostat=ios) expected
+         call check(error, ios == 0, "MANIFEST: exit code of "//name)
+         if (allocated(error)) return
+         setup = field(line, 3)
+         args = field(line, 4)
+         fragment = field(line, 5)
+         dir = scratch_path("hostile/"//name)
+         call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+         out = dir//"/out"
+         if (setup(1:min(5, len(setup))) == "ckpt:") then
+            call execute_command_line("cp "//corpus//"/"//setup(6:)//" "//out//".ckpt.h5")
+         end if
+         args = replace(replace(args, "@C", corpus), "@OUT", out)
+         call execute_command_line(self_command()//" "//args//" > "//dir//".stdout 2> "//dir//".stderr", &
+            exitstat=code)
+         message = read_text(dir//".stderr")
+         call check(error, code, expected, name//": exit code (message: "//trim(message)//")")
+         if (allocated(error)) return
+         call check(error, contains_text(message, fragment), name//": the message '"//trim(message)// &
+            "' should contain '"//fragment//"'")
+         if (allocated(error)) return
+         ! Nothing under the prefix but what the set-up put there.
+         call execute_command_line("ls -A "//dir//" > "//dir//".listing")
+         listing = read_text(dir//".listing")
+         if (setup(1:min(5, len(setup))) == "ckpt:") then
+            call check(error, listing == "out.ckpt.h5"//new_line("a"), name//": files left: "//listing)
+         else
+            call check(error, len(listing) == 0, name//": files left: "//listing)
+         end if
+         if (allocated(error)) return
+         ncases = ncases + 1
+      end do
+      call check(error, ncases >= 25, "the corpus holds "//to_string(ncases)//" cases, at least 25")
+   end subroutine test_corpus
+
+   !> A deck and an output prefix with blanks in their paths.
+   subroutine test_spaces(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir
+      integer :: code
+      dir = scratch_path("dir with spaces")
+      call execute_command_line("rm -rf '"//dir//"' && mkdir -p '"//dir//"' && cp "//corpus//"/ok.deck '"// &
+         dir//"/my deck.deck'")
+      call run_femcod([string_type("run"), string_type(dir//"/my deck.deck"), string_type("-o"), &
+         string_type(dir//"/my results"), string_type("--quiet")], code)
+      call check(error, code, 0, "run")
+      if (allocated(error)) return
+      call check(error, file_exists(dir//"/my results.h5") .and. file_exists(dir//"/my results.history.csv"), &
+         "results written beside the deck")
+   end subroutine test_spaces
+
+   !> Field k of a " | "-separated line, trimmed.
+   function field(line, k) result(f)
+      character(len=*), intent(in) :: line
+      integer, intent(in) :: k
+      character(len=:), allocatable :: f
+      integer :: a, b, m
+      a = 1
+      do m = 1, k - 1
+         b = index(line(a:), "|")
+         if (b == 0) then
+            f = ""
+            return
+         end if
+         a = a + b
+      end do
+      b = index(line(a:), "|")
+      if (b == 0) then
+         f = trim(adjustl(line(a:)))
+      else
+         f = trim(adjustl(line(a:a + b - 2)))
+      end if
+   end function field
+
+   !> Every occurrence of `from` replaced by `to`.
+   function replace(text, from, to) result(r)
+      character(len=*), intent(in) :: text, from, to
+      character(len=:), allocatable :: r
+      integer :: a, b
+      r = ""
+      a = 1
+      do
+         b = index(text(a:), from)
+         if (b == 0) exit
+         r = r//text(a:a + b - 2)//to
+         a = a + b - 1 + len(from)
+      end do
+      r = r//text(a:)
+   end function replace
+end module test_hostile

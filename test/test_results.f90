@@ -1,0 +1,405 @@
+!> Results a user can keep: the HDF5 file and its schema, XDMF, SVG, --force,
+!> heights straight from files, checkpoint and restart under SIGKILL.
+module test_results
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, STATUS_BAD_INPUT
+   use femcod_deck, only: deck_type, read_deck, write_deck
+   use femcod_strings, only: string_type
+   use femcod_cli, only: run_femcod
+   use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_exists, h5_read_string_attribute, h5_create, &
+      h5_write
+   use femcod_generate, only: deck_spec, build_deck
+   use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   implicit none
+   private
+   public :: collect_results, self_command, csv_column
+
+contains
+
+   subroutine collect_results(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest("HDF5: schema, units, maps balance the load", test_hdf5), &
+         new_unittest("HDF5: maps in C order (h5dump reads row i, column j)", test_c_order), &
+         new_unittest("XDMF: every referenced dataset exists", test_xdmf), &
+         new_unittest("SVG: complete documents, fitted exponent and pressure scale", test_svg), &
+         new_unittest("existing results are kept without --force", test_force), &
+         new_unittest("--lower/--upper: ASCII and HDF5 heights equal the deck", test_height_files), &
+         new_unittest("checkpoint: killed with SIGKILL and restarted, the same results", test_sigkill) &
+         ]
+   end subroutine collect_results
+
+   !> This test executable run as femcod (test/main.f90 handles --femcod).
+   function self_command() result(cmd)
+      character(len=:), allocatable :: cmd
+      integer :: length
+      call get_command_argument(0, length=length)
+      allocate(character(len=length) :: cmd)
+      call get_command_argument(0, cmd)
+      cmd = cmd//" --femcod"
+   end function self_command
+
+   !> Column `col` (1-based) of a CSV file without its header, as numbers.
+   function csv_column(path, col) result(values)
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: col
+      real(dp), allocatable :: values(:)
+      character(len=:), allocatable :: text, line
+      integer :: a, b, k, c, p, q
+      real(dp) :: v
+      text = read_text(path)
+      allocate(values(0))
+      a = index(text, new_line("a")) + 1
+      do while (a <= len(text))
+         b = index(text(a:), new_line("a"))
+         if (b == 0) exit
+         line = text(a:a + b - 2)//","
+         a = a + b
+         p = 1
+         do c = 1, col - 1
+            p = p + index(line(p:), ",")
+         end do
+         q = p + index(line(p:), ",") - 2
+         read(line(p:q), *) v
+         values = [values, v]
+      end do
+      k = size(values)
+   end function csv_column
+
+   !> A run of the 1 nm sphere deck at two loads, into a fresh prefix.
+   subroutine sphere_run(name, prefix, code)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable, intent(out) :: prefix
+      integer, intent(out) :: code
+      prefix = scratch_path(name)
+      call execute_command_line("rm -f '"//prefix//"'.*")
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--loads"), string_type("100,1000"), string_type("--quiet")], code)
+   end subroutine sphere_run
+
+   !> Every dataset of the schema (doc/results.md) with its units; the pressure map
+   !> integrates to the requested load (force balance, an independent physical check);
+   !> the gap is >= 0 everywhere and 0 at the contacts; history and contacts equal the CSV.
+   subroutine test_hdf5(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, units
+      character(len=*), parameter :: datasets(*) = [character(len=28) :: "/surfaces/lower", "/surfaces/upper", &
+         "/history/step", "/history/contacts", "/history/load", "/history/approach", "/history/area", &
+         "/history/area_fraction", "/contacts/i", "/contacts/j", "/contacts/step", "/contacts/force", &
+         "/loads/1/pressure", "/loads/1/gap", "/loads/2/pressure", "/loads/2/gap", "/run/max_penetration"]
+      type(h5_file) :: file
+      type(status_type) :: st
+      real(dp), allocatable :: p(:, :), g(:, :), load(:), force(:), ci(:), cj(:)
+      real(dp) :: pixel
+      integer :: code, k, np
+      call sphere_run("h5-sphere", prefix, code)
+      call check(error, code, 0, "femcod run")
+      if (allocated(error)) return
+      call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
+      call check(error, st%code, 0, "open "//prefix//".h5")
+      if (allocated(error)) return
+      do k = 1, size(datasets)
+         call check(error, h5_exists(file, trim(datasets(k))), "dataset "//trim(datasets(k)))
+         if (allocated(error)) exit
+         call h5_read_string_attribute(file, trim(datasets(k)), "units", 16, units, st, STATUS_BAD_INPUT)
+         call check(error, st%code == 0 .and. len(units) > 0, "units of "//trim(datasets(k)))
+         if (allocated(error)) exit
+      end do
+      if (allocated(error)) return
+      call h5_read_string_attribute(file, "/loads/2/pressure", "units", 16, units, st, STATUS_BAD_INPUT)
+      call check(error, units, "GPa")
+      if (allocated(error)) return
+      call h5_read(file, "/loads/2/pressure", p, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/loads/2/gap", g, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/history/load", load, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/contacts/force", force, st, STATUS_BAD_INPUT)
+      call h5_close(file, st)
+      call check(error, st%code, 0, "reading the maps")
+      if (allocated(error)) return
+      ! The deck: NP = 30, d = 1 nm. Force balance: sum p d^2 = 1000 nN.
+      np = 30
+      pixel = 1
+      call check(error, size(p, 1) == np .and. size(p, 2) == np, "map shape NP x NP")
+      if (allocated(error)) return
+      call check(error, abs(sum(p)*pixel**2 - 1000)/1000 < 1.0e-12_dp, "pressure integrates to 1000 nN, got "// &
+         to_string(sum(p)*pixel**2))
+      if (allocated(error)) return
+      call check(error, minval(g) >= -1.0e-9_dp, "no penetration in the gap map")
+      if (allocated(error)) return
+      call check(error, all(pack(g, p > 0) == 0) .and. all(pack(g, p == 0) > 0), "gap 0 exactly at the contacts")
+      if (allocated(error)) return
+      call check(error, maxval(abs(load - csv_column(prefix//".history.csv", 3))) <= 1.0e-12_dp*maxval(load), &
+         "/history/load equals history.csv")
+      if (allocated(error)) return
+      ! contacts.csv: i, j, force; the map holds force / d^2 at (i, j).
+      ci = csv_column(prefix//".contacts.csv", 1)
+      cj = csv_column(prefix//".contacts.csv", 2)
+      call check(error, size(ci), size(force), "contacts in the CSV and in /contacts")
+      if (allocated(error)) return
+      do k = 1, size(ci)
+         call check(error, abs(p(nint(ci(k)), nint(cj(k))) - force(k)/pixel**2) <= 1.0e-12_dp*maxval(p), &
+            "pressure map at contact "//to_string(k))
+         if (allocated(error)) return
+      end do
+   end subroutine test_hdf5
+
+   !> h5dump, a reader independent of femcod, must see data[i, j] = row i, column j.
+   subroutine test_c_order(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck
+      type(status_type) :: st
+      character(len=:), allocatable :: prefix, text
+      integer :: code, ios, a
+      real(dp) :: v
+      prefix = scratch_path("h5-order")
+      call execute_command_line("rm -f "//prefix//".*")
+      ! The rough deck's lower surface is flat; its upper is not symmetric.
+      call read_deck("input/rough_selfaffine_32.deck", deck, st)
+      call run_femcod([string_type("run"), string_type("input/rough_selfaffine_32.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--max-contacts"), string_type("3"), string_type("--quiet")], code)
+      call check(error, code, 0, "femcod run")
+      if (allocated(error)) return
+      ! Row 2, column 5 (0-based [1, 4]).
+      call execute_command_line("h5dump -d /surfaces/upper -s 1,4 -c 1,1 -m %.17g "//prefix//".h5 > "// &
+         prefix//".dump 2>&1", exitstat=ios)
+      call check(error, ios, 0, "h5dump (Debian hdf5-tools, installed by setup.sh)")
+      if (allocated(error)) return
+      text = read_text(prefix//".dump")
+      a = index(text, "(1,4):")
+      call check(error, a > 0, "h5dump printed element (1,4)")
+      if (allocated(error)) return
+      read(text(a + 6:), *) v
+      call check(error, v, deck%upper(2, 5), "upper(2, 5) as h5dump sees it")
+   end subroutine test_c_order
+
+   !> Every `file.h5:/path` in the XDMF names a dataset of the HDF5 file beside it, with
+   !> the dimensions the XDMF states.
+   subroutine test_xdmf(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, text, name, path
+      type(h5_file) :: file
+      type(status_type) :: st
+      real(dp), allocatable :: map(:, :)
+      integer :: code, a, b, found
+      call sphere_run("xdmf-sphere", prefix, code)
+      call check(error, code, 0, "femcod run")
+      if (allocated(error)) return
+      text = read_text(prefix//".xdmf")
+      call check(error, contains_text(text, '<Xdmf Version="3.0">') .and. contains_text(text, "</Xdmf>"), &
+         "an XDMF 3 document")
+      if (allocated(error)) return
+      name = "xdmf-sphere.h5:"
+      call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
+      found = 0
+      a = 1
+      do
+         b = index(text(a:), name)
+         if (b == 0) exit
+         a = a + b - 1 + len(name)
+         path = text(a:a + index(text(a:), "<") - 2)
+         call h5_read(file, path, map, st, STATUS_BAD_INPUT)
+         call check(error, st%code == 0 .and. size(map, 1) == 30 .and. size(map, 2) == 30, "XDMF item "//path)
+         if (allocated(error)) exit
+         found = found + 1
+      end do
+      call h5_close(file, st)
+      if (allocated(error)) return
+      ! Two surfaces, and pressure and gap at two loads.
+      call check(error, found, 6, "datasets referenced")
+   end subroutine test_xdmf
+
+   !> The figures are complete SVG documents; the area-load figure states the exponent
+   !> of a least-squares fit of log(area) on log(load) over the history, computed here
+   !> independently from history.csv; the pressure map's scale ends at the maximum
+   !> pressure of loads.csv.
+   subroutine test_svg(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, text
+      real(dp), allocatable :: load(:), area(:), x(:), y(:), pmax(:)
+      real(dp) :: slope, shown
+      integer :: code, k, a
+      character(len=*), parameter :: figures(*) = [character(len=20) :: ".load_approach.svg", ".area_load.svg", &
+         ".pressure_1.svg", ".pressure_2.svg"]
+      call sphere_run("svg-sphere", prefix, code)
+      call check(error, code, 0, "femcod run")
+      if (allocated(error)) return
+      do k = 1, size(figures)
+         text = read_text(prefix//trim(figures(k)))
+         call check(error, len(text) > 200, trim(figures(k))//" written")
+         if (allocated(error)) return
+         call check(error, text(1:5) == "<?xml" .and. contains_text(text, "<svg xmlns=") .and. &
+            text(len(text) - 6:) == "</svg>"//new_line("a"), trim(figures(k))//" is a complete SVG document")
+         if (allocated(error)) return
+      end do
+      load = csv_column(prefix//".history.csv", 3)
+      area = csv_column(prefix//".history.csv", 5)
+      x = log(pack(load, load > 0))
+      y = log(pack(area, load > 0))
+      slope = (size(x)*sum(x*y) - sum(x)*sum(y))/(size(x)*sum(x*x) - sum(x)**2)
+      text = read_text(prefix//".area_load.svg")
+      a = index(text, "fit: exponent ")
+      call check(error, a > 0, "the fitted exponent is shown")
+      if (allocated(error)) return
+      read(text(a + 14:a + 14 + index(text(a + 14:), "<") - 2), *) shown
+      call check(error, abs(shown - slope) < 6.0e-4_dp, "exponent shown "//to_string(shown)//", fitted here "// &
+         to_string(slope))
+      if (allocated(error)) return
+      pmax = csv_column(prefix//".loads.csv", 6)
+      text = read_text(prefix//".pressure_2.svg")
+      a = index(text, ">max ")
+      call check(error, a > 0, "the colour bar states its maximum")
+      if (allocated(error)) return
+      read(text(a + 5:a + 5 + index(text(a + 5:), "<") - 2), *) shown
+      call check(error, abs(shown - pmax(2)) < 1.0e-3_dp*pmax(2), "colour bar maximum "//to_string(shown)// &
+         " GPa, loads.csv "//to_string(pmax(2)))
+   end subroutine test_svg
+
+   !> A second run to the same prefix fails with exit 5 before solving and leaves the
+   !> results as they were; --force replaces them.
+   subroutine test_force(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, before
+      integer :: code
+      call sphere_run("force-sphere", prefix, code)
+      call check(error, code, 0, "first run")
+      if (allocated(error)) return
+      call write_text(prefix//".history.csv", "kept"//new_line("a"))
+      before = read_text(prefix//".h5")
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--quiet")], code)
+      call check(error, code, 5, "existing results: exit 5")
+      if (allocated(error)) return
+      call check(error, read_text(prefix//".history.csv") == "kept"//new_line("a") .and. &
+         read_text(prefix//".h5") == before, "results untouched")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--quiet"), string_type("--force")], code)
+      call check(error, code, 0, "--force")
+      if (allocated(error)) return
+      call check(error, read_text(prefix//".history.csv") /= "kept"//new_line("a"), "--force replaced the results")
+   end subroutine test_force
+
+   !> The sphere deck's upper surface written as an ASCII matrix and as an HDF5 dataset,
+   !> run with --upper FILE and the deck's pixel, material and MAXCONT: the same history
+   !> as the deck (the same scene reached two ways).
+   subroutine test_height_files(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck
+      type(status_type) :: st
+      type(h5_file) :: file
+      character(len=:), allocatable :: dir, ref, text, maxc
+      character(len=40) :: buf
+      integer :: code, i, j
+      dir = scratch_path("heights")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call read_deck("input/sphere_d1.deck", deck, st)
+      maxc = int_text(deck%maxcont)
+      text = "# sphere_d1 upper surface, nm"//new_line("a")
+      do i = 1, deck%np
+         do j = 1, deck%np
+            write(buf, '(es25.17)') deck%upper(i, j)
+            text = text//trim(buf)
+         end do
+         text = text//new_line("a")
+      end do
+      call write_text(dir//"/upper.txt", text)
+      call h5_create(dir//"/upper.h5", file, st)
+      call h5_write(file, "/heights", deck%upper, "nm", st)
+      call h5_close(file, st)
+      call check(error, st%code, 0, "writing upper.h5")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
+         string_type(dir//"/deck"), string_type("--max-contacts"), string_type("60"), string_type("--quiet")], code)
+      ref = read_text(dir//"/deck.history.csv")
+      call check(error, code == 0 .and. len(ref) > 100, "the deck's run")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("--upper"), string_type(dir//"/upper.txt"), &
+         string_type("--pixel"), string_type("1"), string_type("--maxcont"), string_type(maxc), &
+         string_type("-o"), string_type(dir//"/ascii"), string_type("--max-contacts"), string_type("60"), &
+         string_type("--quiet")], code)
+      call check(error, code, 0, "--upper upper.txt")
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/ascii.history.csv") == ref, "ASCII heights: the same history")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("--upper"), string_type(dir//"/upper.h5:/heights"), &
+         string_type("--pixel"), string_type("1"), string_type("--maxcont"), string_type(maxc), &
+         string_type("--max-contacts"), string_type("60"), string_type("--quiet")], code)
+      ! Without -o the results are named after the file, in the current directory.
+      call check(error, code, 0, "--upper upper.h5:/heights")
+      if (allocated(error)) return
+      call check(error, read_text("upper.history.csv") == ref, "HDF5 heights: the same history")
+      call execute_command_line("rm -f upper.*")
+   end subroutine test_height_files
+
+   function int_text(v) result(s)
+      integer, intent(in) :: v
+      character(len=:), allocatable :: s
+      character(len=16) :: buf
+      write(buf, '(i0)') v
+      s = trim(buf)
+   end function int_text
+
+   !> A run with a checkpoint after every step is killed with SIGKILL at several
+   !> moments (each restart may be killed again), then completed with --restart: its
+   !> history, contacts and loads files equal, byte for byte, those of a run never
+   !> interrupted. The kill times spread over the reference run's own duration.
+   subroutine test_sigkill(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_spec) :: spec
+      type(deck_type) :: deck
+      type(status_type) :: st
+      character(len=:), allocatable :: dir, cmd, run_args
+      character(len=16) :: delay
+      real(dp) :: duration
+      integer :: code, k, killed, resumed
+      integer(8) :: c0, c1, rate
+      real(dp), parameter :: fractions(*) = [0.15_dp, 0.3_dp, 0.45_dp, 0.6_dp, 0.75_dp, 0.9_dp, 1.05_dp]
+      dir = scratch_path("sigkill")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      spec%kind = "self-affine"
+      spec%label = "checkpoint test: self-affine 48 x 48"
+      spec%matrix_file = ""
+      spec%np = 48
+      spec%pixel = 10
+      spec%rms = 3
+      spec%maxcont = 400
+      call build_deck(spec, deck, st)
+      call write_deck(dir//"/scene.deck", deck, st)
+      call check(error, st%code, 0, "deck")
+      if (allocated(error)) return
+      run_args = " run "//dir//"/scene.deck --loads 3e4,1e9 --quiet "
+      call system_clock(c0, rate)
+      call execute_command_line(self_command()//run_args//"-o "//dir//"/ref", exitstat=code)
+      call system_clock(c1)
+      duration = real(c1 - c0, dp)/rate
+      call check(error, code, 0, "the uninterrupted run")
+      if (allocated(error)) return
+      killed = 0
+      resumed = 0
+      cmd = self_command()//run_args//"-o "//dir//"/ck --checkpoint-interval 0 --restart"
+      do k = 1, size(fractions)
+         write(delay, '(f0.3)') fractions(k)*duration
+         if (file_exists(dir//"/ck.ckpt.h5")) resumed = resumed + 1
+         call execute_command_line("timeout -s KILL "//trim(delay)//" "//cmd//" 2>/dev/null", exitstat=code)
+         if (code == 137) killed = killed + 1
+         if (code /= 137 .and. code /= 0) exit
+      end do
+      call check(error, code == 0 .or. code == 137, "killed runs exit by the signal only, got "//to_string(code))
+      if (allocated(error)) return
+      call execute_command_line(cmd, exitstat=code)
+      call check(error, code, 0, "the final --restart")
+      if (allocated(error)) return
+      call check(error, killed >= 3 .and. resumed >= 2, "runs killed: "//to_string(killed)//", resumed from a "// &
+         "checkpoint: "//to_string(resumed))
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/ck.history.csv") == read_text(dir//"/ref.history.csv") .and. &
+         len(read_text(dir//"/ref.history.csv")) > 1000, "history identical")
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/ck.contacts.csv") == read_text(dir//"/ref.contacts.csv"), "contacts identical")
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/ck.loads.csv") == read_text(dir//"/ref.loads.csv"), "loads identical")
+      if (allocated(error)) return
+      call check(error, .not. file_exists(dir//"/ck.ckpt.h5"), "the checkpoint is removed at the end")
+   end subroutine test_sigkill
+end module test_results
