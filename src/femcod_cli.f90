@@ -153,8 +153,9 @@ contains
          "                [--lmax 1000 nm] [--lmin 1 nm] [--ridges 10] [--seed 1]", &
          "  self-affine   Gaussian random surface by FFT filtering, C(q) ~ q^-2(1+H) from 2pi/L to pi/d;", &
          "                [--hurst 0.8] [--rms 1 nm] [--seed 1]", &
-         "  matrix        heights from an ASCII matrix: --file FILE (one row per line, '#' comments,", &
-         "                Gwyddion export); [--remove-plane] subtracts the least-squares plane", &
+         "  matrix        heights from --file FILE: an ASCII matrix (one row per line, '#' comments,", &
+         "                Gwyddion export) or FILE.h5:/dataset (square, C order); [--remove-plane]", &
+         "                subtracts the least-squares plane", &
          "", &
          "common options:", &
          "  -o FILE               output deck (written atomically)", &

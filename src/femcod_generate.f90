@@ -7,6 +7,7 @@
 !> `RIGID_FACTOR` (1e5) times the elastic body's, as in the thesis; the contact and
 !> interface elements get the same rigid modulus (section 4.4).
 module femcod_generate
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
    use femcod_deck, only: deck_type, parse_real, validate_deck, format_real
@@ -294,7 +295,7 @@ contains
                int_str(size(z, 1))//" x "//int_str(size(z, 2)))
             return
          end if
-         if (.not. all(abs(z) <= huge(1.0_dp))) then
+         if (.not. all(ieee_is_finite(z))) then
             call set_error(status, STATUS_BAD_INPUT, path//": expected finite heights (nm), found NaN or Inf")
             return
          end if

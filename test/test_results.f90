@@ -25,6 +25,7 @@ contains
          new_unittest("XDMF: every referenced dataset exists", test_xdmf), &
          new_unittest("SVG: complete documents, fitted exponent and pressure scale", test_svg), &
          new_unittest("existing results are kept without --force", test_force), &
+         new_unittest("a result that cannot be put in place leaves no partial set", test_partial), &
          new_unittest("--lower/--upper: ASCII and HDF5 heights equal the deck", test_height_files), &
          new_unittest("checkpoint: killed with SIGKILL and restarted, the same results", test_sigkill) &
          ]
@@ -279,6 +280,25 @@ contains
       if (allocated(error)) return
       call check(error, read_text(prefix//".history.csv") /= "kept"//new_line("a"), "--force replaced the results")
    end subroutine test_force
+
+   !> PREFIX.h5 is a directory, so the last rename fails: exit 5 and none of the files
+   !> renamed before it stays behind.
+   subroutine test_partial(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix
+      integer :: code
+      prefix = scratch_path("partial")
+      call execute_command_line("rm -rf "//prefix//".* && mkdir -p "//prefix//".h5")
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--loads"), string_type("100"), string_type("--quiet"), &
+         string_type("--force")], code)
+      call check(error, code, 5, "exit code")
+      if (allocated(error)) return
+      call check(error, .not. (file_exists(prefix//".history.csv") .or. file_exists(prefix//".contacts.csv") .or. &
+         file_exists(prefix//".loads.csv") .or. file_exists(prefix//".xdmf") .or. &
+         file_exists(prefix//".pressure_1.svg") .or. file_exists(prefix//".h5.part")), "no partial result set")
+      call execute_command_line("rmdir "//prefix//".h5")
+   end subroutine test_partial
 
    !> The sphere deck's upper surface written as an ASCII matrix and as an HDF5 dataset,
    !> run with --upper FILE and the deck's pixel, material and MAXCONT: the same history
