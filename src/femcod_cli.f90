@@ -11,6 +11,7 @@ module femcod_cli
    use femcod_run, only: run_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
+   use femcod_stability_report, only: write_stability_report
    use femcod_strings, only: string_type, int_str
    implicit none
    private
@@ -62,6 +63,8 @@ contains
          call run_command(args(2:), code)
       case ("verify")
          call verify_command(args(2:), code)
+      case ("stability")
+         call stability_command(args(2:), code)
       case default
          call usage_error("unknown command '"//args(1)%s//"'")
          code = STATUS_USAGE
@@ -79,6 +82,7 @@ contains
          "  mkdeck KIND [options]     generate a deck (femcod mkdeck --help)", &
          "  workspace NP MAXCONT      print the Appendix B memory map (Tables B.1, B.2)", &
          "  verify [-o FILE]          recompute the thesis checks, write doc/verification.md", &
+         "  stability [-o FILE]       run the hard cases, write doc/stability.md", &
          "  bench [--full]            speed against error, one table (use the release build)", &
          "  --help, --version", &
          "", &
@@ -166,6 +170,9 @@ contains
          "  --young E --poisson NU  the elastic body (default 200 GPa, 0.25)", &
          "  --shape-on upper|lower  surface that carries the shape (default upper)", &
          "  --rigid upper|lower|none  rigid body (default upper)", &
+         "  --rigid-factor R      modulus of the rigid body and of the contact/interface elements over", &
+         "                        the elastic one (default 1e10: penalty error ~4e-11, doc/stability.md;", &
+         "                        the thesis and input/ use 1e5; for --solver legacy 3e7 is best)", &
          "  --label TEXT          first line of the deck", &
          "", &
          "verification decks (input/): circle_punch_d1 d3 d9 (Table 4.1), square_punch_n1 n3 n9 n27", &
@@ -252,6 +259,9 @@ contains
                call parse_real(v, spec%young, ok)
             case ("--poisson")
                call parse_real(v, spec%poisson, ok)
+            case ("--rigid-factor")
+               call parse_real(v, spec%rigid_factor, ok)
+               if (ok) ok = spec%rigid_factor >= 1
             case ("--radius")
                call parse_real(v, spec%radius, ok)
             case ("--area")
@@ -282,7 +292,7 @@ contains
                return
             end select
             if (.not. ok) then
-               call usage_error("mkdeck: option "//key//" expects a number, found '"//v//"'")
+               call usage_error("mkdeck: option "//key//" expects a number (--rigid-factor: >= 1), found '"//v//"'")
                code = STATUS_USAGE
                return
             end if
@@ -381,6 +391,58 @@ contains
       end if
       write(output_unit, '(a)') "wrote "//output
    end subroutine verify_command
+
+   !> `femcod stability [-o FILE] [--events N]`.
+   subroutine stability_command(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      type(status_type) :: status
+      character(len=:), allocatable :: output
+      integer :: i, events
+      logical :: ok
+      code = 0
+      output = "doc/stability.md"
+      events = 5000
+      i = 1
+      do while (i <= size(args))
+         select case (args(i)%s)
+         case ("-h", "--help")
+            write(output_unit, '(a)') "usage: femcod stability [-o FILE] [--events N]", &
+               "Runs the hard cases of doc/stability.md (stiff springs, ties and symmetry, degenerate scenes,", &
+               "precision, a long run of N events, default 5000) and writes the table to FILE (default", &
+               "doc/stability.md). About a minute with the release build."
+            return
+         case ("-o", "--events")
+            if (i == size(args)) then
+               call usage_error("stability: "//args(i)%s//" needs a value")
+               code = STATUS_USAGE
+               return
+            end if
+            if (args(i)%s == "-o") then
+               output = args(i + 1)%s
+            else
+               call parse_integer(args(i + 1)%s, events, ok)
+               if (.not. ok .or. events < 2) then
+                  call usage_error("stability: --events expects an integer >= 2, found '"//args(i + 1)%s//"'")
+                  code = STATUS_USAGE
+                  return
+               end if
+            end if
+            i = i + 2
+         case default
+            call usage_error("stability: unknown argument "//args(i)%s)
+            code = STATUS_USAGE
+            return
+         end select
+      end do
+      call write_stability_report(output, events, status, .true.)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod: "//status%message
+         code = status%code
+         return
+      end if
+      write(output_unit, '(a)') "wrote "//output
+   end subroutine stability_command
 
    function kinds_list() result(s)
       character(len=:), allocatable :: s

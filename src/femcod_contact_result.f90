@@ -67,6 +67,13 @@ module femcod_contact_result
       !> Deepest penetration of any pixel not in contact at the end (nm, >= 0), from the
       !> full-field check.
       real(dp) :: max_penetration = 0
+      !> Legacy solver: the largest TRFACT pivot loss of the run (about log10 of it digits
+      !> lost to cancellation; 1 for the incremental solver, which has no springs in its
+      !> matrix).
+      real(dp) :: pivot_loss = 1
+      !> Legacy solver: the largest 1-norm condition estimate of its skyline system
+      !> (TRFACT + LAPACK dlacn2); 0 for the incremental solver.
+      real(dp) :: condition = 0
       real(dp) :: wall_seconds = 0
    end type contact_result
 

@@ -143,10 +143,25 @@ contains
          call restore(resume)
          if (status%code /= 0) return
       else
-         ! The first contact: the smallest gap (ties join at the next step with no load).
+         ! The first step: the smallest gap and every pixel tied with it (within the tie
+         ! tolerance of the gaps' range; the load scale is still zero), in pixel order.
          call pop_valid(p)
-         call add_contact(p, 1)
-         if (status%code /= 0) return
+         njoin = 1
+         joiners(1) = p
+         do while (heap%size > 0 .and. njoin < maxc)
+            if (heap_top_key(heap) > g0(p) + options%tie_tolerance*(maxval(g0) - g0(p))) exit
+            njoin = njoin + 1
+            call heap_pop(heap, key, joiners(njoin))
+         end do
+         if (njoin > 1) then
+            allocate(order(njoin))
+            call merge_sort_index(real(joiners(1:njoin), dp), order)
+            joiners(1:njoin) = joiners(order)
+         end if
+         do q = 1, njoin
+            call add_contact(joiners(q), 1)
+            if (status%code /= 0) return
+         end do
       end if
       call wall_clock(last_checkpoint)
 

@@ -4,7 +4,7 @@ module femcod_lapack
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv
+   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv, dlacn2
 
    interface
       pure subroutine dpotrf(uplo, n, a, lda, info)
@@ -75,5 +75,12 @@ module femcod_lapack
          real(dp), intent(inout) :: ap(*)
          integer, intent(out) :: info
       end subroutine dpptrf
+      !> LAPACK's 1-norm estimator (Higham's reverse-communication form of Hager's method).
+      subroutine dlacn2(n, v, x, isgn, est, kase, isave)
+         import :: dp
+         integer, intent(in) :: n
+         real(dp), intent(inout) :: v(*), x(*), est
+         integer, intent(inout) :: isgn(*), kase, isave(3)
+      end subroutine dlacn2
    end interface
 end module femcod_lapack

@@ -21,7 +21,7 @@ module femcod_legacy
       boussinesq_element
    use femcod_spring, only: spring_stiffness, spring_element
    use femcod_skyline, only: colht, diagonal_addresses, assemble_element, skyline_matvec
-   use femcod_trfact, only: trfact, TRFACT_FACTOR, TRFACT_SOLVE
+   use femcod_trfact, only: trfact, trfact_condition, TRFACT_FACTOR, TRFACT_SOLVE
    use femcod_postp, only: candidate_count, postp_search
    use femcod_condensed, only: solve_active_set, gap_at
    use femcod_contact_result, only: contact_result, contact_options, append_step, progress_interface, STOP_MAXCONT, &
@@ -47,6 +47,7 @@ contains
       logical, allocatable :: in_contact(:)
       real(dp) :: c1, c2, csum, kspring, delta, lambda, total, approach, tstart, t0, t1, max_load
       integer :: np, npix, maxc, n, step, ncand, njoin, nmissed, k, p, first
+      real(dp) :: loss, kappa
       integer :: isurf, igaps, isort
       logical :: finished
 
@@ -80,10 +81,17 @@ contains
       allocate(ic(maxc), jc(maxc), cstep(maxc), ftot(maxc), funit(maxc), in_contact(npix), joiners(npix))
       in_contact = .false.
       ftot = 0
-      ! The first contact: the smallest gap; ties join at the second step.
+      ! The first step: the smallest gap and every pixel tied with it (within the tie
+      ! tolerance of the gaps' range; the load scale is still zero), up to MAXCONT.
       first = ws%ia(isort)
       n = 1
       call add_contact(first, 1)
+      do k = 2, min(npix, maxc)
+         p = ws%ia(isort + k - 1)
+         if (g0(p) > g0(first) + options%tie_tolerance*(maxval(g0) - g0(first))) exit
+         n = n + 1
+         call add_contact(p, 1)
+      end do
 
       max_load = -huge(1.0_dp)
       if (allocated(options%loads)) then
@@ -101,7 +109,10 @@ contains
       do while (.not. finished)
          step = step + 1
          call wall_clock(t0)
-         call legacy_unit_solution(ic(1:n), jc(1:n), table, c1, c2, kspring, ws, delta, funit(1:n), status)
+         call legacy_unit_solution(ic(1:n), jc(1:n), table, c1, c2, kspring, ws, delta, funit(1:n), status, loss, &
+            kappa)
+         res%pivot_loss = max(res%pivot_loss, loss)
+         res%condition = max(res%condition, kappa)
          if (status%code /= 0) return
          ncand = candidate_count(n, npix)
          call postp_search(np, ws%ia(isort:isort + npix - 1), ncand, in_contact, g0, table, csum, ic(1:n), &
@@ -223,12 +234,16 @@ contains
    !> assemble BOUSSINESQ (both surfaces, one flexibility) and SPRING (interface and
    !> penalty), TRFACT factor and solve under the unit load. Returns the approach per
    !> nN `delta` and the contact forces per nN `funit`.
-   subroutine legacy_unit_solution(ic, jc, table, c1, c2, kspring, ws, delta, funit, status)
+   subroutine legacy_unit_solution(ic, jc, table, c1, c2, kspring, ws, delta, funit, status, pivot_loss, condition)
       integer, intent(in) :: ic(:), jc(:)
       real(dp), intent(in) :: table(0:, 0:), c1, c2, kspring
       type(workspace_type), intent(inout) :: ws
       real(dp), intent(out) :: delta, funit(:)
       type(status_type), intent(inout) :: status
+      !> TRFACT's estimate of the digits lost (see trfact), for this factorisation.
+      real(dp), intent(out), optional :: pivot_loss
+      !> LAPACK-style 1-norm condition estimate of the skyline system (trfact_condition).
+      real(dp), intent(out), optional :: condition
       real(dp), allocatable :: flex(:, :), kinv(:, :), element(:, :), b(:), rhs(:), r(:), kcopy(:)
       integer, allocatable :: height(:), eqs1(:), eqs2(:), iadr(:)
       integer :: n, neq, k, istif, nstif, inod
@@ -303,8 +318,9 @@ contains
          rhs(neq) = -1
          b = rhs
          kcopy = a
-         call trfact(a, iadr, b, TRFACT_FACTOR, status)
+         call trfact(a, iadr, b, TRFACT_FACTOR, status, pivot_loss)
          if (status%code /= 0) return
+         if (present(condition)) condition = trfact_condition(a, kcopy, iadr)
          call trfact(a, iadr, b, TRFACT_SOLVE, status)
          call skyline_matvec(kcopy, iadr, b, r)
          r = rhs - r

@@ -70,7 +70,7 @@ contains
          "  --upper FILE       upper surface heights, the same formats (missing: flat)", &
          "  --pixel D          pixel size in nm (required)", &
          "  --young E, --poisson NU   the elastic body (default 200 GPa, 0.25)", &
-         "  --rigid upper|lower|none  rigid body (default upper), as femcod mkdeck", &
+         "  --rigid upper|lower|none  rigid body (default upper), --rigid-factor R (default 1e10), as mkdeck", &
          "  --maxcont M        maximum contacts (default 5 % of the pixels)", &
          "  --remove-plane     subtract each surface's least-squares plane", &
          "", &
@@ -206,7 +206,11 @@ contains
                spec%label = v
             case ("--rigid")
                spec%rigid = v
-            case ("--pixel", "--young", "--poisson")
+            case ("--pixel", "--young", "--poisson", "--rigid-factor")
+               if (key == "--rigid-factor") then
+                  call parse_real(v, spec%rigid_factor, ok)
+                  if (ok) ok = spec%rigid_factor >= 1
+               end if
                if (key == "--pixel") call parse_real(v, spec%pixel, ok)
                if (key == "--young") call parse_real(v, spec%young, ok)
                if (key == "--poisson") call parse_real(v, spec%poisson, ok)
@@ -458,6 +462,11 @@ contains
                " contacts found late by the candidate search, "//int_str(res%missed_final_check)// &
                " found by the final check of all pixels; exact re-solve differs by "// &
                real_str(res%final_check_difference, 2)
+            write(output_unit, '(a)') "  TRFACT    : condition estimate "//real_str(res%condition, 2)// &
+               " (LAPACK dlacn2): relative errors up to about "//real_str(epsilon(1.0_dp)*res%condition, 1)
+            if (epsilon(1.0_dp)*res%condition > 1.0e-8_dp) write(output_unit, '(a)') &
+               "  warning   : the stiff springs and rigid body cost the legacy solver digits; the incremental "// &
+               "solver is immune (doc/stability.md)"
          end if
          write(output_unit, '(a)') "  written   : "//current_prefix//".h5, .xdmf, .history.csv, .contacts.csv, "// &
             ".load_approach.svg, .area_load.svg"//trim(merge(", .loads.csv, .pressure_<k>.svg", &

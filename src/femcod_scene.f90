@@ -21,11 +21,14 @@ contains
 
    !> Initial gaps (nm), pixel numbered row-wise: k = (i-1)*NP + j.
    !>   g(i,j) = max_{k,l}[hl(k,l) + hu(NP+1-k,l)] - [hl(i,j) + hu(NP+1-i,j)]
+   !> Each surface is first taken relative to its own highest point: heights offset by
+   !> a large constant then subtract exactly (Sterbenz), and only the small relative
+   !> heights are added, so no offset cancels in the sum.
    pure function initial_gaps(lower, upper) result(gaps)
       real(dp), intent(in) :: lower(:, :), upper(:, :)
       real(dp) :: gaps(size(lower))
       real(dp) :: total(size(lower, 1), size(lower, 2))
-      total = lower + flip_upper(upper)
+      total = (lower - maxval(lower)) + flip_upper(upper - maxval(upper))
       ! Row-wise numbering: transpose so that j runs fastest.
       gaps = reshape(transpose(maxval(total) - total), [size(lower)])
    end function initial_gaps

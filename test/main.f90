@@ -13,6 +13,7 @@ program tester
    use test_incremental, only: collect_incremental
    use test_results, only: collect_results
    use test_hostile, only: collect_hostile
+   use test_stability, only: collect_stability
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
    use femcod_strings, only: string_type
@@ -30,7 +31,8 @@ program tester
       new_testsuite("legacy", collect_legacy), &
       new_testsuite("incremental", collect_incremental), &
       new_testsuite("results", collect_results), &
-      new_testsuite("hostile", collect_hostile) &
+      new_testsuite("hostile", collect_hostile), &
+      new_testsuite("stability", collect_stability) &
       ]
    stat = 0
    total = 0

@@ -301,7 +301,8 @@ contains
    end subroutine test_partial
 
    !> The sphere deck's upper surface written as an ASCII matrix and as an HDF5 dataset,
-   !> run with --upper FILE and the deck's pixel, material and MAXCONT: the same history
+   !> run with --upper FILE and the deck's pixel, materials (the thesis' rigid factor
+   !> 1e5) and MAXCONT: the same history
    !> as the deck (the same scene reached two ways).
    subroutine test_height_files(error)
       type(error_type), allocatable, intent(out) :: error
@@ -335,7 +336,8 @@ contains
       call check(error, code == 0 .and. len(ref) > 100, "the deck's run")
       if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("--upper"), string_type(dir//"/upper.txt"), &
-         string_type("--pixel"), string_type("1"), string_type("--maxcont"), string_type(maxc), &
+         string_type("--pixel"), string_type("1"), string_type("--rigid-factor"), string_type("1e5"), &
+         string_type("--maxcont"), string_type(maxc), &
          string_type("-o"), string_type(dir//"/ascii"), string_type("--max-contacts"), string_type("60"), &
          string_type("--quiet")], code)
       call check(error, code, 0, "--upper upper.txt")
@@ -343,7 +345,8 @@ contains
       call check(error, read_text(dir//"/ascii.history.csv") == ref, "ASCII heights: the same history")
       if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("--upper"), string_type(dir//"/upper.h5:/heights"), &
-         string_type("--pixel"), string_type("1"), string_type("--maxcont"), string_type(maxc), &
+         string_type("--pixel"), string_type("1"), string_type("--rigid-factor"), string_type("1e5"), &
+         string_type("--maxcont"), string_type(maxc), &
          string_type("--max-contacts"), string_type("60"), string_type("--quiet")], code)
       ! Without -o the results are named after the file, in the current directory.
       call check(error, code, 0, "--upper upper.h5:/heights")
