@@ -5,7 +5,9 @@
 !>
 !> Layout: /deck (label, NP, pixel, MAXCONT, young, poisson; lower, upper),
 !> /options (max_contacts, loads, tie_tolerance, hardness, final_check),
-!> /state (step, n, total, approach, operations, cstep, ftot),
+!> /state (step, n, total, approach, phi, pix, cstep, ftot, ld, factor (the upper
+!> triangle packed by columns), y, x, cache_pixel, cache_l, cache_w, predicted,
+!> since_refill, heap_key, heap_item),
 !> /history (contacts, load, approach, seconds), /states/<k> (the requested loads
 !> reached so far), /counters.
 module femcod_checkpoint
@@ -23,7 +25,7 @@ module femcod_checkpoint
    public :: write_checkpoint, read_checkpoint
 
    !> Marks a file as a femcod checkpoint (attribute /format).
-   character(len=*), parameter :: FORMAT_TAG = "femcod checkpoint 1"
+   character(len=*), parameter :: FORMAT_TAG = "femcod checkpoint 2"
 
 contains
 
@@ -64,9 +66,21 @@ contains
       call h5_write(file, "/state/n", state%n, "1", status)
       call h5_write(file, "/state/total", state%total, "nN", status)
       call h5_write(file, "/state/approach", state%approach, "nm", status)
-      call h5_write(file, "/state/operations", state%operations, "1", status)
+      call h5_write(file, "/state/phi", state%phi, "nm", status)
+      call h5_write(file, "/state/pix", state%pix, "1", status)
       call h5_write(file, "/state/cstep", state%cstep, "1", status)
       call h5_write(file, "/state/ftot", state%ftot, "nN", status)
+      call h5_write(file, "/state/ld", state%ld, "1", status)
+      call h5_write(file, "/state/factor", state%factor, "(nm/nN)^0.5", status)
+      call h5_write(file, "/state/y", state%y, "(nN/nm)^0.5", status)
+      call h5_write(file, "/state/x", state%x, "nN/nm", status)
+      call h5_write(file, "/state/cache_pixel", state%cache_pixel, "1", status)
+      call h5_write(file, "/state/cache_l", state%cache_l, "(nm/nN)^0.5", status)
+      call h5_write(file, "/state/cache_w", state%cache_w, "1", status)
+      call h5_write(file, "/state/predicted", state%predicted, "nN", status)
+      call h5_write(file, "/state/since_refill", state%since_refill, "1", status)
+      call h5_write(file, "/state/heap_key", state%heap_key, "nm", status)
+      call h5_write(file, "/state/heap_item", state%heap_item, "1", status)
       call h5_group(file, "/history", status)
       call h5_write(file, "/history/contacts", state%res%step_contacts(1:m), "1", status)
       call h5_write(file, "/history/load", state%res%step_load(1:m), "nN", status)
@@ -200,9 +214,23 @@ contains
       call h5_read(file, "/state/n", state%n, status, bad)
       call h5_read(file, "/state/total", state%total, status, bad)
       call h5_read(file, "/state/approach", state%approach, status, bad)
-      call h5_read(file, "/state/operations", state%operations, status, bad)
+      call h5_read(file, "/state/phi", state%phi, status, bad)
+      call h5_read(file, "/state/pix", state%pix, status, bad)
       call h5_read(file, "/state/cstep", state%cstep, status, bad)
       call h5_read(file, "/state/ftot", state%ftot, status, bad)
+      call h5_read(file, "/state/ld", state%ld, status, bad)
+      call h5_read(file, "/state/factor", state%factor, status, bad)
+      call h5_read(file, "/state/y", state%y, status, bad)
+      call h5_read(file, "/state/x", state%x, status, bad)
+      call h5_read(file, "/state/cache_pixel", state%cache_pixel, status, bad)
+      call h5_read(file, "/state/cache_l", r2, status, bad)
+      state%cache_l = r2
+      call h5_read(file, "/state/cache_w", r2, status, bad)
+      state%cache_w = r2
+      call h5_read(file, "/state/predicted", state%predicted, status, bad)
+      call h5_read(file, "/state/since_refill", state%since_refill, status, bad)
+      call h5_read(file, "/state/heap_key", state%heap_key, status, bad)
+      call h5_read(file, "/state/heap_item", state%heap_item, status, bad)
       call h5_read(file, "/history/contacts", state%res%step_contacts, status, bad)
       call h5_read(file, "/history/load", state%res%step_load, status, bad)
       call h5_read(file, "/history/approach", state%res%step_approach, status, bad)
@@ -216,7 +244,11 @@ contains
       if (size(state%res%step_contacts) /= m .or. size(state%res%step_approach) /= m .or. &
          size(state%res%step_seconds) /= m .or. m /= state%step .or. size(state%cstep) /= state%n .or. &
          size(state%ftot) /= state%n .or. state%n < 1 .or. state%n > deck%maxcont .or. &
-         any(abs(state%operations) < 1) .or. any(state%operations > deck%np**2)) then
+         size(state%pix) /= state%n .or. size(state%y) /= state%n .or. size(state%x) /= state%n .or. &
+         size(state%cache_l, 1) /= state%n .or. size(state%cache_w, 1) /= state%n .or. &
+         size(state%heap_key) /= size(state%heap_item) .or. any(state%pix < 1) .or. &
+         any(state%pix > deck%np**2) .or. any(state%heap_item < 1) .or. any(state%heap_item > deck%np**2) .or. &
+         any(state%cache_pixel < 0) .or. any(state%cache_pixel > deck%np**2)) then
          call refuse("its state is inconsistent (corrupted)")
          return
       end if

@@ -61,6 +61,9 @@ module femcod_contact_result
       integer :: releases = 0
       !> Exact pixel evaluations made by the candidate search (incremental solver).
       integer(i8) :: evaluations = 0
+      !> Incremental solver: contacts whose bordering columns came from the candidate
+      !> cache, contacts that needed their own triangular solves, and cache refills.
+      integer :: cache_hits = 0, cache_misses = 0, cache_refills = 0, cache_columns = 0
       !> Largest relative difference between the accumulated state and an exact
       !> active-set solve at the end (a consistency check of the step accumulation).
       real(dp) :: final_check_difference = 0
@@ -77,17 +80,27 @@ module femcod_contact_result
       real(dp) :: wall_seconds = 0
    end type contact_result
 
-   !> Everything the incremental solver needs to continue a run exactly where it was:
-   !> the contacts are rebuilt by replaying `operations` in order (the same bordered
-   !> updates, so the factor is the same to the last bit), the rest is stored.
+   !> Everything the incremental solver needs to continue a run exactly where it was,
+   !> bit for bit: the contacts, the Cholesky factor and the vectors derived from it,
+   !> the candidate cache and the event heap, the accumulated load, approach and forces.
    type :: solver_state
       integer :: step = 0, n = 0
-      real(dp) :: total = 0, approach = 0
-      !> +p: pixel p joined; -k: contact k was released.
-      integer, allocatable :: operations(:)
-      !> The current contacts: step joined and force (nN).
-      integer, allocatable :: cstep(:)
+      real(dp) :: total = 0, approach = 0, phi = 0
+      !> The current contacts: pixel (row-wise number), step joined, force (nN).
+      integer, allocatable :: pix(:), cstep(:)
       real(dp), allocatable :: ftot(:)
+      !> Leading dimension of the factor's storage and the factor's upper triangle,
+      !> packed column by column; y = U^-T 1 and x = M^-1 1.
+      integer :: ld = 0
+      real(dp), allocatable :: factor(:), y(:), x(:)
+      !> Candidate cache: pixel per slot (0: empty), columns l and w (n x slots), the
+      !> predicted closing loads, contacts joined since the last refill.
+      integer, allocatable :: cache_pixel(:)
+      real(dp), allocatable :: cache_l(:, :), cache_w(:, :), predicted(:)
+      integer :: since_refill = 0
+      !> The event heap: keys and items in heap order.
+      real(dp), allocatable :: heap_key(:)
+      integer, allocatable :: heap_item(:)
       !> The results so far (history, states reached, counters).
       type(contact_result) :: res
    end type solver_state

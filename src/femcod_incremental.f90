@@ -7,9 +7,11 @@
 !> the compliance of the springs in series at a contact (two interface springs and the
 !> penalty spring, 3/k). Under a unit load increment f = M^-1 1/(1'M^-1 1) and the
 !> approach rate is delta = 1/(1'M^-1 1). M = U'U is kept as a Cholesky factor in full
-!> column storage that grows by doubling; a new contact borders it with one column (a
-!> triangular solve, BLAS dtrsv), never a refactorisation, except when a contact is
-!> released.
+!> column storage that grows by doubling; a new contact borders it with one column
+!> l = U^-T m, never a refactorisation, except when a contact is released. l and
+!> w = M^-1 m of the next contact usually come from a cache of the candidates predicted
+!> to close next, kept current in O(n) each per contact and refilled with BLAS-3 solves
+!> (doc/solver.md); x = M^-1 1 is updated from w, so a normal event streams no factor.
 !>
 !> The next event is found exactly: every pixel not in contact sits in a heap keyed by
 !> a lower bound on its gap. Since F >= 0, a gap never shrinks faster than
@@ -25,7 +27,7 @@ module femcod_incremental
    use femcod_scene, only: initial_gaps
    use femcod_boussinesq, only: offset_table, surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
-   use femcod_lapack, only: dtrsv, dpotrf
+   use femcod_lapack, only: dtrsv, dtrsm, dpotrf
    use femcod_condensed, only: gap_and_rate
    use femcod_heap, only: min_heap, heap_build, heap_push, heap_pop, heap_top_key
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
@@ -38,6 +40,11 @@ module femcod_incremental
    implicit none
    private
    public :: solve_incremental, scene_report
+
+   !> Candidates whose bordering columns l = U^-T m and w = M^-1 m are kept up to date
+   !> (O(n) each per new contact), and how many contacts join between refills of the
+   !> cache (one pair of BLAS-3 triangular solves for the new candidates).
+   integer, parameter :: CACHE_SIZE = 128, REFILL_EVERY = 64
 
 contains
 
@@ -86,8 +93,12 @@ contains
       procedure(progress_interface), optional :: progress
       procedure(checkpoint_interface), optional :: checkpoint
       type(solver_state), intent(in), optional :: resume
-      integer, allocatable :: ops(:), order(:)
-      integer :: nops
+      integer, allocatable :: order(:)
+      ! The candidate cache: slot -> pixel, pixel -> slot, columns l and w per slot,
+      ! each pixel's predicted closing load (from its last exact evaluation).
+      integer, allocatable :: cpix(:), cslot(:)
+      real(dp), allocatable :: lc(:, :), wc(:, :), wq(:), pred(:)
+      integer :: kc, since_refill
       real(dp) :: last_checkpoint
       real(dp), allocatable :: table(:, :), g0(:), ftot(:), funit(:), u(:, :), y(:), x(:), col(:), keys(:)
       real(dp), allocatable :: lam_eval(:), gap_eval(:), loads(:)
@@ -114,6 +125,12 @@ contains
       allocate(ic(maxc), jc(maxc), pix(maxc), cstep(maxc), ftot(maxc), funit(maxc), y(maxc), x(maxc), col(maxc))
       allocate(slot(npix), eval_pix(npix), lam_eval(npix), gap_eval(npix), joiners(npix))
       slot = 0
+      kc = min(CACHE_SIZE, npix)
+      allocate(cpix(kc), cslot(npix), lc(ld, kc), wc(ld, kc), wq(maxc), pred(npix))
+      cpix = 0
+      cslot = 0
+      pred = huge(1.0_dp)
+      since_refill = 0
 
       ! Every pixel in the heap, keyed by its exact gap at zero load.
       allocate(items(npix))
@@ -137,8 +154,6 @@ contains
       approach = 0
       n = 0
       step = 0
-      allocate(ops(64))
-      nops = 0
       if (present(resume)) then
          call restore(resume)
          if (status%code /= 0) return
@@ -169,9 +184,7 @@ contains
          if (present(checkpoint)) call maybe_checkpoint()
          step = step + 1
          call wall_clock(t0)
-         ! Unit-load solution from the factor: x = M^-1 1 = U^-1 y, beta = 1'x = y'y.
-         x(1:n) = y(1:n)
-         call dtrsv("U", "N", "N", n, u, ld, x, 1)
+         ! Unit-load solution x = M^-1 1 (kept up to date by add_contact), beta = 1'x = y'y.
          beta = sum(y(1:n)**2)
          delta = 1/beta
          funit(1:n) = x(1:n)*delta
@@ -216,6 +229,8 @@ contains
                lam_eval(neval) = huge(1.0_dp)
             end if
             lam_best = min(lam_best, lam_eval(neval))
+            pred(p) = huge(1.0_dp)
+            if (lam_eval(neval) < huge(1.0_dp)) pred(p) = total + lam_eval(neval)
             if (neval == npix) exit
          end do
          tie = options%tie_tolerance*(total + max(lam_best, 0.0_dp))
@@ -284,6 +299,8 @@ contains
             call add_contact(joiners(q), step + 1)
             if (status%code /= 0) return
          end do
+         since_refill = since_refill + njoin
+         if (since_refill >= REFILL_EVERY) call refill_cache()
       end do
 
       if (options%final_check) call final_check()
@@ -298,6 +315,7 @@ contains
       subroutine maybe_checkpoint()
          type(solver_state) :: state
          real(dp) :: now
+         integer :: jj, at
          if (options%checkpoint_interval < 0 .or. step == 0) return
          call wall_clock(now)
          if (now - last_checkpoint < options%checkpoint_interval) return
@@ -305,76 +323,151 @@ contains
          state%n = n
          state%total = total
          state%approach = approach
-         state%operations = ops(1:nops)
+         state%phi = phi
+         state%pix = pix(1:n)
          state%cstep = cstep(1:n)
          state%ftot = ftot(1:n)
+         state%ld = ld
+         allocate(state%factor(n*(n + 1)/2))
+         at = 0
+         do jj = 1, n
+            state%factor(at + 1:at + jj) = u(1:jj, jj)
+            at = at + jj
+         end do
+         state%y = y(1:n)
+         state%x = x(1:n)
+         state%cache_pixel = cpix
+         state%cache_l = lc(1:n, :)
+         state%cache_w = wc(1:n, :)
+         state%predicted = pred
+         state%since_refill = since_refill
+         state%heap_key = heap%key(1:heap%size)
+         state%heap_item = heap%item(1:heap%size)
          state%res = res
          call checkpoint(state)
          call wall_clock(last_checkpoint)
       end subroutine maybe_checkpoint
 
-      !> Continue from a stored state: replay the contact operations (the same bordered
-      !> updates in the same order give the same factor), restore the accumulated
-      !> quantities, and key the heap by the current gaps from one FFT convolution
-      !> (less a margin, so the keys stay lower bounds).
+      !> Continue from a stored state: everything the loop reads is restored bit for bit
+      !> (the factor into storage of the same leading dimension), so the run goes on
+      !> exactly as the uninterrupted one did.
       subroutine restore(state)
          type(solver_state), intent(in) :: state
-         type(love_convolution) :: conv
-         real(dp), allocatable :: field(:, :), disp(:, :)
-         real(dp) :: margin
-         integer :: qq, iq, jq, m
-         do qq = 1, size(state%operations)
-            if (state%operations(qq) > 0) then
-               call add_contact(state%operations(qq), 0)
-            else
-               call release_contact(-state%operations(qq))
-            end if
-            if (status%code /= 0) return
-         end do
-         if (n /= state%n) then
-            call set_error(status, STATUS_NUMERICAL, "incremental: the checkpoint's contact list is inconsistent")
+         integer :: jj, at
+         n = state%n
+         if (n > maxc .or. state%ld > maxc .or. state%ld < n .or. size(state%factor) /= n*(n + 1)/2 .or. &
+            size(state%cache_pixel) /= kc .or. size(state%predicted) /= npix .or. &
+            size(state%heap_key) > npix) then
+            call set_error(status, STATUS_NUMERICAL, "incremental: the checkpoint's state does not fit this deck")
             return
          end if
+         ld = state%ld
+         deallocate(u, lc, wc)
+         allocate(u(ld, ld), lc(ld, kc), wc(ld, kc))
+         at = 0
+         do jj = 1, n
+            u(1:jj, jj) = state%factor(at + 1:at + jj)
+            at = at + jj
+         end do
+         pix(1:n) = state%pix
+         do jj = 1, n
+            ic(jj) = (pix(jj) - 1)/np + 1
+            jc(jj) = pix(jj) - (ic(jj) - 1)*np
+            slot(pix(jj)) = jj
+         end do
          cstep(1:n) = state%cstep
          ftot(1:n) = state%ftot
+         y(1:n) = state%y
+         x(1:n) = state%x
+         cpix = state%cache_pixel
+         cslot = 0
+         do jj = 1, kc
+            if (cpix(jj) > 0) cslot(cpix(jj)) = jj
+         end do
+         lc(1:n, :) = state%cache_l
+         wc(1:n, :) = state%cache_w
+         pred = state%predicted
+         since_refill = state%since_refill
          total = state%total
          approach = state%approach
+         phi = state%phi
          step = state%step
+         ! A valid heap rebuilt by sifting is left exactly as it was.
+         call heap_build(heap, state%heap_key, state%heap_item, npix)
          res = state%res
-         allocate(field(np, np), disp(np, np))
-         field = 0
-         do qq = 1, n
-            field(ic(qq), jc(qq)) = ftot(qq)
-         end do
-         call convolution_setup(conv, table)
-         call convolution_apply(conv, field, disp)
-         call convolution_free(conv)
-         margin = 1.0e-9_dp*(abs(approach) + maxval(abs(g0)))
-         m = 0
-         do qq = 1, npix
-            if (slot(qq) /= 0) cycle
-            iq = (qq - 1)/np + 1
-            jq = qq - (iq - 1)*np
-            m = m + 1
-            keys(m) = g0(qq) - approach + c*disp(iq, jq) - margin
-            items(m) = qq
-         end do
-         call heap_build(heap, keys(1:m), items(1:m), npix)
-         phi = 0
       end subroutine restore
 
-      !> Record a contact operation for checkpoints (+pixel joined, -k released).
-      subroutine log_operation(op)
-         integer, intent(in) :: op
-         integer, allocatable :: longer(:)
-         if (nops == size(ops)) then
-            allocate(longer(2*size(ops)))
-            longer(1:nops) = ops(1:nops)
-            call move_alloc(longer, ops)
-         end if
-         nops = nops + 1
-         ops(nops) = op
-      end subroutine log_operation
+      !> Refill the cache with the candidates predicted to close next (smallest predicted
+      !> closing load from their last exact evaluation): the new ones get l = U^-T M_c
+      !> and w = U^-1 l from two BLAS-3 triangular solves with all of them at once,
+      !> which run at arithmetic speed where one triangular solve per contact streams
+      !> the whole factor from memory.
+      subroutine refill_cache()
+         integer, allocatable :: cand(:), rank(:), fresh(:)
+         real(dp), allocatable :: block(:, :)
+         logical, allocatable :: wanted(:)
+         integer :: m, nfresh, a, b, sa, ia, ja
+         since_refill = 0
+         m = 0
+         do a = 1, npix
+            if (slot(a) == 0 .and. pred(a) < huge(1.0_dp)) m = m + 1
+         end do
+         if (m == 0 .or. n == 0) return
+         allocate(cand(m), rank(m))
+         m = 0
+         do a = 1, npix
+            if (slot(a) == 0 .and. pred(a) < huge(1.0_dp)) then
+               m = m + 1
+               cand(m) = a
+            end if
+         end do
+         call merge_sort_index(pred(cand), rank)
+         allocate(wanted(kc), fresh(kc))
+         wanted = .false.
+         ! Keep cached candidates still among the best; evict the others.
+         nfresh = 0
+         do a = 1, min(kc, m)
+            b = cand(rank(a))
+            if (cslot(b) == 0) then
+               nfresh = nfresh + 1
+               fresh(nfresh) = b
+            else
+               wanted(cslot(b)) = .true.
+            end if
+         end do
+         do sa = 1, kc
+            if (cpix(sa) > 0 .and. .not. wanted(sa)) then
+               cslot(cpix(sa)) = 0
+               cpix(sa) = 0
+            end if
+         end do
+         if (nfresh == 0) return
+         allocate(block(n, nfresh))
+         do b = 1, nfresh
+            ia = (fresh(b) - 1)/np + 1
+            ja = fresh(b) - (ia - 1)*np
+            do a = 1, n
+               block(a, b) = c*table(abs(ia - ic(a)), abs(ja - jc(a)))
+            end do
+         end do
+         call dtrsm("L", "U", "T", "N", n, nfresh, 1.0_dp, u, ld, block, n)
+         b = 0
+         do sa = 1, kc
+            if (cpix(sa) /= 0) cycle
+            b = b + 1
+            if (b > nfresh) exit
+            cpix(sa) = fresh(b)
+            cslot(fresh(b)) = sa
+            lc(1:n, sa) = block(:, b)
+         end do
+         call dtrsm("L", "U", "N", "N", n, nfresh, 1.0_dp, u, ld, block, n)
+         do b = 1, nfresh
+            wc(1:n, cslot(fresh(b))) = block(:, b)
+         end do
+         res%cache_refills = res%cache_refills + 1
+         res%cache_columns = res%cache_columns + nfresh
+      end subroutine refill_cache
+
 
       !> Pop the heap until a pixel not in contact appears.
       subroutine pop_valid(pixel)
@@ -401,8 +494,8 @@ contains
       !> (Uk = U^-T m, diagonal sqrt(mu - |Uk|^2)) and y = U^-T 1 one entry.
       subroutine add_contact(pixel, joined)
          integer, intent(in) :: pixel, joined
-         integer :: ip, jp, kk, stat
-         real(dp) :: d2
+         integer :: ip, jp, kk, stat, sq, ss, ipp, jpp
+         real(dp) :: d2, dq, tt
          real(dp), allocatable :: bigger(:, :)
          ip = (pixel - 1)/np + 1
          jp = pixel - (ip - 1)*np
@@ -426,19 +519,57 @@ contains
             bigger(1:n, 1:n) = u(1:n, 1:n)
             call move_alloc(bigger, u)
             ld = size(u, 1)
+            allocate(bigger(ld, kc))
+            bigger(1:n, :) = lc(1:n, :)
+            call move_alloc(bigger, lc)
+            allocate(bigger(ld, kc))
+            bigger(1:n, :) = wc(1:n, :)
+            call move_alloc(bigger, wc)
          end if
-         do kk = 1, n
-            col(kk) = c*table(abs(ip - ic(kk)), abs(jp - jc(kk)))
-         end do
-         if (n > 0) call dtrsv("U", "T", "N", n, u, ld, col, 1)
+         sq = cslot(pixel)
+         if (sq > 0) then
+            ! A cached candidate: its columns are ready.
+            col(1:n) = lc(1:n, sq)
+            wq(1:n) = wc(1:n, sq)
+            cslot(pixel) = 0
+            cpix(sq) = 0
+            res%cache_hits = res%cache_hits + 1
+         else
+            ! l = U^-T m and w = U^-1 l = M^-1 m by two triangular solves.
+            do kk = 1, n
+               col(kk) = c*table(abs(ip - ic(kk)), abs(jp - jc(kk)))
+            end do
+            if (n > 0) call dtrsv("U", "T", "N", n, u, ld, col, 1)
+            wq(1:n) = col(1:n)
+            if (n > 0) call dtrsv("U", "N", "N", n, u, ld, wq, 1)
+            res%cache_misses = res%cache_misses + 1
+         end if
          d2 = self - sum(col(1:n)**2)
          if (.not. d2 > epsilon(1.0_dp)*self) then
             call set_error(status, STATUS_NUMERICAL, "incremental: the contact compliance lost positive definiteness")
             return
          end if
+         dq = sqrt(d2)
+         ! Every cached candidate p follows: l_p gains (mu_pq - l_q'l_p)/d, and
+         ! w_p = M^-1 m_p becomes [w_p - w_q t; t], t = (mu_pq - l_q'l_p)/d^2 (the bordered
+         ! inverse). Slots are independent: the same bits for any number of threads.
+         !$omp parallel do schedule(static) private(ss, ipp, jpp, tt) if (n > 200000)
+         do ss = 1, kc
+            if (cpix(ss) == 0) cycle
+            ipp = (cpix(ss) - 1)/np + 1
+            jpp = cpix(ss) - (ipp - 1)*np
+            tt = (c*table(abs(ipp - ip), abs(jpp - jp)) - dot_product(col(1:n), lc(1:n, ss)))/dq
+            lc(n + 1, ss) = tt
+            wc(1:n, ss) = wc(1:n, ss) - wq(1:n)*(tt/dq)
+            wc(n + 1, ss) = tt/dq
+         end do
+         !$omp end parallel do
          u(1:n, n + 1) = col(1:n)
-         u(n + 1, n + 1) = sqrt(d2)
-         y(n + 1) = (1 - sum(col(1:n)*y(1:n)))/u(n + 1, n + 1)
+         u(n + 1, n + 1) = dq
+         y(n + 1) = (1 - sum(col(1:n)*y(1:n)))/dq
+         ! x = M^-1 1 = U^-1 y: [x - w_q eta/d; eta/d] with eta the new entry of y.
+         x(1:n) = x(1:n) - wq(1:n)*(y(n + 1)/dq)
+         x(n + 1) = y(n + 1)/dq
          n = n + 1
          ic(n) = ip
          jc(n) = jp
@@ -446,14 +577,12 @@ contains
          cstep(n) = joined
          ftot(n) = 0
          slot(pixel) = n
-         call log_operation(pixel)
       end subroutine add_contact
 
       !> Remove contact k (its force is zero) and refactor the rest (LAPACK dpptrf).
       subroutine release_contact(krm)
          integer, intent(in) :: krm
          integer :: a, b
-         call log_operation(-krm)
          ftot(krm) = 0
          slot(pix(krm)) = 0
          call heap_push(heap, phi, pix(krm))
@@ -479,6 +608,13 @@ contains
          end if
          y(1:n) = 1
          call dtrsv("U", "T", "N", n, u, ld, y, 1)
+         x(1:n) = y(1:n)
+         call dtrsv("U", "N", "N", n, u, ld, x, 1)
+         ! The cached columns belonged to the old factor.
+         do a = 1, kc
+            if (cpix(a) > 0) cslot(cpix(a)) = 0
+         end do
+         cpix = 0
          res%releases = res%releases + 1
       end subroutine release_contact
 

@@ -4,7 +4,7 @@ module femcod_lapack
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv, dlacn2
+   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv, dlacn2, dtrsm
 
    interface
       pure subroutine dpotrf(uplo, n, a, lda, info)
@@ -68,6 +68,13 @@ module femcod_lapack
          real(dp), intent(in) :: a(lda, *)
          real(dp), intent(inout) :: x(*)
       end subroutine dtrsv
+      pure subroutine dtrsm(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb)
+         import :: dp
+         character(len=1), intent(in) :: side, uplo, transa, diag
+         integer, intent(in) :: m, n, lda, ldb
+         real(dp), intent(in) :: alpha, a(lda, *)
+         real(dp), intent(inout) :: b(ldb, *)
+      end subroutine dtrsm
       pure subroutine dpptrf(uplo, n, ap, info)
          import :: dp
          character(len=1), intent(in) :: uplo

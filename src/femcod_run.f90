@@ -457,6 +457,9 @@ contains
                " nm); "//int_str(res%releases)//" releases; "//real_str(real(res%evaluations, dp), 3)// &
                " exact pixel evaluations; exact re-solve differs by "// &
                real_str(res%final_check_difference, 2)
+            write(output_unit, '(a)') "  cache     : "//int_str(res%cache_hits)//" contacts bordered from the candidate "// &
+               "cache, "//int_str(res%cache_misses)//" by their own triangular solves; "//int_str(res%cache_refills)// &
+               " refills ("//int_str(res%cache_columns)//" columns by BLAS-3 solves)"
          else
             write(output_unit, '(a)') "  checked   : "//int_str(res%missed_during_run)// &
                " contacts found late by the candidate search, "//int_str(res%missed_final_check)// &
