@@ -7,7 +7,7 @@
 !> /options (max_contacts, loads, tie_tolerance, hardness, final_check),
 !> /state (step, n, total, approach, phi, pix, cstep, ftot, ld, factor (the upper
 !> triangle packed by columns), y, x, cache_pixel, cache_l, cache_w, predicted,
-!> since_refill, heap_key, heap_item),
+!> since_refill, last_neval, heap_key, heap_item),
 !> /history (contacts, load, approach, seconds), /states/<k> (the requested loads
 !> reached so far), /counters.
 module femcod_checkpoint
@@ -79,6 +79,7 @@ contains
       call h5_write(file, "/state/cache_w", state%cache_w, "1", status)
       call h5_write(file, "/state/predicted", state%predicted, "nN", status)
       call h5_write(file, "/state/since_refill", state%since_refill, "1", status)
+      call h5_write(file, "/state/last_neval", state%last_neval, "1", status)
       call h5_write(file, "/state/heap_key", state%heap_key, "nm", status)
       call h5_write(file, "/state/heap_item", state%heap_item, "1", status)
       call h5_group(file, "/history", status)
@@ -229,6 +230,7 @@ contains
       state%cache_w = r2
       call h5_read(file, "/state/predicted", state%predicted, status, bad)
       call h5_read(file, "/state/since_refill", state%since_refill, status, bad)
+      call h5_read(file, "/state/last_neval", state%last_neval, status, bad)
       call h5_read(file, "/state/heap_key", state%heap_key, status, bad)
       call h5_read(file, "/state/heap_item", state%heap_item, status, bad)
       call h5_read(file, "/history/contacts", state%res%step_contacts, status, bad)

@@ -23,6 +23,9 @@ module femcod_contact_result
       real(dp) :: tie_tolerance = 1.0e-9_dp
       !> Check every pixel for penetration at the end, and correct (Appendix B).
       logical :: final_check = .true.
+      !> Event search of the incremental solver: "auto" (the cheaper of the two, from
+      !> measured costs), "bound" (gap bound and exact evaluations) or "fft" (full field).
+      character(len=5) :: event_search = "auto"
       !> Hand the solver state to the checkpoint procedure every this many seconds of
       !> wall time (0: after every step; negative: never).
       real(dp) :: checkpoint_interval = -1
@@ -64,6 +67,8 @@ module femcod_contact_result
       !> Incremental solver: contacts whose bordering columns came from the candidate
       !> cache, contacts that needed their own triangular solves, and cache refills.
       integer :: cache_hits = 0, cache_misses = 0, cache_refills = 0, cache_columns = 0
+      !> Incremental solver: steps whose event search used the full-field FFT.
+      integer :: fft_steps = 0
       !> Largest relative difference between the accumulated state and an exact
       !> active-set solve at the end (a consistency check of the step accumulation).
       real(dp) :: final_check_difference = 0
@@ -98,6 +103,8 @@ module femcod_contact_result
       integer, allocatable :: cache_pixel(:)
       real(dp), allocatable :: cache_l(:, :), cache_w(:, :), predicted(:)
       integer :: since_refill = 0
+      !> Exact evaluations of the last bound search (the event-search choice).
+      integer :: last_neval = 0
       !> The event heap: keys and items in heap order.
       real(dp), allocatable :: heap_key(:)
       integer, allocatable :: heap_item(:)

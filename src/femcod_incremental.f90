@@ -94,6 +94,11 @@ contains
       procedure(checkpoint_interface), optional :: checkpoint
       type(solver_state), intent(in), optional :: resume
       integer, allocatable :: order(:)
+      ! Event search by FFT: plans and kernel (made on first use), measured costs.
+      type(love_convolution) :: search_conv
+      real(dp), allocatable :: field_f(:, :), field_u(:, :), disp_f(:, :), disp_u(:, :)
+      integer :: last_neval
+      logical :: use_fft
       ! The candidate cache: slot -> pixel, pixel -> slot, columns l and w per slot,
       ! each pixel's predicted closing load (from its last exact evaluation).
       integer, allocatable :: cpix(:), cslot(:)
@@ -125,6 +130,7 @@ contains
       allocate(ic(maxc), jc(maxc), pix(maxc), cstep(maxc), ftot(maxc), funit(maxc), y(maxc), x(maxc), col(maxc))
       allocate(slot(npix), eval_pix(npix), lam_eval(npix), gap_eval(npix), joiners(npix))
       slot = 0
+      last_neval = 0
       kc = min(CACHE_SIZE, npix)
       allocate(cpix(kc), cslot(npix), lc(ld, kc), wc(ld, kc), wq(maxc), pred(npix))
       cpix = 0
@@ -138,7 +144,9 @@ contains
          items(p) = p
       end do
       keys = g0
-      call heap_build(heap, keys, items, npix)
+      ! Room for stale entries: a pixel found by the FFT search joins without leaving the
+      ! heap, and a released contact is pushed back.
+      call heap_build(heap, keys, items, 2*npix)
       phi = 0
 
       max_load = -huge(1.0_dp)
@@ -202,10 +210,19 @@ contains
             end if
          end do
 
-         ! Closing events: pop every pixel whose lower bound allows closing first.
+         ! Closing events. Either the full field by two FFT convolutions (gaps and rates
+         ! of every pixel; the few within reach of the smallest closing load are then
+         ! evaluated exactly), or the gap bound: pop every pixel whose lower bound allows
+         ! closing first. The cheaper is chosen from the measured costs of both.
          lam_best = lam_release
          neval = 0
+         use_fft = choose_fft()
+         if (use_fft) then
+            call fft_search()
+            res%fft_steps = res%fft_steps + 1
+         end if
          do
+            if (use_fft) exit
             tie = options%tie_tolerance*(total + max(lam_best, 0.0_dp))
             if (lam_best < huge(1.0_dp)) then
                bound = (lam_best + tie)*delta_max
@@ -233,14 +250,16 @@ contains
             if (lam_eval(neval) < huge(1.0_dp)) pred(p) = total + lam_eval(neval)
             if (neval == npix) exit
          end do
+         if (.not. use_fft) last_neval = neval
          tie = options%tie_tolerance*(total + max(lam_best, 0.0_dp))
          njoin = 0
          do q = 1, neval
             if (lam_eval(q) <= lam_best + tie .and. lam_eval(q) < huge(1.0_dp)) then
                njoin = njoin + 1
                joiners(njoin) = eval_pix(q)
-            else
-               ! Back into the heap with its exact gap as the new bound.
+            else if (.not. use_fft) then
+               ! Back into the heap with its exact gap as the new bound (the FFT search
+               ! pops nothing: the heap's bounds stay valid as they are).
                call heap_push(heap, gap_eval(q) + phi, eval_pix(q))
             end if
          end do
@@ -276,9 +295,11 @@ contains
          if (size(loads) > 0) then
             if (max_load <= total) then
                res%stop_reason = STOP_LOADS
-               do q = 1, njoin
-                  call heap_push(heap, phi, joiners(q))
-               end do
+               if (.not. use_fft) then
+                  do q = 1, njoin
+                     call heap_push(heap, phi, joiners(q))
+                  end do
+               end if
                exit
             end if
          end if
@@ -290,9 +311,11 @@ contains
          end if
          if (n + njoin > maxc) then
             res%stop_reason = STOP_MAXCONT
-            do q = 1, njoin
-               call heap_push(heap, phi, joiners(q))
-            end do
+            if (.not. use_fft) then
+               do q = 1, njoin
+                  call heap_push(heap, phi, joiners(q))
+               end do
+            end if
             exit
          end if
          do q = 1, njoin
@@ -303,6 +326,7 @@ contains
          if (since_refill >= REFILL_EVERY) call refill_cache()
       end do
 
+      call convolution_free(search_conv)
       if (options%final_check) call final_check()
       if (status%code /= 0) return
       call finish_contacts(res, ic(1:n), jc(1:n), cstep(1:n), ftot(1:n), total)
@@ -310,6 +334,84 @@ contains
       res%wall_seconds = t1 - tstart
 
    contains
+
+      !> Full-field search this step? options%event_search: "fft", "bound" or "auto".
+      !> Auto compares the last bound search's exact evaluations (neval n table look-ups,
+      !> about 2 ns each here) with two convolutions on the (2NP)^2 grid (about 5 ns per
+      !> point and level each), and tries the bound search again every 16th step. The
+      !> rule depends on the state only, never on timings, so runs and restarts repeat
+      !> bit for bit.
+      logical function choose_fft()
+         real(dp) :: m2
+         select case (options%event_search)
+         case ("fft")
+            choose_fft = n > 0
+         case ("bound")
+            choose_fft = .false.
+         case default
+            m2 = real(2*np, dp)**2
+            choose_fft = n > 0 .and. mod(step, 16) /= 0 .and. &
+               2.0e-9_dp*real(last_neval, dp)*n > 2*5.0e-9_dp*m2*log(m2)/log(2.0_dp)
+         end select
+      end function choose_fft
+
+      !> Gaps and closing rates of every pixel from two zero-padded FFT convolutions
+      !> (accumulated and unit-load forces); every pixel whose closing load lies within
+      !> the FFT's error bound of the smallest (1e-9 of the displacement scale, far above
+      !> the transforms' round-off) is evaluated exactly, so the event is exact.
+      subroutine fft_search()
+         real(dp) :: lam_min, margin, gq, rq
+         real(dp), allocatable :: lam(:)
+         integer :: qq, iq, jq
+         if (search_conv%m == 0) then
+            call convolution_setup(search_conv, table)
+            allocate(field_f(np, np), field_u(np, np), disp_f(np, np), disp_u(np, np))
+         end if
+         field_f = 0
+         field_u = 0
+         do qq = 1, n
+            field_f(ic(qq), jc(qq)) = ftot(qq)
+            field_u(ic(qq), jc(qq)) = funit(qq)
+         end do
+         call convolution_apply(search_conv, field_f, disp_f)
+         call convolution_apply(search_conv, field_u, disp_u)
+         allocate(lam(npix))
+         lam_min = lam_release
+         do qq = 1, npix
+            lam(qq) = huge(1.0_dp)
+            if (slot(qq) /= 0) cycle
+            iq = (qq - 1)/np + 1
+            jq = qq - (iq - 1)*np
+            gq = g0(qq) - approach + c*disp_f(iq, jq)
+            rq = delta - c*disp_u(iq, jq)
+            if (gq <= 0) then
+               lam(qq) = 0
+            else if (rq > 0) then
+               lam(qq) = gq/rq
+            end if
+            lam_min = min(lam_min, lam(qq))
+         end do
+         if (lam_min >= huge(1.0_dp)) return
+         margin = options%tie_tolerance*(total + lam_min) + 1.0e-9_dp*(abs(approach) + maxval(abs(g0)))/delta
+         do qq = 1, npix
+            if (lam(qq) > lam_min + 2*margin) cycle
+            call evaluate(qq, gq, rq)
+            res%evaluations = res%evaluations + 1
+            neval = neval + 1
+            eval_pix(neval) = qq
+            gap_eval(neval) = gq
+            if (gq <= 0) then
+               lam_eval(neval) = 0
+            else if (rq > 0) then
+               lam_eval(neval) = gq/rq
+            else
+               lam_eval(neval) = huge(1.0_dp)
+            end if
+            lam_best = min(lam_best, lam_eval(neval))
+            pred(qq) = huge(1.0_dp)
+            if (lam_eval(neval) < huge(1.0_dp)) pred(qq) = total + lam_eval(neval)
+         end do
+      end subroutine fft_search
 
       !> Hand the state to the checkpoint procedure when the interval has passed.
       subroutine maybe_checkpoint()
@@ -341,6 +443,7 @@ contains
          state%cache_w = wc(1:n, :)
          state%predicted = pred
          state%since_refill = since_refill
+         state%last_neval = last_neval
          state%heap_key = heap%key(1:heap%size)
          state%heap_item = heap%item(1:heap%size)
          state%res = res
@@ -357,7 +460,7 @@ contains
          n = state%n
          if (n > maxc .or. state%ld > maxc .or. state%ld < n .or. size(state%factor) /= n*(n + 1)/2 .or. &
             size(state%cache_pixel) /= kc .or. size(state%predicted) /= npix .or. &
-            size(state%heap_key) > npix) then
+            size(state%heap_key) > 2*npix) then
             call set_error(status, STATUS_NUMERICAL, "incremental: the checkpoint's state does not fit this deck")
             return
          end if
@@ -388,12 +491,13 @@ contains
          wc(1:n, :) = state%cache_w
          pred = state%predicted
          since_refill = state%since_refill
+         last_neval = state%last_neval
          total = state%total
          approach = state%approach
          phi = state%phi
          step = state%step
          ! A valid heap rebuilt by sifting is left exactly as it was.
-         call heap_build(heap, state%heap_key, state%heap_item, npix)
+         call heap_build(heap, state%heap_key, state%heap_item, 2*npix)
          res = state%res
       end subroutine restore
 

@@ -312,6 +312,7 @@ contains
       call h5_write(file, "/run/max_penetration", res%max_penetration, "nm", local)
       call h5_write(file, "/run/final_resolve_difference", res%final_check_difference, "1", local)
       call h5_write(file, "/run/releases", res%releases, "1", local)
+      call h5_write(file, "/run/fft_search_steps", res%fft_steps, "1", local)
       call h5_write(file, "/run/trfact_pivot_loss", res%pivot_loss, "1", local)
       call h5_write(file, "/run/trfact_condition", res%condition, "1", local)
       call h5_write(file, "/run/exact_evaluations", real(res%evaluations, dp), "1", local)

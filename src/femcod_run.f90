@@ -57,6 +57,11 @@ contains
          "  --hardness H       GPa, for n_above_hardness (default 11, polysilicon)", &
          "  --no-final-check   skip the final check of every pixel for missed contacts", &
          "  --quiet            no summary on standard output, no progress lines on standard error", &
+         "  --event-search E   incremental solver: how the next contact is found. bound: a heap of", &
+         "                     lower bounds on the gaps and exact O(n) evaluations of the pixels that", &
+         "                     can close first; fft: gaps and rates of every pixel from two FFT", &
+         "                     convolutions, then exact evaluations near the minimum; auto (default):", &
+         "                     the cheaper by a cost model of both; all three give the same events", &
          "  --checkpoint-interval S  write PREFIX.ckpt.h5 (atomically) every S seconds of wall time", &
          "                     (default 300; 0: after every step; incremental solver); removed at the end", &
          "  --restart          continue from PREFIX.ckpt.h5 if it exists (refused if it belongs to another", &
@@ -192,6 +197,12 @@ contains
                   call usage("--hardness expects a positive number in GPa, found '"//v//"'")
                   return
                end if
+            case ("--event-search")
+               if (v /= "auto" .and. v /= "bound" .and. v /= "fft") then
+                  call usage("--event-search expects auto, bound or fft, found '"//v//"'")
+                  return
+               end if
+               options%event_search = v
             case ("--checkpoint-interval")
                call parse_real(v, options%checkpoint_interval, ok)
                if (.not. ok .or. options%checkpoint_interval < 0) then
@@ -457,6 +468,9 @@ contains
                " nm); "//int_str(res%releases)//" releases; "//real_str(real(res%evaluations, dp), 3)// &
                " exact pixel evaluations; exact re-solve differs by "// &
                real_str(res%final_check_difference, 2)
+            write(output_unit, '(a)') "  search    : "//int_str(res%fft_steps)//" of "//int_str(res%nsteps)// &
+               " steps by full-field FFT, the others by the gap bound (--event-search "// &
+               trim(options%event_search)//")"
             write(output_unit, '(a)') "  cache     : "//int_str(res%cache_hits)//" contacts bordered from the candidate "// &
                "cache, "//int_str(res%cache_misses)//" by their own triangular solves; "//int_str(res%cache_refills)// &
                " refills ("//int_str(res%cache_columns)//" columns by BLAS-3 solves)"

@@ -27,7 +27,8 @@ contains
          new_unittest("rigid springs: equals a fixed-load active-set solution", test_active_set), &
          new_unittest("Table 4.1 and 4.2 values, with no missed contact", test_tables), &
          new_unittest("a deck whose MAXCONT is NP^2 runs (the factor grows)", test_growth), &
-         new_unittest("OpenMP: 1 and 2 threads give the same results", test_threads) &
+         new_unittest("OpenMP: 1 and 2 threads give the same results", test_threads), &
+         new_unittest("event search: full-field FFT and gap bound find the same events", test_event_search) &
          ]
    end subroutine collect_incremental
 
@@ -250,4 +251,41 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_threads
+
+   !> Two independent event searches: the heap of gap bounds with exact evaluations, and
+   !> gaps and rates of every pixel from two FFT convolutions. The same events on every
+   !> input/ deck (contacts equal, loads to 1e-12); auto reports its choice.
+   subroutine test_event_search(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_type) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: a, b
+      type(status_type) :: status
+      integer :: d, n
+      do d = 1, size(VERIFICATION_DECKS)
+         if (index(VERIFICATION_DECKS(d), "d05") > 0 .or. index(VERIFICATION_DECKS(d), "d9") > 0) cycle
+         call read_deck("input/"//trim(VERIFICATION_DECKS(d))//".deck", deck, status)
+         options%loads = [real(dp) ::]
+         if (index(VERIFICATION_DECKS(d), "sphere") > 0) options%loads = [3000.0_dp]
+         options%event_search = "bound"
+         call solve_incremental(deck, options, a, status)
+         options%event_search = "fft"
+         call solve_incremental(deck, options, b, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         n = a%nsteps
+         call check(error, b%nsteps == n .and. b%fft_steps == n .and. a%fft_steps == 0, &
+            trim(VERIFICATION_DECKS(d))//": steps and search counts")
+         if (allocated(error)) return
+         call check(error, all(a%step_contacts(1:n) == b%step_contacts(1:n)), trim(VERIFICATION_DECKS(d))// &
+            ": contacts at every step")
+         if (allocated(error)) return
+         call check(error, maxval(abs(a%step_load(1:n) - b%step_load(1:n))) <= 1.0e-12_dp*maxval(a%step_load(1:n)), &
+            trim(VERIFICATION_DECKS(d))//": loads")
+         if (allocated(error)) return
+      end do
+      options%event_search = "auto"
+      call solve_incremental(deck, options, b, status)
+      call check(error, b%fft_steps >= 0 .and. b%fft_steps <= b%nsteps, "auto reports its choice")
+   end subroutine test_event_search
 end module test_incremental
