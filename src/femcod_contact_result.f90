@@ -38,6 +38,10 @@ module femcod_contact_result
       real(dp) :: max_pressure = 0
       integer :: n_above_hardness = 0
       logical :: reached = .false.
+      !> Fixed-load solver only: iterations, relative complementarity residual, deepest
+      !> penetration (nm), largest |gap| on contact (nm), relative load error.
+      integer :: iterations = 0
+      real(dp) :: residual = 0, penetration = 0, contact_gap = 0, load_error = 0
       !> The contact pixels (row, column) and their forces (nN) at this load.
       integer, allocatable :: i(:), j(:)
       real(dp), allocatable :: force(:)

@@ -291,6 +291,13 @@ contains
             call h5_attribute(file, g, "area_nm2", s%contacts*area_pixel, local)
             call h5_attribute(file, g, "max_pressure_GPa", s%max_pressure, local)
             call h5_attribute(file, g, "n_above_hardness", s%n_above_hardness, local)
+            if (info%solver == "cg") then
+               call h5_attribute(file, g, "cg_iterations", s%iterations, local)
+               call h5_attribute(file, g, "cg_residual", s%residual, local)
+               call h5_attribute(file, g, "cg_penetration_nm", s%penetration, local)
+               call h5_attribute(file, g, "cg_contact_gap_nm", s%contact_gap, local)
+               call h5_attribute(file, g, "cg_load_error", s%load_error, local)
+            end if
             call h5_write(file, g//"/pressure", maps(k)%pressure, "GPa", local)
             call h5_write(file, g//"/gap", maps(k)%gap, "nm", local)
          end associate

@@ -13,11 +13,12 @@ module femcod_run
    use femcod_files, only: remove_file
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental, scene_report
+   use femcod_cg, only: solve_cg, cg_residuals
    use femcod_results, only: write_results, run_info, result_files
    use femcod_generate, only: deck_spec, build_deck
    use femcod_files, only: path_exists
    use femcod_about, only: FEMCOD_VERSION
-   use femcod_status, only: STATUS_IO
+   use femcod_status, only: STATUS_IO, STATUS_NUMERICAL
    implicit none
    private
    public :: run_command
@@ -39,7 +40,7 @@ contains
 
    subroutine run_help()
       write(output_unit, '(a)') &
-         "usage: femcod run DECK [DECK ...] [-o PREFIX] [--solver incremental|legacy] [--loads F1,F2,...]", &
+         "usage: femcod run DECK [DECK ...] [-o PREFIX] [--solver incremental|legacy|cg] [--loads F1,F2,...]", &
          "                  [--max-contacts N] [--hardness H] [--no-final-check] [--quiet] [--force]", &
          "       femcod run --lower FILE [--upper FILE] --pixel D [--young E] [--poisson NU]", &
          "                  [--rigid upper|lower|none] [--maxcont M] [--remove-plane] [options as above]", &
@@ -51,6 +52,9 @@ contains
          "  --solver S         incremental (default): event-exact, condensed to the contacts, bordered", &
          "                     Cholesky factor, exact candidate bound, full-field FFT check at the end;", &
          "                     legacy: the Appendix B program (skyline, COLHT, TRFACT, POSTP)", &
+         "                     cg: the state at each requested load only, by constrained conjugate", &
+         "                     gradients (Polonsky-Keer) with FFT convolutions; --tol T (default 1e-8,", &
+         "                     gap violations over the height range), --max-iterations N (default 2000)", &
          "  --loads F1,...     total loads in nN at which to report the state (PREFIX.loads.csv);", &
          "                     the run stops once the largest is reached", &
          "  --max-contacts N   stop after N contacts (default: the deck's MAXCONT)", &
@@ -100,12 +104,17 @@ contains
       type(deck_spec) :: spec
       type(run_info) :: info
       type(solver_state) :: resume
+      type(cg_residuals), allocatable :: cg_report(:)
+      real(dp) :: cg_tol
+      integer :: cg_iterations
       logical :: quiet, ok, force, restart
       integer :: i, k, d, rc
       code = 0
       quiet = .false.
       force = .false.
       restart = .false.
+      cg_tol = 1.0e-8_dp
+      cg_iterations = 2000
       options%checkpoint_interval = 300
       spec%kind = "matrix"
       spec%label = ""
@@ -170,8 +179,8 @@ contains
                prefix = v
             case ("--solver")
                solver = v
-               if (solver /= "legacy" .and. solver /= "incremental") then
-                  call usage("unknown solver '"//v//"' (available: incremental, legacy)")
+               if (solver /= "legacy" .and. solver /= "incremental" .and. solver /= "cg") then
+                  call usage("unknown solver '"//v//"' (available: incremental, legacy, cg)")
                   return
                end if
             case ("--loads")
@@ -195,6 +204,18 @@ contains
                call parse_real(v, options%hardness, ok)
                if (.not. ok .or. options%hardness <= 0) then
                   call usage("--hardness expects a positive number in GPa, found '"//v//"'")
+                  return
+               end if
+            case ("--tol")
+               call parse_real(v, cg_tol, ok)
+               if (.not. ok .or. .not. cg_tol > 0) then
+                  call usage("--tol expects a positive number, found '"//v//"'")
+                  return
+               end if
+            case ("--max-iterations")
+               call parse_integer(v, cg_iterations, ok)
+               if (.not. ok .or. cg_iterations <= 0) then
+                  call usage("--max-iterations expects a positive integer, found '"//v//"'")
                   return
                end if
             case ("--event-search")
@@ -269,8 +290,12 @@ contains
          call usage("run needs a DECK")
          return
       end if
-      if (restart .and. solver == "legacy") then
+      if (restart .and. solver /= "incremental") then
          call usage("--restart: checkpoints are written by the incremental solver only")
+         return
+      end if
+      if (solver == "cg" .and. size(options%loads) == 0) then
+         call usage("--solver cg solves at given loads: add --loads F1,F2,...")
          return
       end if
       if (size(decks) > 1 .and. prefix /= "") then
@@ -334,6 +359,19 @@ contains
          growth = merge(4.0_dp, 3.0_dp, solver == "legacy")
          if (st%code == 0) then
             select case (solver)
+            case ("cg")
+               call solve_cg(deck, options, cg_tol, cg_iterations, res, cg_report, st)
+               if (st%code == 0) then
+                  do k = 1, size(cg_report)
+                     if (cg_report(k)%residual > cg_tol) then
+                        st%code = STATUS_NUMERICAL
+                        st%message = "cg: load "//format_real(options%loads(k))//" nN: residual "// &
+                           real_str(cg_report(k)%residual, 2)//" after "//int_str(cg_report(k)%iterations)// &
+                           " iterations, above --tol "//real_str(cg_tol, 2)//" (raise --max-iterations)"
+                        exit
+                     end if
+                  end do
+               end if
             case ("legacy")
                if (quiet) then
                   call solve_legacy(deck, options, res, st)
@@ -379,7 +417,12 @@ contains
                end do
             else
                allocate(info%scene(1))
-               info%scene(1)%s = "nothing: the legacy solver models every node and spring of Appendix B"
+               if (solver == "cg") then
+                  info%scene(1)%s = "handles and springs condensed: one composite compliance c1 + c2 with the springs' "// &
+                     "3/k on the diagonal, one composite gap"
+               else
+                  info%scene(1)%s = "nothing: the legacy solver models every node and spring of Appendix B"
+               end if
             end if
             call write_results(current_prefix, deck, res, info, st)
             deallocate(info%scene)
@@ -458,7 +501,14 @@ contains
          end do
          write(output_unit, '(a)') "  wall time : "//real_str(res%wall_seconds, 3)//" s in total, "// &
             real_str(res%wall_seconds/max(last, 1), 3)//" s per step"
-         if (solver == "incremental") then
+         if (solver == "cg") then
+            do k = 1, size(res%states)
+               write(output_unit, '(a)') "  cg        : load "//real_str(res%states(k)%load, 6)//" nN: "// &
+                  int_str(res%states(k)%iterations)//" iterations, residual "//real_str(res%states(k)%residual, 2)// &
+                  ", penetration "//real_str(res%states(k)%penetration, 2)//" nm, |gap| on contact "// &
+                  real_str(res%states(k)%contact_gap, 2)//" nm, load error "//real_str(res%states(k)%load_error, 2)
+            end do
+         else if (solver == "incremental") then
             lines = scene_report(deck)
             do k = 1, size(lines)
                write(output_unit, '(a)') "  model     : "//trim(lines(k))

@@ -14,6 +14,7 @@ program tester
    use test_results, only: collect_results
    use test_hostile, only: collect_hostile
    use test_stability, only: collect_stability
+   use test_cg, only: collect_cg
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
    use femcod_strings, only: string_type
@@ -32,7 +33,8 @@ program tester
       new_testsuite("incremental", collect_incremental), &
       new_testsuite("results", collect_results), &
       new_testsuite("hostile", collect_hostile), &
-      new_testsuite("stability", collect_stability) &
+      new_testsuite("stability", collect_stability), &
+      new_testsuite("cg", collect_cg) &
       ]
    stat = 0
    total = 0
