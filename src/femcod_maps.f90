@@ -1,4 +1,4 @@
-!> Pressure and gap maps of a recorded load state (no I/O).
+!> Pressure and gap maps of the recorded load states (no I/O).
 module femcod_maps
    use femcod_kinds, only: dp
    use femcod_deck, only: deck_type
@@ -8,41 +8,51 @@ module femcod_maps
    use femcod_contact_result, only: load_state
    implicit none
    private
-   public :: load_maps
+   public :: load_maps, state_maps
+
+   !> The maps of one load state.
+   type :: state_maps
+      real(dp), allocatable :: pressure(:, :), gap(:, :)
+   end type state_maps
 
 contains
 
-   !> pressure(i, j) (GPa) = contact force / pixel area; gap(i, j) (nm) = separation of
-   !> the deformed surfaces, g0 - approach + c (I * F), from one zero-padded FFT
-   !> convolution over the grid, and 0 at the contacts (where the penalty springs'
-   !> compression s F is the only remaining separation).
-   subroutine load_maps(deck, state, pressure, gap)
+   !> For every reached state: pressure(i, j) (GPa) = contact force / pixel area;
+   !> gap(i, j) (nm) = separation of the deformed surfaces, g0 - approach + c (I * F),
+   !> from one zero-padded FFT convolution, and 0 at the contacts (where the penalty
+   !> springs' compression s F is the only remaining separation). The Love table and the
+   !> FFT plans are made once for all states.
+   subroutine load_maps(deck, states, maps)
       type(deck_type), intent(in) :: deck
-      type(load_state), intent(in) :: state
-      real(dp), allocatable, intent(out) :: pressure(:, :), gap(:, :)
+      type(load_state), intent(in) :: states(:)
+      type(state_maps), allocatable, intent(out) :: maps(:)
       type(love_convolution) :: conv
-      real(dp), allocatable :: force(:, :), disp(:, :), g0(:), table(:, :)
+      real(dp), allocatable :: force(:, :), disp(:, :), g0(:, :), table(:, :)
       real(dp) :: c
-      integer :: np, k
+      integer :: np, k, s
+      allocate(maps(size(states)))
+      if (.not. any(states%reached)) return
       np = deck%np
-      allocate(pressure(np, np), gap(np, np), force(np, np), disp(np, np))
-      force = 0
-      do k = 1, size(state%force)
-         force(state%i(k), state%j(k)) = state%force(k)
-      end do
-      pressure = force/deck%pixel**2
-      allocate(table(0:np - 1, 0:np - 1))
+      allocate(force(np, np), disp(np, np), table(0:np - 1, 0:np - 1))
       table = offset_table(np)
       c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
          surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
+      ! g0 is numbered pixel by pixel along rows: p = (i - 1) np + j.
+      g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
       call convolution_setup(conv, table)
-      call convolution_apply(conv, force, disp)
-      call convolution_free(conv)
-      g0 = initial_gaps(deck%lower, deck%upper)
-      ! g0 is stored pixel by pixel along rows: p = (i - 1) np + j.
-      gap = transpose(reshape(g0, [np, np])) - state%approach + c*disp
-      do k = 1, size(state%force)
-         gap(state%i(k), state%j(k)) = 0
+      do s = 1, size(states)
+         if (.not. states(s)%reached) cycle
+         force = 0
+         do k = 1, size(states(s)%force)
+            force(states(s)%i(k), states(s)%j(k)) = states(s)%force(k)
+         end do
+         maps(s)%pressure = force/deck%pixel**2
+         call convolution_apply(conv, force, disp)
+         maps(s)%gap = g0 - states(s)%approach + c*disp
+         do k = 1, size(states(s)%force)
+            maps(s)%gap(states(s)%i(k), states(s)%j(k)) = 0
+         end do
       end do
+      call convolution_free(conv)
    end subroutine load_maps
 end module femcod_maps

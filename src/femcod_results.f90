@@ -14,7 +14,7 @@ module femcod_results
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_write, h5_attribute
-   use femcod_maps, only: load_maps
+   use femcod_maps, only: load_maps, state_maps
    use femcod_svg, only: svg_plot, svg_pressure_map, fmt_sig
    use femcod_richardson, only: power_law_fit
    implicit none
@@ -27,11 +27,6 @@ module femcod_results
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
    end type run_info
-
-   !> The maps of one requested load.
-   type :: maps_type
-      real(dp), allocatable :: pressure(:, :), gap(:, :)
-   end type maps_type
 
 contains
 
@@ -61,13 +56,11 @@ contains
       type(run_info), intent(in) :: info
       type(status_type), intent(inout) :: status
       type(string_type), allocatable :: names(:), temps(:)
-      type(maps_type), allocatable :: maps(:)
+      type(state_maps), allocatable :: maps(:)
       integer :: k, m
       if (status%code /= 0) return
-      allocate(names(0), temps(0), maps(size(res%states)))
-      do k = 1, size(res%states)
-         if (res%states(k)%reached) call load_maps(deck, res%states(k), maps(k)%pressure, maps(k)%gap)
-      end do
+      allocate(names(0), temps(0))
+      call load_maps(deck, res%states, maps)
       call add(".history.csv")
       call write_history_csv(temps(size(temps))%s, deck, res, status)
       call add(".contacts.csv")
@@ -239,7 +232,7 @@ contains
       type(deck_type), intent(in) :: deck
       type(contact_result), intent(in) :: res
       type(run_info), intent(in) :: info
-      type(maps_type), intent(in) :: maps(:)
+      type(state_maps), intent(in) :: maps(:)
       type(status_type), intent(inout) :: status
       type(h5_file) :: file
       type(status_type) :: local
