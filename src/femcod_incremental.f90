@@ -233,21 +233,7 @@ contains
             if (heap_top_key(heap) - phi > bound) exit
             call heap_pop(heap, key, p)
             if (slot(p) /= 0) cycle
-            call evaluate(p, g, rate)
-            res%evaluations = res%evaluations + 1
-            neval = neval + 1
-            eval_pix(neval) = p
-            gap_eval(neval) = g
-            if (g <= 0) then
-               lam_eval(neval) = 0
-            else if (rate > 0) then
-               lam_eval(neval) = g/rate
-            else
-               lam_eval(neval) = huge(1.0_dp)
-            end if
-            lam_best = min(lam_best, lam_eval(neval))
-            pred(p) = huge(1.0_dp)
-            if (lam_eval(neval) < huge(1.0_dp)) pred(p) = total + lam_eval(neval)
+            call record_evaluation(p)
             if (neval == npix) exit
          end do
          if (.not. use_fft) last_neval = neval
@@ -335,6 +321,29 @@ contains
 
    contains
 
+      !> Evaluate a pixel exactly and record it for this step's event: its gap, the load
+      !> increment that closes it, the best so far, and its predicted closing load (for
+      !> the candidate cache).
+      subroutine record_evaluation(pixel)
+         integer, intent(in) :: pixel
+         real(dp) :: gp, rp
+         call evaluate(pixel, gp, rp)
+         res%evaluations = res%evaluations + 1
+         neval = neval + 1
+         eval_pix(neval) = pixel
+         gap_eval(neval) = gp
+         if (gp <= 0) then
+            lam_eval(neval) = 0
+         else if (rp > 0) then
+            lam_eval(neval) = gp/rp
+         else
+            lam_eval(neval) = huge(1.0_dp)
+         end if
+         lam_best = min(lam_best, lam_eval(neval))
+         pred(pixel) = huge(1.0_dp)
+         if (lam_eval(neval) < huge(1.0_dp)) pred(pixel) = total + lam_eval(neval)
+      end subroutine record_evaluation
+
       !> Full-field search this step? options%event_search: "fft", "bound" or "auto".
       !> Auto compares the last bound search's exact evaluations (neval n table look-ups,
       !> about 2 ns each here) with two convolutions on the (2NP)^2 grid (about 5 ns per
@@ -395,21 +404,7 @@ contains
          margin = options%tie_tolerance*(total + lam_min) + 1.0e-9_dp*(abs(approach) + maxval(abs(g0)))/delta
          do qq = 1, npix
             if (lam(qq) > lam_min + 2*margin) cycle
-            call evaluate(qq, gq, rq)
-            res%evaluations = res%evaluations + 1
-            neval = neval + 1
-            eval_pix(neval) = qq
-            gap_eval(neval) = gq
-            if (gq <= 0) then
-               lam_eval(neval) = 0
-            else if (rq > 0) then
-               lam_eval(neval) = gq/rq
-            else
-               lam_eval(neval) = huge(1.0_dp)
-            end if
-            lam_best = min(lam_best, lam_eval(neval))
-            pred(qq) = huge(1.0_dp)
-            if (lam_eval(neval) < huge(1.0_dp)) pred(qq) = total + lam_eval(neval)
+            call record_evaluation(qq)
          end do
       end subroutine fft_search
 
