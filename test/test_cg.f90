@@ -12,6 +12,7 @@ module test_cg
    use femcod_generate, only: VERIFICATION_DECKS
    use femcod_analytic, only: hertz_approach
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   use test_support, only: segedin_approach
    implicit none
    private
    public :: collect_cg
@@ -86,8 +87,7 @@ contains
       type(contact_result) :: res
       type(cg_residuals), allocatable :: report(:)
       type(status_type) :: status
-      real(dp) :: estar, r, a, lo, hi, segedin
-      integer :: it
+      real(dp) :: estar, r, segedin
       call read_deck("input/sphere_d05.deck", deck, status)
       options%loads = [1000.0_dp, 18000.0_dp]
       call solve_cg(deck, options, 1.0e-8_dp, 5000, res, report, status)
@@ -99,18 +99,8 @@ contains
       call check(error, res%states(1)%approach, hertz_approach(1000.0_dp, r, estar), rel=.true., thr=0.01_dp, &
          message="Hertz at 1000 nN")
       if (allocated(error)) return
-      ! Segedin's rigid sphere: F = E*/2 [(a^2+R^2) ln((R+a)/(R-a)) - 2 a R], delta = a/2 ln((R+a)/(R-a)).
-      lo = 0
-      hi = r*(1 - 1.0e-12_dp)
-      do it = 1, 200
-         a = (lo + hi)/2
-         if (estar/2*((a*a + r*r)*log((r + a)/(r - a)) - 2*a*r) < 18000) then
-            lo = a
-         else
-            hi = a
-         end if
-      end do
-      segedin = a/2*log((r + a)/(r - a))
+      ! Segedin's rigid sphere (test_support: an independent bisection).
+      segedin = segedin_approach(18000.0_dp, r, estar)
       call check(error, res%states(2)%approach, segedin, rel=.true., thr=0.005_dp, message="Segedin at 18000 nN")
    end subroutine test_sphere
 

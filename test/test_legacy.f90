@@ -9,7 +9,7 @@ module test_legacy
    use femcod_richardson, only: convergence_rate, richardson_extrapolate
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
-   use test_support, only: scratch_path, read_text, file_exists, contains_text
+   use test_support, only: scratch_path, read_text, file_exists, contains_text, segedin_approach
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -124,8 +124,7 @@ contains
       type(contact_options) :: options
       type(contact_result) :: res
       type(status_type) :: status
-      real(dp) :: estar, r, hertz, a, lo, hi, segedin
-      integer :: it
+      real(dp) :: estar, r, hertz, segedin
       call read_deck("input/sphere_d05.deck", deck, status)
       options%loads = [1000.0_dp, 18000.0_dp]
       call solve_legacy(deck, options, res, status)
@@ -137,18 +136,8 @@ contains
       hertz = (9*1000.0_dp**2/(16*r*estar**2))**(1.0_dp/3)
       call check(error, res%states(1)%approach, hertz, rel=.true., thr=0.01_dp, message="Hertz at 1000 nN")
       if (allocated(error)) return
-      ! Segedin's rigid sphere: F = E*/2 [(a^2+R^2) ln((R+a)/(R-a)) - 2 a R], delta = a/2 ln((R+a)/(R-a)).
-      lo = 0
-      hi = r*(1 - 1.0e-12_dp)
-      do it = 1, 200
-         a = (lo + hi)/2
-         if (estar/2*((a*a + r*r)*log((r + a)/(r - a)) - 2*a*r) < 18000) then
-            lo = a
-         else
-            hi = a
-         end if
-      end do
-      segedin = a/2*log((r + a)/(r - a))
+      ! Segedin's rigid sphere (test_support: an independent bisection).
+      segedin = segedin_approach(18000.0_dp, r, estar)
       call check(error, res%states(2)%approach, segedin, rel=.true., thr=0.005_dp, message="Segedin at 18000 nN")
    end subroutine test_sphere
 
