@@ -20,7 +20,7 @@ module femcod_cg
    use femcod_boussinesq, only: offset_table, surface_compliance
    use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
-   use femcod_contact_result, only: contact_result, contact_options, append_step, STOP_LOADS, STOP_MAXCONT
+   use femcod_contact_result, only: contact_result, contact_options, append_step, STOP_LOADS
    use femcod_clock, only: wall_clock
    implicit none
    private
@@ -48,7 +48,7 @@ contains
       real(dp), allocatable :: table(:, :), g0(:, :), p(:, :), t(:, :), u(:, :), r(:, :), g(:, :), pold(:, :)
       integer, allocatable :: order(:)
       real(dp) :: c, s, load, scale, tstart, t0, t1
-      integer :: np, k, kk, m, i, j
+      integer :: np, k, kk, m, i, j, nc
       call wall_clock(tstart)
       np = deck%np
       m = size(options%loads)
@@ -93,18 +93,17 @@ contains
             st%max_pressure = maxval(p)/deck%pixel**2
             st%n_above_hardness = count(p/deck%pixel**2 > options%hardness)
             allocate(st%i(st%contacts), st%j(st%contacts), st%force(st%contacts))
-            m = 0
+            nc = 0
             do i = 1, np
                do j = 1, np
                   if (p(i, j) > 0) then
-                     m = m + 1
-                     st%i(m) = i
-                     st%j(m) = j
-                     st%force(m) = p(i, j)
+                     nc = nc + 1
+                     st%i(nc) = i
+                     st%j(nc) = j
+                     st%force(nc) = p(i, j)
                   end if
                end do
             end do
-            m = size(options%loads)
             call append_step(res, st%contacts, load, st%approach, t1 - t0)
             if (load == maxval(options%loads)) then
                res%contact_i = st%i
