@@ -104,7 +104,7 @@ contains
                   end if
                end do
             end do
-            call append_step(res, st%contacts, load, st%approach, t1 - t0)
+            call append_step(res, st%contacts, st%n_above_hardness, load, st%approach, t1 - t0)
             if (load == maxval(options%loads)) then
                res%contact_i = st%i
                res%contact_j = st%j

@@ -25,7 +25,7 @@ module femcod_checkpoint
    public :: write_checkpoint, read_checkpoint
 
    !> Marks a file as a femcod checkpoint (attribute /format).
-   character(len=*), parameter :: FORMAT_TAG = "femcod checkpoint 2"
+   character(len=*), parameter :: FORMAT_TAG = "femcod checkpoint 3"
 
 contains
 
@@ -84,6 +84,7 @@ contains
       call h5_write(file, "/state/heap_item", state%heap_item, "1", status)
       call h5_group(file, "/history", status)
       call h5_write(file, "/history/contacts", state%res%step_contacts(1:m), "1", status)
+      call h5_write(file, "/history/above_hardness", state%res%step_above_hardness(1:m), "1", status)
       call h5_write(file, "/history/load", state%res%step_load(1:m), "nN", status)
       call h5_write(file, "/history/approach", state%res%step_approach(1:m), "nm", status)
       call h5_write(file, "/history/seconds", state%res%step_seconds(1:m), "s", status)
@@ -234,6 +235,7 @@ contains
       call h5_read(file, "/state/heap_key", state%heap_key, status, bad)
       call h5_read(file, "/state/heap_item", state%heap_item, status, bad)
       call h5_read(file, "/history/contacts", state%res%step_contacts, status, bad)
+      call h5_read(file, "/history/above_hardness", state%res%step_above_hardness, status, bad)
       call h5_read(file, "/history/load", state%res%step_load, status, bad)
       call h5_read(file, "/history/approach", state%res%step_approach, status, bad)
       call h5_read(file, "/history/seconds", state%res%step_seconds, status, bad)
@@ -244,6 +246,7 @@ contains
       m = size(state%res%step_load)
       state%res%nsteps = m
       if (size(state%res%step_contacts) /= m .or. size(state%res%step_approach) /= m .or. &
+         size(state%res%step_above_hardness) /= m .or. &
          size(state%res%step_seconds) /= m .or. m /= state%step .or. size(state%cstep) /= state%n .or. &
          size(state%ftot) /= state%n .or. state%n < 1 .or. state%n > deck%maxcont .or. &
          size(state%pix) /= state%n .or. size(state%y) /= state%n .or. size(state%x) /= state%n .or. &

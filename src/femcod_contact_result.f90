@@ -50,8 +50,9 @@ module femcod_contact_result
    !> Results of a run. Units: nN, nm, GPa.
    type :: contact_result
       integer :: nsteps = 0
-      !> Per step: contacts carrying load, total load and approach at the end of the step.
-      integer, allocatable :: step_contacts(:)
+      !> Per step: contacts carrying load, total load and approach at the end of the step,
+      !> and the contacts whose pressure exceeds the hardness there (thesis Fig. 4.21).
+      integer, allocatable :: step_contacts(:), step_above_hardness(:)
       real(dp), allocatable :: step_load(:), step_approach(:), step_seconds(:)
       !> Requested loads, in the order given.
       type(load_state), allocatable :: states(:)
@@ -134,22 +135,27 @@ module femcod_contact_result
 
 contains
 
-   !> Append one history row.
-   pure subroutine append_step(res, contacts, load, approach, seconds)
+   !> Append one history row: contacts carrying load, how many of them press harder
+   !> than the hardness, total load (nN), approach (nm), seconds the step took.
+   pure subroutine append_step(res, contacts, above_hardness, load, approach, seconds)
       type(contact_result), intent(inout) :: res
-      integer, intent(in) :: contacts
+      integer, intent(in) :: contacts, above_hardness
       real(dp), intent(in) :: load, approach, seconds
       integer, allocatable :: itmp(:)
       real(dp), allocatable :: rtmp(:)
       integer :: cap
       if (.not. allocated(res%step_contacts)) then
-         allocate(res%step_contacts(64), res%step_load(64), res%step_approach(64), res%step_seconds(64))
+         allocate(res%step_contacts(64), res%step_above_hardness(64), res%step_load(64), res%step_approach(64), &
+            res%step_seconds(64))
       end if
       cap = size(res%step_contacts)
       if (res%nsteps == cap) then
          allocate(itmp(2*cap))
          itmp(1:cap) = res%step_contacts
          call move_alloc(itmp, res%step_contacts)
+         allocate(itmp(2*cap))
+         itmp(1:cap) = res%step_above_hardness
+         call move_alloc(itmp, res%step_above_hardness)
          allocate(rtmp(2*cap))
          rtmp(1:cap) = res%step_load
          call move_alloc(rtmp, res%step_load)
@@ -162,6 +168,7 @@ contains
       end if
       res%nsteps = res%nsteps + 1
       res%step_contacts(res%nsteps) = contacts
+      res%step_above_hardness(res%nsteps) = above_hardness
       res%step_load(res%nsteps) = load
       res%step_approach(res%nsteps) = approach
       res%step_seconds(res%nsteps) = seconds

@@ -268,7 +268,7 @@ contains
                if (max_load > total) call advance(max_load - total)
             end if
             call wall_clock(t1)
-            call append_step(res, n, total, approach, t1 - t0)
+            call append_step(res, n, count(ftot(1:n)/deck%pixel**2 > options%hardness), total, approach, t1 - t0)
             exit
          end if
          lam_best = max(lam_best, 0.0_dp)
@@ -276,7 +276,7 @@ contains
             deck%pixel, options%hardness, ic(1:n), jc(1:n))
          call advance(lam_best)
          call wall_clock(t1)
-         call append_step(res, n, total, approach, t1 - t0)
+         call append_step(res, n, count(ftot(1:n)/deck%pixel**2 > options%hardness), total, approach, t1 - t0)
          if (present(progress)) call progress(step, n, total, t1 - tstart)
          if (size(loads) > 0) then
             if (max_load <= total) then

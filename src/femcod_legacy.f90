@@ -133,12 +133,12 @@ contains
                if (max_load > total) call advance(max_load - total)
             end if
             call wall_clock(t1)
-            call append_step(res, n, total, approach, t1 - t0)
+            call append_step(res, n, count(ftot(1:n)/deck%pixel**2 > options%hardness), total, approach, t1 - t0)
             exit
          end if
          call advance(lambda)
          call wall_clock(t1)
-         call append_step(res, n, total, approach, t1 - t0)
+         call append_step(res, n, count(ftot(1:n)/deck%pixel**2 > options%hardness), total, approach, t1 - t0)
          if (present(progress)) call progress(step, n, total, t1 - tstart)
          if (size(loads) > 0) then
             if (max_load <= total) then
@@ -226,6 +226,7 @@ contains
             approach = aex
             res%step_approach(res%nsteps) = aex
             res%step_contacts(res%nsteps) = n
+            res%step_above_hardness(res%nsteps) = count(ftot(1:n)/deck%pixel**2 > options%hardness)
          end if
       end subroutine final_check
    end subroutine solve_legacy

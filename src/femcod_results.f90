@@ -1,6 +1,6 @@
 !> Result files of a run, written under temporary names and renamed only when all of
 !> them are complete, so a failed run leaves no partial result (doc/results.md):
-!>   PREFIX.history.csv   step,contacts,load_nN,approach_nm,area_nm2,area_fraction
+!>   PREFIX.history.csv   step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness
 !>   PREFIX.loads.csv     load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness
 !>   PREFIX.contacts.csv  i,j,step,force_nN,pressure_GPa
 !>   PREFIX.h5            /deck /surfaces /history /contacts /loads/<k> /run
@@ -19,7 +19,7 @@ module femcod_results
    use femcod_richardson, only: power_law_fit
    implicit none
    private
-   public :: write_results, run_info, result_files
+   public :: write_results, run_info, result_files, write_file_set
 
    !> What the run was, for /run in the HDF5 file.
    type :: run_info
@@ -87,6 +87,23 @@ contains
       ! PREFIX.h5 is renamed last: when it exists, the whole set is complete.
       call add(".h5")
       call write_hdf5(temps(size(temps))%s, deck, res, info, maps, status)
+      call commit_set(names, temps, status)
+   contains
+      subroutine add(suffix)
+         character(len=*), intent(in) :: suffix
+         names = [names, string_type(prefix//suffix)]
+         temps = [temps, string_type(temporary_name(prefix//suffix))]
+      end subroutine add
+   end subroutine write_results
+
+
+   !> Rename every temporary into place, in order; if anything failed before or a
+   !> rename fails, remove the temporaries and the files of this set already renamed,
+   !> so that a set is there whole or not at all.
+   subroutine commit_set(names, temps, status)
+      type(string_type), intent(in) :: names(:), temps(:)
+      type(status_type), intent(inout) :: status
+      integer :: k, m
       if (status%code /= 0) then
          do m = 1, size(temps)
             call remove_file(temps(m)%s)
@@ -96,7 +113,6 @@ contains
       do k = 1, size(names)
          call atomic_rename(temps(k)%s, names(k)%s, status)
          if (status%code /= 0) then
-            ! No partial set: drop the files of this set already in place too.
             do m = 1, size(temps)
                call remove_file(temps(m)%s)
                if (m < k) call remove_file(names(m)%s)
@@ -104,14 +120,23 @@ contains
             return
          end if
       end do
-   contains
-      subroutine add(suffix)
-         character(len=*), intent(in) :: suffix
-         names = [names, string_type(prefix//suffix)]
-         temps = [temps, string_type(temporary_name(prefix//suffix))]
-      end subroutine add
-   end subroutine write_results
+   end subroutine commit_set
 
+   !> Write text files as one set (each to PATH.part, then all renamed into place; on
+   !> any failure none is left behind). Used by the study commands.
+   subroutine write_file_set(names, texts, status)
+      type(string_type), intent(in) :: names(:), texts(:)
+      type(status_type), intent(inout) :: status
+      type(string_type), allocatable :: temps(:)
+      integer :: k
+      if (status%code /= 0) return
+      allocate(temps(size(names)))
+      do k = 1, size(names)
+         temps(k)%s = temporary_name(names(k)%s)
+         call write_text(temps(k)%s, texts(k)%s, status)
+      end do
+      call commit_set(names, temps, status)
+   end subroutine write_file_set
 
    !> Open a temporary file for writing; on failure `status` names the result file.
    subroutine open_for_writing(tmp, unit, status)
@@ -174,12 +199,13 @@ contains
       if (status%code /= 0) return
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      write(unit, '(a)', iostat=ios) "step,contacts,load_nN,approach_nm,area_nm2,area_fraction"
+      write(unit, '(a)', iostat=ios) "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness"
       do k = 1, res%nsteps
          if (ios /= 0) exit
          write(unit, '(a)', iostat=ios) int_str(k)//","//int_str(res%step_contacts(k))//","// &
             format_real(res%step_load(k))//","//format_real(res%step_approach(k))//","// &
-            format_real(res%step_contacts(k)*area_pixel)//","//format_real(res%step_contacts(k)*area_pixel/region)
+            format_real(res%step_contacts(k)*area_pixel)//","//format_real(res%step_contacts(k)*area_pixel/region)// &
+            ","//int_str(res%step_above_hardness(k))
       end do
       call close_written(unit, tmp, ios, status)
    end subroutine write_history_csv
@@ -266,6 +292,7 @@ contains
       call h5_write(file, "/history/approach", res%step_approach(1:n), "nm", local)
       call h5_write(file, "/history/area", res%step_contacts(1:n)*area_pixel, "nm^2", local)
       call h5_write(file, "/history/area_fraction", res%step_contacts(1:n)*area_pixel/region, "1", local)
+      call h5_write(file, "/history/n_above_hardness", res%step_above_hardness(1:n), "1", local)
       call h5_group(file, "/contacts", local)
       call h5_attribute(file, "/contacts", "load_nN", res%reported_load, local)
       call h5_write(file, "/contacts/i", res%contact_i, "1", local)

@@ -21,7 +21,7 @@ module femcod_run
    use femcod_status, only: STATUS_IO, STATUS_NUMERICAL
    implicit none
    private
-   public :: run_command
+   public :: run_command, default_prefix, file_part
 
    !> Elapsed time (s) of the last progress line.
    real(dp), save :: last_report = 0
@@ -83,7 +83,8 @@ contains
          "  --maxcont M        maximum contacts (default 5 % of the pixels)", &
          "  --remove-plane     subtract each surface's least-squares plane", &
          "", &
-         "outputs: PREFIX.history.csv (step,contacts,load_nN,approach_nm,area_nm2,area_fraction),", &
+         "outputs: PREFIX.history.csv (step,contacts,load_nN,approach_nm,area_nm2,area_fraction,", &
+         "         n_above_hardness),", &
          "         PREFIX.contacts.csv (i,j,step,force_nN,pressure_GPa) at the largest requested load", &
          "         or the last step, PREFIX.loads.csv (load_nN,approach_nm,contacts,area_nm2,area_fraction,", &
          "         max_pressure_GPa,n_above_hardness), PREFIX.h5 (everything, with the pressure and gap", &

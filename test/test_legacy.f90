@@ -180,7 +180,8 @@ contains
       call check(error, code, 0)
       if (allocated(error)) return
       text = read_text(prefix//".history.csv")
-      call check(error, text(1:index(text, new_line("a")) - 1), "step,contacts,load_nN,approach_nm,area_nm2,area_fraction")
+      call check(error, text(1:index(text, new_line("a")) - 1), &
+         "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness")
       if (allocated(error)) return
       text = read_text(prefix//".loads.csv")
       call check(error, text(1:index(text, new_line("a")) - 1), &
