@@ -3,14 +3,49 @@ module femcod_strings
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: string_type, int_str, real_str, split_list
+   public :: string_type, int_str, real_str, split_list, text_builder, add_line, built_text
 
    !> A string of any length, for lists of arguments.
    type :: string_type
       character(len=:), allocatable :: s
    end type string_type
 
+   !> A growing text (a CSV file being built): lines are appended in amortised O(length),
+   !> where repeated concatenation would copy the whole text every time.
+   type :: text_builder
+      character(len=:), allocatable :: buffer
+      integer :: length = 0
+   end type text_builder
+
 contains
+
+   !> Append `line` and a line end.
+   pure subroutine add_line(builder, line)
+      type(text_builder), intent(inout) :: builder
+      character(len=*), intent(in) :: line
+      character(len=:), allocatable :: bigger
+      integer :: need
+      need = builder%length + len(line) + 1
+      if (.not. allocated(builder%buffer)) allocate(character(len=max(4096, 2*need)) :: builder%buffer)
+      if (need > len(builder%buffer)) then
+         allocate(character(len=2*need) :: bigger)
+         bigger(1:builder%length) = builder%buffer(1:builder%length)
+         call move_alloc(bigger, builder%buffer)
+      end if
+      builder%buffer(builder%length + 1:need) = line//new_line("a")
+      builder%length = need
+   end subroutine add_line
+
+   !> The text built so far.
+   pure function built_text(builder) result(text)
+      type(text_builder), intent(in) :: builder
+      character(len=:), allocatable :: text
+      if (builder%length == 0) then
+         text = ""
+      else
+         text = builder%buffer(1:builder%length)
+      end if
+   end function built_text
 
    !> An integer without blanks.
    pure function int_str(i) result(s)

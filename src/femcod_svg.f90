@@ -7,7 +7,14 @@ module femcod_svg
    use femcod_strings, only: int_str
    implicit none
    private
-   public :: svg_plot, svg_pressure_map, nice_ticks, fmt_sig
+   public :: svg_plot, svg_pressure_map, nice_ticks, fmt_sig, svg_series, svg_multi_plot, add_series
+
+   !> One curve of a multi-series plot: legend label, points, dashed line, markers.
+   type :: svg_series
+      character(len=:), allocatable :: label
+      real(dp), allocatable :: x(:), y(:)
+      logical :: dashed = .false., markers = .true.
+   end type svg_series
 
    character(len=1), parameter :: nl = new_line("a")
    !> Plot frame (px): width, height and margins left, right, top, bottom.
@@ -87,6 +94,105 @@ contains
          pyv = h - mb - (yv - y0)/(y1 - y0)*(h - mt - mb)
       end subroutine to_px
    end function svg_plot
+
+   !> Append a curve to a list (component by component: gfortran mishandles array
+   !> constructors of this type built from function results).
+   subroutine add_series(list, label, x, y, dashed, markers)
+      type(svg_series), allocatable, intent(inout) :: list(:)
+      character(len=*), intent(in) :: label
+      real(dp), intent(in) :: x(:), y(:)
+      logical, intent(in), optional :: dashed, markers
+      type(svg_series), allocatable :: longer(:)
+      integer :: n, k
+      n = 0
+      if (allocated(list)) n = size(list)
+      allocate(longer(n + 1))
+      do k = 1, n
+         call move_alloc(list(k)%label, longer(k)%label)
+         call move_alloc(list(k)%x, longer(k)%x)
+         call move_alloc(list(k)%y, longer(k)%y)
+         longer(k)%dashed = list(k)%dashed
+         longer(k)%markers = list(k)%markers
+      end do
+      longer(n + 1)%label = label
+      allocate(longer(n + 1)%x(size(x)), longer(n + 1)%y(size(y)))
+      longer(n + 1)%x = x
+      longer(n + 1)%y = y
+      if (present(dashed)) longer(n + 1)%dashed = dashed
+      if (present(markers)) longer(n + 1)%markers = markers
+      call move_alloc(longer, list)
+   end subroutine add_series
+
+   !> Several curves on common axes, each in its own colour with a legend entry (the
+   !> thesis' figures 3.2, 4.17, 4.18 and 4.21 put one curve per image or model on one
+   !> plot). Values <= 0 are left out of a logarithmic axis.
+   function svg_multi_plot(title, xlabel, ylabel, series, logx, logy) result(svg)
+      character(len=*), intent(in) :: title, xlabel, ylabel
+      type(svg_series), intent(in) :: series(:)
+      logical, intent(in) :: logx, logy
+      character(len=:), allocatable :: svg
+      character(len=7), parameter :: palette(8) = [character(len=7) :: "#1f4e9c", "#c0392b", "#27ae60", &
+         "#8e44ad", "#d35400", "#16a085", "#7f8c8d", "#2c3e50"]
+      type(svg_series), allocatable :: kept(:)
+      real(dp), allocatable :: xt(:), yt(:)
+      logical, allocatable :: keep(:)
+      real(dp) :: x0, x1, y0, y1, lo_x, hi_x, lo_y, hi_y, px, py
+      character(len=:), allocatable :: path, dash
+      character(len=7) :: c
+      integer :: k, s, m
+      allocate(kept(size(series)))
+      lo_x = huge(1.0_dp); hi_x = -huge(1.0_dp); lo_y = huge(1.0_dp); hi_y = -huge(1.0_dp)
+      do s = 1, size(series)
+         keep = [(.true., k = 1, size(series(s)%x))]
+         if (logx) keep = keep .and. series(s)%x > 0
+         if (logy) keep = keep .and. series(s)%y > 0
+         kept(s)%x = pack(series(s)%x, keep)
+         kept(s)%y = pack(series(s)%y, keep)
+         if (logx) kept(s)%x = log10(kept(s)%x)
+         if (logy) kept(s)%y = log10(kept(s)%y)
+         if (size(kept(s)%x) == 0) cycle
+         lo_x = min(lo_x, minval(kept(s)%x)); hi_x = max(hi_x, maxval(kept(s)%x))
+         lo_y = min(lo_y, minval(kept(s)%y)); hi_y = max(hi_y, maxval(kept(s)%y))
+      end do
+      svg = header(title)
+      if (lo_x > hi_x) then
+         svg = svg//text(w/2, h/2, "no data", "middle", 14)//"</svg>"//nl
+         return
+      end if
+      call axis_range(lo_x, hi_x, logx, x0, x1, xt)
+      call axis_range(lo_y, hi_y, logy, y0, y1, yt)
+      svg = svg//axes(x0, x1, y0, y1, xt, yt, logx, logy, xlabel, ylabel)
+      do s = 1, size(series)
+         c = palette(mod(s - 1, size(palette)) + 1)
+         dash = ""
+         if (series(s)%dashed) dash = ' stroke-dasharray="6,4"'
+         path = ""
+         do k = 1, size(kept(s)%x)
+            call to_px(kept(s)%x(k), kept(s)%y(k), px, py)
+            path = path//fmt(px)//","//fmt(py)//" "
+         end do
+         if (size(kept(s)%x) > 0) svg = svg//'<polyline fill="none" stroke="'//c//'" stroke-width="1.5"'//dash// &
+            ' points="'//path//'"/>'//nl
+         if (series(s)%markers) then
+            m = max(1, size(kept(s)%x)/60)
+            do k = 1, size(kept(s)%x), m
+               call to_px(kept(s)%x(k), kept(s)%y(k), px, py)
+               svg = svg//'<circle cx="'//fmt(px)//'" cy="'//fmt(py)//'" r="2.5" fill="'//c//'"/>'//nl
+            end do
+         end if
+         py = mt + 18 + 18*(s - 1)
+         svg = svg//'<line x1="'//fmt(ml + 12)//'" y1="'//fmt(py)//'" x2="'//fmt(ml + 42)//'" y2="'//fmt(py)// &
+            '" stroke="'//c//'" stroke-width="1.5"'//dash//'/>'//text(ml + 48, py + 4, escape(series(s)%label), "start", 12)
+      end do
+      svg = svg//"</svg>"//nl
+   contains
+      subroutine to_px(xv, yv, pxv, pyv)
+         real(dp), intent(in) :: xv, yv
+         real(dp), intent(out) :: pxv, pyv
+         pxv = ml + (xv - x0)/(x1 - x0)*(w - ml - mr)
+         pyv = h - mb - (yv - y0)/(y1 - y0)*(h - mt - mb)
+      end subroutine to_px
+   end function svg_multi_plot
 
    !> A map (GPa) of `values(i, j)` (row i drawn downwards, column j to the right) over
    !> a square of side `side` nm: zero pixels are white, the others coloured on a
@@ -210,8 +316,9 @@ contains
       real(dp), allocatable, intent(out) :: ticks(:)
       integer :: k, d0, d1
       if (logscale) then
-         d0 = floor(lo)
-         d1 = ceiling(hi)
+         ! At most 40 decades (a degenerate curve must not produce a runaway axis).
+         d1 = ceiling(min(hi, 300.0_dp))
+         d0 = floor(max(lo, hi - 40, -300.0_dp))
          if (d1 == d0) d1 = d0 + 1
          a0 = d0
          a1 = d1
