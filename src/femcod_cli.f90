@@ -9,6 +9,7 @@ module femcod_cli
    use femcod_workspace, only: workspace_type, workspace_layout, workspace_table
    use femcod_generate, only: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, KINDS
    use femcod_run, only: run_command
+   use femcod_studies, only: resolution_command, summits_command, multiscale_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
    use femcod_stability_report, only: write_stability_report
@@ -61,6 +62,12 @@ contains
          call mkdeck_command(args(2:), code)
       case ("run")
          call run_command(args(2:), code)
+      case ("resolution")
+         call resolution_command(args(2:), code)
+      case ("summits")
+         call summits_command(args(2:), code)
+      case ("multiscale")
+         call multiscale_command(args(2:), code)
       case ("verify")
          call verify_command(args(2:), code)
       case ("stability")
@@ -80,6 +87,9 @@ contains
          "commands:", &
          "  run DECK [options]        contact history of a deck (femcod run --help)", &
          "  mkdeck KIND [options]     generate a deck (femcod mkdeck --help)", &
+         "  resolution DECK [options] the resolution study of section 4.5 (femcod resolution --help)", &
+         "  summits FILE [options]    summit search, PSD and structure function of chapter 3", &
+         "  multiscale FILE [options] the multiscale Hertz model of section 3.3", &
          "  workspace NP MAXCONT      print the Appendix B memory map (Tables B.1, B.2)", &
          "  verify [-o FILE]          recompute the thesis checks, write doc/verification.md", &
          "  stability [-o FILE]       run the hard cases, write doc/stability.md", &

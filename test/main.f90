@@ -15,6 +15,7 @@ program tester
    use test_hostile, only: collect_hostile
    use test_stability, only: collect_stability
    use test_cg, only: collect_cg
+   use test_studies, only: collect_studies
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
    use femcod_strings, only: string_type
@@ -34,7 +35,8 @@ program tester
       new_testsuite("results", collect_results), &
       new_testsuite("hostile", collect_hostile), &
       new_testsuite("stability", collect_stability), &
-      new_testsuite("cg", collect_cg) &
+      new_testsuite("cg", collect_cg), &
+      new_testsuite("studies", collect_studies) &
       ]
    stat = 0
    total = 0

@@ -1,0 +1,871 @@
+!> The command-line studies of the thesis: `femcod resolution` (section 4.5), `femcod
+!> summits` (chapter 3: summit search, PSD, structure function) and `femcod multiscale`
+!> (section 3.3). Each reads its input, calls the numerical modules, and writes its CSV
+!> and SVG files as one set (temporaries renamed into place; nothing on failure).
+module femcod_studies
+   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO
+   use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real
+   use femcod_strings, only: string_type, int_str, real_str, split_list, text_builder, add_line, built_text
+   use femcod_generate, only: deck_spec, build_deck, read_heights
+   use femcod_run, only: default_prefix, file_part
+   use femcod_files, only: path_exists
+   use femcod_results, only: write_file_set
+   use femcod_svg, only: svg_series, svg_multi_plot, fmt_sig, add_series
+   use femcod_clock, only: wall_clock
+   use femcod_resolution_study, only: resolution_level, solve_level, extrapolate_levels
+   use femcod_summits, only: summit_statistics, summit_search, summits_of_size, default_sizes, profile_psd, summit_power_laws, &
+      structure_function, psd_dimension, structure_dimension
+   use femcod_multiscale, only: roughness_template, multiscale_result, multiscale_hertz
+   use femcod_scene, only: flip_upper
+   use femcod_surfaces, only: remove_plane
+   use femcod_richardson, only: power_law_fit
+   implicit none
+   private
+   public :: resolution_command, summits_command, multiscale_command
+
+   !> Options shared by `summits` and `multiscale`.
+   type :: surface_options
+      character(len=:), allocatable :: input, prefix
+      real(dp) :: pixel = 0
+      logical :: plane = .false., force = .false., quiet = .false.
+      integer, allocatable :: sizes(:)
+   end type surface_options
+
+   !> Progress of the solve inside a level: a line on standard error every 10 s.
+   real(dp), save :: last_report = 0
+   logical, save :: progress_quiet = .false.
+
+contains
+
+   subroutine resolution_help()
+      write(output_unit, '(a)') &
+         "usage: femcod resolution DECK [--levels 512,256,128,64] [--method subsample|average] [-o PREFIX]", &
+         "                         [--hardness H] [--force] [--quiet]", &
+         "       femcod resolution FILE --pixel D [--young E] [--poisson NU] [--maxcont M] [options as above]", &
+         "", &
+         "The resolution study of the thesis, section 4.5: the surfaces down-sampled by keeping the odd/odd", &
+         "pixels (subsample, default) or by averaging 2 x 2 blocks (average), the pixel size doubling at each", &
+         "halving and MAXCONT scaled with the pixel count; the event-exact contact history at every level,", &
+         "and beside it the estimates of Figs. 4.17, 4.18 and 4.21. FILE: heights (nm) as an ASCII matrix or", &
+         "FILE.h5:/dataset on an elastic lower body (default 200 GPa, 0.25) against a rigid flat.", &
+         "  --levels L1,...    NP of each level (default: NP, NP/2, NP/4, NP/8 down to 8 pixels)", &
+         "  --hardness H       GPa, for the pixels above the hardness per step (default 11, polysilicon)", &
+         "", &
+         "outputs: PREFIX.resolution.csv  np,method,load_nN,approach_nm,area_nm2 (one row per step and level)", &
+         "         PREFIX.powerlaw.csv    np,exponent,prefactor (area = prefactor * load^exponent over the run)", &
+         "         PREFIX.estimates.csv   np,model,load_nN,area_nm2 with model coupled (femcod), uncoupled", &
+         "                                (rigid substrate, independent voxels of the single-pixel compliance,", &
+         "                                at femcod's approaches), mccool (Greenwood-Williamson from the RMS", &
+         "                                height, slope and curvature at that resolution, at femcod's loads),", &
+         "                                richardson (rate-1 extrapolation from the next coarser level; np is", &
+         "                                the finer one)", &
+         "         PREFIX.hardness.csv    np,step,area_fraction,contacts,n_above_hardness,fraction_above_hardness", &
+         "         PREFIX.load_displacement.svg, .area_displacement.svg (Fig. 4.17), .area_pressure.svg,", &
+         "         .richardson.svg (Fig. 4.18), .hardness.svg (Fig. 4.21)", &
+         "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
+   end subroutine resolution_help
+
+   !> `femcod resolution`.
+   subroutine resolution_command(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      type(deck_type) :: deck
+      type(status_type) :: status
+      type(resolution_level), allocatable :: levels(:)
+      type(string_type), allocatable :: parts(:), names(:), texts(:)
+      integer, allocatable :: nps(:)
+      character(len=:), allocatable :: input, prefix, method, key, v
+      real(dp) :: hardness, pixel, young, poisson, t0, t1
+      integer :: k, maxcont, n
+      logical :: ok, force, quiet
+      code = 0
+      input = ""
+      prefix = ""
+      method = "subsample"
+      hardness = 11
+      pixel = 0
+      young = 200
+      poisson = 0.25_dp
+      maxcont = 0
+      force = .false.
+      quiet = .false.
+      allocate(nps(0))
+      k = 0
+      do while (k < size(args))
+         k = k + 1
+         key = args(k)%s
+         select case (key)
+         case ("-h", "--help")
+            call resolution_help()
+            return
+         case ("--force")
+            force = .true.
+            cycle
+         case ("--quiet")
+            quiet = .true.
+            cycle
+         case ("-o", "--levels", "--method", "--hardness", "--pixel", "--young", "--poisson", "--maxcont")
+            if (k == size(args)) then
+               call usage(key//" needs a value")
+               return
+            end if
+            k = k + 1
+            v = args(k)%s
+         case default
+            if (key(1:1) == "-" .and. len(key) > 1) then
+               call usage("unknown option '"//key//"'")
+               return
+            end if
+            if (input /= "") then
+               call usage("one input only (found '"//input//"' and '"//key//"')")
+               return
+            end if
+            input = key
+            cycle
+         end select
+         ok = .true.
+         select case (key)
+         case ("-o")
+            prefix = v
+         case ("--method")
+            method = v
+            ok = v == "subsample" .or. v == "average"
+         case ("--levels")
+            parts = split_list(v)
+            deallocate(nps)
+            allocate(nps(size(parts)))
+            do n = 1, size(parts)
+               call parse_integer(parts(n)%s, nps(n), ok)
+               if (.not. ok) exit
+               ok = nps(n) >= 1
+               if (.not. ok) exit
+            end do
+         case ("--hardness")
+            call parse_real(v, hardness, ok)
+            ok = ok .and. hardness > 0
+         case ("--pixel")
+            call parse_real(v, pixel, ok)
+            ok = ok .and. pixel > 0
+         case ("--young")
+            call parse_real(v, young, ok)
+            ok = ok .and. young > 0
+         case ("--poisson")
+            call parse_real(v, poisson, ok)
+         case ("--maxcont")
+            call parse_integer(v, maxcont, ok)
+            ok = ok .and. maxcont > 0
+         end select
+         if (.not. ok) then
+            call usage(key//": invalid value '"//v//"'")
+            return
+         end if
+      end do
+      if (input == "") then
+         call usage("no deck or height file given")
+         return
+      end if
+      call study_deck(input, pixel, young, poisson, maxcont, deck, status)
+      if (status%code /= 0) then
+         call fail(status)
+         return
+      end if
+      if (size(nps) == 0) then
+         n = deck%np
+         do while (n >= 8 .and. size(nps) < 4)
+            nps = [nps, n]
+            if (method == "average") then
+               n = n/2
+            else
+               n = (n + 1)/2
+            end if
+         end do
+         if (size(nps) == 0) nps = [deck%np]
+      end if
+      if (prefix == "") prefix = default_prefix(file_part(input))
+      names = [string_type(prefix//".resolution.csv"), string_type(prefix//".powerlaw.csv"), &
+         string_type(prefix//".estimates.csv"), string_type(prefix//".hardness.csv"), &
+         string_type(prefix//".load_displacement.svg"), string_type(prefix//".area_displacement.svg"), &
+         string_type(prefix//".area_pressure.svg"), string_type(prefix//".richardson.svg"), &
+         string_type(prefix//".hardness.svg")]
+      call check_outputs(names, force, status)
+      if (status%code /= 0) then
+         call fail(status)
+         return
+      end if
+      progress_quiet = quiet
+      allocate(levels(size(nps)))
+      do k = 1, size(nps)
+         call wall_clock(t0)
+         last_report = 0
+         call solve_level(deck, nps(k), method, hardness, levels(k), status, level_progress)
+         if (status%code /= 0) then
+            status%message = "level NP = "//int_str(nps(k))//": "//status%message
+            call fail(status)
+            return
+         end if
+         call wall_clock(t1)
+         if (.not. quiet) then
+            associate(r => levels(k)%res)
+               write(output_unit, '(a)') "femcod resolution: NP = "//int_str(levels(k)%np)//" ("//method//", pixel "// &
+                  fmt_sig(levels(k)%pixel, 6)//" nm): "//int_str(r%nsteps)//" steps, "// &
+                  int_str(r%step_contacts(r%nsteps))//" contacts, load "//fmt_sig(r%step_load(r%nsteps), 6)// &
+                  " nN, area ~ load^"//fmt_sig(levels(k)%exponent, 4)//", "//fmt_sig(t1 - t0, 3)//" s"
+            end associate
+         end if
+      end do
+      call extrapolate_levels(levels)
+      texts = resolution_texts(levels, method, deck%np*deck%pixel)
+      call write_file_set(names, texts, status)
+      if (status%code /= 0) then
+         call fail(status)
+         return
+      end if
+      if (.not. quiet) then
+         do k = 1, size(levels)
+            if (levels(k)%coarser_np > 0) write(output_unit, '(a)') "  Richardson "//int_str(levels(k)%coarser_np)// &
+               " & "//int_str(levels(k)%np)//": area ~ load^"//fmt_sig(fitted_exponent(levels(k)%richardson_load, &
+               levels(k)%richardson_area), 4)
+            write(output_unit, '(a)') "  McCool NP = "//int_str(levels(k)%np)//": area ~ load^"// &
+               fmt_sig(fitted_exponent(levels(k)%res%step_load(1:levels(k)%res%nsteps), levels(k)%mccool_area), 4)// &
+               " (eta "//fmt_sig(levels(k)%mccool%density, 4)//" /nm^2, R "//fmt_sig(levels(k)%mccool%radius, 4)// &
+               " nm, sigma_s "//fmt_sig(levels(k)%mccool%sigma, 4)//" nm)"
+         end do
+         write(output_unit, '(a)') "  wrote "//prefix//".resolution.csv, .powerlaw.csv, .estimates.csv, .hardness.csv "// &
+            "and 5 SVG figures"
+      end if
+   contains
+      subroutine usage(message)
+         character(len=*), intent(in) :: message
+         write(error_unit, '(a)') "femcod resolution: "//message//" (femcod resolution --help)"
+         code = STATUS_USAGE
+      end subroutine usage
+      subroutine fail(st)
+         type(status_type), intent(in) :: st
+         write(error_unit, '(a)') "femcod resolution: "//st%message
+         code = st%code
+      end subroutine fail
+   end subroutine resolution_command
+
+   !> The CSV and SVG texts of a resolution study, in the order of the names above.
+   function resolution_texts(levels, method, side) result(texts)
+      type(resolution_level), intent(in) :: levels(:)
+      character(len=*), intent(in) :: method
+      real(dp), intent(in) :: side
+      type(string_type) :: texts(9)
+      type(text_builder) :: b(4)
+      type(svg_series), allocatable :: s1(:), s2(:), s3(:), s4(:), s5(:)
+      integer :: k, i, n
+      real(dp) :: a0, px2
+      character(len=:), allocatable :: npk
+      a0 = side**2
+      call add_line(b(1), "np,method,load_nN,approach_nm,area_nm2")
+      call add_line(b(2), "np,exponent,prefactor")
+      call add_line(b(3), "np,model,load_nN,area_nm2")
+      call add_line(b(4), "np,step,area_fraction,contacts,n_above_hardness,fraction_above_hardness")
+      allocate(s1(0), s2(0), s3(0), s4(0), s5(0))
+      do k = 1, size(levels)
+         associate(r => levels(k)%res)
+            n = r%nsteps
+            npk = int_str(levels(k)%np)
+            px2 = levels(k)%pixel**2
+            do i = 1, n
+               call add_line(b(1), npk//","//method//","//format_real(r%step_load(i))//","// &
+                  format_real(r%step_approach(i))//","//format_real(r%step_contacts(i)*px2))
+            end do
+            call add_line(b(2), npk//","//format_real(levels(k)%exponent)//","//format_real(levels(k)%prefactor))
+            do i = 1, n
+               call add_line(b(3), npk//",coupled,"//format_real(r%step_load(i))//","//format_real(r%step_contacts(i)*px2))
+            end do
+            do i = 1, n
+               call add_line(b(3), npk//",uncoupled,"//format_real(levels(k)%uncoupled_load(i))//","// &
+                  format_real(levels(k)%uncoupled_area(i)))
+            end do
+            do i = 1, n
+               call add_line(b(3), npk//",mccool,"//format_real(r%step_load(i))//","//format_real(levels(k)%mccool_area(i)))
+            end do
+            do i = 1, size(levels(k)%richardson_load)
+               call add_line(b(3), npk//",richardson,"//format_real(levels(k)%richardson_load(i))//","// &
+                  format_real(levels(k)%richardson_area(i)))
+            end do
+            do i = 1, n
+               call add_line(b(4), npk//","//int_str(i)//","//format_real(r%step_contacts(i)*px2/a0)//","// &
+                  int_str(r%step_contacts(i))//","//int_str(r%step_above_hardness(i))//","// &
+                  format_real(real(r%step_above_hardness(i), dp)/max(r%step_contacts(i), 1)))
+            end do
+            ! Figures: loads in mN and areas in um^2 against displacement (Fig. 4.17),
+            ! area fraction against apparent pressure in MPa (Fig. 4.18), the share of
+            ! contacts above the hardness against the area fraction in % (Fig. 4.21).
+            call add_series(s1, npk//" x "//npk, r%step_approach(1:n), r%step_load(1:n)*1.0e-6_dp)
+            call add_series(s2, npk//" x "//npk, r%step_approach(1:n), r%step_contacts(1:n)*px2*1.0e-6_dp)
+            call add_series(s3, "femcod "//npk//" x "//npk, r%step_load(1:n)/a0*1.0e3_dp, &
+               r%step_contacts(1:n)*px2/a0, dashed=.true.)
+            call add_series(s3, "McCool "//npk//" x "//npk, r%step_load(1:n)/a0*1.0e3_dp, &
+               levels(k)%mccool_area/a0, markers=.false.)
+            call add_series(s4, "femcod "//npk//" x "//npk, r%step_load(1:n)/a0*1.0e3_dp, &
+               r%step_contacts(1:n)*px2/a0, dashed=.true.)
+            if (size(levels(k)%richardson_load) > 0) call add_series(s4, "extrapolation "// &
+               int_str(levels(k)%coarser_np)//" & "//npk, levels(k)%richardson_load/a0*1.0e3_dp, &
+               levels(k)%richardson_area/a0, markers=.false.)
+            call add_series(s5, npk//" x "//npk, r%step_contacts(1:n)*px2/a0*100, &
+               100*real(r%step_above_hardness(1:n), dp)/max(r%step_contacts(1:n), 1))
+         end associate
+      end do
+      ! The uncoupled model of the finest level (dashed, as in Fig. 4.17).
+      k = maxloc(levels%np, 1)
+      n = levels(k)%res%nsteps
+      call add_series(s1, "no coupling ("//int_str(levels(k)%np)//")", levels(k)%res%step_approach(1:n), &
+         levels(k)%uncoupled_load*1.0e-6_dp, dashed=.true., markers=.false.)
+      call add_series(s2, "no coupling ("//int_str(levels(k)%np)//")", levels(k)%res%step_approach(1:n), &
+         levels(k)%uncoupled_area*1.0e-6_dp, dashed=.true., markers=.false.)
+      ! In Fig. 4.18a only up to the largest load femcod reached, so that the axes fit.
+      associate(keep => levels(k)%uncoupled_load <= levels(k)%res%step_load(n))
+         call add_series(s3, "no coupling ("//int_str(levels(k)%np)//")", &
+            pack(levels(k)%uncoupled_load, keep)/a0*1.0e3_dp, pack(levels(k)%uncoupled_area, keep)/a0, &
+            dashed=.true., markers=.false.)
+      end associate
+      do k = 1, 4
+         texts(k)%s = built_text(b(k))
+      end do
+      texts(5)%s = svg_multi_plot("load against displacement (thesis Fig. 4.17a)", "displacement (nm)", &
+         "contact load (mN)", s1, .false., .false.)
+      texts(6)%s = svg_multi_plot("area against displacement (thesis Fig. 4.17b)", "displacement (nm)", &
+         "contact area (um^2)", s2, .false., .false.)
+      texts(7)%s = svg_multi_plot("area fraction against pressure: femcod and McCool (Fig. 4.18a)", &
+         "apparent pressure (MPa)", "fraction of the area in contact", s3, .false., .false.)
+      texts(8)%s = svg_multi_plot("Richardson extrapolation, rate 1 (thesis Fig. 4.18b)", "apparent pressure (MPa)", &
+         "fraction of the area in contact", s4, .false., .false.)
+      texts(9)%s = svg_multi_plot("contacts above the hardness (thesis Fig. 4.21)", &
+         "contact area / total surface area (%)", "contacts with p > H (%)", s5, .false., .false.)
+   end function resolution_texts
+
+   !> The fitted power law at the points, or nothing when the fit failed (fewer than
+   !> two positive values).
+   function fit_line(prefactor, exponent, x) result(y)
+      real(dp), intent(in) :: prefactor, exponent, x(:)
+      real(dp), allocatable :: y(:)
+      if (prefactor > 0) then
+         y = prefactor*x**exponent
+      else
+         y = 0*x
+      end if
+   end function fit_line
+
+   !> Exponent of the least-squares power law through the positive points.
+   function fitted_exponent(x, y) result(e)
+      real(dp), intent(in) :: x(:), y(:)
+      real(dp) :: e, pre
+      logical, allocatable :: keep(:)
+      keep = x > 0 .and. y > 0
+      call power_law_fit(pack(x, keep), pack(y, keep), e, pre)
+   end function fitted_exponent
+
+   !> The problem of a study: a deck, or (with --pixel) a height file on an elastic
+   !> lower body against a rigid flat.
+   subroutine study_deck(input, pixel, young, poisson, maxcont, deck, status)
+      character(len=*), intent(in) :: input
+      real(dp), intent(in) :: pixel, young, poisson
+      integer, intent(in) :: maxcont
+      type(deck_type), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      type(deck_spec) :: spec
+      if (pixel > 0) then
+         spec%kind = "matrix"
+         spec%label = "heights from "//input
+         spec%matrix_file = input
+         spec%second_file = ""
+         spec%pixel = pixel
+         spec%young = young
+         spec%poisson = poisson
+         spec%maxcont = maxcont
+         call build_deck(spec, deck, status)
+      else
+         call read_deck(input, deck, status)
+      end if
+   end subroutine study_deck
+
+   !> Refuse to overwrite (exit 5 before any work) unless --force; check that the
+   !> directory takes files.
+   subroutine check_outputs(names, force, status)
+      type(string_type), intent(in) :: names(:)
+      logical, intent(in) :: force
+      type(status_type), intent(inout) :: status
+      integer :: k, unit, ios
+      if (.not. force) then
+         do k = 1, size(names)
+            if (path_exists(names(k)%s)) then
+               call set_error(status, STATUS_IO, names(k)%s//": exists; not overwritten (use --force to replace)")
+               return
+            end if
+         end do
+      end if
+      open(newunit=unit, file=names(1)%s//".part", status="replace", action="write", iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_IO, names(1)%s//": cannot write (directory missing or not writable); nothing was run")
+         return
+      end if
+      close(unit, status="delete")
+   end subroutine check_outputs
+
+   !> Progress within a level's solve, every 10 s on standard error.
+   subroutine level_progress(step, contacts, load, elapsed)
+      integer, intent(in) :: step, contacts
+      real(dp), intent(in) :: load, elapsed
+      if (progress_quiet .or. elapsed - last_report < 10) return
+      last_report = elapsed
+      write(error_unit, '(a)') "femcod resolution: event "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
+         real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s"
+      flush(error_unit)
+   end subroutine level_progress
+
+   !> Heights for the surface studies: a height file (with --pixel) or a deck, whose
+   !> composite roughness (lower surface plus the upper as it faces it) is analysed.
+   subroutine study_heights(input, pixel, plane, z, d, status)
+      character(len=*), intent(in) :: input
+      real(dp), intent(in) :: pixel
+      logical, intent(in) :: plane
+      real(dp), allocatable, intent(out) :: z(:, :)
+      real(dp), intent(out) :: d
+      type(status_type), intent(inout) :: status
+      type(deck_type) :: deck
+      if (pixel > 0) then
+         call read_heights(input, z, status)
+         d = pixel
+      else
+         call read_deck(input, deck, status)
+         if (status%code /= 0) return
+         z = deck%lower + flip_upper(deck%upper)
+         d = deck%pixel
+      end if
+      if (status%code /= 0) return
+      if (size(z, 1) < 5) then
+         call set_error(status, STATUS_BAD_INPUT, input//": expected at least 5 x 5 heights for a surface study, found "// &
+            int_str(size(z, 1))//" x "//int_str(size(z, 2)))
+         return
+      end if
+      if (plane) call remove_plane(z)
+   end subroutine study_heights
+
+   subroutine summits_help()
+      write(output_unit, '(a)') &
+         "usage: femcod summits FILE [--pixel D] [--sizes 1,2,3,...] [--remove-plane] [-o PREFIX] [--force] [--quiet]", &
+         "", &
+         "The surface analysis of the thesis, chapter 3. FILE is a deck (its composite roughness: the lower", &
+         "surface plus the upper one as it faces it) or, with --pixel D (nm), heights (nm) as an ASCII matrix", &
+         "or FILE.h5:/dataset.", &
+         "  Summit search (section 3.2): for each neighbourhood size n the box is d_n = (2n+1) L/N (eq. 3.2);", &
+         "  a summit is higher than its 8 neighbours and the highest pixel of its box, searched in the central", &
+         "  region common to all sizes; at each summit the least-squares elliptic paraboloid with axes along x", &
+         "  and y and its maximum at the summit pixel gives Rx, Ry; the radius is sqrt(Rx Ry). Heights are", &
+         "  measured from the image's mean.", &
+         "  --sizes n1,...     neighbourhood sizes (default 1, 2, 3, 4, 6, 8, 11, 16, ... up to N/8)", &
+         "  Profile PSD (eq. 2.12) over rows and columns, fractal dimension D = (5 + slope)/2 (eq. 3.1) fitted", &
+         "  from 4/L to 1/(4d); structure function (eq. 2.14), D = 2 - slope/2 (eq. 2.15) from d to L/16.", &
+         "", &
+         "outputs: PREFIX.summits.csv  box_nm,n,density_per_um2,mean_height_nm,mean_radius_nm", &
+         "         PREFIX.summit_exponents.csv  quantity,exponent,prefactor (power laws against the box in nm)", &
+         "         PREFIX.psd.csv  frequency_per_nm,power_nm3;  PREFIX.structure.csv  tau_nm,structure_nm2", &
+         "         PREFIX.fractal.csv  method,profile_dimension,surface_dimension,fit_from,fit_to", &
+         "         PREFIX.summit_density.svg, .summit_height.svg, .summit_radius.svg (Fig. 3.2), .psd.svg, .structure.svg", &
+         "exit codes: 0 ok, 2 usage, 3 bad input, 5 I/O"
+   end subroutine summits_help
+
+   !> Parse the options of `summits` and `multiscale`; others are handed back in `rest`
+   !> as key/value pairs.
+   subroutine parse_surface_options(command, args, opts, rest, code)
+      character(len=*), intent(in) :: command
+      type(string_type), intent(in) :: args(:)
+      type(surface_options), intent(out) :: opts
+      type(string_type), allocatable, intent(out) :: rest(:)
+      integer, intent(out) :: code
+      type(string_type), allocatable :: parts(:)
+      character(len=:), allocatable :: key, v
+      logical :: ok
+      integer :: k, n
+      code = 0
+      opts%input = ""
+      opts%prefix = ""
+      allocate(opts%sizes(0), rest(0))
+      k = 0
+      do while (k < size(args))
+         k = k + 1
+         key = args(k)%s
+         select case (key)
+         case ("--remove-plane")
+            opts%plane = .true.
+            cycle
+         case ("--force")
+            opts%force = .true.
+            cycle
+         case ("--quiet")
+            opts%quiet = .true.
+            cycle
+         case ("-h", "--help")
+            code = -1
+            return
+         end select
+         if (key(1:1) /= "-" .or. len(key) == 1) then
+            if (opts%input /= "") then
+               call usage_line(command, "one input only (found '"//opts%input//"' and '"//key//"')")
+               code = STATUS_USAGE
+               return
+            end if
+            opts%input = key
+            cycle
+         end if
+         if (k == size(args)) then
+            call usage_line(command, key//" needs a value")
+            code = STATUS_USAGE
+            return
+         end if
+         k = k + 1
+         v = args(k)%s
+         ok = .true.
+         select case (key)
+         case ("-o")
+            opts%prefix = v
+         case ("--pixel")
+            call parse_real(v, opts%pixel, ok)
+            ok = ok .and. opts%pixel > 0
+         case ("--sizes")
+            parts = split_list(v)
+            deallocate(opts%sizes)
+            allocate(opts%sizes(size(parts)))
+            do n = 1, size(parts)
+               call parse_integer(parts(n)%s, opts%sizes(n), ok)
+               if (.not. ok) exit
+               ok = opts%sizes(n) >= 1
+               if (.not. ok) exit
+            end do
+         case default
+            rest = [rest, string_type(key), string_type(v)]
+         end select
+         if (.not. ok) then
+            call usage_line(command, key//": invalid value '"//v//"'")
+            code = STATUS_USAGE
+            return
+         end if
+      end do
+      if (opts%input == "") then
+         call usage_line(command, "no deck or height file given")
+         code = STATUS_USAGE
+         return
+      end if
+      if (opts%prefix == "") opts%prefix = default_prefix(file_part(opts%input))
+   end subroutine parse_surface_options
+
+   subroutine usage_line(command, message)
+      character(len=*), intent(in) :: command, message
+      write(error_unit, '(a)') "femcod "//command//": "//message//" (femcod "//command//" --help)"
+   end subroutine usage_line
+
+   !> `femcod summits`.
+   subroutine summits_command(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      type(surface_options) :: opts
+      type(string_type), allocatable :: rest(:), names(:), texts(:)
+      type(status_type) :: status
+      type(summit_statistics), allocatable :: stats(:)
+      real(dp), allocatable :: z(:, :), freq(:), power(:), tau(:), sf(:), e(:), p(:)
+      type(text_builder) :: b(5)
+      type(svg_series), allocatable :: series(:)
+      character(len=14), parameter :: quantity(3) = [character(len=14) :: "density", "mean_height", "mean_radius"]
+      real(dp) :: d, side, dpsd, slope, dsf, g
+      integer :: k, q
+      call parse_surface_options("summits", args, opts, rest, code)
+      if (code == -1) then
+         code = 0
+         call summits_help()
+         return
+      end if
+      if (code /= 0) return
+      if (size(rest) > 0) then
+         call usage_line("summits", "unknown option '"//rest(1)%s//"'")
+         code = STATUS_USAGE
+         return
+      end if
+      call study_heights(opts%input, opts%pixel, opts%plane, z, d, status)
+      if (status%code /= 0) then
+         call fail_with("summits", status, code)
+         return
+      end if
+      if (size(opts%sizes) == 0) opts%sizes = default_sizes(size(z, 1))
+      names = [string_type(opts%prefix//".summits.csv"), string_type(opts%prefix//".summit_exponents.csv"), &
+         string_type(opts%prefix//".psd.csv"), string_type(opts%prefix//".structure.csv"), &
+         string_type(opts%prefix//".fractal.csv"), string_type(opts%prefix//".summit_density.svg"), &
+         string_type(opts%prefix//".summit_height.svg"), string_type(opts%prefix//".summit_radius.svg"), &
+         string_type(opts%prefix//".psd.svg"), string_type(opts%prefix//".structure.svg")]
+      call check_outputs(names, opts%force, status)
+      if (status%code == 0) call summit_search(z, d, opts%sizes, stats, status)
+      if (status%code /= 0) then
+         call fail_with("summits", status, code)
+         return
+      end if
+      side = size(z, 1)*d
+      call profile_psd(z, d, freq, power)
+      call psd_dimension(freq, power, 4/side, 1/(4*d), dpsd, slope)
+      call structure_function(z, d, max(1, size(z, 1)/4), tau, sf)
+      call structure_dimension(tau, sf, d, side/16, dsf, g)
+      call add_line(b(1), "box_nm,n,density_per_um2,mean_height_nm,mean_radius_nm")
+      do k = 1, size(stats)
+         call add_line(b(1), format_real(stats(k)%box)//","//int_str(stats(k)%n)//","//format_real(stats(k)%density)// &
+            ","//format_real(stats(k)%mean_height)//","//format_real(stats(k)%mean_radius))
+      end do
+      call add_line(b(2), "quantity,exponent,prefactor")
+      allocate(e(3), p(3))
+      call summit_power_laws(stats, e, p)
+      do q = 1, 3
+         call add_line(b(2), trim(quantity(q))//","//format_real(e(q))//","//format_real(p(q)))
+      end do
+      call add_line(b(3), "frequency_per_nm,power_nm3")
+      do k = 1, size(freq)
+         call add_line(b(3), format_real(freq(k))//","//format_real(power(k)))
+      end do
+      call add_line(b(4), "tau_nm,structure_nm2")
+      do k = 1, size(tau)
+         call add_line(b(4), format_real(tau(k))//","//format_real(sf(k)))
+      end do
+      call add_line(b(5), "method,profile_dimension,surface_dimension,fit_from,fit_to")
+      call add_line(b(5), "psd,"//format_real(dpsd)//","//format_real(dpsd + 1)//","//format_real(4/side)//","// &
+         format_real(1/(4*d)))
+      call add_line(b(5), "structure,"//format_real(dsf)//","//format_real(dsf + 1)//","//format_real(d)//","// &
+         format_real(side/16))
+      allocate(texts(10))
+      do k = 1, 5
+         texts(k)%s = built_text(b(k))
+      end do
+      if (allocated(series)) deallocate(series)
+      allocate(series(0))
+      call add_series(series, "summits", stats%box, stats%density)
+      call add_series(series, "fit: d^"//fmt_sig(e(1), 3), stats%box, fit_line(p(1), e(1), stats%box), dashed=.true., &
+         markers=.false.)
+      texts(6)%s = svg_multi_plot("summit density against box size (thesis Fig. 3.2a)", "box size d (nm)", &
+         "summits per um^2", series, .true., .true.)
+      if (allocated(series)) deallocate(series)
+      allocate(series(0))
+      call add_series(series, "summits", stats%box, stats%mean_height)
+      call add_series(series, "fit: d^"//fmt_sig(e(2), 3), stats%box, fit_line(p(2), e(2), stats%box), dashed=.true., &
+         markers=.false.)
+      texts(7)%s = svg_multi_plot("mean summit height against box size (thesis Fig. 3.2b)", "box size d (nm)", &
+         "mean height (nm)", series, .true., .true.)
+      if (allocated(series)) deallocate(series)
+      allocate(series(0))
+      call add_series(series, "summits", stats%box, stats%mean_radius)
+      call add_series(series, "fit: d^"//fmt_sig(e(3), 3), stats%box, fit_line(p(3), e(3), stats%box), dashed=.true., &
+         markers=.false.)
+      texts(8)%s = svg_multi_plot("mean radius of curvature against box size (thesis Fig. 3.2c)", "box size d (nm)", &
+         "mean radius (nm)", series, .true., .true.)
+      if (allocated(series)) deallocate(series)
+      allocate(series(0))
+      call add_series(series, "profile PSD", freq, power, markers=.false.)
+      texts(9)%s = svg_multi_plot("power spectral density: D = "//fmt_sig(dpsd, 3)//" (eq. 3.1, slope "// &
+         fmt_sig(slope, 3)//")", "frequency (1/nm)", "power (nm^3)", series, .true., .true.)
+      if (allocated(series)) deallocate(series)
+      allocate(series(0))
+      call add_series(series, "structure function", tau, sf, markers=.false.)
+      texts(10)%s = svg_multi_plot("structure function: D = "//fmt_sig(dsf, 3)//" (eq. 2.15)", "tau (nm)", &
+         "S (nm^2)", series, .true., .true.)
+      call write_file_set(names, texts, status)
+      if (status%code /= 0) then
+         call fail_with("summits", status, code)
+         return
+      end if
+      if (.not. opts%quiet) then
+         write(output_unit, '(a)') "femcod summits: "//int_str(size(z, 1))//" x "//int_str(size(z, 2))//" heights, pixel "// &
+            fmt_sig(d, 6)//" nm, "//int_str(size(stats))//" box sizes from "//fmt_sig(stats(1)%box, 4)//" to "// &
+            fmt_sig(stats(size(stats))%box, 4)//" nm"
+         write(output_unit, '(a)') "  density ~ d^"//fmt_sig(e(1), 4)//", height ~ d^"//fmt_sig(e(2), 4)// &
+            ", radius ~ d^"//fmt_sig(e(3), 4)
+         write(output_unit, '(a)') "  fractal dimension of a profile: "//fmt_sig(dpsd, 4)//" (PSD), "//fmt_sig(dsf, 4)// &
+            " (structure function); surface: +1"
+         write(output_unit, '(a)') "  wrote "//opts%prefix//".summits.csv, .summit_exponents.csv, .psd.csv, .structure.csv, "// &
+            ".fractal.csv and 5 SVG figures"
+      end if
+   end subroutine summits_command
+
+   subroutine fail_with(command, status, code)
+      character(len=*), intent(in) :: command
+      type(status_type), intent(in) :: status
+      integer, intent(out) :: code
+      write(error_unit, '(a)') "femcod "//command//": "//status%message
+      code = status%code
+   end subroutine fail_with
+
+   subroutine multiscale_help()
+      write(output_unit, '(a)') &
+         "usage: femcod multiscale FILE [--pixel D] [--sizes ...] [--template-size n] [--s 2.5,5,10]", &
+         "                         [--min-length 4] [--scales K] [--load 1e6] [--estar 200] [--exponents eh,eR,eN]", &
+         "                         [--remove-plane] [-o PREFIX] [--force] [--quiet]", &
+         "", &
+         "The hierarchical multiscale Hertz model of the thesis, section 3.3. The summit search of", &
+         "`femcod summits` gives the power laws of summit height, radius and density against the box size", &
+         "and the roughness template (the summits of one size); the template is scaled to the finer length", &
+         "scales d1/s^(k-1), and the load is shared down the scales by Hertz contacts (eqs. 3.9-3.13), with", &
+         "the close-packed and the asperity-density constraints on the asperities a host carries (3.3.1).", &
+         "  --template-size n  neighbourhood size of the template (default: the size whose summit count is", &
+         "                     nearest 100, as the thesis' template)", &
+         "  --s s1,...         length scaling constants (default 2.5,5,10)", &
+         "  --min-length L     finest length scale in nm (default 4: ten atomic spacings, the limit of", &
+         "                     the elastic solution); --scales K fixes the number of scales instead", &
+         "  --load F           total load in nN (default 1e6, 1 mN);  --estar E  composite modulus in GPa", &
+         "                     (default 200)", &
+         "  --exponents eh,eR,eN  override the power laws of the summit search", &
+         "", &
+         "outputs: PREFIX.multiscale.csv  s,constraint,scale,length_nm,load_nN,area_nm2,contacts", &
+         "         PREFIX.multiscale.svg (area against the smallest length scale, Fig. 3.10)", &
+         "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
+   end subroutine multiscale_help
+
+   !> `femcod multiscale`.
+   subroutine multiscale_command(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      type(surface_options) :: opts
+      type(string_type), allocatable :: rest(:), names(:), texts(:), parts(:)
+      type(status_type) :: status
+      type(summit_statistics), allocatable :: stats(:)
+      type(roughness_template) :: template
+      type(multiscale_result) :: result
+      type(text_builder) :: b
+      type(svg_series), allocatable :: series(:)
+      real(dp), allocatable :: z(:, :), svals(:), heights(:), rx(:), ry(:), ex(:)
+      integer, allocatable :: rows(:), cols(:)
+      character(len=12), parameter :: constraints(2) = [character(len=12) :: "close-packed", "density"]
+      real(dp) :: d, load, estar, min_length, region, e3(3), p3(3)
+      integer :: k, scales, tsize, ks, kc, m, best
+      logical :: ok
+      call parse_surface_options("multiscale", args, opts, rest, code)
+      if (code == -1) then
+         code = 0
+         call multiscale_help()
+         return
+      end if
+      if (code /= 0) return
+      svals = [2.5_dp, 5.0_dp, 10.0_dp]
+      load = 1.0e6_dp
+      estar = 200
+      min_length = 4
+      scales = 0
+      tsize = 0
+      allocate(ex(0))
+      do k = 1, size(rest), 2
+         ok = .true.
+         select case (rest(k)%s)
+         case ("--s")
+            parts = split_list(rest(k + 1)%s)
+            deallocate(svals)
+            allocate(svals(size(parts)))
+            do m = 1, size(parts)
+               call parse_real(parts(m)%s, svals(m), ok)
+               if (.not. ok) exit
+               ok = svals(m) > 1
+               if (.not. ok) exit
+            end do
+         case ("--exponents")
+            parts = split_list(rest(k + 1)%s)
+            ok = size(parts) == 3
+            if (ok) then
+               deallocate(ex)
+               allocate(ex(3))
+               do m = 1, 3
+                  call parse_real(parts(m)%s, ex(m), ok)
+                  if (.not. ok) exit
+               end do
+            end if
+         case ("--load")
+            call parse_real(rest(k + 1)%s, load, ok)
+            ok = ok .and. load > 0
+         case ("--estar")
+            call parse_real(rest(k + 1)%s, estar, ok)
+            ok = ok .and. estar > 0
+         case ("--min-length")
+            call parse_real(rest(k + 1)%s, min_length, ok)
+            ok = ok .and. min_length > 0
+         case ("--scales")
+            call parse_integer(rest(k + 1)%s, scales, ok)
+            ok = ok .and. scales >= 1 .and. scales <= 60
+         case ("--template-size")
+            call parse_integer(rest(k + 1)%s, tsize, ok)
+            ok = ok .and. tsize >= 1
+         case default
+            call usage_line("multiscale", "unknown option '"//rest(k)%s//"'")
+            code = STATUS_USAGE
+            return
+         end select
+         if (.not. ok) then
+            call usage_line("multiscale", rest(k)%s//": invalid value '"//rest(k + 1)%s//"'")
+            code = STATUS_USAGE
+            return
+         end if
+      end do
+      call study_heights(opts%input, opts%pixel, opts%plane, z, d, status)
+      if (status%code /= 0) then
+         call fail_with("multiscale", status, code)
+         return
+      end if
+      if (size(opts%sizes) == 0) opts%sizes = default_sizes(size(z, 1))
+      if (tsize > 0 .and. .not. any(opts%sizes == tsize)) opts%sizes = [opts%sizes, tsize]
+      names = [string_type(opts%prefix//".multiscale.csv"), string_type(opts%prefix//".multiscale.svg")]
+      call check_outputs(names, opts%force, status)
+      if (status%code == 0) call summit_search(z, d, opts%sizes, stats, status)
+      if (status%code /= 0) then
+         call fail_with("multiscale", status, code)
+         return
+      end if
+      if (size(ex) == 0) then
+         call summit_power_laws(stats, e3, p3)
+         ! The model takes heights, radii, density in that order.
+         ex = [e3(2), e3(3), e3(1)]
+      end if
+      if (tsize == 0) then
+         best = minloc(abs(stats%count - 100), 1)
+         tsize = stats(best)%n
+      end if
+      ! The template: the summits of that size whose paraboloid opens downwards.
+      call summits_of_size(z, d, tsize, maxval(opts%sizes), rows, cols, heights, rx, ry)
+      template%heights = pack(heights, rx > 0 .and. ry > 0)
+      template%radii = pack(sqrt(rx*ry), rx > 0 .and. ry > 0)
+      template%box = (2*tsize + 1)*d
+      region = real(size(z, 1) - 2*maxval(opts%sizes), dp)*(size(z, 2) - 2*maxval(opts%sizes))*d**2
+      template%density = size(heights)/region
+      call add_line(b, "s,constraint,scale,length_nm,load_nN,area_nm2,contacts")
+      allocate(series(0))
+      do ks = 1, size(svals)
+         m = scales
+         if (m == 0) m = max(1, 1 + floor(log(template%box/min_length)/log(svals(ks))))
+         do kc = 1, 2
+            call multiscale_hertz(template, ex(1), ex(2), ex(3), svals(ks), m, load, estar, trim(constraints(kc)), &
+               result, status)
+            if (status%code /= 0) then
+               call fail_with("multiscale", status, code)
+               return
+            end if
+            do k = 1, m
+               call add_line(b, format_real(svals(ks))//","//trim(constraints(kc))//","//int_str(k)//","// &
+                  format_real(result%length(k))//","//format_real(load)//","//format_real(result%area(k))//","// &
+                  int_str(result%contacts(k)))
+            end do
+            call add_series(series, "s = "//fmt_sig(svals(ks), 3)//", "//trim(constraints(kc)), result%length, &
+               result%area, dashed=kc == 2)
+         end do
+      end do
+      allocate(texts(2))
+      texts(1)%s = built_text(b)
+      texts(2)%s = svg_multi_plot("true contact area against the smallest length scale (thesis Fig. 3.10)", &
+         "smallest length scale (nm)", "true contact area (nm^2)", series, .true., .true.)
+      call write_file_set(names, texts, status)
+      if (status%code /= 0) then
+         call fail_with("multiscale", status, code)
+         return
+      end if
+      if (.not. opts%quiet) then
+         write(output_unit, '(a)') "femcod multiscale: template of "//int_str(size(template%heights))//" summits (n = "// &
+            int_str(tsize)//", box "//fmt_sig(template%box, 4)//" nm, density "//fmt_sig(template%density*1.0e6_dp, 4)// &
+            " per um^2); heights ~ d^"//fmt_sig(ex(1), 3)//", radii ~ d^"//fmt_sig(ex(2), 3)//", density ~ d^"// &
+            fmt_sig(ex(3), 3)
+         write(output_unit, '(a)') "  wrote "//opts%prefix//".multiscale.csv and .multiscale.svg"
+      end if
+   end subroutine multiscale_command
+end module femcod_studies
