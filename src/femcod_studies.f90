@@ -43,7 +43,8 @@ contains
       write(output_unit, '(a)') &
          "usage: femcod resolution DECK [--levels 512,256,128,64] [--method subsample|average] [-o PREFIX]", &
          "                         [--hardness H] [--force] [--quiet]", &
-         "       femcod resolution FILE --pixel D [--young E] [--poisson NU] [--maxcont M] [options as above]", &
+         "       femcod resolution FILE --pixel D [--young E] [--poisson NU] [--maxcont M] [--remove-plane]", &
+         "                         [options as above]", &
          "", &
          "The resolution study of the thesis, section 4.5: the surfaces down-sampled by keeping the odd/odd", &
          "pixels (subsample, default) or by averaging 2 x 2 blocks (average), the pixel size doubling at each", &
@@ -79,8 +80,9 @@ contains
       character(len=:), allocatable :: input, prefix, method, key, v
       real(dp) :: hardness, pixel, young, poisson, t0, t1
       integer :: k, maxcont, n
-      logical :: ok, force, quiet
+      logical :: ok, force, quiet, plane
       code = 0
+      plane = .false.
       input = ""
       prefix = ""
       method = "subsample"
@@ -102,6 +104,9 @@ contains
             return
          case ("--force")
             force = .true.
+            cycle
+         case ("--remove-plane")
+            plane = .true.
             cycle
          case ("--quiet")
             quiet = .true.
@@ -166,7 +171,7 @@ contains
          call usage("no deck or height file given")
          return
       end if
-      call study_deck(input, pixel, young, poisson, maxcont, deck, status)
+      call study_deck(input, pixel, young, poisson, maxcont, plane, deck, status)
       if (status%code /= 0) then
          call fail(status)
          return
@@ -363,10 +368,11 @@ contains
 
    !> The problem of a study: a deck, or (with --pixel) a height file on an elastic
    !> lower body against a rigid flat.
-   subroutine study_deck(input, pixel, young, poisson, maxcont, deck, status)
+   subroutine study_deck(input, pixel, young, poisson, maxcont, plane, deck, status)
       character(len=*), intent(in) :: input
       real(dp), intent(in) :: pixel, young, poisson
       integer, intent(in) :: maxcont
+      logical, intent(in) :: plane
       type(deck_type), intent(out) :: deck
       type(status_type), intent(inout) :: status
       type(deck_spec) :: spec
@@ -379,6 +385,7 @@ contains
          spec%young = young
          spec%poisson = poisson
          spec%maxcont = maxcont
+         spec%plane = plane
          call build_deck(spec, deck, status)
       else
          call read_deck(input, deck, status)
