@@ -345,6 +345,19 @@ contains
          "contact area / total surface area (%)", "contacts with p > H (%)", s5, .false., .false.)
    end function resolution_texts
 
+   !> One of the Fig. 3.2 panels: a summit statistic against the box size, log-log,
+   !> with its fitted power law dashed.
+   function summit_plot(title, ylabel, box, values, exponent, prefactor) result(svg)
+      character(len=*), intent(in) :: title, ylabel
+      real(dp), intent(in) :: box(:), values(:), exponent, prefactor
+      character(len=:), allocatable :: svg
+      type(svg_series), allocatable :: series(:)
+      call add_series(series, "summits", box, values)
+      call add_series(series, "fit: d^"//fmt_sig(exponent, 3), box, fit_line(prefactor, exponent, box), dashed=.true., &
+         markers=.false.)
+      svg = svg_multi_plot(title, "box size d (nm)", ylabel, series, .true., .true.)
+   end function summit_plot
+
    !> The fitted power law at the points, or nothing when the fit failed (fewer than
    !> two positive values).
    function fit_line(prefactor, exponent, x) result(y)
@@ -575,7 +588,7 @@ contains
       type(string_type), allocatable :: rest(:), names(:), texts(:)
       type(status_type) :: status
       type(summit_statistics), allocatable :: stats(:)
-      real(dp), allocatable :: z(:, :), freq(:), power(:), tau(:), sf(:), e(:), p(:)
+      real(dp), allocatable :: z(:, :), freq(:), power(:), tau(:), sf(:), e(:), p(:), box(:)
       type(text_builder) :: b(5)
       type(svg_series), allocatable :: series(:)
       character(len=14), parameter :: quantity(3) = [character(len=14) :: "density", "mean_height", "mean_radius"]
@@ -643,27 +656,14 @@ contains
       do k = 1, 5
          texts(k)%s = built_text(b(k))
       end do
-      if (allocated(series)) deallocate(series)
-      allocate(series(0))
-      call add_series(series, "summits", stats%box, stats%density)
-      call add_series(series, "fit: d^"//fmt_sig(e(1), 3), stats%box, fit_line(p(1), e(1), stats%box), dashed=.true., &
-         markers=.false.)
-      texts(6)%s = svg_multi_plot("summit density against box size (thesis Fig. 3.2a)", "box size d (nm)", &
-         "summits per um^2", series, .true., .true.)
-      if (allocated(series)) deallocate(series)
-      allocate(series(0))
-      call add_series(series, "summits", stats%box, stats%mean_height)
-      call add_series(series, "fit: d^"//fmt_sig(e(2), 3), stats%box, fit_line(p(2), e(2), stats%box), dashed=.true., &
-         markers=.false.)
-      texts(7)%s = svg_multi_plot("mean summit height against box size (thesis Fig. 3.2b)", "box size d (nm)", &
-         "mean height (nm)", series, .true., .true.)
-      if (allocated(series)) deallocate(series)
-      allocate(series(0))
-      call add_series(series, "summits", stats%box, stats%mean_radius)
-      call add_series(series, "fit: d^"//fmt_sig(e(3), 3), stats%box, fit_line(p(3), e(3), stats%box), dashed=.true., &
-         markers=.false.)
-      texts(8)%s = svg_multi_plot("mean radius of curvature against box size (thesis Fig. 3.2c)", "box size d (nm)", &
-         "mean radius (nm)", series, .true., .true.)
+      ! Plain arrays (a component of an array of derived type would be copied per call).
+      box = stats%box
+      texts(6)%s = summit_plot("summit density against box size (thesis Fig. 3.2a)", "summits per um^2", &
+         box, [(stats(k)%density, k = 1, size(stats))], e(1), p(1))
+      texts(7)%s = summit_plot("mean summit height against box size (thesis Fig. 3.2b)", "mean height (nm)", &
+         box, [(stats(k)%mean_height, k = 1, size(stats))], e(2), p(2))
+      texts(8)%s = summit_plot("mean radius of curvature against box size (thesis Fig. 3.2c)", "mean radius (nm)", &
+         box, [(stats(k)%mean_radius, k = 1, size(stats))], e(3), p(3))
       if (allocated(series)) deallocate(series)
       allocate(series(0))
       call add_series(series, "profile PSD", freq, power, markers=.false.)
