@@ -394,6 +394,8 @@ contains
          spec%label = "heights from "//input
          spec%matrix_file = input
          spec%second_file = ""
+         ! The heights on the elastic lower body, the rigid flat above (as `run --lower`).
+         spec%shape_on = "lower"
          spec%pixel = pixel
          spec%young = young
          spec%poisson = poisson
