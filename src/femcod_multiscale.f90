@@ -95,7 +95,7 @@ contains
       character(len=*), intent(in) :: constraint
       type(multiscale_result), intent(out) :: result
       type(status_type), intent(inout) :: status
-      real(dp), allocatable :: hf(:), ha(:), nf(:), na(:), h(:), r(:), f(:), a(:)
+      real(dp), allocatable :: hf(:), ha(:), nf(:), na(:), h(:), r(:), f(:), a(:), hk(:), rk(:)
       integer, allocatable :: order(:)
       real(dp) :: ratio, density
       integer :: k, i, nt, nh, m, found
@@ -133,13 +133,16 @@ contains
          ratio = s**(-(k - 1))
          result%length(k) = template%box*ratio
          density = template%density*ratio**en
+         ! The template at this scale, once for all hosts.
+         hk = h*ratio**eh
+         rk = r*ratio**er
          allocate(nf(max(16, size(hf))), na(max(16, size(hf))))
          found = 0
          do i = 1, size(hf)
-            nh = hosted(constraint, ha(i), hf(i), h*ratio**eh, r*ratio**er, density, estar)
+            nh = hosted(constraint, ha(i), hf(i), hk, rk, density, estar)
             deallocate(f, a)
             allocate(f(nh), a(nh))
-            call share_load(h(1:nh)*ratio**eh, r(1:nh)*ratio**er, hf(i), estar, f, a)
+            call share_load(hk(1:nh), rk(1:nh), hf(i), estar, f, a)
             m = count(f > 0)
             if (found + m > MAX_CONTACTS_PER_SCALE) then
                call set_error(status, STATUS_NUMERICAL, "more than "//int_str(MAX_CONTACTS_PER_SCALE)// &
