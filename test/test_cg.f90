@@ -10,9 +10,8 @@ module test_cg
    use femcod_incremental, only: solve_incremental
    use femcod_cg, only: solve_cg, cg_residuals
    use femcod_generate, only: VERIFICATION_DECKS
-   use femcod_analytic, only: hertz_approach
+   use femcod_analytic, only: hertz_approach, segedin_sphere
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
-   use test_support, only: segedin_approach
    implicit none
    private
    public :: collect_cg
@@ -87,7 +86,7 @@ contains
       type(contact_result) :: res
       type(cg_residuals), allocatable :: report(:)
       type(status_type) :: status
-      real(dp) :: estar, r, segedin
+      real(dp) :: estar, r, segedin, a
       call read_deck("input/sphere_d05.deck", deck, status)
       options%loads = [1000.0_dp, 18000.0_dp]
       call solve_cg(deck, options, 1.0e-8_dp, 5000, res, report, status)
@@ -99,8 +98,8 @@ contains
       call check(error, res%states(1)%approach, hertz_approach(1000.0_dp, r, estar), rel=.true., thr=0.01_dp, &
          message="Hertz at 1000 nN")
       if (allocated(error)) return
-      ! Segedin's rigid sphere (test_support: an independent bisection).
-      segedin = segedin_approach(18000.0_dp, r, estar)
+      ! Segedin's rigid sphere, the closed form of femcod_analytic (contact radius by bisection).
+      call segedin_sphere(18000.0_dp, r, estar, a, segedin)
       call check(error, res%states(2)%approach, segedin, rel=.true., thr=0.005_dp, message="Segedin at 18000 nN")
    end subroutine test_sphere
 

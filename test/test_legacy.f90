@@ -9,7 +9,8 @@ module test_legacy
    use femcod_richardson, only: convergence_rate, richardson_extrapolate
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
-   use test_support, only: scratch_path, read_text, file_exists, contains_text, segedin_approach
+   use test_support, only: scratch_path, read_text, file_exists, contains_text
+   use femcod_analytic, only: segedin_sphere
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -124,7 +125,7 @@ contains
       type(contact_options) :: options
       type(contact_result) :: res
       type(status_type) :: status
-      real(dp) :: estar, r, hertz, segedin
+      real(dp) :: estar, r, hertz, segedin, a
       call read_deck("input/sphere_d05.deck", deck, status)
       options%loads = [1000.0_dp, 18000.0_dp]
       call solve_legacy(deck, options, res, status)
@@ -136,8 +137,8 @@ contains
       hertz = (9*1000.0_dp**2/(16*r*estar**2))**(1.0_dp/3)
       call check(error, res%states(1)%approach, hertz, rel=.true., thr=0.01_dp, message="Hertz at 1000 nN")
       if (allocated(error)) return
-      ! Segedin's rigid sphere (test_support: an independent bisection).
-      segedin = segedin_approach(18000.0_dp, r, estar)
+      ! Segedin's rigid sphere, the closed form of femcod_analytic (contact radius by bisection).
+      call segedin_sphere(18000.0_dp, r, estar, a, segedin)
       call check(error, res%states(2)%approach, segedin, rel=.true., thr=0.005_dp, message="Segedin at 18000 nN")
    end subroutine test_sphere
 

@@ -3,7 +3,7 @@ module test_support
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: write_text, read_text, scratch_path, contains_text, remove_scratch, file_exists, segedin_approach
+   public :: write_text, read_text, scratch_path, contains_text, remove_scratch, file_exists
 
    character(len=*), parameter :: scratch_dir = "build/test-scratch"
 
@@ -62,26 +62,4 @@ contains
       character(len=*), intent(in) :: text, part
       contains_text = index(text, part) > 0
    end function contains_text
-
-   !> Segedin's rigid sphere of radius r on a half-space of effective modulus estar, solved
-   !> here independently of femcod_analytic: the contact radius a from
-   !> F = E*/2 [(a^2 + R^2) ln((R+a)/(R-a)) - 2 a R] by bisection, then the approach
-   !> delta = a/2 ln((R+a)/(R-a)).
-   pure real(dp) function segedin_approach(force, r, estar) result(delta)
-      real(dp), intent(in) :: force, r, estar
-      real(dp) :: a, lo, hi
-      integer :: it
-      lo = 0
-      hi = r*(1 - 1.0e-12_dp)
-      a = 0
-      do it = 1, 200
-         a = (lo + hi)/2
-         if (estar/2*((a*a + r*r)*log((r + a)/(r - a)) - 2*a*r) < force) then
-            lo = a
-         else
-            hi = a
-         end if
-      end do
-      delta = a/2*log((r + a)/(r - a))
-   end function segedin_approach
 end module test_support
