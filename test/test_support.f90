@@ -1,6 +1,5 @@
 !> Helpers shared by the test suites: scratch files and text checks.
 module test_support
-   use femcod_kinds, only: dp
    implicit none
    private
    public :: write_text, read_text, scratch_path, contains_text, remove_scratch, file_exists
