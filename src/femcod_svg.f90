@@ -33,7 +33,7 @@ contains
       character(len=:), allocatable :: svg
       real(dp), allocatable :: tx(:), ty(:), xt(:), yt(:)
       logical, allocatable :: keep(:)
-      real(dp) :: x0, x1, y0, y1, px, py, xf
+      real(dp) :: x0, x1, y0, y1, px, py, xf, yf
       integer :: k, m
       character(len=:), allocatable :: path
       allocate(keep(size(x)))
@@ -55,13 +55,13 @@ contains
       ! Data: a polyline and markers.
       path = ""
       do k = 1, size(tx)
-         call to_px(tx(k), ty(k), px, py)
+         call to_pixels([x0, x1, y0, y1], tx(k), ty(k), px, py)
          path = path//fmt(px)//","//fmt(py)//" "
       end do
       svg = svg//'<polyline fill="none" stroke="#1f4e9c" stroke-width="1.5" points="'//path//'"/>'//nl
       m = max(1, size(tx)/200)
       do k = 1, size(tx), m
-         call to_px(tx(k), ty(k), px, py)
+         call to_pixels([x0, x1, y0, y1], tx(k), ty(k), px, py)
          svg = svg//'<circle cx="'//fmt(px)//'" cy="'//fmt(py)//'" r="2.5" fill="#1f4e9c"/>'//nl
       end do
       svg = svg//'<line x1="'//fmt(w - mr - 190)//'" y1="'//fmt(mt + 18)//'" x2="'//fmt(w - mr - 160)//'" y2="'// &
@@ -71,12 +71,12 @@ contains
          do k = 0, 50
             xf = x0 + (x1 - x0)*k/50
             if (logx .and. logy) then
-               py = log10(prefactor) + exponent*xf
+               yf = log10(prefactor) + exponent*xf
             else
-               py = prefactor*xf**exponent
+               yf = prefactor*xf**exponent
             end if
-            if (py < y0 .or. py > y1) cycle
-            call to_px(xf, py, px, py)
+            if (yf < y0 .or. yf > y1) cycle
+            call to_pixels([x0, x1, y0, y1], xf, yf, px, py)
             path = path//fmt(px)//","//fmt(py)//" "
          end do
          svg = svg//'<polyline fill="none" stroke="#c0392b" stroke-width="1.5" stroke-dasharray="6,4" points="'// &
@@ -86,13 +86,6 @@ contains
             text(w - mr - 154, mt + 42, "fit: exponent "//fmt_sig(exponent, 4), "start", 12)
       end if
       svg = svg//"</svg>"//nl
-   contains
-      subroutine to_px(xv, yv, pxv, pyv)
-         real(dp), intent(in) :: xv, yv
-         real(dp), intent(out) :: pxv, pyv
-         pxv = ml + (xv - x0)/(x1 - x0)*(w - ml - mr)
-         pyv = h - mb - (yv - y0)/(y1 - y0)*(h - mt - mb)
-      end subroutine to_px
    end function svg_plot
 
    !> Append a curve to a list (component by component: gfortran mishandles array
@@ -168,7 +161,7 @@ contains
          if (series(s)%dashed) dash = ' stroke-dasharray="6,4"'
          path = ""
          do k = 1, size(kept(s)%x)
-            call to_px(kept(s)%x(k), kept(s)%y(k), px, py)
+            call to_pixels([x0, x1, y0, y1], kept(s)%x(k), kept(s)%y(k), px, py)
             path = path//fmt(px)//","//fmt(py)//" "
          end do
          if (size(kept(s)%x) > 0) svg = svg//'<polyline fill="none" stroke="'//c//'" stroke-width="1.5"'//dash// &
@@ -176,7 +169,7 @@ contains
          if (series(s)%markers) then
             m = max(1, size(kept(s)%x)/60)
             do k = 1, size(kept(s)%x), m
-               call to_px(kept(s)%x(k), kept(s)%y(k), px, py)
+               call to_pixels([x0, x1, y0, y1], kept(s)%x(k), kept(s)%y(k), px, py)
                svg = svg//'<circle cx="'//fmt(px)//'" cy="'//fmt(py)//'" r="2.5" fill="'//c//'"/>'//nl
             end do
          end if
@@ -185,13 +178,6 @@ contains
             '" stroke="'//c//'" stroke-width="1.5"'//dash//'/>'//text(ml + 48, py + 4, escape(series(s)%label), "start", 12)
       end do
       svg = svg//"</svg>"//nl
-   contains
-      subroutine to_px(xv, yv, pxv, pyv)
-         real(dp), intent(in) :: xv, yv
-         real(dp), intent(out) :: pxv, pyv
-         pxv = ml + (xv - x0)/(x1 - x0)*(w - ml - mr)
-         pyv = h - mb - (yv - y0)/(y1 - y0)*(h - mt - mb)
-      end subroutine to_px
    end function svg_multi_plot
 
    !> A map (GPa) of `values(i, j)` (row i drawn downwards, column j to the right) over
@@ -262,6 +248,15 @@ contains
       svg = svg//text(x0 + size_px + 50, h - mb + 18, "max "//fmt_sig(vmax, 4), "middle", 11)
       svg = svg//"</svg>"//nl
    end function svg_pressure_map
+
+   !> Plot coordinates (px) of the data point (xv, yv) in the frame x0..x1, y0..y1
+   !> (`frame`, axis units: decades on a log axis).
+   pure subroutine to_pixels(frame, xv, yv, pxv, pyv)
+      real(dp), intent(in) :: frame(4), xv, yv
+      real(dp), intent(out) :: pxv, pyv
+      pxv = ml + (xv - frame(1))/(frame(2) - frame(1))*(w - ml - mr)
+      pyv = h - mb - (yv - frame(3))/(frame(4) - frame(3))*(h - mt - mb)
+   end subroutine to_pixels
 
    function header(title) result(svg)
       character(len=*), intent(in) :: title
