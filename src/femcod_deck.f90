@@ -17,10 +17,11 @@ module femcod_deck
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_files, only: commit_file, temporary_name, path_exists, path_is_directory
-   use femcod_strings, only: int_str
+   use femcod_strings, only: int_str, string_type, split_list
    implicit none
    private
    public :: deck_type, read_deck, write_deck, validate_deck, format_real, parse_real, parse_integer
+   public :: parse_real_list, parse_integer_list
    public :: MAX_NP
 
    !> Largest NP accepted: NP**2 must fit a default integer.
@@ -399,6 +400,39 @@ contains
       value = int(wide)
       ok = .true.
    end subroutine parse_integer
+
+   !> Parse a comma-separated list of numbers (command-line options such as --loads);
+   !> `ok` is false when an item is not a number.
+   subroutine parse_real_list(text, values, ok)
+      character(len=*), intent(in) :: text
+      real(dp), allocatable, intent(out) :: values(:)
+      logical, intent(out) :: ok
+      type(string_type), allocatable :: parts(:)
+      integer :: k
+      parts = split_list(text)
+      allocate(values(size(parts)))
+      ok = size(parts) > 0
+      do k = 1, size(parts)
+         call parse_real(parts(k)%s, values(k), ok)
+         if (.not. ok) return
+      end do
+   end subroutine parse_real_list
+
+   !> Parse a comma-separated list of integers; `ok` is false when an item is not one.
+   subroutine parse_integer_list(text, values, ok)
+      character(len=*), intent(in) :: text
+      integer, allocatable, intent(out) :: values(:)
+      logical, intent(out) :: ok
+      type(string_type), allocatable :: parts(:)
+      integer :: k
+      parts = split_list(text)
+      allocate(values(size(parts)))
+      ok = size(parts) > 0
+      do k = 1, size(parts)
+         call parse_integer(parts(k)%s, values(k), ok)
+         if (.not. ok) return
+      end do
+   end subroutine parse_integer_list
 
    pure logical function is_digit(c)
       character(len=1), intent(in) :: c

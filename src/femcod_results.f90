@@ -57,7 +57,7 @@ contains
       type(status_type), intent(inout) :: status
       type(string_type), allocatable :: names(:), temps(:)
       type(state_maps), allocatable :: maps(:)
-      integer :: k, m
+      integer :: k
       if (status%code /= 0) return
       allocate(names(0), temps(0))
       call load_maps(deck, res%states, maps)

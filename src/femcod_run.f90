@@ -6,7 +6,7 @@ module femcod_run
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, STATUS_USAGE
-   use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real
+   use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real, parse_real_list
    use femcod_strings, only: string_type, int_str, real_str, split_list
    use femcod_contact_result, only: contact_result, contact_options, stop_reason_text, solver_state
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
@@ -97,10 +97,9 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(deck_type) :: deck
-      type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: res
-      type(string_type), allocatable :: parts(:), decks(:), failed(:)
+      type(string_type), allocatable :: decks(:), failed(:)
       character(len=:), allocatable :: deck_path, prefix, solver, key, current_prefix
       type(deck_spec) :: spec
       type(run_info) :: info
@@ -185,16 +184,12 @@ contains
                   return
                end if
             case ("--loads")
-               parts = split_list(v)
-               deallocate(options%loads)
-               allocate(options%loads(size(parts)))
-               do k = 1, size(parts)
-                  call parse_real(parts(k)%s, options%loads(k), ok)
-                  if (.not. ok .or. options%loads(k) < 0) then
-                     call usage("--loads expects non-negative numbers in nN, found '"//parts(k)%s//"'")
-                     return
-                  end if
-               end do
+               call parse_real_list(v, options%loads, ok)
+               if (ok) ok = all(options%loads >= 0)
+               if (.not. ok) then
+                  call usage("--loads expects non-negative numbers in nN, found '"//v//"'")
+                  return
+               end if
             case ("--max-contacts")
                call parse_integer(v, options%max_contacts, ok)
                if (.not. ok .or. options%max_contacts <= 0) then

@@ -6,7 +6,7 @@ module femcod_studies
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO
-   use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real
+   use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
    use femcod_strings, only: string_type, int_str, real_str, split_list, text_builder, add_line, built_text
    use femcod_generate, only: deck_spec, build_deck, read_heights
    use femcod_run, only: default_prefix, file_part
@@ -75,7 +75,7 @@ contains
       type(deck_type) :: deck
       type(status_type) :: status
       type(resolution_level), allocatable :: levels(:)
-      type(string_type), allocatable :: parts(:), names(:), texts(:)
+      type(string_type), allocatable :: names(:), texts(:)
       integer, allocatable :: nps(:)
       character(len=:), allocatable :: input, prefix, method, key, v
       real(dp) :: hardness, pixel, young, poisson, t0, t1
@@ -138,15 +138,8 @@ contains
             method = v
             ok = v == "subsample" .or. v == "average"
          case ("--levels")
-            parts = split_list(v)
-            deallocate(nps)
-            allocate(nps(size(parts)))
-            do n = 1, size(parts)
-               call parse_integer(parts(n)%s, nps(n), ok)
-               if (.not. ok) exit
-               ok = nps(n) >= 1
-               if (.not. ok) exit
-            end do
+            call parse_integer_list(v, nps, ok)
+            if (ok) ok = all(nps >= 1)
          case ("--hardness")
             call parse_real(v, hardness, ok)
             ok = ok .and. hardness > 0
@@ -501,10 +494,9 @@ contains
       type(surface_options), intent(out) :: opts
       type(string_type), allocatable, intent(out) :: rest(:)
       integer, intent(out) :: code
-      type(string_type), allocatable :: parts(:)
       character(len=:), allocatable :: key, v
       logical :: ok
-      integer :: k, n
+      integer :: k
       code = 0
       opts%input = ""
       opts%prefix = ""
@@ -551,15 +543,8 @@ contains
             call parse_real(v, opts%pixel, ok)
             ok = ok .and. opts%pixel > 0
          case ("--sizes")
-            parts = split_list(v)
-            deallocate(opts%sizes)
-            allocate(opts%sizes(size(parts)))
-            do n = 1, size(parts)
-               call parse_integer(parts(n)%s, opts%sizes(n), ok)
-               if (.not. ok) exit
-               ok = opts%sizes(n) >= 1
-               if (.not. ok) exit
-            end do
+            call parse_integer_list(v, opts%sizes, ok)
+            if (ok) ok = all(opts%sizes >= 1)
          case default
             rest = [rest, string_type(key), string_type(v)]
          end select
@@ -732,7 +717,7 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(surface_options) :: opts
-      type(string_type), allocatable :: rest(:), names(:), texts(:), parts(:)
+      type(string_type), allocatable :: rest(:), names(:), texts(:)
       type(status_type) :: status
       type(summit_statistics), allocatable :: stats(:)
       type(roughness_template) :: template
@@ -763,26 +748,11 @@ contains
          ok = .true.
          select case (rest(k)%s)
          case ("--s")
-            parts = split_list(rest(k + 1)%s)
-            deallocate(svals)
-            allocate(svals(size(parts)))
-            do m = 1, size(parts)
-               call parse_real(parts(m)%s, svals(m), ok)
-               if (.not. ok) exit
-               ok = svals(m) > 1
-               if (.not. ok) exit
-            end do
+            call parse_real_list(rest(k + 1)%s, svals, ok)
+            if (ok) ok = all(svals > 1)
          case ("--exponents")
-            parts = split_list(rest(k + 1)%s)
-            ok = size(parts) == 3
-            if (ok) then
-               deallocate(ex)
-               allocate(ex(3))
-               do m = 1, 3
-                  call parse_real(parts(m)%s, ex(m), ok)
-                  if (.not. ok) exit
-               end do
-            end if
+            call parse_real_list(rest(k + 1)%s, ex, ok)
+            if (ok) ok = size(ex) == 3
          case ("--load")
             call parse_real(rest(k + 1)%s, load, ok)
             ok = ok .and. load > 0
