@@ -10,7 +10,7 @@ module femcod_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_deck, only: deck_type, format_real
-   use femcod_strings, only: string_type, int_str
+   use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_write, h5_attribute
@@ -62,12 +62,12 @@ contains
       allocate(names(0), temps(0))
       call load_maps(deck, res%states, maps)
       call add(".history.csv")
-      call write_history_csv(temps(size(temps))%s, deck, res, status)
+      call write_text(temps(size(temps))%s, history_csv(deck, res), status)
       call add(".contacts.csv")
-      call write_contacts_csv(temps(size(temps))%s, deck, res, status)
+      call write_text(temps(size(temps))%s, contacts_csv(deck, res), status)
       if (size(res%states) > 0) then
          call add(".loads.csv")
-         call write_loads_csv(temps(size(temps))%s, deck, res, status)
+         call write_text(temps(size(temps))%s, loads_csv(deck, res), status)
       end if
       call add(".xdmf")
       call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res), status)
@@ -138,21 +138,6 @@ contains
       call commit_set(names, temps, status)
    end subroutine write_file_set
 
-   !> Open a temporary file for writing; on failure `status` names the result file.
-   subroutine open_for_writing(tmp, unit, status)
-      character(len=*), intent(in) :: tmp
-      integer, intent(out) :: unit
-      type(status_type), intent(inout) :: status
-      integer :: ios
-      unit = -1
-      if (status%code /= 0) return
-      open(newunit=unit, file=tmp, status="replace", action="write", iostat=ios)
-      if (ios /= 0) then
-         unit = -1
-         call set_error(status, STATUS_IO, result_name(tmp)//": cannot write (directory missing or not writable)")
-      end if
-   end subroutine open_for_writing
-
    subroutine close_written(unit, tmp, ios, status)
       integer, intent(in) :: unit, ios
       character(len=*), intent(in) :: tmp
@@ -188,69 +173,64 @@ contains
       call close_written(unit, tmp, ios, status)
    end subroutine write_text
 
-   subroutine write_history_csv(tmp, deck, res, status)
-      character(len=*), intent(in) :: tmp
+   !> PREFIX.history.csv: one row per step.
+   function history_csv(deck, res) result(text)
       type(deck_type), intent(in) :: deck
       type(contact_result), intent(in) :: res
-      type(status_type), intent(inout) :: status
-      integer :: unit, ios, k
+      character(len=:), allocatable :: text
+      type(text_builder) :: b
+      integer :: k
       real(dp) :: area_pixel, region
-      call open_for_writing(tmp, unit, status)
-      if (status%code /= 0) return
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      write(unit, '(a)', iostat=ios) "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness"
+      call add_line(b, "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness")
       do k = 1, res%nsteps
-         if (ios /= 0) exit
-         write(unit, '(a)', iostat=ios) int_str(k)//","//int_str(res%step_contacts(k))//","// &
+         call add_line(b, int_str(k)//","//int_str(res%step_contacts(k))//","// &
             format_real(res%step_load(k))//","//format_real(res%step_approach(k))//","// &
             format_real(res%step_contacts(k)*area_pixel)//","//format_real(res%step_contacts(k)*area_pixel/region)// &
-            ","//int_str(res%step_above_hardness(k))
+            ","//int_str(res%step_above_hardness(k)))
       end do
-      call close_written(unit, tmp, ios, status)
-   end subroutine write_history_csv
+      text = built_text(b)
+   end function history_csv
 
-   subroutine write_contacts_csv(tmp, deck, res, status)
-      character(len=*), intent(in) :: tmp
+   !> PREFIX.contacts.csv: the contact pixels and their forces at the reported load.
+   function contacts_csv(deck, res) result(text)
       type(deck_type), intent(in) :: deck
       type(contact_result), intent(in) :: res
-      type(status_type), intent(inout) :: status
-      integer :: unit, ios, k
-      call open_for_writing(tmp, unit, status)
-      if (status%code /= 0) return
-      write(unit, '(a)', iostat=ios) "i,j,step,force_nN,pressure_GPa"
+      character(len=:), allocatable :: text
+      type(text_builder) :: b
+      integer :: k
+      call add_line(b, "i,j,step,force_nN,pressure_GPa")
       do k = 1, size(res%contact_i)
-         if (ios /= 0) exit
-         write(unit, '(a)', iostat=ios) int_str(res%contact_i(k))//","//int_str(res%contact_j(k))//","// &
+         call add_line(b, int_str(res%contact_i(k))//","//int_str(res%contact_j(k))//","// &
             int_str(res%contact_step(k))//","//format_real(res%contact_force(k))//","// &
-            format_real(res%contact_force(k)/deck%pixel**2)
+            format_real(res%contact_force(k)/deck%pixel**2))
       end do
-      call close_written(unit, tmp, ios, status)
-   end subroutine write_contacts_csv
+      text = built_text(b)
+   end function contacts_csv
 
-   subroutine write_loads_csv(tmp, deck, res, status)
-      character(len=*), intent(in) :: tmp
+   !> PREFIX.loads.csv: the states at the requested loads that were reached.
+   function loads_csv(deck, res) result(text)
       type(deck_type), intent(in) :: deck
       type(contact_result), intent(in) :: res
-      type(status_type), intent(inout) :: status
-      integer :: unit, ios, k
+      character(len=:), allocatable :: text
+      type(text_builder) :: b
+      integer :: k
       real(dp) :: area_pixel, region
-      call open_for_writing(tmp, unit, status)
-      if (status%code /= 0) return
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      write(unit, '(a)', iostat=ios) "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness"
+      call add_line(b, "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness")
       do k = 1, size(res%states)
-         if (.not. res%states(k)%reached .or. ios /= 0) cycle
+         if (.not. res%states(k)%reached) cycle
          associate(s => res%states(k))
-            write(unit, '(a)', iostat=ios) format_real(s%load)//","//format_real(s%approach)//","// &
+            call add_line(b, format_real(s%load)//","//format_real(s%approach)//","// &
                int_str(s%contacts)//","//format_real(s%contacts*area_pixel)//","// &
                format_real(s%contacts*area_pixel/region)//","//format_real(s%max_pressure)//","// &
-               int_str(s%n_above_hardness)
+               int_str(s%n_above_hardness))
          end associate
       end do
-      call close_written(unit, tmp, ios, status)
-   end subroutine write_loads_csv
+      text = built_text(b)
+   end function loads_csv
 
    !> The HDF5 file (schema in doc/results.md).
    subroutine write_hdf5(tmp, deck, res, info, maps, status)
