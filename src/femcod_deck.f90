@@ -17,7 +17,7 @@ module femcod_deck
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_files, only: commit_file, temporary_name, path_exists, path_is_directory
-   use femcod_strings, only: int_str, string_type, split_list
+   use femcod_strings, only: int_str, string_type, split_list, without_trailing_zeros
    implicit none
    private
    public :: deck_type, read_deck, write_deck, validate_deck, format_real, parse_real, parse_integer
@@ -299,12 +299,7 @@ contains
       buf = adjustl(buf)
       e = index(buf, "E")
       s = buf(1:e - 1)
-      if (index(s, ".") > 0) then
-         do while (s(len(s):len(s)) == "0")
-            s = s(1:len(s) - 1)
-         end do
-         if (s(len(s):len(s)) == ".") s = s(1:len(s) - 1)
-      end if
+      s = without_trailing_zeros(s)
       read(buf(e + 1:), *) p
       if (p /= 0) s = s//"e"//int_str(p)
       ! Plain fixed notation when it reads back exactly and is not longer.

@@ -3,7 +3,7 @@ module femcod_strings
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: string_type, int_str, real_str, split_list, text_builder, add_line, built_text
+   public :: string_type, int_str, real_str, split_list, text_builder, add_line, built_text, without_trailing_zeros
 
    !> A string of any length, for lists of arguments.
    type :: string_type
@@ -18,6 +18,19 @@ module femcod_strings
    end type text_builder
 
 contains
+
+   !> A decimal mantissa without trailing zeros after its point, nor a bare point
+   !> ("2.500" -> "2.5", "3.000" -> "3"); text without a point is returned as it is.
+   pure function without_trailing_zeros(s) result(t)
+      character(len=*), intent(in) :: s
+      character(len=:), allocatable :: t
+      t = s
+      if (index(t, ".") == 0) return
+      do while (t(len(t):len(t)) == "0")
+         t = t(1:len(t) - 1)
+      end do
+      if (t(len(t):len(t)) == ".") t = t(1:len(t) - 1)
+   end function without_trailing_zeros
 
    !> Append `line` and a line end.
    pure subroutine add_line(builder, line)

@@ -4,7 +4,7 @@
 !> the whole document as a string; writing it is the caller's business.
 module femcod_svg
    use femcod_kinds, only: dp
-   use femcod_strings, only: int_str
+   use femcod_strings, only: int_str, without_trailing_zeros
    implicit none
    private
    public :: svg_plot, svg_pressure_map, nice_ticks, fmt_sig, svg_series, svg_multi_plot, add_series
@@ -438,12 +438,7 @@ contains
       if (e >= -3 .and. e < 6) then
          write(buf, '(f0.'//int_str(max(0, digits - 1 - e))//')') v
          s = trim(adjustl(buf))
-         if (index(s, ".") > 0) then
-            do while (s(len(s):len(s)) == "0")
-               s = s(1:len(s) - 1)
-            end do
-            if (s(len(s):len(s)) == ".") s = s(1:len(s) - 1)
-         end if
+         s = without_trailing_zeros(s)
          if (s(1:1) == ".") s = "0"//s
          if (len(s) > 1) then
             if (s(1:2) == "-.") s = "-0"//s(2:)
