@@ -8,9 +8,14 @@ module femcod_bench
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental
-   use femcod_cg, only: solve_cg, cg_residuals
-   use femcod_strings, only: string_type, int_str, real_str
+   use femcod_cg, only: solve_cg, cg_residuals, cg_method
+   use femcod_strings, only: string_type, int_str, real_str, fixed_str
    use femcod_analytic, only: segedin_sphere
+   use femcod_scene, only: initial_gaps
+   use femcod_deck, only: parse_real, parse_real_list, parse_integer_list
+   use femcod_boussinesq, only: surface_compliance
+   use femcod_clock, only: wall_clock
+   use femcod_wisdom, only: load_wisdom, save_wisdom
    implicit none
    private
    public :: bench_command
@@ -32,6 +37,12 @@ contains
       type(cg_residuals), allocatable :: cg_report(:)
       real(dp) :: err, ref, peak
       code = 0
+      if (size(args) > 0) then
+         if (args(1)%s == "cg") then
+            call bench_cg(args(2:), code)
+            return
+         end if
+      end if
       legacy_contacts = 300
       full = .false.
       i = 1
@@ -39,6 +50,7 @@ contains
          select case (args(i)%s)
          case ("-h", "--help")
             write(output_unit, '(a)') "usage: femcod bench [--full] [--legacy-contacts N]", &
+               "       femcod bench cg [--np LIST] [--contact LIST] [--tol T] [--peers PYTHON]  (--help for more)", &
                "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
                "event, peak memory (resident, per case), error against the reference. The rough surface is", &
                "the one of issue 4: self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa,", &
@@ -159,6 +171,189 @@ contains
          call row(name, deck%np, leg, "legacy", abs(leg%states(1)%approach/reference - 1), what, peak_mb())
       end subroutine verification_row
    end subroutine bench_command
+
+   !> `femcod bench cg`: the fixed-load solver on self-affine surfaces of growing size at
+   !> the mean pressures that give about the requested contact fractions, side by side with
+   !> the peer solvers when a Python with them is given.
+   subroutine bench_cg(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      integer, allocatable :: sizes(:)
+      real(dp), allocatable :: fractions(:), g0(:, :)
+      character(len=:), allocatable :: python, path, peer_out, wisdom
+      type(deck_spec) :: spec
+      type(deck_type) :: deck
+      type(status_type) :: status
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(cg_residuals), allocatable :: report(:)
+      type(cg_method) :: method
+      real(dp) :: tol, estar, slope, pressure, load, length, peak
+      integer :: i, n, k, np, unit, ios, max_iterations
+      logical :: ok, loaded
+      character(len=512) :: line
+      character(len=*), parameter :: peers(2) = [character(len=16) :: "aspher", "contactmechanics"]
+      sizes = [512, 1024]
+      fractions = [1.0_dp, 5.0_dp, 10.0_dp]
+      tol = 1.0e-8_dp
+      max_iterations = 5000
+      python = ""
+      wisdom = ""
+      i = 1
+      do while (i <= size(args))
+         ok = i < size(args)
+         select case (args(i)%s)
+         case ("-h", "--help")
+            write(output_unit, '(a)') &
+               "usage: femcod bench cg [--np 512,1024] [--contact 1,5,10] [--tol 1e-8] [--peers PYTHON]", &
+               "The fixed-load solver (--solver cg) on the self-affine surface of issue 5: Hurst 0.8, rms 3 nm,", &
+               "5 um square, E = 200 GPa, nu = 0.25, against a rigid flat (seed 1), at each NP of --np. The mean", &
+               "pressure for a contact fraction f (percent) is f/100 * E* h'rms / 2 (the linear law with", &
+               "kappa = 2, h'rms the surface's own rms slope); the fraction reached is printed. Each load is", &
+               "solved from a cold start. --peers PYTHON: also run the peers installed in that Python", &
+               "(app/femcod_peers.py; aspher at every NP, contactmechanics at NP <= 512) on the same gaps,", &
+               "pressures and tolerance. --fftw-wisdom FILE: measured FFTW plans kept in FILE (the first run", &
+               "on a size pays the planning inside its wall time). Method switches, for the speed/accuracy", &
+               "table: --nested on|off, --coarsest N, --coarse-tol T, --single-until R (0: no float32),", &
+               "--direct N (0: two convolutions per iteration), --restart on|off, --precondition on|off.", &
+               "Run it with the release build.", &
+               "Columns: NP, target %, solver, wall (s), iterations, residual, contact %, peak RSS (MB)."
+            return
+         case ("--np")
+            if (ok) call parse_integer_list(args(i + 1)%s, sizes, ok)
+         case ("--contact")
+            if (ok) call parse_real_list(args(i + 1)%s, fractions, ok)
+         case ("--tol")
+            if (ok) call parse_real(args(i + 1)%s, tol, ok)
+         case ("--peers")
+            if (ok) python = args(i + 1)%s
+         case ("--nested")
+            if (ok) method%nested = args(i + 1)%s == "on"
+         case ("--fftw-wisdom")
+            if (ok) then
+               wisdom = args(i + 1)%s
+               method%measure_plans = .true.
+               call load_wisdom(wisdom, loaded)
+            end if
+         case ("--restart")
+            if (ok) method%restart_on_entry = args(i + 1)%s == "on"
+         case ("--precondition")
+            if (ok) method%precondition = args(i + 1)%s == "on"
+         case ("--coarsest")
+            if (ok) call parse_integer(args(i + 1)%s, method%coarsest, ok)
+         case ("--coarse-tol")
+            if (ok) call parse_real(args(i + 1)%s, method%coarse_tol, ok)
+         case ("--single-until")
+            if (ok) call parse_real(args(i + 1)%s, method%single_until, ok)
+         case ("--direct")
+            if (ok) call parse_integer(args(i + 1)%s, method%direct_corrections, ok)
+         case default
+            ok = .false.
+         end select
+         if (.not. ok) then
+            write(error_unit, '(a)') "femcod bench cg: bad or incomplete argument "//args(i)%s//" (--help)"
+            code = 2
+            return
+         end if
+         i = i + 2
+      end do
+      write(output_unit, '(a)') "| NP | target % | solver | wall (s) | iterations | residual | contact % "// &
+         "| peak RSS (MB) | status |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|"
+      do n = 1, size(sizes)
+         np = sizes(n)
+         length = 5000
+         spec%kind = "self-affine"
+         spec%np = np
+         spec%pixel = length/np
+         spec%hurst = 0.8_dp
+         spec%rms = 3
+         spec%seed = 1
+         spec%shape_on = "lower"
+         spec%rigid = "upper"
+         spec%label = "bench cg"
+         spec%matrix_file = ""
+         spec%maxcont = 1
+         call build_deck(spec, deck, status)
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod bench cg: "//status%message
+            code = status%code
+            return
+         end if
+         ! The composite modulus of the solver's model: pi/(c pixel) with c the summed
+         ! single-pixel compliances' Love factor (E* for an elastic body on a rigid one).
+         estar = 1/(1/(deck%young(1)/(1 - deck%poisson(1)**2)) + 1/(deck%young(2)/(1 - deck%poisson(2)**2)))
+         g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
+         slope = sqrt((sum((g0(2:, :) - g0(:np - 1, :))**2) + sum((g0(:, 2:) - g0(:, :np - 1))**2)) &
+            /(np*(np - 1.0_dp)))/deck%pixel
+         if (len(python) > 0) then
+            path = "femcod-bench-gaps.f64"
+            open(newunit=unit, file=path, access="stream", form="unformatted", status="replace", action="write")
+            write(unit) g0
+            close(unit)
+         end if
+         do k = 1, size(fractions)
+            pressure = fractions(k)/100*estar*slope/2
+            load = pressure*length**2
+            options%loads = [load]
+            options%max_contacts = 0
+            call reset_peak()
+            call solve_cg(deck, options, tol, max_iterations, res, report, status, method)
+            peak = peak_mb()
+            if (len(wisdom) > 0 .and. status%code == 0) call save_wisdom(wisdom, status)
+            if (status%code /= 0) then
+               write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | | | | | | "// &
+                  status%message//" |"
+               status = status_type()
+               cycle
+            end if
+            write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | "// &
+               fixed_str(res%wall_seconds, 2)//" | "//int_str(report(1)%iterations)//" (+"// &
+               int_str(report(1)%coarse_iterations)//" coarse, "//int_str(report(1)%convolutions)//" fresh) | "// &
+               real_str(report(1)%residual, 2)//" | "//fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)// &
+               " | "//fixed_str(peak, 0)//" | "//trim(merge("converged  ", "not reached", report(1)%residual <= tol))//" |"
+            flush(output_unit)
+            if (len(python) == 0) cycle
+            do i = 1, size(peers)
+               if (trim(peers(i)) == "contactmechanics" .and. np > 512) cycle
+               peer_out = "femcod-bench-peer.txt"
+               call execute_command_line(python//" app/femcod_peers.py "//trim(peers(i))//" "//path//" "// &
+                  int_str(np)//" "//real_str(deck%pixel, 16)//" "//real_str(estar, 16)//" "// &
+                  real_str(pressure, 16)//" "//real_str(tol, 3)//" > "//peer_out, exitstat=ios)
+               line = trim(peers(i))//" - - - - - failed"
+               open(newunit=unit, file=peer_out, action="read", status="old", iostat=ios)
+               if (ios == 0) then
+                  read(unit, '(a)', iostat=ios) line
+                  close(unit, status="delete")
+               end if
+               call peer_row(np, fractions(k), line)
+            end do
+         end do
+         if (len(python) > 0) then
+            open(newunit=unit, file=path, status="old", iostat=ios)
+            if (ios == 0) close(unit, status="delete")
+         end if
+      end do
+   end subroutine bench_cg
+
+   !> One table row from the peer script's line "peer seconds iterations residual fraction
+   !> peak status" (fraction as a share, printed in percent).
+   subroutine peer_row(np, target, line)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: target
+      character(len=*), intent(in) :: line
+      character(len=64) :: words(7)
+      real(dp) :: fraction
+      integer :: ios
+      words = "-"
+      read(line, *, iostat=ios) words
+      read(words(5), *, iostat=ios) fraction
+      if (ios == 0) words(5) = fixed_str(100*fraction, 2)
+      write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(target, 1)//" | "//trim(words(1))//" | "// &
+         trim(words(2))//" | "//trim(words(3))//" | "//trim(words(4))//" | "//trim(words(5))//" | "// &
+         trim(words(6))//" | "//trim(words(7))//" |"
+      flush(output_unit)
+   end subroutine peer_row
 
    subroutine row(problem, np, res, solver, error, reference, peak)
       character(len=*), intent(in) :: problem, solver, reference

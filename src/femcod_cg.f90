@@ -5,13 +5,27 @@
 !> compliance c = c1 + c2 with the exact Love kernel I, the springs' s = 3/k on the
 !> diagonal, one composite gap g0), by the constrained conjugate gradients of Polonsky and
 !> Keer (Wear 231, 1999, 206-219). I * F is a zero-padded (2NP)^2 FFT convolution (FFTW,
-!> plans made once). Each load starts from the previous load's forces (warm start).
+!> plans made once, femcod_convolution).
+!>
+!> What makes it fast without changing the answer (each can be switched off, cg_method):
+!> - Nested grids: the first load starts from the solution on grids of NP/2, NP/4, ...
+!>   (2 x 2 averages of the gaps, twice the pixel, the same total load), each solved to a
+!>   loose tolerance and handed down with every coarse force split equally over its four
+!>   pixels. Later loads start from the previous load's forces, scaled (warm start).
+!> - One convolution per iteration: the displacements of the new forces are the old ones
+!>   minus tau times those of the search direction, which the step needs anyway; only
+!>   the pixels the projection changes (forces clipped to zero, overlapping pixels that
+!>   enter) need a correction, added directly from the Love table when they are few, by
+!>   a fresh convolution otherwise.
+!> - float32 transforms while the residual is large (above `single_until`), then double.
+!>   Every switch, and the final answer, starts from a fresh double convolution.
 !>
 !> Stopping rule: the relative complementarity residual
 !>     r = max( max over contacts |g| , max over the rest max(-g, 0) ) / (max g0 - min g0)
 !> (the largest gap violation in units of the height range) below `tol` (default 1e-8),
-!> with the load balanced to round-off by construction. The residuals reached are
-!> returned: max penetration (nm), largest |gap| on contact (nm), load error, r.
+!> evaluated on displacements from a fresh double-precision convolution of the final
+!> forces, with the load balanced to round-off by construction. The residuals reached
+!> are returned: max penetration (nm), largest |gap| on contact (nm), load error, r.
 module femcod_cg
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
@@ -19,24 +33,64 @@ module femcod_cg
    use femcod_scene, only: initial_gaps
    use femcod_boussinesq, only: offset_table, surface_compliance
    use femcod_spring, only: spring_stiffness
-   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
+   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
+      convolution_free, inverse_kernel_taps
    use femcod_contact_result, only: contact_result, contact_options, append_step, STOP_LOADS
    use femcod_clock, only: wall_clock
    implicit none
    private
-   public :: solve_cg, cg_residuals
+   public :: solve_cg, cg_residuals, cg_method
 
    !> What the CG solver reached at one load.
    type :: cg_residuals
-      integer :: iterations = 0
+      !> Iterations on the full grid, and on all coarser grids together.
+      integer :: iterations = 0, coarse_iterations = 0
+      !> Fresh convolutions on the full grid (one per iteration, plus restarts and checks).
+      integer :: convolutions = 0
       real(dp) :: penetration = 0, contact_gap = 0, load_error = 0, residual = 0
    end type cg_residuals
+
+   !> How the solver accelerates (defaults: all on).
+   type :: cg_method
+      !> Start the first load from nested coarser grids (down to `coarsest` pixels a side).
+      logical :: nested = .true.
+      integer :: coarsest = 64
+      !> Relative residual to which the coarser grids are solved.
+      real(dp) :: coarse_tol = 1.0e-4_dp
+      !> float32 transforms while the residual is above this (0: never).
+      real(dp) :: single_until = 1.0e-5_dp
+      !> Precondition the search direction with the 13-point stencil of the inverse Love
+      !> operator (a discrete |q|), applied on the contact set.
+      logical :: precondition = .true.
+      !> Restart the conjugate directions (beta = 0) after overlapping pixels enter the
+      !> contact, as Polonsky and Keer do (off: keep them; measured 10-25 % fewer
+      !> iterations at NP = 1024, doc/performance.md).
+      logical :: restart_on_entry = .false.
+      !> Largest number of projection changes corrected directly (0: a fresh convolution
+      !> every iteration, i.e. two per iteration as in Polonsky and Keer).
+      integer :: direct_corrections = 32
+      !> Let FFTW time its plans (FFTW_MEASURE) instead of estimating them; worth it
+      !> with a wisdom file (`femcod run --fftw-wisdom`), which keeps the plans.
+      logical :: measure_plans = .false.
+   end type cg_method
+
+   !> One grid of the problem: gaps (nm), pixel (nm), compliance c (nm/nN) and spring
+   !> compliance s (nm/nN), the Love table and its convolution.
+   type :: cg_grid
+      integer :: np = 0
+      real(dp) :: pixel = 0, c = 0, s = 0, scale = 1
+      real(dp), allocatable :: g0(:, :), table(:, :)
+      !> Preconditioner taps (inverse_kernel_taps); `preconditioned` false: none.
+      logical :: preconditioned = .false.
+      real(dp) :: taps(0:2, 0:2) = 0
+      type(love_convolution) :: conv
+   end type cg_grid
 
 contains
 
    !> Solve at every requested load (ascending order of computation; results in the
    !> order given). `report(k)` holds the residuals at load k.
-   subroutine solve_cg(deck, options, tol, max_iterations, res, report, status)
+   subroutine solve_cg(deck, options, tol, max_iterations, res, report, status, method)
       type(deck_type), intent(in) :: deck
       type(contact_options), intent(in) :: options
       real(dp), intent(in) :: tol
@@ -44,12 +98,15 @@ contains
       type(contact_result), intent(out) :: res
       type(cg_residuals), allocatable, intent(out) :: report(:)
       type(status_type), intent(inout) :: status
-      type(love_convolution) :: conv
-      real(dp), allocatable :: table(:, :), g0(:, :), p(:, :), t(:, :), u(:, :), r(:, :), g(:, :), pold(:, :)
+      type(cg_method), intent(in), optional :: method
+      type(cg_method) :: how
+      type(cg_grid) :: fine
+      real(dp), allocatable :: p(:, :)
       integer, allocatable :: order(:)
-      real(dp) :: c, s, load, scale, tstart, t0, t1
+      real(dp) :: load, tstart, t0, t1, approach
       integer :: np, k, kk, m, i, j, nc
       call wall_clock(tstart)
+      if (present(method)) how = method
       np = deck%np
       m = size(options%loads)
       allocate(report(m), res%states(m))
@@ -58,15 +115,8 @@ contains
          call set_error(status, STATUS_NUMERICAL, "cg: --solver cg needs --loads")
          return
       end if
-      allocate(table(0:np - 1, 0:np - 1))
-      table = offset_table(np)
-      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
-         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
-      s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
-      g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
-      scale = max(maxval(g0) - minval(g0), tiny(1.0_dp))
-      call convolution_setup(conv, table)
-      allocate(p(np, np), t(np, np), u(np, np), r(np, np), g(np, np), pold(np, np))
+      call make_grid(fine, transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np])), deck, deck%pixel, how)
+      allocate(p(np, np))
       ! Ascending loads, each warm-started from the last.
       allocate(order(m))
       order = [(k, k = 1, m)]
@@ -83,12 +133,31 @@ contains
          k = order(kk)
          load = options%loads(k)
          call wall_clock(t0)
-         call one_load(load, report(k))
-         if (status%code /= 0) exit
+         if (load <= 0) then
+            p = 0
+            approach = -minval(fine%g0)
+         else
+            if (.not. sum(p) > 0) then
+               if (how%nested) then
+                  call nested_start(fine, deck, load, how, p, report(k), status)
+               else
+                  call first_guess(fine, load, p)
+               end if
+               if (status%code /= 0) exit
+            end if
+            call constrained_cg(fine, load, tol, max_iterations, how, p, approach, report(k), status)
+            if (status%code /= 0) exit
+         end if
          call wall_clock(t1)
          ! The state at this load.
          associate(st => res%states(k))
             st%reached = .true.
+            st%approach = approach
+            st%iterations = report(k)%iterations
+            st%residual = report(k)%residual
+            st%penetration = report(k)%penetration
+            st%contact_gap = report(k)%contact_gap
+            st%load_error = report(k)%load_error
             st%contacts = count(p > 0)
             st%max_pressure = maxval(p)/deck%pixel**2
             st%n_above_hardness = count(p/deck%pixel**2 > options%hardness)
@@ -114,101 +183,370 @@ contains
             end if
          end associate
       end do
-      call convolution_free(conv)
+      call convolution_free(fine%conv)
       res%stop_reason = STOP_LOADS
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
-   contains
-      !> Polonsky-Keer constrained CG at total load P, from the current p.
-      subroutine one_load(total_load, rep)
-         real(dp), intent(in) :: total_load
-         type(cg_residuals), intent(out) :: rep
-         real(dp) :: gbar, big_g, big_g_old, tau, rbar, num, den, approach, rsum, beta
-         logical :: restart
-         integer :: it, nc
-         if (total_load <= 0) then
-            p = 0
-            res%states(k)%approach = -minval(g0)
-            rep%residual = 0
+   end subroutine solve_cg
+
+   !> A grid for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's materials.
+   subroutine make_grid(grid, g0, deck, pixel, how)
+      type(cg_grid), intent(inout) :: grid
+      real(dp), intent(in) :: g0(:, :)
+      type(deck_type), intent(in) :: deck
+      real(dp), intent(in) :: pixel
+      type(cg_method), intent(in) :: how
+      grid%np = size(g0, 1)
+      grid%pixel = pixel
+      grid%g0 = g0
+      grid%c = surface_compliance(deck%young(1), deck%poisson(1), pixel) + &
+         surface_compliance(deck%young(2), deck%poisson(2), pixel)
+      grid%s = 3/spring_stiffness(deck%young(3), deck%poisson(3), pixel, pixel)
+      grid%scale = max(maxval(g0) - minval(g0), tiny(1.0_dp))
+      allocate(grid%table(0:grid%np - 1, 0:grid%np - 1))
+      grid%table = offset_table(grid%np)
+      call convolution_setup(grid%conv, grid%table, how%single_until > 0, how%measure_plans)
+      if (how%precondition) call inverse_kernel_taps(grid%conv, grid%taps, grid%preconditioned)
+   end subroutine make_grid
+
+   !> Start: the load spread over the pixels within a tenth of the height range of the
+   !> first touch.
+   subroutine first_guess(grid, total_load, p)
+      type(cg_grid), intent(in) :: grid
+      real(dp), intent(in) :: total_load
+      real(dp), intent(out) :: p(:, :)
+      where (grid%g0 <= minval(grid%g0) + 0.1_dp*grid%scale)
+         p = 1
+      elsewhere
+         p = 0
+      end where
+      p = p*(total_load/sum(p))
+   end subroutine first_guess
+
+   !> The first load's start from nested grids: halve while the side stays even and at
+   !> least 2 * coarsest; solve the coarsest from the first guess, then each finer grid
+   !> from the coarser solution, to coarse_tol; return the forces on the finest grid.
+   recursive subroutine nested_start(grid, deck, total_load, how, p, rep, status)
+      type(cg_grid), intent(in) :: grid
+      type(deck_type), intent(in) :: deck
+      real(dp), intent(in) :: total_load
+      type(cg_method), intent(in) :: how
+      real(dp), intent(out) :: p(:, :)
+      type(cg_residuals), intent(inout) :: rep
+      type(status_type), intent(inout) :: status
+      type(cg_grid) :: coarse
+      type(cg_residuals) :: coarse_rep
+      real(dp), allocatable :: pc(:, :)
+      real(dp) :: approach
+      integer :: n, i, j
+      n = grid%np
+      if (mod(n, 2) /= 0 .or. n < 2*how%coarsest) then
+         call first_guess(grid, total_load, p)
+         return
+      end if
+      n = n/2
+      call make_grid(coarse, (grid%g0(1::2, 1::2) + grid%g0(2::2, 1::2) + grid%g0(1::2, 2::2) + &
+         grid%g0(2::2, 2::2))/4, deck, 2*grid%pixel, how)
+      allocate(pc(n, n))
+      call nested_start(coarse, deck, total_load, how, pc, rep, status)
+      if (status%code == 0) call constrained_cg(coarse, total_load, how%coarse_tol, 10000, how, pc, approach, &
+         coarse_rep, status)
+      call convolution_free(coarse%conv)
+      if (status%code /= 0) return
+      rep%coarse_iterations = rep%coarse_iterations + coarse_rep%iterations + coarse_rep%coarse_iterations
+      do j = 1, n
+         do i = 1, n
+            p(2*i - 1:2*i, 2*j - 1:2*j) = pc(i, j)/4
+         end do
+      end do
+   end subroutine nested_start
+
+   !> Polonsky-Keer constrained CG on `grid` at total load P from the forces p (nN, any
+   !> positive start; returned: the solution). `approach` (nm) is the mean gap of the
+   !> contact pixels before the rigid shift, i.e. the approach from first touch.
+   subroutine constrained_cg(grid, total_load, tol, max_iterations, how, p, approach, rep, status)
+      type(cg_grid), intent(inout) :: grid
+      real(dp), intent(in) :: total_load, tol
+      integer, intent(in) :: max_iterations
+      type(cg_method), intent(in) :: how
+      real(dp), intent(inout) :: p(:, :)
+      real(dp), intent(out) :: approach
+      type(cg_residuals), intent(inout) :: rep
+      type(status_type), intent(inout) :: status
+      real(dp), allocatable :: w(:, :), g(:, :), t(:, :), r(:, :), gm(:, :), z(:, :)
+      integer, allocatable :: changed(:, :)
+      real(dp), allocatable :: delta(:)
+      real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, residual, &
+         contact_gap, penetration, alpha, pn, lin
+      integer :: np, i, j, it, nc, nchanged, limit
+      logical :: restart, single, fresh, overflow, fresh_double
+      np = grid%np
+      c = grid%c
+      s = grid%s
+      limit = max(how%direct_corrections, 0)
+      allocate(w(np, np), g(np, np), t(np, np), r(np, np), changed(2, limit), delta(limit))
+      if (grid%preconditioned) then
+         allocate(gm(-1:np + 2, -1:np + 2), z(np, np))
+         gm = 0
+      end if
+      p = p*(total_load/sum(p))
+      single = how%single_until > 0
+      fresh = .true.
+      restart = .true.
+      big_g_old = 1
+      t = 0
+      it = 0
+      fresh_double = .false.
+      do
+         if (fresh) then
+            call displacements(p, w)
+            fresh = .false.
+            restart = .true.
+         end if
+         ! Gaps and the contacts' mean gap.
+         nc = 0
+         gbar = 0
+         !$omp parallel do private(i) reduction(+:nc, gbar)
+         do j = 1, np
+            do i = 1, np
+               g(i, j) = grid%g0(i, j) + w(i, j) + s*p(i, j)
+               if (p(i, j) > 0) then
+                  nc = nc + 1
+                  gbar = gbar + g(i, j)
+               end if
+            end do
+         end do
+         if (nc == 0) then
+            call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
             return
          end if
-         if (sum(p) <= 0) then
-            ! Start: the load spread over the pixels of the smallest gaps' tenth.
-            where (g0 <= minval(g0) + 0.1_dp*scale)
-               p = 1
-            elsewhere
-               p = 0
-            end where
-         end if
-         p = p*(total_load/sum(p))
-         big_g_old = 1
-         restart = .true.
-         t = 0
-         do it = 1, max_iterations
-            rep%iterations = it
-            call convolution_apply(conv, p, u)
-            g = g0 + c*u + s*p
-            nc = count(p > 0)
-            if (nc == 0) exit
-            gbar = sum(g, mask=p > 0)/nc
-            approach = gbar
-            g = g - gbar
-            big_g = sum(g**2, mask=p > 0)
-            if (restart .or. .not. big_g_old > 0) then
-               beta = 0
-            else
-               beta = big_g/big_g_old
-            end if
-            where (p > 0)
-               t = g + beta*t
-            elsewhere
-               t = 0
-            end where
-            big_g_old = big_g
-            call convolution_apply(conv, t, r)
-            r = c*r + s*t
-            rbar = sum(r, mask=p > 0)/nc
-            r = r - rbar
-            num = sum(g*t, mask=p > 0)
-            den = sum(r*t, mask=p > 0)
-            if (.not. abs(den) > 0) exit
-            tau = num/den
-            pold = p
-            where (p > 0) p = p - tau*t
-            where (p < 0) p = 0
-            ! Overlapping pixels enter the contact.
-            restart = any(pold <= 0 .and. g < 0)
-            where (pold <= 0 .and. g < 0) p = p - tau*g
-            rsum = sum(p)
-            if (.not. rsum > 0) then
-               call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
-               return
-            end if
-            p = p*(total_load/rsum)
-            ! Residuals of the current iterate (gaps from the last convolution).
-            rep%contact_gap = maxval(abs(g), mask=pold > 0)
-            rep%penetration = max(0.0_dp, -minval(g, mask=pold <= 0))
-            rep%residual = max(rep%contact_gap, rep%penetration)/scale
-            if (rep%residual < tol .and. it > 1) exit
+         gbar = gbar/nc
+         approach = gbar
+         ! Residuals of the current forces, and the new search direction's norm.
+         big_g = 0
+         contact_gap = 0
+         penetration = 0
+         !$omp parallel do private(i) reduction(+:big_g) reduction(max:contact_gap, penetration)
+         do j = 1, np
+            do i = 1, np
+               g(i, j) = g(i, j) - gbar
+               if (p(i, j) > 0) then
+                  big_g = big_g + g(i, j)**2
+                  contact_gap = max(contact_gap, abs(g(i, j)))
+               else
+                  penetration = max(penetration, -g(i, j))
+               end if
+            end do
          end do
-         ! Final residuals from a fresh convolution of the final forces.
-         call convolution_apply(conv, p, u)
-         g = g0 + c*u + s*p
-         nc = max(count(p > 0), 1)
-         approach = sum(g, mask=p > 0)/nc
-         g = g - approach
-         rep%contact_gap = maxval(abs(g), mask=p > 0)
-         rep%penetration = max(0.0_dp, -minval(g, mask=p <= 0))
-         rep%residual = max(rep%contact_gap, rep%penetration)/scale
-         rep%load_error = abs(sum(p) - total_load)/total_load
-         ! Approach measured as in the other solvers: from first touch (gap 0 at the
-         ! highest pair of voxels).
-         res%states(k)%approach = approach
-         res%states(k)%iterations = rep%iterations
-         res%states(k)%residual = rep%residual
-         res%states(k)%penetration = rep%penetration
-         res%states(k)%contact_gap = rep%contact_gap
-         res%states(k)%load_error = rep%load_error
-      end subroutine one_load
-   end subroutine solve_cg
+         residual = max(contact_gap, penetration)/grid%scale
+         if (grid%preconditioned) call precondition(big_g)
+         if (residual < tol .or. it >= max_iterations) then
+            ! Accept only on displacements from a fresh double-precision convolution.
+            if (.not. fresh_double) then
+               single = .false.
+               fresh = .true.
+               cycle
+            end if
+            exit
+         end if
+         if (single .and. residual < how%single_until) then
+            single = .false.
+            fresh = .true.
+            cycle
+         end if
+         it = it + 1
+         if (restart .or. .not. big_g_old > 0) then
+            beta = 0
+         else
+            beta = big_g/big_g_old
+         end if
+         big_g_old = big_g
+         num = 0
+         !$omp parallel do private(i) reduction(+:num)
+         do j = 1, np
+            do i = 1, np
+               if (p(i, j) > 0) then
+                  if (grid%preconditioned) then
+                     t(i, j) = z(i, j) + beta*t(i, j)
+                  else
+                     t(i, j) = g(i, j) + beta*t(i, j)
+                  end if
+                  num = num + g(i, j)*t(i, j)
+               else
+                  t(i, j) = 0
+               end if
+            end do
+         end do
+         ! r = c (I * t): the displacements of the search direction.
+         call convolve(t, r)
+         rt = 0
+         rsum = 0
+         tsum = 0
+         !$omp parallel do private(i) reduction(+:rt, rsum, tsum)
+         do j = 1, np
+            do i = 1, np
+               if (p(i, j) > 0) then
+                  rt = rt + (r(i, j) + s*t(i, j))*t(i, j)
+                  rsum = rsum + r(i, j) + s*t(i, j)
+                  tsum = tsum + t(i, j)
+               end if
+            end do
+         end do
+         rbar = rsum/nc
+         den = rt - rbar*tsum
+         if (.not. abs(den) > 0) then
+            ! Nothing left to move: the forces are the solution to round-off.
+            if (.not. fresh_double) then
+               single = .false.
+               fresh = .true.
+               cycle
+            end if
+            exit
+         end if
+         tau = num/den
+         ! Step, projection, overlap correction; the displacements follow linearly
+         ! (w - tau r) except where the projection changed a force.
+         nchanged = 0
+         overflow = .false.
+         restart = .false.
+         psum = 0
+         do j = 1, np
+            do i = 1, np
+               if (p(i, j) > 0) then
+                  lin = p(i, j) - tau*t(i, j)
+                  pn = max(lin, 0.0_dp)
+               else
+                  lin = 0
+                  pn = 0
+                  if (g(i, j) < 0) then
+                     pn = -tau*g(i, j)
+                     restart = how%restart_on_entry
+                  end if
+               end if
+               p(i, j) = pn
+               w(i, j) = w(i, j) - tau*r(i, j)
+               psum = psum + pn
+               if (pn /= lin) then
+                  nchanged = nchanged + 1
+                  if (nchanged <= limit) then
+                     changed(:, nchanged) = [i, j]
+                     delta(nchanged) = pn - lin
+                  else
+                     overflow = .true.
+                  end if
+               end if
+            end do
+         end do
+         fresh_double = .false.
+         if (.not. psum > 0) then
+            call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
+            return
+         end if
+         if (overflow) then
+            fresh = .true.
+         else if (nchanged > 0) then
+            call add_direct(nchanged)
+         end if
+         alpha = total_load/psum
+         !$omp parallel do private(i)
+         do j = 1, np
+            do i = 1, np
+               p(i, j) = alpha*p(i, j)
+               w(i, j) = alpha*w(i, j)
+            end do
+         end do
+      end do
+      rep%iterations = rep%iterations + it
+      rep%residual = residual
+      rep%contact_gap = contact_gap
+      rep%penetration = penetration
+      rep%load_error = abs(sum(p) - total_load)/total_load
+   contains
+      !> z = the stencil applied to the contacts' gaps, on the contacts, mean removed;
+      !> big_g = g . z (the preconditioned norm for beta).
+      subroutine precondition(big_g)
+         real(dp), intent(out) :: big_g
+         real(dp) :: zsum, gz, gsum, zbar
+         integer :: ii, jj
+         !$omp parallel do private(ii)
+         do jj = 1, np
+            do ii = 1, np
+               if (p(ii, jj) > 0) then
+                  gm(ii, jj) = g(ii, jj)
+               else
+                  gm(ii, jj) = 0
+               end if
+            end do
+         end do
+         zsum = 0
+         gz = 0
+         gsum = 0
+         associate(a => grid%taps)
+            !$omp parallel do private(ii) reduction(+:zsum, gz, gsum)
+            do jj = 1, np
+               do ii = 1, np
+                  if (p(ii, jj) > 0) then
+                     z(ii, jj) = a(0, 0)*gm(ii, jj) + a(1, 0)*(gm(ii - 1, jj) + gm(ii + 1, jj)) + &
+                        a(0, 1)*(gm(ii, jj - 1) + gm(ii, jj + 1)) + &
+                        a(1, 1)*(gm(ii - 1, jj - 1) + gm(ii + 1, jj - 1) + gm(ii - 1, jj + 1) + gm(ii + 1, jj + 1)) + &
+                        a(2, 0)*(gm(ii - 2, jj) + gm(ii + 2, jj)) + a(0, 2)*(gm(ii, jj - 2) + gm(ii, jj + 2))
+                     zsum = zsum + z(ii, jj)
+                     gz = gz + g(ii, jj)*z(ii, jj)
+                     gsum = gsum + g(ii, jj)
+                  end if
+               end do
+            end do
+         end associate
+         zbar = zsum/nc
+         big_g = gz - zbar*gsum
+         !$omp parallel do private(ii)
+         do jj = 1, np
+            do ii = 1, np
+               if (p(ii, jj) > 0) z(ii, jj) = z(ii, jj) - zbar
+            end do
+         end do
+      end subroutine precondition
+
+      !> w = c (I * f) with fresh transforms (float32 while `single`).
+      subroutine displacements(f, out)
+         real(dp), intent(in) :: f(:, :)
+         real(dp), intent(out) :: out(:, :)
+         call convolve(f, out)
+         rep%convolutions = rep%convolutions + 1
+         fresh_double = .not. single
+      end subroutine displacements
+
+      subroutine convolve(f, out)
+         real(dp), intent(in) :: f(:, :)
+         real(dp), intent(out) :: out(:, :)
+         integer :: jj
+         if (single) then
+            call convolution_apply_single(grid%conv, f, out)
+         else
+            call convolution_apply(grid%conv, f, out)
+         end if
+         fresh_double = .false.
+         !$omp parallel do
+         do jj = 1, np
+            out(:, jj) = c*out(:, jj)
+         end do
+      end subroutine convolve
+
+      !> w += c * I * (the changed forces' corrections), summed directly from the table.
+      subroutine add_direct(n)
+         integer, intent(in) :: n
+         integer :: jj, ii, q, iq, jq
+         !$omp parallel do private(ii, q, iq, jq)
+         do jj = 1, np
+            do q = 1, n
+               iq = changed(1, q)
+               jq = changed(2, q)
+               do ii = 1, np
+                  w(ii, jj) = w(ii, jj) + c*delta(q)*grid%table(abs(ii - iq), abs(jj - jq))
+               end do
+            end do
+         end do
+         fresh_double = .false.
+      end subroutine add_direct
+   end subroutine constrained_cg
 end module femcod_cg

@@ -13,7 +13,8 @@ module femcod_run
    use femcod_files, only: remove_file
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental, scene_report
-   use femcod_cg, only: solve_cg, cg_residuals
+   use femcod_cg, only: solve_cg, cg_residuals, cg_method
+   use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_results, only: write_results, run_info, result_files
    use femcod_generate, only: deck_spec, build_deck
    use femcod_files, only: path_exists
@@ -54,7 +55,9 @@ contains
          "                     legacy: the Appendix B program (skyline, COLHT, TRFACT, POSTP)", &
          "                     cg: the state at each requested load only, by constrained conjugate", &
          "                     gradients (Polonsky-Keer) with FFT convolutions; --tol T (default 1e-8,", &
-         "                     gap violations over the height range), --max-iterations N (default 2000)", &
+         "                     gap violations over the height range), --max-iterations N (default 2000),", &
+         "                     --fftw-wisdom FILE: FFTW measures its plans once and keeps them in FILE", &
+         "                     and FILE.float32 (seconds of planning the first time, faster transforms)", &
          "  --loads F1,...     total loads in nN at which to report the state (PREFIX.loads.csv);", &
          "                     the run stops once the largest is reached", &
          "  --max-contacts N   stop after N contacts (default: the deck's MAXCONT)", &
@@ -105,6 +108,8 @@ contains
       type(run_info) :: info
       type(solver_state) :: resume
       type(cg_residuals), allocatable :: cg_report(:)
+      type(cg_method) :: cg_how
+      character(len=:), allocatable :: wisdom
       real(dp) :: cg_tol
       integer :: cg_iterations
       logical :: quiet, ok, force, restart
@@ -128,6 +133,7 @@ contains
       deck_path = ""
       allocate(decks(0), failed(0))
       prefix = ""
+      wisdom = ""
       solver = "incremental"
       allocate(options%loads(0))
       i = 1
@@ -208,6 +214,8 @@ contains
                   call usage("--tol expects a positive number, found '"//v//"'")
                   return
                end if
+            case ("--fftw-wisdom")
+               wisdom = v
             case ("--max-iterations")
                call parse_integer(v, cg_iterations, ok)
                if (.not. ok .or. cg_iterations <= 0) then
@@ -356,7 +364,12 @@ contains
          if (st%code == 0) then
             select case (solver)
             case ("cg")
-               call solve_cg(deck, options, cg_tol, cg_iterations, res, cg_report, st)
+               if (len(wisdom) > 0) then
+                  cg_how%measure_plans = .true.
+                  call load_wisdom(wisdom, ok)
+               end if
+               call solve_cg(deck, options, cg_tol, cg_iterations, res, cg_report, st, cg_how)
+               if (st%code == 0 .and. len(wisdom) > 0) call save_wisdom(wisdom, st)
                if (st%code == 0) then
                   do k = 1, size(cg_report)
                      if (cg_report(k)%residual > cg_tol) then

@@ -3,7 +3,7 @@ module femcod_strings
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: string_type, int_str, real_str, split_list, text_builder, add_line, built_text, without_trailing_zeros
+   public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, built_text, without_trailing_zeros
 
    !> A string of any length, for lists of arguments.
    type :: string_type
@@ -79,6 +79,19 @@ contains
       write(buf, fmt) x
       s = trim(adjustl(buf))
    end function real_str
+
+   !> A real in fixed-point form with `decimals` digits after the point (tables).
+   function fixed_str(x, decimals) result(s)
+      real(dp), intent(in) :: x
+      integer, intent(in) :: decimals
+      character(len=:), allocatable :: s
+      character(len=40) :: buf, fmt
+      write(fmt, '("(f0.",i0,")")') decimals
+      write(buf, fmt) x
+      s = trim(adjustl(buf))
+      if (s(1:1) == ".") s = "0"//s
+      if (s(1:min(2, len(s))) == "-.") s = "-0"//s(2:)
+   end function fixed_str
 
    !> Split "a,b,c" at commas.
    function split_list(text) result(parts)
