@@ -8,8 +8,13 @@ module test_cg
    use femcod_cli, only: run_femcod
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_incremental, only: solve_incremental
-   use femcod_cg, only: solve_cg, cg_residuals
-   use femcod_generate, only: VERIFICATION_DECKS
+   use femcod_cg, only: solve_cg, cg_residuals, cg_method
+   use femcod_generate, only: VERIFICATION_DECKS, deck_spec, build_deck
+   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
+      convolution_free
+   use femcod_boussinesq, only: offset_table
+   use femcod_random, only: random_stream, seed_stream, uniform
+   use test_support, only: scratch_path, file_exists, remove_scratch
    use femcod_analytic, only: hertz_approach, segedin_sphere
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -23,7 +28,10 @@ contains
       testsuite = [ &
          new_unittest("equals the event-exact solver inside steps on every input/ deck", test_against_incremental), &
          new_unittest("sphere, 0.5 nm mesh: Hertz at 1000 nN, Segedin at 18000 nN", test_sphere), &
-         new_unittest("--solver cg without --loads is a usage error", test_usage) &
+         new_unittest("--solver cg without --loads is a usage error", test_usage), &
+         new_unittest("pruned padded FFT convolution equals the direct sum (NP 7, 8, 33)", test_convolution), &
+         new_unittest("every acceleration, alone and together, keeps the event-exact answer", test_accelerations), &
+         new_unittest("--fftw-wisdom writes both wisdom files and leaves the answer unchanged", test_wisdom) &
          ]
    end subroutine collect_cg
 
@@ -110,4 +118,161 @@ contains
          string_type("cg"), string_type("--quiet")], code)
       call check(error, code, 2)
    end subroutine test_usage
+   !> The convolution by pruned 1-D passes, the real kernel spectrum and the wrapped
+   !> kernel, against the O(NP^4) direct sum over the same Love table (independent of any
+   !> transform): agreement to round-off in double, and to float32's unit round-off
+   !> (6e-8) times a small growth factor in single precision (bound 1e-5 of the largest
+   !> value). Odd, even and odd-prime sides.
+   subroutine test_convolution(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: sides(3) = [7, 8, 33]
+      type(love_convolution) :: conv
+      type(random_stream) :: stream
+      real(dp), allocatable :: table(:, :), field(:, :), fast(:, :), single(:, :), direct(:, :)
+      integer :: n, np, i, j, k, l
+      call seed_stream(stream, 11)
+      do n = 1, size(sides)
+         np = sides(n)
+         allocate(table(0:np - 1, 0:np - 1), field(np, np), fast(np, np), single(np, np), direct(np, np))
+         table = offset_table(np)
+         do j = 1, np
+            do i = 1, np
+               call uniform(stream, field(i, j))
+            end do
+         end do
+         direct = 0
+         do j = 1, np
+            do i = 1, np
+               do l = 1, np
+                  do k = 1, np
+                     direct(i, j) = direct(i, j) + table(abs(i - k), abs(j - l))*field(k, l)
+                  end do
+               end do
+            end do
+         end do
+         call convolution_setup(conv, table, single=.true.)
+         call convolution_apply(conv, field, fast)
+         call convolution_apply_single(conv, field, single)
+         call convolution_free(conv)
+         call check(error, maxval(abs(fast - direct)) <= 1.0e-13_dp*maxval(abs(direct)), "double, NP = "// &
+            to_string(np)//": "//to_string(maxval(abs(fast - direct))/maxval(abs(direct))))
+         if (allocated(error)) return
+         call check(error, maxval(abs(single - direct)) <= 1.0e-5_dp*maxval(abs(direct)), "float32, NP = "// &
+            to_string(np)//": "//to_string(maxval(abs(single - direct))/maxval(abs(direct))))
+         if (allocated(error)) return
+         deallocate(table, field, fast, single, direct)
+      end do
+   end subroutine test_convolution
+
+   !> A 64 x 64 self-affine surface (Hurst 0.8): the event-exact solver's history gives
+   !> loads strictly inside steps (where contacts and approach are exact by linearity);
+   !> the CG solver with each acceleration alone (nested grids down to 16, float32 early
+   !> iterations, direct corrections, preconditioner, restarts) and with none must find
+   !> the same contact count and the approach to 1e-8 relative (tolerance 1e-10 on the
+   !> gap residual).
+   subroutine test_accelerations(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(deck_spec) :: spec
+      type(deck_type) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: inc, cg
+      type(cg_residuals), allocatable :: report(:)
+      type(cg_method) :: plain, how(6)
+      type(status_type) :: status
+      real(dp), allocatable :: loads(:)
+      integer :: v, k, n, s
+      spec%kind = "self-affine"
+      spec%np = 64
+      spec%pixel = 10
+      spec%hurst = 0.8_dp
+      spec%rms = 3
+      spec%seed = 5
+      spec%shape_on = "lower"
+      spec%rigid = "upper"
+      spec%label = "test"
+      spec%matrix_file = ""
+      spec%maxcont = 200
+      call build_deck(spec, deck, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      options%loads = [real(dp) ::]
+      call solve_incremental(deck, options, inc, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      n = inc%nsteps
+      loads = [((inc%step_load(s) + inc%step_load(s + 1))/2, s=n/8, n - 1, n/4)]
+      options%loads = loads
+      call solve_incremental(deck, options, inc, status)
+      plain = cg_method(nested=.false., single_until=0, direct_corrections=0, precondition=.false., &
+         restart_on_entry=.true.)
+      how = plain
+      how(1)%nested = .true.
+      how(1)%coarsest = 16
+      how(2)%single_until = 1.0e-3_dp
+      how(3)%direct_corrections = 32
+      how(4)%precondition = .true.
+      how(5)%restart_on_entry = .false.
+      how(6) = cg_method(coarsest=16)
+      do v = 0, size(how)
+         if (v == 0) then
+            call solve_cg(deck, options, 1.0e-10_dp, 5000, cg, report, status, plain)
+         else
+            call solve_cg(deck, options, 1.0e-10_dp, 5000, cg, report, status, how(v))
+         end if
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         do k = 1, size(loads)
+            call check(error, report(k)%residual < 1.0e-10_dp, "variant "//to_string(v)//": residual "// &
+               to_string(report(k)%residual))
+            if (allocated(error)) return
+            call check(error, cg%states(k)%contacts, inc%states(k)%contacts, "variant "//to_string(v)// &
+               ": contacts at "//to_string(loads(k))//" nN")
+            if (allocated(error)) return
+            call check(error, abs(cg%states(k)%approach - inc%states(k)%approach) <= &
+               1.0e-8_dp*abs(inc%states(k)%approach), "variant "//to_string(v)//": approach "// &
+               to_string(cg%states(k)%approach)//" vs "//to_string(inc%states(k)%approach))
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_accelerations
+
+   !> `--fftw-wisdom FILE`: both files written; a second run that reads them gives the
+   !> same approach (plans change the round-off only: 1e-12 relative).
+   subroutine test_wisdom(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: wisdom, prefix
+      integer :: code, pass
+      real(dp) :: approach(2)
+      wisdom = scratch_path("cg.wisdom")
+      prefix = scratch_path("cg_wisdom")
+      call remove_scratch(wisdom)
+      call remove_scratch(wisdom//".float32")
+      do pass = 1, 2
+         call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--solver"), &
+            string_type("cg"), string_type("--loads"), string_type("5000"), string_type("--fftw-wisdom"), &
+            string_type(wisdom), string_type("-o"), string_type(prefix), string_type("--force"), &
+            string_type("--quiet")], code)
+         call check(error, code, 0, "run with --fftw-wisdom, pass "//to_string(pass))
+         if (allocated(error)) return
+         call check(error, file_exists(wisdom) .and. file_exists(wisdom//".float32"), "wisdom files")
+         if (allocated(error)) return
+         approach(pass) = loads_approach(prefix//".loads.csv")
+      end do
+      call check(error, abs(approach(2) - approach(1)) <= 1.0e-12_dp*abs(approach(1)), "approach "// &
+         to_string(approach(1))//" then "//to_string(approach(2)))
+   end subroutine test_wisdom
+
+   !> The approach (second column) of the first data row of a loads.csv.
+   real(dp) function loads_approach(path)
+      character(len=*), intent(in) :: path
+      integer :: unit, ios
+      real(dp) :: load
+      character(len=256) :: header
+      loads_approach = -1
+      open(newunit=unit, file=path, action="read", status="old", iostat=ios)
+      if (ios /= 0) return
+      read(unit, '(a)', iostat=ios) header
+      read(unit, *, iostat=ios) load, loads_approach
+      close(unit)
+   end function loads_approach
 end module test_cg
