@@ -19,6 +19,10 @@
 !>   a fresh convolution otherwise.
 !> - float32 transforms while the residual is large (above `single_until`), then double.
 !>   Every switch, and the final answer, starts from a fresh double convolution.
+!> - A preconditioner: the search direction is the contact gaps filtered by the 13-point
+!>   stencil of the inverse Love operator (inverse_kernel_taps, a discrete E*|q|/2).
+!> - No restart of the conjugate directions when overlapping pixels enter the contact
+!>   (Polonsky and Keer restart; `restart_on_entry` brings it back).
 !>
 !> Stopping rule: the relative complementarity residual
 !>     r = max( max over contacts |g| , max over the rest max(-g, 0) ) / (max g0 - min g0)
