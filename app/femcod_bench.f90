@@ -1,7 +1,7 @@
 !> `femcod bench`: speed against error, one table. Every number is measured in this run.
 module femcod_bench
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use femcod_kinds, only: dp, i8
+   use femcod_kinds, only: dp
    use femcod_status, only: status_type
    use femcod_deck, only: deck_type, read_deck, parse_integer
    use femcod_generate, only: deck_spec, build_deck, THESIS_RIGID_FACTOR
@@ -13,8 +13,6 @@ module femcod_bench
    use femcod_analytic, only: segedin_sphere
    use femcod_scene, only: initial_gaps
    use femcod_deck, only: parse_real, parse_real_list, parse_integer_list
-   use femcod_boussinesq, only: surface_compliance
-   use femcod_clock, only: wall_clock
    use femcod_wisdom, only: load_wisdom, save_wisdom
    implicit none
    private

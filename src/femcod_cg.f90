@@ -67,7 +67,7 @@ module femcod_cg
       !> operator (a discrete |q|), applied on the contact set.
       logical :: precondition = .true.
       !> Restart the conjugate directions (beta = 0) after overlapping pixels enter the
-      !> contact, as Polonsky and Keer do (off: keep them; measured 10-25 % fewer
+      !> contact, as Polonsky and Keer do (off: keep them; measured 12-14 % fewer
       !> iterations at NP = 1024, doc/performance.md).
       logical :: restart_on_entry = .false.
       !> Largest number of projection changes corrected directly (0: a fresh convolution
@@ -283,7 +283,7 @@ contains
       real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, residual, &
          contact_gap, penetration, alpha, pn, lin
       integer :: np, i, j, it, nc, nchanged, limit
-      logical :: restart, single, fresh, overflow, fresh_double
+      logical :: restart, single, fresh, overflow, fresh_double, stalled
       np = grid%np
       c = grid%c
       s = grid%s
@@ -301,11 +301,13 @@ contains
       t = 0
       it = 0
       fresh_double = .false.
+      stalled = .false.
       do
          if (fresh) then
             call displacements(p, w)
             fresh = .false.
             restart = .true.
+            stalled = .false.
          end if
          ! Gaps and the contacts' mean gap.
          nc = 0
@@ -343,8 +345,7 @@ contains
             end do
          end do
          residual = max(contact_gap, penetration)/grid%scale
-         if (grid%preconditioned) call precondition(big_g)
-         if (residual < tol .or. it >= max_iterations) then
+         if (residual < tol .or. it >= max_iterations .or. stalled) then
             ! Accept only on displacements from a fresh double-precision convolution.
             if (.not. fresh_double) then
                single = .false.
@@ -358,6 +359,7 @@ contains
             fresh = .true.
             cycle
          end if
+         if (grid%preconditioned) call precondition(big_g)
          it = it + 1
          if (restart .or. .not. big_g_old > 0) then
             beta = 0
@@ -399,13 +401,10 @@ contains
          rbar = rsum/nc
          den = rt - rbar*tsum
          if (.not. abs(den) > 0) then
-            ! Nothing left to move: the forces are the solution to round-off.
-            if (.not. fresh_double) then
-               single = .false.
-               fresh = .true.
-               cycle
-            end if
-            exit
+            ! Nothing left to move: the forces are the solution to round-off; accepted
+            ! at the top of the loop, on fresh displacements.
+            stalled = .true.
+            cycle
          end if
          tau = num/den
          ! Step, projection, overlap correction; the displacements follow linearly
