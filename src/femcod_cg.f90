@@ -17,7 +17,8 @@
 !>   the pixels the projection changes (forces clipped to zero, overlapping pixels that
 !>   enter) need a correction, added directly from the Love table when they are few, by
 !>   a fresh convolution otherwise.
-!> - float32 transforms while the residual is large (above `single_until`), then double.
+!> - float32 transforms for the search directions, and for the forces' own displacements
+!>   while the residual is large (above `single_until`), then double.
 !>   Every switch, and the final answer, starts from a fresh double convolution.
 !> - A preconditioner: the search direction is the contact gaps filtered by the 13-point
 !>   stencil of the inverse Love operator (inverse_kernel_taps, a discrete E*|q|/2).
@@ -287,9 +288,9 @@ contains
       integer, allocatable :: changed(:, :)
       real(dp), allocatable :: delta(:)
       real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, residual, &
-         contact_gap, penetration, alpha, pn, lin, entry
-      integer :: np, i, j, it, nc, nchanged, limit
-      logical :: restart, single, fresh, overflow, fresh_double, stalled
+         contact_gap, penetration, alpha, pn, lin, entry, zbar
+      integer :: np, i, j, it, nc, nchanged, limit, slot
+      logical :: restart, entered, single, fresh, fresh_double, stalled
       np = grid%np
       c = grid%c
       s = grid%s
@@ -299,13 +300,15 @@ contains
          allocate(gm(-1:np + 2, -1:np + 2), z(np, np))
          gm = 0
       end if
-      p = p*(total_load/sum(p))
+      ! The load balance: p and w are multiplied by `alpha` where the gaps are next formed.
+      alpha = total_load/sum(p)
       single = how%single_until > 0
       fresh = .true.
       restart = .true.
       big_g_old = 1
       t = 0
       it = 0
+      zbar = 0
       fresh_double = .false.
       stalled = .false.
       do
@@ -314,12 +317,14 @@ contains
             fresh = .false.
             stalled = .false.
          end if
-         ! Gaps and the contacts' mean gap.
+         ! Load balance, gaps and the contacts' mean gap.
          nc = 0
          gbar = 0
          !$omp parallel do private(i) reduction(+:nc, gbar)
          do j = 1, np
             do i = 1, np
+               p(i, j) = alpha*p(i, j)
+               w(i, j) = alpha*w(i, j)
                g(i, j) = grid%g0(i, j) + w(i, j) + s*p(i, j)
                if (p(i, j) > 0) then
                   nc = nc + 1
@@ -327,13 +332,15 @@ contains
                end if
             end do
          end do
+         alpha = 1
          if (nc == 0) then
             call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
             return
          end if
          gbar = gbar/nc
          approach = gbar
-         ! Residuals of the current forces, and the new search direction's norm.
+         ! Residuals of the current forces, the search direction's norm, and the
+         ! contacts' gaps for the preconditioner (zero elsewhere).
          big_g = 0
          contact_gap = 0
          penetration = 0
@@ -344,8 +351,10 @@ contains
                if (p(i, j) > 0) then
                   big_g = big_g + g(i, j)**2
                   contact_gap = max(contact_gap, abs(g(i, j)))
+                  if (grid%preconditioned) gm(i, j) = g(i, j)
                else
                   penetration = max(penetration, -g(i, j))
+                  if (grid%preconditioned) gm(i, j) = 0
                end if
             end do
          end do
@@ -364,7 +373,7 @@ contains
             fresh = .true.
             cycle
          end if
-         if (grid%preconditioned) call precondition(big_g)
+         if (grid%preconditioned) call precondition(big_g, zbar)
          it = it + 1
          if (restart .or. .not. big_g_old > 0) then
             beta = 0
@@ -378,7 +387,7 @@ contains
             do i = 1, np
                if (p(i, j) > 0) then
                   if (grid%preconditioned) then
-                     t(i, j) = z(i, j) + beta*t(i, j)
+                     t(i, j) = z(i, j) - zbar + beta*t(i, j)
                   else
                      t(i, j) = g(i, j) + beta*t(i, j)
                   end if
@@ -388,8 +397,11 @@ contains
                end if
             end do
          end do
-         ! r = c (I * t): the displacements of the search direction.
-         call convolve(t, r)
+         ! r = c (I * t): the displacements of the search direction, always in float32
+         ! when float32 is on: its round-off (1e-7 of r) scales with the step, and the
+         ! steps shrink with the residual, so it never limits the accuracy; the forces'
+         ! own displacements (fresh) switch to double below `single_until`.
+         call convolve(t, r, how%single_until > 0)
          rt = 0
          rsum = 0
          tsum = 0
@@ -413,13 +425,14 @@ contains
          end if
          tau = num/den
          ! Step, projection, overlap correction; the displacements follow linearly
-         ! (w - tau r) except where the projection changed a force.
+         ! (w - tau r) except where the projection changed a force. The first `limit`
+         ! changes are kept (in any order; sorted below) for a direct correction.
          entry = 1
          if (grid%preconditioned) entry = grid%taps(0, 0)
          nchanged = 0
-         overflow = .false.
-         restart = .false.
+         entered = .false.
          psum = 0
+         !$omp parallel do private(i, lin, pn, slot) reduction(+:psum) reduction(.or.:entered)
          do j = 1, np
             do i = 1, np
                if (p(i, j) > 0) then
@@ -430,41 +443,36 @@ contains
                   pn = 0
                   if (g(i, j) < 0) then
                      pn = -tau*entry*g(i, j)
-                     restart = how%restart_on_entry
+                     entered = .true.
                   end if
                end if
                p(i, j) = pn
                w(i, j) = w(i, j) - tau*r(i, j)
                psum = psum + pn
                if (pn /= lin) then
+                  !$omp atomic capture
                   nchanged = nchanged + 1
-                  if (nchanged <= limit) then
-                     changed(:, nchanged) = [i, j]
-                     delta(nchanged) = pn - lin
-                  else
-                     overflow = .true.
+                  slot = nchanged
+                  !$omp end atomic
+                  if (slot <= limit) then
+                     changed(:, slot) = [i, j]
+                     delta(slot) = pn - lin
                   end if
                end if
             end do
          end do
+         restart = entered .and. how%restart_on_entry
          fresh_double = .false.
          if (.not. psum > 0) then
             call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
             return
          end if
-         if (overflow) then
+         if (nchanged > limit) then
             fresh = .true.
          else if (nchanged > 0) then
             call add_direct(nchanged)
          end if
          alpha = total_load/psum
-         !$omp parallel do private(i)
-         do j = 1, np
-            do i = 1, np
-               p(i, j) = alpha*p(i, j)
-               w(i, j) = alpha*w(i, j)
-            end do
-         end do
       end do
       rep%iterations = rep%iterations + it
       rep%residual = residual
@@ -472,22 +480,13 @@ contains
       rep%penetration = penetration
       rep%load_error = abs(sum(p) - total_load)/total_load
    contains
-      !> z = the stencil applied to the contacts' gaps, on the contacts, mean removed;
-      !> big_g = g . z (the preconditioned norm for beta).
-      subroutine precondition(big_g)
-         real(dp), intent(out) :: big_g
-         real(dp) :: zsum, gz, gsum, zbar
+      !> z = the stencil applied to the contacts' gaps gm (zero off the contacts), on the
+      !> contacts; zbar its mean there (the direction is z - zbar); big_g = g . (z - zbar),
+      !> the preconditioned norm for beta.
+      subroutine precondition(big_g, zbar)
+         real(dp), intent(out) :: big_g, zbar
+         real(dp) :: zsum, gz, gsum
          integer :: ii, jj
-         !$omp parallel do private(ii)
-         do jj = 1, np
-            do ii = 1, np
-               if (p(ii, jj) > 0) then
-                  gm(ii, jj) = g(ii, jj)
-               else
-                  gm(ii, jj) = 0
-               end if
-            end do
-         end do
          zsum = 0
          gz = 0
          gsum = 0
@@ -509,43 +508,50 @@ contains
          end associate
          zbar = zsum/nc
          big_g = gz - zbar*gsum
-         !$omp parallel do private(ii)
-         do jj = 1, np
-            do ii = 1, np
-               if (p(ii, jj) > 0) z(ii, jj) = z(ii, jj) - zbar
-            end do
-         end do
       end subroutine precondition
 
       !> w = c (I * f) with fresh transforms (float32 while `single`).
       subroutine displacements(f, out)
          real(dp), intent(in) :: f(:, :)
          real(dp), intent(out) :: out(:, :)
-         call convolve(f, out)
+         call convolve(f, out, single)
          rep%convolutions = rep%convolutions + 1
          fresh_double = .not. single
       end subroutine displacements
 
-      subroutine convolve(f, out)
+      !> out = c (I * f), in float32 when `in_single`.
+      subroutine convolve(f, out, in_single)
          real(dp), intent(in) :: f(:, :)
          real(dp), intent(out) :: out(:, :)
-         integer :: jj
-         if (single) then
-            call convolution_apply_single(grid%conv, f, out)
+         logical, intent(in) :: in_single
+         if (in_single) then
+            call convolution_apply_single(grid%conv, f, out, c)
          else
-            call convolution_apply(grid%conv, f, out)
+            call convolution_apply(grid%conv, f, out, c)
          end if
          fresh_double = .false.
-         !$omp parallel do
-         do jj = 1, np
-            out(:, jj) = c*out(:, jj)
-         end do
       end subroutine convolve
 
       !> w += c * I * (the changed forces' corrections), summed directly from the table.
       subroutine add_direct(n)
          integer, intent(in) :: n
-         integer :: jj, ii, q, iq, jq
+         integer :: jj, ii, q, iq, jq, key(2)
+         real(dp) :: d
+         ! The threads filled the list in any order: sort it by column, then row, so
+         ! that the sums below, and the answer, do not depend on the threads.
+         do q = 2, n
+            key = changed(:, q)
+            d = delta(q)
+            jj = q - 1
+            do while (jj >= 1)
+               if (changed(2, jj) < key(2) .or. (changed(2, jj) == key(2) .and. changed(1, jj) < key(1))) exit
+               changed(:, jj + 1) = changed(:, jj)
+               delta(jj + 1) = delta(jj)
+               jj = jj - 1
+            end do
+            changed(:, jj + 1) = key
+            delta(jj + 1) = d
+         end do
          !$omp parallel do private(ii, q, iq, jq)
          do jj = 1, np
             do q = 1, n

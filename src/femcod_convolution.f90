@@ -157,12 +157,17 @@ contains
       threads_ready = .true.
    end subroutine start_fft_threads
 
-   !> result(i, j) = sum_{k,l} I(i-k, j-l) field(k, l) over the NP x NP grid.
-   subroutine convolution_apply(conv, field, result)
+   !> result(i, j) = factor * sum_{k,l} I(i-k, j-l) field(k, l) over the NP x NP grid.
+   subroutine convolution_apply(conv, field, result, factor)
       type(love_convolution), intent(inout) :: conv
       real(dp), intent(in) :: field(:, :)
       real(dp), intent(out) :: result(:, :)
+      !> Multiplies the result (default 1): a compliance, folded into the last copy.
+      real(dp), intent(in), optional :: factor
+      real(dp) :: f
       integer :: np, j
+      f = 1
+      if (present(factor)) f = factor
       np = conv%np
       !$omp parallel do
       do j = 1, np
@@ -183,16 +188,21 @@ contains
       call fftw_execute_dft_c2r(conv%double%columns_backward, conv%spectrum, conv%work)
       !$omp parallel do
       do j = 1, np
-         result(:, j) = conv%work(1:np, j)
+         result(:, j) = f*conv%work(1:np, j)
       end do
    end subroutine convolution_apply
 
    !> As convolution_apply, with float32 transforms (needs setup with single = .true.).
-   subroutine convolution_apply_single(conv, field, result)
+   subroutine convolution_apply_single(conv, field, result, factor)
       type(love_convolution), intent(inout) :: conv
       real(dp), intent(in) :: field(:, :)
       real(dp), intent(out) :: result(:, :)
+      !> Multiplies the result (default 1): a compliance, folded into the last copy.
+      real(dp), intent(in), optional :: factor
+      real(dp) :: f
       integer :: np, j
+      f = 1
+      if (present(factor)) f = factor
       np = conv%np
       !$omp parallel do
       do j = 1, np
@@ -213,7 +223,7 @@ contains
       call fftwf_execute_dft_c2r(conv%single%columns_backward, conv%spectrum32, conv%work32)
       !$omp parallel do
       do j = 1, np
-         result(:, j) = real(conv%work32(1:np, j), dp)
+         result(:, j) = f*real(conv%work32(1:np, j), dp)
       end do
    end subroutine convolution_apply_single
 
