@@ -213,7 +213,8 @@ contains
                "pressures and tolerance. --fftw-wisdom FILE: measured FFTW plans kept in FILE (the first run", &
                "on a size pays the planning inside its wall time). Method switches, for the speed/accuracy", &
                "table: --nested on|off, --coarsest N, --coarse-tol T, --single-until R (0: no float32),", &
-               "--direct N (0: two convolutions per iteration), --restart on|off, --precondition on|off.", &
+               "--direct N (0: two convolutions per iteration), --restart on|off, --precondition on|off,", &
+               "--polak-ribiere on|off (off: Fletcher-Reeves beta).", &
                "Run it with the release build.", &
                "Columns: NP, target %, solver, wall (s), iterations, residual, contact %, peak RSS (MB)."
             return
@@ -237,6 +238,8 @@ contains
             if (ok) method%restart_on_entry = args(i + 1)%s == "on"
          case ("--precondition")
             if (ok) method%precondition = args(i + 1)%s == "on"
+         case ("--polak-ribiere")
+            if (ok) method%polak_ribiere = args(i + 1)%s == "on"
          case ("--coarsest")
             if (ok) call parse_integer(args(i + 1)%s, method%coarsest, ok)
          case ("--coarse-tol")

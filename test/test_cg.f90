@@ -177,7 +177,7 @@ contains
       type(contact_options) :: options
       type(contact_result) :: inc, cg
       type(cg_residuals), allocatable :: report(:)
-      type(cg_method) :: plain, how(6)
+      type(cg_method) :: plain, how(7)
       type(status_type) :: status
       real(dp), allocatable :: loads(:)
       integer :: v, k, n, s
@@ -204,7 +204,7 @@ contains
       options%loads = loads
       call solve_incremental(deck, options, inc, status)
       plain = cg_method(nested=.false., single_until=0, direct_corrections=0, precondition=.false., &
-         restart_on_entry=.true.)
+         restart_on_entry=.true., polak_ribiere=.false.)
       how = plain
       how(1)%nested = .true.
       how(1)%coarsest = 16
@@ -212,7 +212,8 @@ contains
       how(3)%direct_corrections = 32
       how(4)%precondition = .true.
       how(5)%restart_on_entry = .false.
-      how(6) = cg_method(coarsest=16)
+      how(6)%polak_ribiere = .true.
+      how(7) = cg_method(coarsest=16)
       do v = 0, size(how)
          if (v == 0) then
             call solve_cg(deck, options, 1.0e-10_dp, 5000, cg, report, status, plain)
