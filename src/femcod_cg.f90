@@ -28,7 +28,7 @@
 !>   step and the contact set swings (at NP = 1024, 1 %: to three times its final size).
 !> - beta by Polak-Ribiere clipped at zero (PR+) rather than Fletcher-Reeves: it restarts
 !>   by itself when the contact set has turned the gradient (2048^2: 45 -> 40 iterations
-!>   at 1 %, 77 -> 73 at 10 %).
+!>   at 1 %, 77 -> 71 at 10 %).
 !> - No restart of the conjugate directions when overlapping pixels enter the contact
 !>   (Polonsky and Keer restart; `restart_on_entry` brings it back), nor after a fresh
 !>   convolution (in the first iterations, when many forces change, that is every
