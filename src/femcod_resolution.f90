@@ -135,7 +135,7 @@ contains
       real(dp), intent(out) :: area(:)
       integer, parameter :: nt = 1301
       real(dp) :: hs(nt), lp(nt), la(nt), t, x
-      integer :: k, lo, hi, mid
+      integer :: k, lo, hi
       area = 0
       if (p%density <= 0 .or. p%sigma <= 0) return
       do k = 1, nt
@@ -155,16 +155,8 @@ contains
             area(k) = exp(la(nt))
             cycle
          end if
-         lo = 1
-         hi = nt
-         do while (hi - lo > 1)
-            mid = (lo + hi)/2
-            if (lp(mid) <= x) then
-               lo = mid
-            else
-               hi = mid
-            end if
-         end do
+         lo = bracket(lp, x)
+         hi = lo + 1
          t = (x - lp(lo))/(lp(hi) - lp(lo))
          area(k) = exp(la(lo) + t*(la(hi) - la(lo)))
       end do
@@ -174,26 +166,40 @@ contains
    !> linear interpolation between steps; -1 outside the history's load range.
    pure real(dp) function interpolate_area(loads, areas, load)
       real(dp), intent(in) :: loads(:), areas(:), load
-      integer :: lo, hi, mid
+      integer :: lo, hi
       interpolate_area = -1
       if (size(loads) == 0) return
       if (load < loads(1) .or. load > loads(size(loads))) return
-      lo = 1
-      hi = size(loads)
-      do while (hi - lo > 1)
-         mid = (lo + hi)/2
-         if (loads(mid) <= load) then
-            lo = mid
-         else
-            hi = mid
-         end if
-      end do
+      if (size(loads) == 1) then
+         interpolate_area = areas(1)
+         return
+      end if
+      lo = bracket(loads, load)
+      hi = lo + 1
       if (loads(hi) == loads(lo)) then
          interpolate_area = areas(hi)
       else
          interpolate_area = areas(lo) + (load - loads(lo))/(loads(hi) - loads(lo))*(areas(hi) - areas(lo))
       end if
    end function interpolate_area
+
+   !> The interval of an ascending table (at least two entries) that holds x: the index lo
+   !> in 1..n-1 with table(lo) <= x <= table(lo + 1), by bisection (the last such lo when
+   !> x equals an entry); x outside the table gives the end interval on its side.
+   pure integer function bracket(table, x) result(lo)
+      real(dp), intent(in) :: table(:), x
+      integer :: hi, mid
+      lo = 1
+      hi = size(table)
+      do while (hi - lo > 1)
+         mid = (lo + hi)/2
+         if (table(mid) <= x) then
+            lo = mid
+         else
+            hi = mid
+         end if
+      end do
+   end function bracket
 
    !> Richardson extrapolation of the area at the fine image's loads (thesis Fig. 4.18b):
    !> A = (r^p A_fine - A_coarse)/(r^p - 1) with r = np_fine/np_coarse and rate p
