@@ -59,7 +59,9 @@ module femcod_cg
    type :: cg_residuals
       !> Iterations on the full grid, and on all coarser grids together.
       integer :: iterations = 0, coarse_iterations = 0
-      !> Fresh convolutions on the full grid (one per iteration, plus restarts and checks).
+      !> Fresh convolutions of the forces on the full grid (when more than
+      !> `direct_corrections` forces changed, at the switch to double, and for the final
+      !> check); each iteration convolves its search direction besides.
       integer :: convolutions = 0
       real(dp) :: penetration = 0, contact_gap = 0, load_error = 0, residual = 0
    end type cg_residuals
@@ -77,8 +79,8 @@ module femcod_cg
       !> operator (a discrete |q|), applied on the contact set.
       logical :: precondition = .true.
       !> Restart the conjugate directions (beta = 0) after overlapping pixels enter the
-      !> contact, as Polonsky and Keer do (off: keep them; measured 12-14 % fewer
-      !> iterations at NP = 1024, doc/performance.md).
+      !> contact, as Polonsky and Keer do (off: keep them; at NP = 1024 on: 59 instead of
+      !> 32 iterations at 1 %, 144 instead of 54 at 10 %, doc/performance.md).
       logical :: restart_on_entry = .false.
       !> beta by Polak-Ribiere, clipped at 0 (PR+: z.(g - g_old)/(z_old.g_old)), which
       !> restarts by itself when the contact set has moved the gradient; off: Fletcher-
@@ -311,6 +313,9 @@ contains
          allocate(g_old(np, np))
          g_old = 0
       end if
+      ! Overlapping pixels enter with the preconditioned step's force for a lone pixel.
+      entry = 1
+      if (grid%preconditioned) entry = grid%taps(0, 0)
       ! The load balance: p and w are multiplied by `alpha` where the gaps are next formed.
       alpha = total_load/sum(p)
       single = how%single_until > 0
@@ -443,8 +448,6 @@ contains
          ! Step, projection, overlap correction; the displacements follow linearly
          ! (w - tau r) except where the projection changed a force. The first `limit`
          ! changes are kept (in any order; sorted below) for a direct correction.
-         entry = 1
-         if (grid%preconditioned) entry = grid%taps(0, 0)
          nchanged = 0
          entered = .false.
          psum = 0
