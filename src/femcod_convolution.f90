@@ -2,18 +2,28 @@
 !> (FFTW, plans made once): (I * F)(p) = sum_k I(p - k) F(k), exact for the non-periodic
 !> half-space because the padding keeps every image out of the grid.
 !>
-!> The 2-D transform is done as two passes of 1-D transforms so that the padding costs
-!> nothing it need not: the forward column pass transforms only the NP columns that hold
-!> data (the other NP are zero), the backward column pass only the NP columns that are
-!> read back. Both row passes are full. That is 3/4 of the work of a full 2-D r2c/c2r
-!> pair. The kernel is even in both offsets, so its spectrum is real and the product is a
-!> real scaling of the complex spectrum.
+!> The 2-D transform is done in three passes of 1-D transforms so that the padding costs
+!> nothing it need not, and each pass works through the grid in blocks of a few lines
+!> that stay in cache (one block per OpenMP thread at a time, FFTW's single-threaded
+!> plans executed on each thread's own buffers):
+!>   1. columns: each of the NP data columns, zero-padded to M = 2 NP, by a real r2c
+!>      transform into the half spectrum (MH = NP + 1 rows; the other NP columns are zero
+!>      and are never stored);
+!>   2. rows: a block of spectrum rows is gathered into contiguous lines of length M (the
+!>      zero half filled in), transformed forward, multiplied by the kernel's spectrum,
+!>      transformed back, and only its first NP entries written back (only those columns
+!>      are read back);
+!>   3. columns: c2r of the NP columns read back, cropped to the grid.
+!> That is 3/4 of the work of a full 2-D r2c/c2r pair, and the spectrum held is MH x NP
+!> instead of MH x M. The kernel is even in both offsets, so its spectrum is real and
+!> even, and is kept for k2 = 0..NP only (the other half is its mirror image).
 !>
 !> `convolution_apply_single` does the same in float32 (FFTW's single-precision library,
 !> on the same memory): about half the time, relative error ~1e-7 of the result. The
-!> fixed-load solver uses it for its early iterations only.
+!> fixed-load solver uses it for its early iterations and its search directions.
 !>
-!> FFTW runs with as many threads as OpenMP allows (OMP_NUM_THREADS, default all cores).
+!> The passes run on as many threads as OpenMP allows (OMP_NUM_THREADS, default all
+!> cores) when the convolution is set up.
 module femcod_convolution
    use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_float, c_double_complex, c_float_complex, c_int, &
       c_size_t, c_f_pointer
@@ -25,7 +35,7 @@ module femcod_convolution
       fftw_destroy_plan, fftwf_destroy_plan, fftw_alloc_real, fftw_alloc_complex, fftw_free, &
       fftw_init_threads, fftwf_init_threads, fftw_plan_with_nthreads, fftwf_plan_with_nthreads, &
       FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, FFTW_BACKWARD
-   !$ use omp_lib, only: omp_get_max_threads
+   !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
    implicit none
    private
    public :: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, convolution_free, &
@@ -33,25 +43,33 @@ module femcod_convolution
 
    integer, parameter :: sp = kind(1.0)
 
-   !> One set of plans for one precision.
+   !> Lines per block in every pass: 8 lines of M = 8192 are 0.5 MB of float32 complex, in
+   !> L2 cache; 4 and 16 were slower at NP = 2048 and 4096 (doc/performance.md).
+   integer, parameter :: lines_per_block = 8
+
+   !> One set of plans for one precision, each for one block of `lines_per_block` lines of
+   !> length M: r2c and c2r down contiguous columns, forward and backward complex along
+   !> contiguous lines (in place). Single-threaded; run on each thread's own buffers.
    type :: plan_set
-      type(c_ptr) :: columns_forward, rows_forward, rows_backward, columns_backward
+      type(c_ptr) :: columns_forward, columns_backward, rows_forward, rows_backward
    end type plan_set
 
-   !> Plans, the transformed kernel and work arrays for one grid size.
+   !> Plans, the transformed kernel, the half spectrum and the threads' buffers for one
+   !> grid size.
    type :: love_convolution
-      !> Grid size NP, padded size M = 2 NP, complex rows MH = M/2 + 1.
-      integer :: np = 0, m = 0, mh = 0
+      !> Grid size NP, padded size M = 2 NP, rows of the half spectrum MH = M/2 + 1, lines
+      !> per block, threads (buffers) the passes run on.
+      integer :: np = 0, m = 0, mh = 0, block = 0, threads = 0
       logical :: has_single = .false.
       type(plan_set) :: double, single
-      type(c_ptr) :: real_mem, complex_mem
-      !> Column-pass data (M x NP) and the half spectrum (MH x M), double and float32 views
-      !> of the same memory.
-      real(c_double), pointer :: work(:, :) => null()
+      !> The half spectrum of the NP data columns (MH x NP), in double or in float32.
+      type(c_ptr) :: spectrum_mem
       complex(c_double_complex), pointer :: spectrum(:, :) => null()
-      real(c_float), pointer :: work32(:, :) => null()
       complex(c_float_complex), pointer :: spectrum32(:, :) => null()
-      !> Real kernel spectrum divided by M^2 (MH x M), and its float32 copy.
+      !> Per thread: a real block (M x block) and a complex block (M x block).
+      type(c_ptr), allocatable :: real_mem(:), complex_mem(:)
+      !> Real kernel spectrum divided by M^2, transposed: kernel(k2, k1), k2 = 0..NP,
+      !> k1 = 1..MH; and its float32 copy.
       real(dp), allocatable :: kernel(:, :)
       real(sp), allocatable :: kernel32(:, :)
    end type love_convolution
@@ -62,91 +80,148 @@ contains
 
    !> Plan the transforms and transform the kernel table(0:np-1, 0:np-1). With
    !> `single` true the float32 plans are made as well. With `measure` true FFTW times
-   !> candidate plans (FFTW_MEASURE: seconds of planning at NP >= 1024, faster transforms;
+   !> candidate plans (FFTW_MEASURE: about a second at NP = 4096, faster transforms;
    !> plans in FFTW's wisdom, which the caller may import beforehand, are reused at once);
    !> otherwise it picks them by estimate.
    subroutine convolution_setup(conv, table, single, measure)
       type(love_convolution), intent(inout) :: conv
       real(dp), intent(in) :: table(0:, 0:)
       logical, intent(in), optional :: single, measure
-      integer :: np, m, mh, p, q, ip, iq, nthreads
+      integer :: np, m, mh, b, t, p, q, j, jb, j0, nb, thread
       integer(c_int) :: flags
+      real(c_double), pointer :: lines(:, :)
+      complex(c_double_complex), pointer :: half(:, :)
       np = size(table, 1)
       m = 2*np
       mh = m/2 + 1
+      b = min(lines_per_block, np)
       conv%np = np
       conv%m = m
       conv%mh = mh
-      nthreads = 1
-      !$ nthreads = omp_get_max_threads()
+      conv%block = b
+      conv%threads = 1
+      !$ conv%threads = omp_get_max_threads()
       call start_fft_threads()
       flags = FFTW_ESTIMATE
       if (present(measure)) then
          if (measure) flags = FFTW_MEASURE
       end if
-      call fftw_plan_with_nthreads(int(nthreads, c_int))
-      call fftwf_plan_with_nthreads(int(nthreads, c_int))
-      conv%real_mem = fftw_alloc_real(int(m, c_size_t)*int(np, c_size_t))
-      conv%complex_mem = fftw_alloc_complex(int(mh, c_size_t)*int(m, c_size_t))
-      call c_f_pointer(conv%real_mem, conv%work, [m, np])
-      call c_f_pointer(conv%complex_mem, conv%spectrum, [mh, m])
-      call c_f_pointer(conv%real_mem, conv%work32, [m, np])
-      call c_f_pointer(conv%complex_mem, conv%spectrum32, [mh, m])
-      associate(d => conv%double)
-         d%columns_forward = fftw_plan_many_dft_r2c(1_c_int, [int(m, c_int)], int(np, c_int), &
-            conv%work, [int(m, c_int)], 1_c_int, int(m, c_int), &
-            conv%spectrum, [int(mh, c_int)], 1_c_int, int(mh, c_int), flags)
-         d%rows_forward = fftw_plan_many_dft(1_c_int, [int(m, c_int)], int(mh, c_int), &
-            conv%spectrum, [int(m, c_int)], int(mh, c_int), 1_c_int, &
-            conv%spectrum, [int(m, c_int)], int(mh, c_int), 1_c_int, FFTW_FORWARD, flags)
-         d%rows_backward = fftw_plan_many_dft(1_c_int, [int(m, c_int)], int(mh, c_int), &
-            conv%spectrum, [int(m, c_int)], int(mh, c_int), 1_c_int, &
-            conv%spectrum, [int(m, c_int)], int(mh, c_int), 1_c_int, FFTW_BACKWARD, flags)
-         d%columns_backward = fftw_plan_many_dft_c2r(1_c_int, [int(m, c_int)], int(np, c_int), &
-            conv%spectrum, [int(mh, c_int)], 1_c_int, int(mh, c_int), &
-            conv%work, [int(m, c_int)], 1_c_int, int(m, c_int), flags)
-      end associate
       conv%has_single = .false.
       if (present(single)) conv%has_single = single
-      if (conv%has_single) then
-         associate(s => conv%single)
-            s%columns_forward = fftwf_plan_many_dft_r2c(1_c_int, [int(m, c_int)], int(np, c_int), &
-               conv%work32, [int(m, c_int)], 1_c_int, int(m, c_int), &
-               conv%spectrum32, [int(mh, c_int)], 1_c_int, int(mh, c_int), flags)
-            s%rows_forward = fftwf_plan_many_dft(1_c_int, [int(m, c_int)], int(mh, c_int), &
-               conv%spectrum32, [int(m, c_int)], int(mh, c_int), 1_c_int, &
-               conv%spectrum32, [int(m, c_int)], int(mh, c_int), 1_c_int, FFTW_FORWARD, flags)
-            s%rows_backward = fftwf_plan_many_dft(1_c_int, [int(m, c_int)], int(mh, c_int), &
-               conv%spectrum32, [int(m, c_int)], int(mh, c_int), 1_c_int, &
-               conv%spectrum32, [int(m, c_int)], int(mh, c_int), 1_c_int, FFTW_BACKWARD, flags)
-            s%columns_backward = fftwf_plan_many_dft_c2r(1_c_int, [int(m, c_int)], int(np, c_int), &
-               conv%spectrum32, [int(mh, c_int)], 1_c_int, int(mh, c_int), &
-               conv%work32, [int(m, c_int)], 1_c_int, int(m, c_int), flags)
-         end associate
-      end if
+      conv%spectrum_mem = fftw_alloc_complex(int(mh, c_size_t)*int(np, c_size_t))
+      call c_f_pointer(conv%spectrum_mem, conv%spectrum, [mh, np])
+      call c_f_pointer(conv%spectrum_mem, conv%spectrum32, [mh, np])
+      allocate(conv%real_mem(0:conv%threads - 1), conv%complex_mem(0:conv%threads - 1))
+      do t = 0, conv%threads - 1
+         conv%real_mem(t) = fftw_alloc_real(int(m, c_size_t)*int(b, c_size_t))
+         conv%complex_mem(t) = fftw_alloc_complex(int(m, c_size_t)*int(b, c_size_t))
+      end do
+      call fftw_plan_with_nthreads(1_c_int)
+      call fftwf_plan_with_nthreads(1_c_int)
+      call make_plans_double(conv, flags)
+      if (conv%has_single) call make_plans_single(conv, flags)
       ! Kernel on the padded grid: offsets 0..np-1 and -(np-1)..-1 (wrapped); the
-      ! middle row/column (offset np) is never reached by a pair of grid pixels. Only
-      ! the first NP columns (offsets q = 0..np-1) fit the column-pass buffer, so the
-      ! kernel's spectrum is built from its even symmetry in q: the column pass of
-      ! column -q equals that of column q.
-      do q = 0, np - 1
-         do p = -(np - 1), np - 1
-            ip = modulo(p, m) + 1
-            conv%work(ip, q + 1) = table(abs(p), q)
+      ! middle line (offset np) is never reached by a pair of grid pixels. Columns
+      ! q = 0..np-1 go through the column pass into the half spectrum; the row pass fills
+      ! columns q = np+1..m-1 from their mirror images m-q (the kernel is even in q).
+      !$omp parallel num_threads(conv%threads) private(thread, lines, half, jb, j0, nb, j, q, p)
+      thread = 0
+      !$ thread = omp_get_thread_num()
+      call c_f_pointer(conv%real_mem(thread), lines, [m, b])
+      call c_f_pointer(conv%complex_mem(thread), half, [mh, b])
+      !$omp do schedule(static)
+      do jb = 1, (np + b - 1)/b
+         j0 = (jb - 1)*b
+         nb = min(b, np - j0)
+         lines = 0
+         do j = 1, nb
+            q = j0 + j - 1
+            do p = -(np - 1), np - 1
+               lines(modulo(p, m) + 1, j) = table(abs(p), q)
+            end do
          end do
-         conv%work(np + 1, q + 1) = 0
+         call fftw_execute_dft_r2c(conv%double%columns_forward, lines, half)
+         conv%spectrum(:, j0 + 1:j0 + nb) = half(:, 1:nb)
       end do
-      call fftw_execute_dft_r2c(conv%double%columns_forward, conv%work, conv%spectrum)
-      do q = 1, np - 1
-         iq = m - q + 1
-         conv%spectrum(:, iq) = conv%spectrum(:, q + 1)
+      !$omp end do
+      !$omp end parallel
+      allocate(conv%kernel(0:np, mh))
+      !$omp parallel num_threads(conv%threads) private(thread, half, jb, j0, nb, j, q)
+      thread = 0
+      !$ thread = omp_get_thread_num()
+      call c_f_pointer(conv%complex_mem(thread), half, [m, b])
+      !$omp do schedule(static)
+      do jb = 1, (mh + b - 1)/b
+         j0 = (jb - 1)*b
+         nb = min(b, mh - j0)
+         half = 0
+         do q = 0, np - 1
+            half(q + 1, 1:nb) = conv%spectrum(j0 + 1:j0 + nb, q + 1)
+         end do
+         do q = np + 1, m - 1
+            half(q + 1, 1:nb) = half(m - q + 1, 1:nb)
+         end do
+         call fftw_execute_dft(conv%double%rows_forward, half, half)
+         ! Even kernel: the spectrum is real (the imaginary part is round-off).
+         do j = 1, nb
+            conv%kernel(:, j0 + j) = real(half(1:np + 1, j), dp)/real(m, dp)**2
+         end do
       end do
-      conv%spectrum(:, np + 1) = 0
-      call fftw_execute_dft(conv%double%rows_forward, conv%spectrum, conv%spectrum)
-      ! Even kernel: the spectrum is real (the imaginary part is round-off).
-      conv%kernel = real(conv%spectrum, dp)/real(m, dp)**2
-      if (conv%has_single) conv%kernel32 = real(conv%kernel, sp)
+      !$omp end do
+      !$omp end parallel
+      if (conv%has_single) then
+         allocate(conv%kernel32(0:np, mh))
+         conv%kernel32(:, :) = real(conv%kernel, sp)
+      end if
    end subroutine convolution_setup
+
+   !> The double-precision plans, made on thread 0's buffers.
+   subroutine make_plans_double(conv, flags)
+      type(love_convolution), intent(inout) :: conv
+      integer(c_int), intent(in) :: flags
+      real(c_double), pointer :: lines(:, :)
+      complex(c_double_complex), pointer :: half(:, :)
+      integer(c_int) :: m, mh, b
+      m = int(conv%m, c_int)
+      mh = int(conv%mh, c_int)
+      b = int(conv%block, c_int)
+      call c_f_pointer(conv%real_mem(0), lines, [m, b])
+      call c_f_pointer(conv%complex_mem(0), half, [m, b])
+      associate(d => conv%double)
+         d%columns_forward = fftw_plan_many_dft_r2c(1_c_int, [m], b, lines, [m], 1_c_int, m, &
+            half, [mh], 1_c_int, mh, flags)
+         d%columns_backward = fftw_plan_many_dft_c2r(1_c_int, [m], b, half, [mh], 1_c_int, mh, &
+            lines, [m], 1_c_int, m, flags)
+         d%rows_forward = fftw_plan_many_dft(1_c_int, [m], b, half, [m], 1_c_int, m, &
+            half, [m], 1_c_int, m, FFTW_FORWARD, flags)
+         d%rows_backward = fftw_plan_many_dft(1_c_int, [m], b, half, [m], 1_c_int, m, &
+            half, [m], 1_c_int, m, FFTW_BACKWARD, flags)
+      end associate
+   end subroutine make_plans_double
+
+   !> The float32 plans, made on thread 0's buffers.
+   subroutine make_plans_single(conv, flags)
+      type(love_convolution), intent(inout) :: conv
+      integer(c_int), intent(in) :: flags
+      real(c_float), pointer :: lines(:, :)
+      complex(c_float_complex), pointer :: half(:, :)
+      integer(c_int) :: m, mh, b
+      m = int(conv%m, c_int)
+      mh = int(conv%mh, c_int)
+      b = int(conv%block, c_int)
+      call c_f_pointer(conv%real_mem(0), lines, [m, b])
+      call c_f_pointer(conv%complex_mem(0), half, [m, b])
+      associate(s => conv%single)
+         s%columns_forward = fftwf_plan_many_dft_r2c(1_c_int, [m], b, lines, [m], 1_c_int, m, &
+            half, [mh], 1_c_int, mh, flags)
+         s%columns_backward = fftwf_plan_many_dft_c2r(1_c_int, [m], b, half, [mh], 1_c_int, mh, &
+            lines, [m], 1_c_int, m, flags)
+         s%rows_forward = fftwf_plan_many_dft(1_c_int, [m], b, half, [m], 1_c_int, m, &
+            half, [m], 1_c_int, m, FFTW_FORWARD, flags)
+         s%rows_backward = fftwf_plan_many_dft(1_c_int, [m], b, half, [m], 1_c_int, m, &
+            half, [m], 1_c_int, m, FFTW_BACKWARD, flags)
+      end associate
+   end subroutine make_plans_single
 
    !> Initialise FFTW's threads once; before any other FFTW call (wisdom included).
    subroutine start_fft_threads()
@@ -162,34 +237,70 @@ contains
       type(love_convolution), intent(inout) :: conv
       real(dp), intent(in) :: field(:, :)
       real(dp), intent(out) :: result(:, :)
-      !> Multiplies the result (default 1): a compliance, folded into the last copy.
+      !> Multiplies the result (default 1): a compliance, folded into the last pass.
       real(dp), intent(in), optional :: factor
+      real(c_double), pointer :: lines(:, :)
+      complex(c_double_complex), pointer :: half(:, :)
       real(dp) :: f
-      integer :: np, j
+      integer :: np, m, mh, b, thread, jb, j0, nb, j
       f = 1
       if (present(factor)) f = factor
       np = conv%np
-      !$omp parallel do
-      do j = 1, np
-         conv%work(1:np, j) = field(:, j)
-         conv%work(np + 1:, j) = 0
+      m = conv%m
+      mh = conv%mh
+      b = conv%block
+      !$omp parallel num_threads(conv%threads) private(thread, lines, half, jb, j0, nb, j)
+      thread = 0
+      !$ thread = omp_get_thread_num()
+      call c_f_pointer(conv%real_mem(thread), lines, [m, b])
+      ! Pass 1: the data columns, zero-padded, into the half spectrum.
+      call c_f_pointer(conv%complex_mem(thread), half, [mh, b])
+      !$omp do schedule(static)
+      do jb = 1, (np + b - 1)/b
+         j0 = (jb - 1)*b
+         nb = min(b, np - j0)
+         lines(1:np, 1:nb) = field(:, j0 + 1:j0 + nb)
+         lines(np + 1:, 1:nb) = 0
+         lines(:, nb + 1:) = 0
+         call fftw_execute_dft_r2c(conv%double%columns_forward, lines, half)
+         conv%spectrum(:, j0 + 1:j0 + nb) = half(:, 1:nb)
       end do
-      call fftw_execute_dft_r2c(conv%double%columns_forward, conv%work, conv%spectrum)
-      !$omp parallel do
-      do j = np + 1, conv%m
-         conv%spectrum(:, j) = 0
+      !$omp end do
+      ! Pass 2: rows of the half spectrum, times the kernel's spectrum.
+      call c_f_pointer(conv%complex_mem(thread), half, [m, b])
+      !$omp do schedule(static)
+      do jb = 1, (mh + b - 1)/b
+         j0 = (jb - 1)*b
+         nb = min(b, mh - j0)
+         do j = 1, np
+            half(j, 1:nb) = conv%spectrum(j0 + 1:j0 + nb, j)
+         end do
+         half(np + 1:, 1:nb) = 0
+         half(:, nb + 1:) = 0
+         call fftw_execute_dft(conv%double%rows_forward, half, half)
+         do j = 1, nb
+            half(1:np + 1, j) = half(1:np + 1, j)*conv%kernel(:, j0 + j)
+            half(np + 2:m, j) = half(np + 2:m, j)*conv%kernel(np - 1:1:-1, j0 + j)
+         end do
+         call fftw_execute_dft(conv%double%rows_backward, half, half)
+         do j = 1, np
+            conv%spectrum(j0 + 1:j0 + nb, j) = half(j, 1:nb)
+         end do
       end do
-      call fftw_execute_dft(conv%double%rows_forward, conv%spectrum, conv%spectrum)
-      !$omp parallel do
-      do j = 1, conv%m
-         conv%spectrum(:, j) = conv%spectrum(:, j)*conv%kernel(:, j)
+      !$omp end do
+      ! Pass 3: the columns read back, cropped and scaled.
+      call c_f_pointer(conv%complex_mem(thread), half, [mh, b])
+      !$omp do schedule(static)
+      do jb = 1, (np + b - 1)/b
+         j0 = (jb - 1)*b
+         nb = min(b, np - j0)
+         half(:, 1:nb) = conv%spectrum(:, j0 + 1:j0 + nb)
+         half(:, nb + 1:) = 0
+         call fftw_execute_dft_c2r(conv%double%columns_backward, half, lines)
+         result(:, j0 + 1:j0 + nb) = f*lines(1:np, 1:nb)
       end do
-      call fftw_execute_dft(conv%double%rows_backward, conv%spectrum, conv%spectrum)
-      call fftw_execute_dft_c2r(conv%double%columns_backward, conv%spectrum, conv%work)
-      !$omp parallel do
-      do j = 1, np
-         result(:, j) = f*conv%work(1:np, j)
-      end do
+      !$omp end do
+      !$omp end parallel
    end subroutine convolution_apply
 
    !> As convolution_apply, with float32 transforms (needs setup with single = .true.).
@@ -197,72 +308,128 @@ contains
       type(love_convolution), intent(inout) :: conv
       real(dp), intent(in) :: field(:, :)
       real(dp), intent(out) :: result(:, :)
-      !> Multiplies the result (default 1): a compliance, folded into the last copy.
+      !> Multiplies the result (default 1): a compliance, folded into the last pass.
       real(dp), intent(in), optional :: factor
+      real(c_float), pointer :: lines(:, :)
+      complex(c_float_complex), pointer :: half(:, :)
       real(dp) :: f
-      integer :: np, j
+      integer :: np, m, mh, b, thread, jb, j0, nb, j
       f = 1
       if (present(factor)) f = factor
       np = conv%np
-      !$omp parallel do
-      do j = 1, np
-         conv%work32(1:np, j) = real(field(:, j), sp)
-         conv%work32(np + 1:, j) = 0
+      m = conv%m
+      mh = conv%mh
+      b = conv%block
+      !$omp parallel num_threads(conv%threads) private(thread, lines, half, jb, j0, nb, j)
+      thread = 0
+      !$ thread = omp_get_thread_num()
+      call c_f_pointer(conv%real_mem(thread), lines, [m, b])
+      call c_f_pointer(conv%complex_mem(thread), half, [mh, b])
+      !$omp do schedule(static)
+      do jb = 1, (np + b - 1)/b
+         j0 = (jb - 1)*b
+         nb = min(b, np - j0)
+         lines(1:np, 1:nb) = real(field(:, j0 + 1:j0 + nb), sp)
+         lines(np + 1:, 1:nb) = 0
+         lines(:, nb + 1:) = 0
+         call fftwf_execute_dft_r2c(conv%single%columns_forward, lines, half)
+         conv%spectrum32(:, j0 + 1:j0 + nb) = half(:, 1:nb)
       end do
-      call fftwf_execute_dft_r2c(conv%single%columns_forward, conv%work32, conv%spectrum32)
-      !$omp parallel do
-      do j = np + 1, conv%m
-         conv%spectrum32(:, j) = 0
+      !$omp end do
+      call c_f_pointer(conv%complex_mem(thread), half, [m, b])
+      !$omp do schedule(static)
+      do jb = 1, (mh + b - 1)/b
+         j0 = (jb - 1)*b
+         nb = min(b, mh - j0)
+         do j = 1, np
+            half(j, 1:nb) = conv%spectrum32(j0 + 1:j0 + nb, j)
+         end do
+         half(np + 1:, 1:nb) = 0
+         half(:, nb + 1:) = 0
+         call fftwf_execute_dft(conv%single%rows_forward, half, half)
+         do j = 1, nb
+            half(1:np + 1, j) = half(1:np + 1, j)*conv%kernel32(:, j0 + j)
+            half(np + 2:m, j) = half(np + 2:m, j)*conv%kernel32(np - 1:1:-1, j0 + j)
+         end do
+         call fftwf_execute_dft(conv%single%rows_backward, half, half)
+         do j = 1, np
+            conv%spectrum32(j0 + 1:j0 + nb, j) = half(j, 1:nb)
+         end do
       end do
-      call fftwf_execute_dft(conv%single%rows_forward, conv%spectrum32, conv%spectrum32)
-      !$omp parallel do
-      do j = 1, conv%m
-         conv%spectrum32(:, j) = conv%spectrum32(:, j)*conv%kernel32(:, j)
+      !$omp end do
+      call c_f_pointer(conv%complex_mem(thread), half, [mh, b])
+      !$omp do schedule(static)
+      do jb = 1, (np + b - 1)/b
+         j0 = (jb - 1)*b
+         nb = min(b, np - j0)
+         half(:, 1:nb) = conv%spectrum32(:, j0 + 1:j0 + nb)
+         half(:, nb + 1:) = 0
+         call fftwf_execute_dft_c2r(conv%single%columns_backward, half, lines)
+         result(:, j0 + 1:j0 + nb) = f*real(lines(1:np, 1:nb), dp)
       end do
-      call fftwf_execute_dft(conv%single%rows_backward, conv%spectrum32, conv%spectrum32)
-      call fftwf_execute_dft_c2r(conv%single%columns_backward, conv%spectrum32, conv%work32)
-      !$omp parallel do
-      do j = 1, np
-         result(:, j) = f*real(conv%work32(1:np, j), dp)
-      end do
+      !$omp end do
+      !$omp end parallel
    end subroutine convolution_apply_single
 
    !> The central coefficients of the inverse of the convolution on the padded periodic
    !> grid: taps(a, b), a, b = 0..2, at offsets (+-a, +-b) (dimensionless, for the table's
    !> units; a discrete form of the |q| operator, E* |q| / 2 in the continuum). `ok` is
    !> false when the kernel spectrum is not positive, so that it has no inverse.
+   !> The inverse's spectrum is real and even in both frequencies, so each tap is a
+   !> cosine sum over the quarter k1, k2 = 0..NP (weight 2 off the lines 0 and NP).
    subroutine inverse_kernel_taps(conv, taps, ok)
-      type(love_convolution), intent(inout) :: conv
+      type(love_convolution), intent(in) :: conv
       real(dp), intent(out) :: taps(0:2, 0:2)
       logical, intent(out) :: ok
-      integer :: j
+      real(dp), parameter :: two_pi = 8*atan(1.0_dp)
+      real(dp), allocatable :: inner(:, :), weight(:), cosines(:, :)
+      integer :: np, k, a
       taps = 0
       ok = minval(conv%kernel) > 0 .and. conv%np >= 3
       if (.not. ok) return
-      do j = 1, conv%m
-         conv%spectrum(:, j) = 1/conv%kernel(:, j)
+      np = conv%np
+      allocate(weight(0:np), cosines(0:np, 0:2), inner(0:2, conv%mh))
+      weight = 2
+      weight(0) = 1
+      weight(np) = 1
+      do a = 0, 2
+         do k = 0, np
+            cosines(k, a) = weight(k)*cos(two_pi*real(a*k, dp)/real(conv%m, dp))
+         end do
       end do
-      call fftw_execute_dft(conv%double%rows_backward, conv%spectrum, conv%spectrum)
-      call fftw_execute_dft_c2r(conv%double%columns_backward, conv%spectrum, conv%work)
-      taps = conv%work(1:3, 1:3)/real(conv%m, dp)**4
+      ! inner(b, k1) = sum over k2 of w cos(2 pi b k2 / M) / kernel(k2, k1)
+      !$omp parallel do num_threads(conv%threads) private(a)
+      do k = 1, conv%mh
+         do a = 0, 2
+            inner(a, k) = sum(cosines(:, a)/conv%kernel(:, k))
+         end do
+      end do
+      do a = 0, 2
+         taps(a, :) = matmul(inner, cosines(:, a))/real(conv%m, dp)**4
+      end do
    end subroutine inverse_kernel_taps
 
    subroutine convolution_free(conv)
       type(love_convolution), intent(inout) :: conv
+      integer :: t
       if (conv%m == 0) return
       call fftw_destroy_plan(conv%double%columns_forward)
+      call fftw_destroy_plan(conv%double%columns_backward)
       call fftw_destroy_plan(conv%double%rows_forward)
       call fftw_destroy_plan(conv%double%rows_backward)
-      call fftw_destroy_plan(conv%double%columns_backward)
       if (conv%has_single) then
          call fftwf_destroy_plan(conv%single%columns_forward)
+         call fftwf_destroy_plan(conv%single%columns_backward)
          call fftwf_destroy_plan(conv%single%rows_forward)
          call fftwf_destroy_plan(conv%single%rows_backward)
-         call fftwf_destroy_plan(conv%single%columns_backward)
       end if
-      call fftw_free(conv%real_mem)
-      call fftw_free(conv%complex_mem)
-      nullify(conv%work, conv%spectrum, conv%work32, conv%spectrum32)
+      do t = 0, conv%threads - 1
+         call fftw_free(conv%real_mem(t))
+         call fftw_free(conv%complex_mem(t))
+      end do
+      deallocate(conv%real_mem, conv%complex_mem)
+      call fftw_free(conv%spectrum_mem)
+      nullify(conv%spectrum, conv%spectrum32)
       if (allocated(conv%kernel)) deallocate(conv%kernel)
       if (allocated(conv%kernel32)) deallocate(conv%kernel32)
       conv%m = 0

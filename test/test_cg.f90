@@ -11,7 +11,7 @@ module test_cg
    use femcod_cg, only: solve_cg, cg_residuals, cg_method
    use femcod_generate, only: VERIFICATION_DECKS, deck_spec, build_deck
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
-      convolution_free
+      convolution_free, inverse_kernel_taps
    use femcod_boussinesq, only: offset_table
    use femcod_random, only: random_stream, seed_stream, uniform
    use test_support, only: scratch_path, file_exists, remove_scratch
@@ -30,6 +30,7 @@ contains
          new_unittest("sphere, 0.5 nm mesh: Hertz at 1000 nN, Segedin at 18000 nN", test_sphere), &
          new_unittest("--solver cg without --loads is a usage error", test_usage), &
          new_unittest("pruned padded FFT convolution equals the direct sum (NP 7, 8, 33)", test_convolution), &
+         new_unittest("preconditioner taps equal the inverse of a direct DFT (NP 4, 5, 9)", test_inverse_taps), &
          new_unittest("every acceleration, alone and together, keeps the event-exact answer", test_accelerations), &
          new_unittest("--fftw-wisdom writes both wisdom files and leaves the answer unchanged", test_wisdom) &
          ]
@@ -163,6 +164,64 @@ contains
          deallocate(table, field, fast, single, direct)
       end do
    end subroutine test_convolution
+
+   !> The preconditioner's taps against an independent calculation: the Love kernel
+   !> wrapped on the padded M x M periodic grid (M = 2 NP, zero on the middle lines),
+   !> its spectrum by the O(M^4) direct cosine sum, and the inverse transform of one over
+   !> it at the nine central offsets: t(a, b) = M^-2 sum_k cos(2 pi (k1 a + k2 b)/M) / K(k).
+   !> Agreement to round-off (1e-12 of the centre tap).
+   subroutine test_inverse_taps(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: sides(3) = [4, 5, 9]
+      real(dp), parameter :: two_pi = 8*atan(1.0_dp)
+      type(love_convolution) :: conv
+      real(dp), allocatable :: table(:, :), wrapped(:, :), spectrum(:, :)
+      real(dp) :: taps(0:2, 0:2), expected(0:2, 0:2)
+      logical :: ok
+      integer :: n, np, m, p, q, k1, k2, a, b
+      do n = 1, size(sides)
+         np = sides(n)
+         m = 2*np
+         allocate(table(0:np - 1, 0:np - 1), wrapped(0:m - 1, 0:m - 1), spectrum(0:m - 1, 0:m - 1))
+         table = offset_table(np)
+         wrapped = 0
+         do q = 0, m - 1
+            do p = 0, m - 1
+               if (p /= np .and. q /= np) wrapped(p, q) = table(min(p, m - p), min(q, m - q))
+            end do
+         end do
+         do k2 = 0, m - 1
+            do k1 = 0, m - 1
+               spectrum(k1, k2) = 0
+               do q = 0, m - 1
+                  do p = 0, m - 1
+                     spectrum(k1, k2) = spectrum(k1, k2) + wrapped(p, q)*cos(two_pi*real(k1*p + k2*q, dp)/m)
+                  end do
+               end do
+            end do
+         end do
+         expected = 0
+         do b = 0, 2
+            do a = 0, 2
+               do k2 = 0, m - 1
+                  do k1 = 0, m - 1
+                     expected(a, b) = expected(a, b) + cos(two_pi*real(k1*a + k2*b, dp)/m)/spectrum(k1, k2)
+                  end do
+               end do
+            end do
+         end do
+         expected = expected/real(m, dp)**2
+         call convolution_setup(conv, table)
+         call inverse_kernel_taps(conv, taps, ok)
+         call convolution_free(conv)
+         call check(error, ok, "NP = "//to_string(np)//": the kernel spectrum is not positive")
+         if (allocated(error)) return
+         call check(error, maxval(abs(taps - expected)) <= 1.0e-12_dp*abs(expected(0, 0)), "NP = "// &
+            to_string(np)//": "//to_string(maxval(abs(taps - expected))/abs(expected(0, 0))))
+         if (allocated(error)) return
+         deallocate(table, wrapped, spectrum)
+      end do
+   end subroutine test_inverse_taps
 
    !> A 64 x 64 self-affine surface (Hurst 0.8): the event-exact solver's history gives
    !> loads strictly inside steps (where contacts and approach are exact by linearity);
