@@ -14,6 +14,11 @@ module femcod_bench
    use femcod_scene, only: initial_gaps
    use femcod_deck, only: parse_real, parse_real_list, parse_integer_list
    use femcod_wisdom, only: load_wisdom, save_wisdom
+   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
+      convolution_free
+   use femcod_boussinesq, only: offset_table
+   use femcod_random, only: random_stream, seed_stream, uniform
+   use femcod_clock, only: wall_clock
    implicit none
    private
    public :: bench_command
@@ -40,6 +45,10 @@ contains
             call bench_cg(args(2:), code)
             return
          end if
+         if (args(1)%s == "convolution") then
+            call bench_convolution(args(2:), code)
+            return
+         end if
       end if
       legacy_contacts = 300
       full = .false.
@@ -49,6 +58,7 @@ contains
          case ("-h", "--help")
             write(output_unit, '(a)') "usage: femcod bench [--full] [--legacy-contacts N]", &
                "       femcod bench cg [--np LIST] [--contact LIST] [--tol T] [--peers PYTHON]  (--help for more)", &
+               "       femcod bench convolution [--np LIST] [--repeat N]  (--help for more)", &
                "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
                "event, peak memory (resident, per case), error against the reference. The rough surface is", &
                "the one of issue 4: self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa,", &
@@ -214,7 +224,8 @@ contains
                "on a size pays the planning inside its wall time). Method switches, for the speed/accuracy", &
                "table: --nested on|off, --coarsest N, --coarse-tol T, --single-until R (0: no float32),", &
                "--direct N (0: two convolutions per iteration), --restart on|off, --precondition on|off,", &
-               "--polak-ribiere on|off (off: Fletcher-Reeves beta).", &
+               "--polak-ribiere on|off (off: Fletcher-Reeves beta), --powell NU (Powell's restart when", &
+               "|z.g_old| >= NU z.g; default 0.2, 0: never).", &
                "Run it with the release build.", &
                "Columns: NP, target %, solver, wall (s), iterations, residual, contact %, peak RSS (MB)."
             return
@@ -240,6 +251,8 @@ contains
             if (ok) method%precondition = args(i + 1)%s == "on"
          case ("--polak-ribiere")
             if (ok) method%polak_ribiere = args(i + 1)%s == "on"
+         case ("--powell")
+            if (ok) call parse_real(args(i + 1)%s, method%powell_restart, ok)
          case ("--coarsest")
             if (ok) call parse_integer(args(i + 1)%s, method%coarsest, ok)
          case ("--coarse-tol")
@@ -336,6 +349,107 @@ contains
          end if
       end do
    end subroutine bench_cg
+
+   !> `femcod bench convolution`: one Love convolution on NP x NP (zero-padded (2NP)^2
+   !> transforms) with FFTW's estimated and measured plans: set-up time (planning, kernel
+   !> spectrum), time per convolution in double and float32, the float32 result's largest
+   !> difference from double, and double's largest difference from the direct sum
+   !> sum_k I(p - k) F(k) at three pixels (corner, centre, edge; O(NP^2) each), all relative
+   !> to the largest value. The field is uniform random on [0, 1) (seed 1).
+   subroutine bench_convolution(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      integer, allocatable :: sizes(:)
+      real(dp), allocatable :: table(:, :), field(:, :), double(:, :), single(:, :)
+      type(love_convolution) :: conv
+      type(random_stream) :: stream
+      real(dp) :: t0, t1, setup, t_double, t_single, err_single, err_direct, direct, scale
+      integer :: i, n, np, repeat, k, plans, probe(2, 3), kk, l
+      logical :: ok
+      sizes = [512, 1024, 2048]
+      repeat = 5
+      i = 1
+      do while (i <= size(args))
+         if (args(i)%s == "-h" .or. args(i)%s == "--help") then
+            write(output_unit, '(a)') "usage: femcod bench convolution [--np 512,1024,2048] [--repeat 5]", &
+               "One Love-kernel convolution on NP x NP by zero-padded (2NP)^2 FFTs, with FFTW's estimated and", &
+               "measured plans (measured here, no wisdom): set-up time, time per convolution (mean of --repeat)", &
+               "in double and float32, float32's largest difference from double, and double's largest", &
+               "difference from the direct sum at three pixels, relative to the largest value.", &
+               "Run it with the release build."
+            return
+         end if
+         ok = i < size(args)
+         if (ok) then
+            select case (args(i)%s)
+            case ("--np")
+               call parse_integer_list(args(i + 1)%s, sizes, ok)
+            case ("--repeat")
+               call parse_integer(args(i + 1)%s, repeat, ok)
+               ok = ok .and. repeat >= 1
+            case default
+               ok = .false.
+            end select
+         end if
+         if (.not. ok .or. minval(sizes) < 2) then
+            write(error_unit, '(a)') "femcod bench convolution: bad or incomplete argument "//args(i)%s//" (--help)"
+            code = 2
+            return
+         end if
+         i = i + 2
+      end do
+      write(output_unit, '(a)') "| NP | plans | set-up (s) | double (s) | float32 (s) | float32 - double "// &
+         "| double - direct sum |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|"
+      do n = 1, size(sizes)
+         np = sizes(n)
+         allocate(table(0:np - 1, 0:np - 1), field(np, np), double(np, np), single(np, np))
+         table = offset_table(np)
+         call seed_stream(stream, 1)
+         do l = 1, np
+            do k = 1, np
+               call uniform(stream, field(k, l))
+            end do
+         end do
+         probe = reshape([1, 1, (np + 1)/2, (np + 1)/2, np, (np + 1)/3], [2, 3])
+         do plans = 1, 2
+            call wall_clock(t0)
+            call convolution_setup(conv, table, single=.true., measure=plans == 2)
+            call wall_clock(t1)
+            setup = t1 - t0
+            call wall_clock(t0)
+            do k = 1, repeat
+               call convolution_apply(conv, field, double)
+            end do
+            call wall_clock(t1)
+            t_double = (t1 - t0)/repeat
+            call wall_clock(t0)
+            do k = 1, repeat
+               call convolution_apply_single(conv, field, single)
+            end do
+            call wall_clock(t1)
+            t_single = (t1 - t0)/repeat
+            call convolution_free(conv)
+            scale = maxval(abs(double))
+            err_single = maxval(abs(single - double))/scale
+            err_direct = 0
+            do kk = 1, 3
+               direct = 0
+               do l = 1, np
+                  do k = 1, np
+                     direct = direct + table(abs(probe(1, kk) - k), abs(probe(2, kk) - l))*field(k, l)
+                  end do
+               end do
+               err_direct = max(err_direct, abs(double(probe(1, kk), probe(2, kk)) - direct)/scale)
+            end do
+            write(output_unit, '(a)') "| "//int_str(np)//" | "//trim(merge("estimated", "measured ", plans == 1))// &
+               " | "//fixed_str(setup, 3)//" | "//fixed_str(t_double, 4)//" | "//fixed_str(t_single, 4)//" | "// &
+               real_str(err_single, 2)//" | "//real_str(err_direct, 2)//" |"
+            flush(output_unit)
+         end do
+         deallocate(table, field, double, single)
+      end do
+   end subroutine bench_convolution
 
    !> One table row from the peer script's line "peer seconds iterations residual fraction
    !> peak status" (fraction as a share, printed in percent).

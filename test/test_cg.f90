@@ -226,9 +226,9 @@ contains
    !> A 64 x 64 self-affine surface (Hurst 0.8): the event-exact solver's history gives
    !> loads strictly inside steps (where contacts and approach are exact by linearity);
    !> the CG solver with each acceleration alone (nested grids down to 16, float32 early
-   !> iterations, direct corrections, preconditioner, restarts) and with none must find
-   !> the same contact count and the approach to 1e-8 relative (tolerance 1e-10 on the
-   !> gap residual).
+   !> iterations, direct corrections, preconditioner, no restart on entry, Polak-Ribiere,
+   !> Powell's restart), with all of them and with none must find the same contact count
+   !> and the approach to 1e-8 relative (tolerance 1e-10 on the gap residual).
    subroutine test_accelerations(error)
       type(error_type), allocatable, intent(out) :: error
       type(deck_spec) :: spec
@@ -236,7 +236,7 @@ contains
       type(contact_options) :: options
       type(contact_result) :: inc, cg
       type(cg_residuals), allocatable :: report(:)
-      type(cg_method) :: plain, how(7)
+      type(cg_method) :: plain, how(8)
       type(status_type) :: status
       real(dp), allocatable :: loads(:)
       integer :: v, k, n, s
@@ -263,7 +263,7 @@ contains
       options%loads = loads
       call solve_incremental(deck, options, inc, status)
       plain = cg_method(nested=.false., single_until=0, direct_corrections=0, precondition=.false., &
-         restart_on_entry=.true., polak_ribiere=.false.)
+         restart_on_entry=.true., polak_ribiere=.false., powell_restart=0.0_dp)
       how = plain
       how(1)%nested = .true.
       how(1)%coarsest = 16
@@ -272,7 +272,8 @@ contains
       how(4)%precondition = .true.
       how(5)%restart_on_entry = .false.
       how(6)%polak_ribiere = .true.
-      how(7) = cg_method(coarsest=16)
+      how(7)%powell_restart = 0.2_dp
+      how(8) = cg_method(coarsest=16)
       do v = 0, size(how)
          if (v == 0) then
             call solve_cg(deck, options, 1.0e-10_dp, 5000, cg, report, status, plain)
