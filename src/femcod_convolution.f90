@@ -44,7 +44,7 @@ module femcod_convolution
    integer, parameter :: sp = kind(1.0)
 
    !> Lines per block in every pass: 8 lines of M = 8192 are 0.5 MB of float32 complex, in
-   !> L2 cache; 4 and 16 were slower at NP = 2048 and 4096 (doc/performance.md).
+   !> L2 cache; 4 and 16 were slower at NP = 4096 (doc/performance.md, the convolution).
    integer, parameter :: lines_per_block = 8
 
    !> One set of plans for one precision, each for one block of `lines_per_block` lines of
