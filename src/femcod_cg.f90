@@ -83,8 +83,8 @@ module femcod_cg
       !> operator (a discrete |q|), applied on the contact set.
       logical :: precondition = .true.
       !> Restart the conjugate directions (beta = 0) after overlapping pixels enter the
-      !> contact, as Polonsky and Keer do (off: keep them; at NP = 1024 on: 59 instead of
-      !> 32 iterations at 1 %, 144 instead of 54 at 10 %, doc/performance.md).
+      !> contact, as Polonsky and Keer do (off: keep them; at NP = 2048 on: 97 instead of
+      !> 43 iterations at 1 %, 302 instead of 69 at 10 %, doc/performance.md).
       logical :: restart_on_entry = .false.
       !> beta by Polak-Ribiere, clipped at 0 (PR+: z.(g - g_old)/(z_old.g_old)), which
       !> restarts by itself when the contact set has moved the gradient; off: Fletcher-

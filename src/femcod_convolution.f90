@@ -33,13 +33,12 @@ module femcod_convolution
       fftwf_plan_many_dft_r2c, fftwf_plan_many_dft_c2r, fftwf_plan_many_dft, &
       fftwf_execute_dft_r2c, fftwf_execute_dft_c2r, fftwf_execute_dft, &
       fftw_destroy_plan, fftwf_destroy_plan, fftw_alloc_real, fftw_alloc_complex, fftw_free, &
-      fftw_init_threads, fftwf_init_threads, fftw_plan_with_nthreads, fftwf_plan_with_nthreads, &
       FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, FFTW_BACKWARD
    !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
    implicit none
    private
    public :: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, convolution_free, &
-      inverse_kernel_taps, start_fft_threads
+      inverse_kernel_taps
 
    integer, parameter :: sp = kind(1.0)
 
@@ -74,8 +73,6 @@ module femcod_convolution
       real(sp), allocatable :: kernel32(:, :)
    end type love_convolution
 
-   logical, save :: threads_ready = .false.
-
 contains
 
    !> Plan the transforms and transform the kernel table(0:np-1, 0:np-1). With
@@ -101,7 +98,6 @@ contains
       conv%block = b
       conv%threads = 1
       !$ conv%threads = omp_get_max_threads()
-      call start_fft_threads()
       flags = FFTW_ESTIMATE
       if (present(measure)) then
          if (measure) flags = FFTW_MEASURE
@@ -116,8 +112,6 @@ contains
          conv%real_mem(t) = fftw_alloc_real(int(m, c_size_t)*int(b, c_size_t))
          conv%complex_mem(t) = fftw_alloc_complex(int(m, c_size_t)*int(b, c_size_t))
       end do
-      call fftw_plan_with_nthreads(1_c_int)
-      call fftwf_plan_with_nthreads(1_c_int)
       call make_plans_double(conv, flags)
       if (conv%has_single) call make_plans_single(conv, flags)
       ! Kernel on the padded grid: offsets 0..np-1 and -(np-1)..-1 (wrapped); the
@@ -222,15 +216,6 @@ contains
             half, [m], 1_c_int, m, FFTW_BACKWARD, flags)
       end associate
    end subroutine make_plans_single
-
-   !> Initialise FFTW's threads once; before any other FFTW call (wisdom included).
-   subroutine start_fft_threads()
-      integer(c_int) :: ios
-      if (threads_ready) return
-      ios = fftw_init_threads()
-      ios = fftwf_init_threads()
-      threads_ready = .true.
-   end subroutine start_fft_threads
 
    !> result(i, j) = factor * sum_{k,l} I(i-k, j-l) field(k, l) over the NP x NP grid.
    subroutine convolution_apply(conv, field, result, factor)

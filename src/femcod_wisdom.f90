@@ -8,7 +8,6 @@ module femcod_wisdom
       fftw_export_wisdom_to_filename, fftwf_export_wisdom_to_filename
    use femcod_files, only: atomic_rename, path_exists, temporary_name, remove_file
    use femcod_status, only: set_error, STATUS_IO
-   use femcod_convolution, only: start_fft_threads
    implicit none
    private
    public :: load_wisdom, save_wisdom
@@ -21,7 +20,6 @@ contains
       character(len=*), intent(in) :: path
       logical, intent(out) :: loaded
       integer(c_int) :: ok
-      call start_fft_threads()
       loaded = .false.
       if (path_exists(path)) then
          ok = fftw_import_wisdom_from_filename(path//c_null_char)
