@@ -3,16 +3,16 @@ module femcod_bench
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck, parse_integer
+   use femcod_deck, only: deck_type, read_deck
    use femcod_generate, only: deck_spec, build_deck, THESIS_RIGID_FACTOR
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental
    use femcod_cg, only: solve_cg, cg_residuals, cg_method
-   use femcod_strings, only: string_type, int_str, real_str, fixed_str
+   use femcod_strings, only: string_type, int_str, real_str, fixed_str, parse_integer, &
+      parse_real, parse_real_list, parse_integer_list
    use femcod_analytic, only: segedin_sphere
    use femcod_scene, only: initial_gaps
-   use femcod_deck, only: parse_real, parse_real_list, parse_integer_list
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free

@@ -2,8 +2,8 @@
 module test_deck
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck, write_deck, format_real
-   use femcod_strings, only: string_type
+   use femcod_deck, only: deck_type, read_deck, write_deck
+   use femcod_strings, only: string_type, format_real
    use femcod_cli, only: run_femcod
    use test_support, only: write_text, scratch_path, contains_text, file_exists
    use testdrive, only: new_unittest, unittest_type, error_type, check

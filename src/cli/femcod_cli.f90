@@ -5,7 +5,7 @@ module femcod_cli
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, STATUS_USAGE, STATUS_BAD_INPUT
-   use femcod_deck, only: deck_type, write_deck, parse_real, parse_integer, format_real
+   use femcod_deck, only: deck_type, write_deck
    use femcod_workspace, only: workspace_type, workspace_layout, workspace_table
    use femcod_generate, only: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, KINDS
    use femcod_run, only: run_command
@@ -13,7 +13,7 @@ module femcod_cli
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
    use femcod_stability_report, only: write_stability_report
-   use femcod_strings, only: string_type, int_str
+   use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real
    implicit none
    private
    public :: femcod_command, run_femcod, command_arguments, FEMCOD_VERSION

@@ -6,8 +6,9 @@ module femcod_run
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, STATUS_USAGE
-   use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real, parse_real_list
-   use femcod_strings, only: string_type, int_str, real_str, split_list
+   use femcod_deck, only: deck_type, read_deck
+   use femcod_strings, only: string_type, int_str, real_str, split_list, parse_real, parse_integer, &
+      format_real, parse_real_list
    use femcod_contact_result, only: contact_result, contact_options, stop_reason_text, solver_state
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
    use femcod_files, only: remove_file

@@ -6,8 +6,9 @@ module femcod_studies
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO
-   use femcod_deck, only: deck_type, read_deck, parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
-   use femcod_strings, only: string_type, int_str, real_str, split_list, text_builder, add_line, built_text
+   use femcod_deck, only: deck_type, read_deck
+   use femcod_strings, only: string_type, int_str, real_str, split_list, text_builder, add_line, built_text, &
+      parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
    use femcod_generate, only: deck_spec, build_deck, read_heights
    use femcod_run, only: default_prefix, file_part
    use femcod_files, only: path_exists

@@ -13,8 +13,8 @@
 module femcod_checkpoint
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
-   use femcod_deck, only: deck_type, format_real
-   use femcod_strings, only: int_str
+   use femcod_deck, only: deck_type
+   use femcod_strings, only: int_str, format_real
    use femcod_files, only: atomic_rename, remove_file, temporary_name
    use femcod_contact_result, only: contact_options, solver_state
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_read, h5_attribute, &

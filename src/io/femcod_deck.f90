@@ -13,15 +13,13 @@
 !> and what was expected and found (doc/deck-format.md).
 module femcod_deck
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use, intrinsic :: ieee_exceptions, only: ieee_overflow, ieee_get_halting_mode, ieee_set_halting_mode, ieee_set_flag
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_files, only: commit_file, temporary_name, path_exists, path_is_directory
-   use femcod_strings, only: int_str, string_type, split_list, without_trailing_zeros
+   use femcod_strings, only: int_str, parse_real, parse_integer, format_real, is_digit
    implicit none
    private
-   public :: deck_type, read_deck, write_deck, validate_deck, format_real, parse_real, parse_integer
-   public :: parse_real_list, parse_integer_list
+   public :: deck_type, read_deck, write_deck, validate_deck
    public :: MAX_NP
 
    !> Largest NP accepted: NP**2 must fit a default integer.
@@ -279,160 +277,11 @@ contains
       end subroutine write_row
    end subroutine write_deck
 
-   !> The shortest decimal form of `x` that reads back to the same double.
-   function format_real(x) result(s)
-      real(dp), intent(in) :: x
-      character(len=:), allocatable :: s
-      character(len=40) :: buf, fmt
-      real(dp) :: back
-      integer :: p, ios, e
-      if (x == 0) then
-         s = "0"
-         return
-      end if
-      do p = 0, 16
-         write(fmt, '("(es40.",i0,"e3)")') p
-         write(buf, fmt) x
-         read(buf, *, iostat=ios) back
-         if (ios == 0 .and. back == x) exit
-      end do
-      buf = adjustl(buf)
-      e = index(buf, "E")
-      s = buf(1:e - 1)
-      s = without_trailing_zeros(s)
-      read(buf(e + 1:), *) p
-      if (p /= 0) s = s//"e"//int_str(p)
-      ! Plain fixed notation when it reads back exactly and is not longer.
-      if (abs(x) >= 1.0e-4_dp .and. abs(x) < 1.0e15_dp) then
-         do p = 0, 20
-            write(fmt, '("(f0.",i0,")")') p
-            write(buf, fmt) x
-            read(buf, *, iostat=ios) back
-            if (ios == 0 .and. back == x) exit
-         end do
-         buf = adjustl(buf)
-         if (buf(1:1) == ".") buf = "0"//buf
-         if (buf(1:2) == "-.") buf = "-0"//buf(2:)
-         e = len_trim(buf)
-         if (buf(e:e) == ".") e = e - 1
-         if (e <= len(s)) s = buf(1:e)
-      end if
-   end function format_real
 
-   !> Parse a real token: [sign] digits [. digits] [(e|E|d|D) [sign] digits], at least
-   !> one mantissa digit. NaN, Inf, repeat counts and overflow are refused.
-   subroutine parse_real(token, value, ok)
-      character(len=*), intent(in) :: token
-      real(dp), intent(out) :: value
-      logical, intent(out) :: ok
-      character(len=len(token)) :: t
-      integer :: i, n, ndig, ios
-      logical :: halting
-      value = 0
-      ok = .false.
-      t = token
-      n = len(t)
-      i = 1
-      if (n == 0) return
-      if (t(i:i) == "+" .or. t(i:i) == "-") i = i + 1
-      ndig = 0
-      do while (i <= n)
-         if (.not. is_digit(t(i:i))) exit
-         i = i + 1
-         ndig = ndig + 1
-      end do
-      if (i <= n) then
-         if (t(i:i) == ".") then
-            i = i + 1
-            do while (i <= n)
-               if (.not. is_digit(t(i:i))) exit
-               i = i + 1
-               ndig = ndig + 1
-            end do
-         end if
-      end if
-      if (ndig == 0) return
-      if (i <= n) then
-         if (index("eEdD", t(i:i)) == 0) return
-         t(i:i) = "e"
-         i = i + 1
-         if (i <= n) then
-            if (t(i:i) == "+" .or. t(i:i) == "-") i = i + 1
-         end if
-         if (i > n) return
-         do while (i <= n)
-            if (.not. is_digit(t(i:i))) return
-            i = i + 1
-         end do
-      end if
-      ! An overflowing literal must give a message, not a trap under -ffpe-trap=overflow.
-      call ieee_get_halting_mode(ieee_overflow, halting)
-      if (halting) call ieee_set_halting_mode(ieee_overflow, .false.)
-      read(t, *, iostat=ios) value
-      call ieee_set_flag(ieee_overflow, .false.)
-      if (halting) call ieee_set_halting_mode(ieee_overflow, .true.)
-      ok = ios == 0 .and. ieee_is_finite(value)
-   end subroutine parse_real
 
-   !> Parse an integer token: [sign] digits, within the range of a default integer.
-   subroutine parse_integer(token, value, ok)
-      character(len=*), intent(in) :: token
-      integer, intent(out) :: value
-      logical, intent(out) :: ok
-      integer :: i, i0, ios
-      integer(i8) :: wide
-      value = 0
-      ok = .false.
-      if (len(token) == 0 .or. len(token) > 18) return
-      i0 = 1
-      if (token(1:1) == "+" .or. token(1:1) == "-") i0 = 2
-      if (i0 > len(token)) return
-      do i = i0, len(token)
-         if (.not. is_digit(token(i:i))) return
-      end do
-      read(token, *, iostat=ios) wide
-      if (ios /= 0 .or. abs(wide) > huge(value)) return
-      value = int(wide)
-      ok = .true.
-   end subroutine parse_integer
 
-   !> Parse a comma-separated list of numbers (command-line options such as --loads);
-   !> `ok` is false when an item is not a number.
-   subroutine parse_real_list(text, values, ok)
-      character(len=*), intent(in) :: text
-      real(dp), allocatable, intent(out) :: values(:)
-      logical, intent(out) :: ok
-      type(string_type), allocatable :: parts(:)
-      integer :: k
-      parts = split_list(text)
-      allocate(values(size(parts)))
-      ok = size(parts) > 0
-      do k = 1, size(parts)
-         call parse_real(parts(k)%s, values(k), ok)
-         if (.not. ok) return
-      end do
-   end subroutine parse_real_list
 
-   !> Parse a comma-separated list of integers; `ok` is false when an item is not one.
-   subroutine parse_integer_list(text, values, ok)
-      character(len=*), intent(in) :: text
-      integer, allocatable, intent(out) :: values(:)
-      logical, intent(out) :: ok
-      type(string_type), allocatable :: parts(:)
-      integer :: k
-      parts = split_list(text)
-      allocate(values(size(parts)))
-      ok = size(parts) > 0
-      do k = 1, size(parts)
-         call parse_integer(parts(k)%s, values(k), ok)
-         if (.not. ok) return
-      end do
-   end subroutine parse_integer_list
 
-   pure logical function is_digit(c)
-      character(len=1), intent(in) :: c
-      is_digit = c >= "0" .and. c <= "9"
-   end function is_digit
 
    !> Read a whole file as bytes.
    subroutine read_whole_file(path, text, status)

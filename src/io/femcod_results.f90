@@ -9,8 +9,8 @@
 module femcod_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
-   use femcod_deck, only: deck_type, format_real
-   use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text
+   use femcod_deck, only: deck_type
+   use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_write, h5_attribute

@@ -12,10 +12,10 @@ module femcod_generate
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
-   use femcod_deck, only: deck_type, parse_real, validate_deck, format_real
+   use femcod_deck, only: deck_type, validate_deck
    use femcod_files, only: path_exists, path_is_directory
    use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close
-   use femcod_strings, only: int_str
+   use femcod_strings, only: int_str, parse_real, format_real
    use femcod_surfaces, only: circle_punch, square_punch, sphere_cap, sinusoid_surface, weierstrass_mandelbrot, &
       self_affine_surface, remove_plane
    implicit none

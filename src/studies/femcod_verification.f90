@@ -4,8 +4,8 @@
 module femcod_verification
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
-   use femcod_deck, only: deck_type, read_deck, format_real
-   use femcod_strings, only: int_str
+   use femcod_deck, only: deck_type, read_deck
+   use femcod_strings, only: int_str, format_real
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_legacy, only: solve_legacy
    use femcod_boussinesq, only: love_influence, love_influence_exact, love_influence_far, surface_compliance
