@@ -3,8 +3,9 @@ module femcod_bench
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck
-   use femcod_generate, only: deck_spec, build_deck, THESIS_RIGID_FACTOR
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
+   use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental
@@ -16,7 +17,7 @@ module femcod_bench
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free
-   use femcod_boussinesq, only: offset_table
+   use femcod_love, only: offset_table
    use femcod_random, only: random_stream, seed_stream, uniform
    use femcod_clock, only: wall_clock
    implicit none
@@ -29,8 +30,8 @@ contains
    subroutine bench_command(args, code)
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
-      type(deck_type) :: rough, deck
-      type(deck_spec) :: spec
+      type(contact_problem) :: rough, deck
+      type(scene_spec) :: spec
       type(status_type) :: status
       type(contact_result) :: inc, leg
       type(contact_options) :: options
@@ -96,7 +97,7 @@ contains
       spec%label = "bench"
       spec%matrix_file = ""
       spec%maxcont = 512*512/20
-      call build_deck(spec, rough, status)
+      call build_problem(spec, rough, status)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod bench: "//status%message
          code = status%code
@@ -189,8 +190,8 @@ contains
       integer, allocatable :: sizes(:)
       real(dp), allocatable :: fractions(:), g0(:, :)
       character(len=:), allocatable :: python, path, peer_out, wisdom
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: res
@@ -288,7 +289,7 @@ contains
          spec%label = "bench cg"
          spec%matrix_file = ""
          spec%maxcont = 1
-         call build_deck(spec, deck, status)
+         call build_problem(spec, deck, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod bench cg: "//status%message
             code = status%code

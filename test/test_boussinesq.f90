@@ -2,8 +2,9 @@
 module test_boussinesq
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_boussinesq, only: love_influence, love_influence_exact, love_influence_far, surface_compliance, &
-      offset_table, boussinesq_flexibility, boussinesq_inverse, boussinesq_element
+   use femcod_boussinesq, only: boussinesq_flexibility, boussinesq_inverse, boussinesq_element
+   use femcod_love, only: love_influence, love_influence_exact, love_influence_far, surface_compliance, &
+      offset_table
    use femcod_spring, only: spring_stiffness
    use femcod_skyline, only: colht, diagonal_addresses, assemble_element
    use femcod_trfact, only: trfact, TRFACT_FACTOR, TRFACT_SOLVE

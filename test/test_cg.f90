@@ -3,16 +3,17 @@
 module test_cg
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_incremental, only: solve_incremental
    use femcod_cg, only: solve_cg, cg_residuals, cg_method
-   use femcod_generate, only: VERIFICATION_DECKS, deck_spec, build_deck
+   use femcod_generate, only: VERIFICATION_DECKS, scene_spec, build_problem
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
-   use femcod_boussinesq, only: offset_table
+   use femcod_love, only: offset_table
    use femcod_random, only: random_stream, seed_stream, uniform
    use test_support, only: scratch_path, file_exists, remove_scratch
    use femcod_analytic, only: hertz_approach, segedin_sphere
@@ -42,7 +43,7 @@ contains
    !> range) the approach agrees to about that relative size.
    subroutine test_against_incremental(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, cg
       type(cg_residuals), allocatable :: report(:)
@@ -90,7 +91,7 @@ contains
    !> The analytic checks of the legacy suite, with the same tolerances (1 % and 0.5 %).
    subroutine test_sphere(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: res
       type(cg_residuals), allocatable :: report(:)
@@ -231,8 +232,8 @@ contains
    !> and the approach to 1e-8 relative (tolerance 1e-10 on the gap residual).
    subroutine test_accelerations(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, cg
       type(cg_residuals), allocatable :: report(:)
@@ -251,7 +252,7 @@ contains
       spec%label = "test"
       spec%matrix_file = ""
       spec%maxcont = 200
-      call build_deck(spec, deck, status)
+      call build_problem(spec, deck, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       options%loads = [real(dp) ::]

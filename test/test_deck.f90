@@ -2,7 +2,8 @@
 module test_deck
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck, write_deck
+   use femcod_deck, only: read_deck, write_deck
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, format_real
    use femcod_cli, only: run_femcod
    use test_support, only: write_text, scratch_path, contains_text, file_exists
@@ -55,7 +56,7 @@ contains
 
    subroutine test_valid(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: status
       character(len=:), allocatable :: path
       path = scratch_path("valid.deck")
@@ -85,7 +86,7 @@ contains
 
    subroutine test_formats(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: status
       character(len=:), allocatable :: path
       character(len=*), parameter :: cr = achar(13), tab = achar(9)
@@ -109,7 +110,7 @@ contains
 
    subroutine test_roundtrip(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck, back
+      type(contact_problem) :: deck, back
       type(status_type) :: status
       character(len=:), allocatable :: path
       integer :: i, j
@@ -273,7 +274,7 @@ contains
    subroutine run_bad(error, k)
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in) :: k
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: status
       character(len=:), allocatable :: path, name, text, where, expected
       call bad_case(k, name, text, where, expected)
@@ -380,7 +381,7 @@ contains
 
    subroutine test_bad_files(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: status
       call read_deck(scratch_path("no-such.deck"), deck, status)
       call check(error, status%code == 3 .and. contains_text(status%message, "no such file"), &

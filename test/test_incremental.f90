@@ -3,13 +3,14 @@
 module test_incremental
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental
    use femcod_generate, only: VERIFICATION_DECKS
    use femcod_scene, only: initial_gaps
-   use femcod_boussinesq, only: offset_table, surface_compliance
+   use femcod_love, only: offset_table, surface_compliance
    use femcod_condensed, only: solve_active_set, gap_at
    use femcod_spring, only: spring_stiffness
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
@@ -54,7 +55,7 @@ contains
 
    subroutine test_same_events(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, leg
       type(status_type) :: status
@@ -106,7 +107,7 @@ contains
    !> neither exists. A different algorithm from the event stepping.
    subroutine test_active_set(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc
       type(status_type) :: status
@@ -179,7 +180,7 @@ contains
 
    subroutine test_tables(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc
       type(status_type) :: status
@@ -205,7 +206,7 @@ contains
 
    subroutine test_growth(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc
       type(status_type) :: status
@@ -225,7 +226,7 @@ contains
 
    subroutine test_threads(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: one, two
       type(status_type) :: status
@@ -257,7 +258,7 @@ contains
    !> input/ deck (contacts equal, loads to 1e-12); auto reports its choice.
    subroutine test_event_search(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: a, b
       type(status_type) :: status

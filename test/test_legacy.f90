@@ -3,7 +3,8 @@
 module test_legacy
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_legacy, only: solve_legacy
    use femcod_richardson, only: convergence_rate, richardson_extrapolate
@@ -39,7 +40,7 @@ contains
       real(dp), intent(out) :: approach, centre_pressure
       type(contact_result), intent(out) :: res
       type(status_type), intent(inout) :: status
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       integer :: k, c
       call read_deck("input/"//name//".deck", deck, status)
@@ -121,7 +122,7 @@ contains
 
    subroutine test_sphere(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: res
       type(status_type) :: status
@@ -144,7 +145,7 @@ contains
 
    subroutine test_rough(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: res
       type(status_type) :: status

@@ -3,12 +3,13 @@
 module test_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, STATUS_BAD_INPUT
-   use femcod_deck, only: deck_type, read_deck, write_deck
+   use femcod_deck, only: read_deck, write_deck
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_exists, h5_read_string_attribute, h5_create, &
       h5_write
-   use femcod_generate, only: deck_spec, build_deck
+   use femcod_generate, only: scene_spec, build_problem
    use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -148,7 +149,7 @@ contains
    !> h5dump, a reader independent of femcod, must see data[i, j] = row i, column j.
    subroutine test_c_order(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: st
       character(len=:), allocatable :: prefix, text
       integer :: code, ios, a
@@ -306,7 +307,7 @@ contains
    !> as the deck (the same scene reached two ways).
    subroutine test_height_files(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: st
       type(h5_file) :: file
       character(len=:), allocatable :: dir, ref, text, maxc
@@ -369,8 +370,8 @@ contains
    !> interrupted. The kill times spread over the reference run's own duration.
    subroutine test_sigkill(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(status_type) :: st
       character(len=:), allocatable :: dir, cmd, run_args
       character(len=16) :: delay
@@ -387,7 +388,7 @@ contains
       spec%pixel = 10
       spec%rms = 3
       spec%maxcont = 400
-      call build_deck(spec, deck, st)
+      call build_problem(spec, deck, st)
       call write_deck(dir//"/scene.deck", deck, st)
       call check(error, st%code, 0, "deck")
       if (allocated(error)) return

@@ -4,11 +4,11 @@
 module test_stability
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
    use femcod_contact_result, only: contact_result, STOP_MAXCONT
-   use femcod_generate, only: deck_spec, build_deck, verification_spec
+   use femcod_generate, only: scene_spec, build_problem, verification_spec
    use femcod_stability, only: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, &
       single_pixel, first_spike_event, identical_surfaces, height_offset, length_scaling, poisson_limit, &
       love_precision, solve_precision, long_run_drift, solve, STIFFNESS_RATIOS
@@ -78,7 +78,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=*), parameter :: scenes(4) = [character(len=13) :: "sphere-centre", "sphere-corner", &
          "square-punch", "sinusoid"]
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: st
       real(dp) :: defect
       integer :: k, sets, nstates
@@ -137,13 +137,13 @@ contains
    !> usage error; a load beyond MAXCONT is not reached and the run says why.
    subroutine test_loads(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(contact_result) :: res
       type(status_type) :: st
       integer :: code
       call verification_spec("sphere_d2", spec, st)
-      call build_deck(spec, deck, st)
+      call build_problem(spec, deck, st)
       call solve(deck, "incremental", [0.0_dp, 1.0e12_dp], res, st)
       call check(error, st%code, 0, st%message)
       if (allocated(error)) return

@@ -3,10 +3,11 @@
 module test_studies
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, read_deck
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
-   use femcod_boussinesq, only: surface_compliance, love_influence
+   use femcod_love, only: surface_compliance, love_influence
    use femcod_resolution, only: uncoupled_curve, mccool_parameters, mccool_surface, mccool_area, gw_integral, &
       richardson_area, interpolate_area
    use femcod_resolution_study, only: level_deck
@@ -181,7 +182,7 @@ contains
    !> on the chain is a usage error.
    subroutine test_level_deck(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck, level
+      type(contact_problem) :: deck, level
       type(status_type) :: status
       integer :: i, j
       deck%label = "t"
@@ -219,7 +220,7 @@ contains
    !> independently (their own forces); on the 1 nm sphere deck the counts must agree.
    subroutine test_hardness_steps(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: a, b

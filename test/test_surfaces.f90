@@ -2,10 +2,12 @@
 module test_surfaces
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type, write_deck
+   use femcod_deck, only: write_deck
+   use femcod_problem, only: contact_problem
    use femcod_surfaces, only: circle_punch, square_punch, sphere_cap, wm_terms, self_affine_surface, remove_plane, &
       rms_height, sinusoid_surface, downsample_average, downsample_subsample
-   use femcod_generate, only: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, read_ascii_matrix
+   use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS
+   use femcod_heights, only: read_ascii_matrix
    use femcod_scene, only: initial_gaps, flip_upper
    use test_support, only: write_text, read_text, scratch_path, contains_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
@@ -174,14 +176,14 @@ contains
 
    subroutine test_input_decks(error)
       type(error_type), allocatable, intent(out) :: error
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(status_type) :: status
       character(len=:), allocatable :: path, fresh, kept
       integer :: k
       do k = 1, size(VERIFICATION_DECKS)
          call verification_spec(trim(VERIFICATION_DECKS(k)), spec, status)
-         call build_deck(spec, deck, status)
+         call build_problem(spec, deck, status)
          path = scratch_path(trim(VERIFICATION_DECKS(k))//".deck")
          call write_deck(path, deck, status)
          call check(error, status%code, 0)

@@ -5,9 +5,11 @@ module femcod_cli
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, STATUS_USAGE, STATUS_BAD_INPUT
-   use femcod_deck, only: deck_type, write_deck
+   use femcod_deck, only: write_deck
+   use femcod_problem, only: contact_problem
    use femcod_workspace, only: workspace_type, workspace_layout, workspace_table
-   use femcod_generate, only: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, KINDS
+   use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, KINDS
+   use femcod_heights, only: load_scene
    use femcod_run, only: run_command
    use femcod_studies, only: resolution_command, summits_command, multiscale_command
    use femcod_about, only: FEMCOD_VERSION
@@ -193,8 +195,8 @@ contains
    subroutine mkdeck_command(args, code)
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(status_type) :: status
       character(len=:), allocatable :: output, verification, dir, key
       integer :: i, k
@@ -338,7 +340,7 @@ contains
          return
       end if
       if (spec%label == "") spec%label = "femcod mkdeck "//spec%kind
-      call build_deck(spec, deck, status)
+      call load_scene(spec, deck, status)
       if (status%code == 0) call write_deck(output, deck, status)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod: "//status%message
@@ -350,9 +352,9 @@ contains
    contains
       subroutine one_verification(name, path)
          character(len=*), intent(in) :: name, path
-         type(deck_spec) :: vspec
+         type(scene_spec) :: vspec
          call verification_spec(name, vspec, status)
-         if (status%code == 0) call build_deck(vspec, deck, status)
+         if (status%code == 0) call build_problem(vspec, deck, status)
          if (status%code == 0) call write_deck(path, deck, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod: "//status%message

@@ -6,7 +6,8 @@ module femcod_run
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, STATUS_USAGE
-   use femcod_deck, only: deck_type, read_deck
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, real_str, split_list, parse_real, parse_integer, &
       format_real, parse_real_list
    use femcod_contact_result, only: contact_result, contact_options, stop_reason_text, solver_state
@@ -17,7 +18,9 @@ module femcod_run
    use femcod_cg, only: solve_cg, cg_residuals, cg_method
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_results, only: write_results, run_info, result_files
-   use femcod_generate, only: deck_spec, build_deck
+   use femcod_maps, only: load_maps, state_maps
+   use femcod_generate, only: scene_spec
+   use femcod_heights, only: load_scene
    use femcod_files, only: path_exists
    use femcod_about, only: FEMCOD_VERSION
    use femcod_status, only: STATUS_IO, STATUS_NUMERICAL
@@ -34,7 +37,7 @@ module femcod_run
    real(dp), save :: target_load = 0, growth = 3
    !> Where and for what the checkpoint procedure writes (set before each solve).
    character(len=:), allocatable, save :: checkpoint_path
-   type(deck_type), save :: checkpoint_deck
+   type(contact_problem), save :: checkpoint_deck
    type(contact_options), save :: checkpoint_options
    logical, save :: checkpoint_warned = .false.
 
@@ -100,12 +103,12 @@ contains
    subroutine run_command(args, code)
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: res
       type(string_type), allocatable :: decks(:), failed(:)
       character(len=:), allocatable :: deck_path, prefix, solver, key, current_prefix
-      type(deck_spec) :: spec
+      type(scene_spec) :: spec
       type(run_info) :: info
       type(solver_state) :: resume
       type(cg_residuals), allocatable :: cg_report(:)
@@ -334,10 +337,11 @@ contains
          integer, intent(out) :: rc
          type(status_type) :: st
          character(len=160), allocatable :: lines(:)
+         type(state_maps), allocatable :: maps(:)
          rc = 0
          current_prefix = out_prefix
          if (deck_path == "") then
-            call build_deck(spec, deck, st)
+            call load_scene(spec, deck, st)
          else
             call read_deck(deck_path, deck, st)
          end if
@@ -434,7 +438,8 @@ contains
                   info%scene(1)%s = "nothing: the legacy solver models every node and spring of Appendix B"
                end if
             end if
-            call write_results(current_prefix, deck, res, info, st)
+            call load_maps(deck, res%states, maps)
+            call write_results(current_prefix, deck, res, maps, info, st)
             deallocate(info%scene)
          end if
          if (st%code /= 0) then

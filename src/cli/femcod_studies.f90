@@ -6,10 +6,12 @@ module femcod_studies
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO
-   use femcod_deck, only: deck_type, read_deck
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, real_str, split_list, text_builder, add_line, built_text, &
       parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
-   use femcod_generate, only: deck_spec, build_deck, read_heights
+   use femcod_generate, only: scene_spec
+   use femcod_heights, only: load_scene, read_heights
    use femcod_run, only: default_prefix, file_part
    use femcod_files, only: path_exists
    use femcod_results, only: write_file_set
@@ -73,7 +75,7 @@ contains
    subroutine resolution_command(args, code)
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(status_type) :: status
       type(resolution_level), allocatable :: levels(:)
       type(string_type), allocatable :: names(:), texts(:)
@@ -380,9 +382,9 @@ contains
       real(dp), intent(in) :: pixel, young, poisson
       integer, intent(in) :: maxcont
       logical, intent(in) :: plane
-      type(deck_type), intent(out) :: deck
+      type(contact_problem), intent(out) :: deck
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
+      type(scene_spec) :: spec
       if (pixel > 0) then
          spec%kind = "matrix"
          spec%label = "heights from "//input
@@ -395,7 +397,7 @@ contains
          spec%poisson = poisson
          spec%maxcont = maxcont
          spec%plane = plane
-         call build_deck(spec, deck, status)
+         call load_scene(spec, deck, status)
       else
          call read_deck(input, deck, status)
       end if
@@ -444,7 +446,7 @@ contains
       real(dp), allocatable, intent(out) :: z(:, :)
       real(dp), intent(out) :: d
       type(status_type), intent(inout) :: status
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       if (pixel > 0) then
          call read_heights(input, z, status)
          d = pixel

@@ -13,7 +13,7 @@
 module femcod_checkpoint
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
-   use femcod_deck, only: deck_type
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, format_real
    use femcod_files, only: atomic_rename, remove_file, temporary_name
    use femcod_contact_result, only: contact_options, solver_state
@@ -32,7 +32,7 @@ contains
    !> Store `state` for `deck` and `options` in `path`, atomically.
    subroutine write_checkpoint(path, deck, options, state, status)
       character(len=*), intent(in) :: path
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_options), intent(in) :: options
       type(solver_state), intent(in) :: state
       type(status_type), intent(inout) :: status
@@ -120,7 +120,7 @@ contains
    !> written for exactly this deck and these options.
    subroutine read_checkpoint(path, deck, options, state, status)
       character(len=*), intent(in) :: path
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_options), intent(in) :: options
       type(solver_state), intent(out) :: state
       type(status_type), intent(inout) :: status

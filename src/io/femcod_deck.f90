@@ -12,36 +12,15 @@
 !> ends and Fortran `D` exponents are accepted. Every error names the file, the line
 !> and what was expected and found (doc/deck-format.md).
 module femcod_deck
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use femcod_kinds, only: dp, i8
+   use femcod_problem, only: contact_problem, validate_problem, MAX_NP
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_files, only: commit_file, temporary_name, path_exists, path_is_directory
    use femcod_strings, only: int_str, parse_real, parse_integer, format_real, is_digit
    implicit none
    private
-   public :: deck_type, read_deck, write_deck, validate_deck
-   public :: MAX_NP
+   public :: read_deck, write_deck
 
-   !> Largest NP accepted: NP**2 must fit a default integer.
-   integer, parameter :: MAX_NP = 46340
-
-   !> A contact problem as the deck gives it.
-   type :: deck_type
-      !> Free-text label (line 1).
-      character(len=:), allocatable :: label
-      !> Pixels per side.
-      integer :: np = 0
-      !> Pixel side d (nm).
-      real(dp) :: pixel = 0
-      !> Maximum number of contacts.
-      integer :: maxcont = 0
-      !> Young's moduli (GPa): lower surface, upper surface, contact elements.
-      real(dp) :: young(3) = 0
-      !> Poisson's ratios: lower surface, upper surface, contact elements.
-      real(dp) :: poisson(3) = 0
-      !> Heights (nm), `lower(i, j)` is row i, column j as in the deck.
-      real(dp), allocatable :: lower(:, :), upper(:, :)
-   end type deck_type
 
    character(len=*), parameter :: material_names(3) = [character(len=26) :: &
       "lower surface", "upper surface", "contact/interface elements"]
@@ -52,7 +31,7 @@ contains
    !> and `deck` is left unspecified.
    subroutine read_deck(path, deck, status)
       character(len=*), intent(in) :: path
-      type(deck_type), intent(out) :: deck
+      type(contact_problem), intent(out) :: deck
       type(status_type), intent(inout) :: status
       character(len=:), allocatable :: text
       integer, allocatable :: tok_first(:), tok_last(:), tok_line(:)
@@ -201,50 +180,16 @@ contains
       end subroutine get_real
    end subroutine read_deck
 
-   !> Check the semantic limits of a deck built in memory (the reader checks the same).
-   subroutine validate_deck(deck, status)
-      type(deck_type), intent(in) :: deck
-      type(status_type), intent(inout) :: status
-      integer :: i
-      if (deck%np <= 0 .or. deck%np > MAX_NP) then
-         call set_error(status, STATUS_BAD_INPUT, "NP must be from 1 to "//int_str(MAX_NP))
-      else if (.not. (deck%pixel > 0 .and. ieee_is_finite(deck%pixel))) then
-         call set_error(status, STATUS_BAD_INPUT, "PIXEL must be a finite positive size in nm")
-      else if (deck%maxcont <= 0 .or. deck%maxcont > deck%np**2) then
-         call set_error(status, STATUS_BAD_INPUT, "MAXCONT must be from 1 to NP**2")
-      else if (index(deck%label, new_line("a")) > 0) then
-         call set_error(status, STATUS_BAD_INPUT, "the label must be a single line")
-      end if
-      if (status%code /= 0) return
-      do i = 1, 3
-         if (.not. (deck%young(i) > 0 .and. ieee_is_finite(deck%young(i)))) then
-            call set_error(status, STATUS_BAD_INPUT, "E"//int_str(i)//" must be a finite positive modulus in GPa")
-            return
-         end if
-         if (.not. (deck%poisson(i) > -1 .and. deck%poisson(i) < 0.5_dp)) then
-            call set_error(status, STATUS_BAD_INPUT, "NU"//int_str(i)//" must lie in (-1, 0.5)")
-            return
-         end if
-      end do
-      if (.not. allocated(deck%lower) .or. .not. allocated(deck%upper)) then
-         call set_error(status, STATUS_BAD_INPUT, "the deck has no heights")
-      else if (any(shape(deck%lower) /= deck%np) .or. any(shape(deck%upper) /= deck%np)) then
-         call set_error(status, STATUS_BAD_INPUT, "the height maps must be NP x NP")
-      else if (.not. (all(ieee_is_finite(deck%lower)) .and. all(ieee_is_finite(deck%upper)))) then
-         call set_error(status, STATUS_BAD_INPUT, "heights must be finite")
-      end if
-   end subroutine validate_deck
-
    !> Write a deck: validated first, written under a temporary name, then renamed, so
    !> that `path` is either untouched or complete. Each real is written with the fewest
    !> digits that read back to the same double, one image row per line.
    subroutine write_deck(path, deck, status)
       character(len=*), intent(in) :: path
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(status_type), intent(inout) :: status
       character(len=:), allocatable :: tmp
       integer :: unit, ios, i
-      call validate_deck(deck, status)
+      call validate_problem(deck, status)
       if (status%code /= 0) return
       tmp = temporary_name(path)
       open(newunit=unit, file=tmp, status="replace", action="write", form="formatted", iostat=ios)

@@ -9,12 +9,12 @@
 module femcod_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
-   use femcod_deck, only: deck_type
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_write, h5_attribute
-   use femcod_maps, only: load_maps, state_maps
+   use femcod_maps, only: state_maps
    use femcod_svg, only: svg_plot, svg_pressure_map, fmt_sig
    use femcod_richardson, only: power_law_fit
    implicit none
@@ -49,18 +49,18 @@ contains
    !> Write every result file for `prefix`; on failure none is left behind and
    !> existing files of that name are untouched. Each file is renamed into place when
    !> all are written, PREFIX.h5 last, so its presence marks a complete set.
-   subroutine write_results(prefix, deck, res, info, status)
+   subroutine write_results(prefix, deck, res, maps, info, status)
       character(len=*), intent(in) :: prefix
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
+      !> The pressure and gap maps of the reached load states (solvers/femcod_maps).
+      type(state_maps), intent(in) :: maps(:)
       type(run_info), intent(in) :: info
       type(status_type), intent(inout) :: status
       type(string_type), allocatable :: names(:), temps(:)
-      type(state_maps), allocatable :: maps(:)
       integer :: k
       if (status%code /= 0) return
       allocate(names(0), temps(0))
-      call load_maps(deck, res%states, maps)
       call add(".history.csv")
       call write_text(temps(size(temps))%s, history_csv(deck, res), status)
       call add(".contacts.csv")
@@ -175,7 +175,7 @@ contains
 
    !> PREFIX.history.csv: one row per step.
    function history_csv(deck, res) result(text)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       character(len=:), allocatable :: text
       type(text_builder) :: b
@@ -195,7 +195,7 @@ contains
 
    !> PREFIX.contacts.csv: the contact pixels and their forces at the reported load.
    function contacts_csv(deck, res) result(text)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       character(len=:), allocatable :: text
       type(text_builder) :: b
@@ -211,7 +211,7 @@ contains
 
    !> PREFIX.loads.csv: the states at the requested loads that were reached.
    function loads_csv(deck, res) result(text)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       character(len=:), allocatable :: text
       type(text_builder) :: b
@@ -235,7 +235,7 @@ contains
    !> The HDF5 file (schema in doc/results.md).
    subroutine write_hdf5(tmp, deck, res, info, maps, status)
       character(len=*), intent(in) :: tmp
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       type(run_info), intent(in) :: info
       type(state_maps), intent(in) :: maps(:)
@@ -333,7 +333,7 @@ contains
    !> area = prefactor * load^exponent, least squares in log-log over the steps with
    !> positive load (0, 0 when fewer than two).
    subroutine area_fit(deck, res, exponent, prefactor)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       real(dp), intent(out) :: exponent, prefactor
       logical, allocatable :: keep(:)
@@ -347,7 +347,7 @@ contains
    end subroutine area_fit
 
    function area_load_svg(deck, res) result(svg)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       character(len=:), allocatable :: svg
       real(dp) :: exponent, prefactor
@@ -367,7 +367,7 @@ contains
    !> a temporal collection (time = load in nN), cell-centred on a 2DCoRectMesh.
    function xdmf_text(h5name, deck, res) result(x)
       character(len=*), intent(in) :: h5name
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       character(len=:), allocatable :: x
       character(len=1), parameter :: nl = new_line("a")

@@ -12,13 +12,13 @@
 module femcod_legacy
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
-   use femcod_deck, only: deck_type
+   use femcod_problem, only: contact_problem
    use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, MPSURF, MPGAPS, MPDISP, &
       MPFORCE, MPSTIF, IPSORT, IPCONT, IPIADR, IPNOD1, IPNOD2, IPNOD3, IPKFIX
    use femcod_scene, only: initial_gaps
    use femcod_sort, only: merge_sort_index
-   use femcod_boussinesq, only: offset_table, surface_compliance, boussinesq_flexibility, boussinesq_inverse, &
-      boussinesq_element
+   use femcod_boussinesq, only: boussinesq_flexibility, boussinesq_inverse, boussinesq_element
+   use femcod_love, only: offset_table, surface_compliance
    use femcod_spring, only: spring_stiffness, spring_element
    use femcod_skyline, only: colht, diagonal_addresses, assemble_element, skyline_matvec
    use femcod_trfact, only: trfact, trfact_condition, TRFACT_FACTOR, TRFACT_SOLVE
@@ -34,8 +34,8 @@ module femcod_legacy
 contains
 
    !> Run the Appendix B algorithm on a deck.
-   subroutine solve_legacy(deck, options, res, status, progress)
-      type(deck_type), intent(in) :: deck
+   subroutine solve_legacy(problem, options, res, status, progress)
+      type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       type(contact_result), intent(out) :: res
       type(status_type), intent(inout) :: status
@@ -52,9 +52,9 @@ contains
       logical :: finished
 
       call wall_clock(tstart)
-      np = deck%np
+      np = problem%np
       npix = np*np
-      maxc = deck%maxcont
+      maxc = problem%maxcont
       if (options%max_contacts > 0) maxc = min(maxc, options%max_contacts)
       call workspace_layout(np, maxc, ws, status)
       if (status%code /= 0) return
@@ -63,9 +63,9 @@ contains
 
       ! CREATEINPUT: heights into MPSURF, initial gaps into MPGAPS, merge sort into IPSORT.
       isurf = ws%rfirst(MPSURF)
-      ws%ra(isurf:isurf + npix - 1) = reshape(transpose(deck%lower), [npix])
-      ws%ra(isurf + npix:isurf + 2*npix - 1) = reshape(transpose(deck%upper), [npix])
-      g0 = initial_gaps(deck%lower, deck%upper)
+      ws%ra(isurf:isurf + npix - 1) = reshape(transpose(problem%lower), [npix])
+      ws%ra(isurf + npix:isurf + 2*npix - 1) = reshape(transpose(problem%upper), [npix])
+      g0 = initial_gaps(problem%lower, problem%upper)
       igaps = ws%rfirst(MPGAPS)
       ws%ra(igaps:igaps + npix - 1) = g0
       isort = ws%ifirst(IPSORT)
@@ -73,10 +73,10 @@ contains
 
       allocate(table(0:np - 1, 0:np - 1))
       table = offset_table(np)
-      c1 = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel)
-      c2 = surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
+      c1 = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel)
+      c2 = surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
       csum = c1 + c2
-      kspring = spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
+      kspring = spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
 
       allocate(ic(maxc), jc(maxc), cstep(maxc), ftot(maxc), funit(maxc), in_contact(npix), joiners(npix))
       in_contact = .false.
@@ -125,7 +125,7 @@ contains
                njoin, nmissed, ws%ra(igaps:igaps + npix - 1))
          end if
          res%missed_during_run = res%missed_during_run + nmissed
-         call record_load_states(res, lambda, njoin > 0, total, approach, delta, ftot(1:n), funit(1:n), deck%pixel, &
+         call record_load_states(res, lambda, njoin > 0, total, approach, delta, ftot(1:n), funit(1:n), problem%pixel, &
             options%hardness, ic(1:n), jc(1:n))
          if (njoin == 0) then
             res%stop_reason = STOP_NO_CONTACT
@@ -133,12 +133,12 @@ contains
                if (max_load > total) call advance(max_load - total)
             end if
             call wall_clock(t1)
-            call append_step(res, n, count(ftot(1:n)/deck%pixel**2 > options%hardness), total, approach, t1 - t0)
+            call append_step(res, n, count(ftot(1:n)/problem%pixel**2 > options%hardness), total, approach, t1 - t0)
             exit
          end if
          call advance(lambda)
          call wall_clock(t1)
-         call append_step(res, n, count(ftot(1:n)/deck%pixel**2 > options%hardness), total, approach, t1 - t0)
+         call append_step(res, n, count(ftot(1:n)/problem%pixel**2 > options%hardness), total, approach, t1 - t0)
          if (present(progress)) call progress(step, n, total, t1 - tstart)
          if (size(loads) > 0) then
             if (max_load <= total) then
@@ -226,7 +226,7 @@ contains
             approach = aex
             res%step_approach(res%nsteps) = aex
             res%step_contacts(res%nsteps) = n
-            res%step_above_hardness(res%nsteps) = count(ftot(1:n)/deck%pixel**2 > options%hardness)
+            res%step_above_hardness(res%nsteps) = count(ftot(1:n)/problem%pixel**2 > options%hardness)
          end if
       end subroutine final_check
    end subroutine solve_legacy

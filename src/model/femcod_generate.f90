@@ -1,5 +1,6 @@
-!> Deck generators behind `femcod mkdeck`: a `deck_spec` names a surface kind and its
-!> parameters; `build_deck` turns it into a deck. `verification_spec` gives the specs
+!> Scene generators behind `femcod mkdeck`: a `scene_spec` names a surface kind and its
+!> parameters; `build_problem` turns it into a contact problem (no I/O: the heights of
+!> a "matrix" scene come in as an array, read by io/femcod_heights). `verification_spec` gives the specs
 !> of the decks kept in input/ (thesis Tables 4.1, 4.2, Figs. 4.14-4.16).
 !>
 !> Scene convention: the generated shape goes on one surface (`shape_on`), the other
@@ -9,19 +10,15 @@
 !> penalty's model error near 4e-11 of the approach (doc/stability.md); the decks of
 !> input/ keep the thesis' THESIS_RIGID_FACTOR = 1e5 so that they are the thesis' scenes.
 module femcod_generate
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
-   use femcod_deck, only: deck_type, validate_deck
-   use femcod_files, only: path_exists, path_is_directory
-   use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close
-   use femcod_strings, only: int_str, parse_real, format_real
+   use femcod_problem, only: contact_problem, validate_problem
+   use femcod_strings, only: int_str, format_real
    use femcod_surfaces, only: circle_punch, square_punch, sphere_cap, sinusoid_surface, weierstrass_mandelbrot, &
       self_affine_surface, remove_plane
    implicit none
    private
-   public :: deck_spec, build_deck, verification_spec, VERIFICATION_DECKS, read_ascii_matrix, read_heights, RIGID_FACTOR, &
-      THESIS_RIGID_FACTOR, KINDS
+   public :: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, RIGID_FACTOR, THESIS_RIGID_FACTOR, KINDS
 
    !> Modulus ratio of a rigid body to the elastic one (thesis section 4.4).
    real(dp), parameter :: RIGID_FACTOR = 1.0e10_dp, THESIS_RIGID_FACTOR = 1.0e5_dp
@@ -36,7 +33,7 @@ module femcod_generate
       "sphere_d4", "sphere_d2", "sphere_d1", "sphere_d05", "rough_selfaffine_32"]
 
    !> What to generate. Lengths in nm, moduli in GPa.
-   type :: deck_spec
+   type :: scene_spec
       character(len=:), allocatable :: kind, label, matrix_file
       !> With kind "matrix": heights of the other surface from a second file ("": flat).
       character(len=:), allocatable :: second_file
@@ -55,16 +52,19 @@ module femcod_generate
       !> Weierstrass-Mandelbrot eq. (3.6).
       real(dp) :: ds = 2.4_dp, g = 1.36e-2_dp, gamma = 1.5_dp, lmax = 1000, lmin = 1
       logical :: plane = .false.
-   end type deck_spec
+   end type scene_spec
 
 contains
 
-   !> Build a deck from a spec. MAXCONT 0 means a default: the punch pixels for
-   !> punches, NP**2 for a flat, 5 % of NP**2 otherwise.
-   subroutine build_deck(spec, deck, status)
-      type(deck_spec), intent(in) :: spec
-      type(deck_type), intent(out) :: deck
+   !> Build a problem from a spec. MAXCONT 0 means a default: the punch pixels for
+   !> punches, NP**2 for a flat, 5 % of NP**2 otherwise. A "matrix" scene takes its
+   !> heights (nm) from `heights` and, when not empty, the other surface's from `second`
+   !> (io/femcod_heights reads them from the spec's files).
+   subroutine build_problem(spec, problem, status, heights, second)
+      type(scene_spec), intent(in) :: spec
+      type(contact_problem), intent(out) :: problem
       type(status_type), intent(inout) :: status
+      real(dp), intent(in), optional :: heights(:, :), second(:, :)
       real(dp), allocatable :: shape(:, :)
       integer :: npunch, np
       real(dp) :: area
@@ -107,8 +107,11 @@ contains
          allocate(shape(np, np))
          call self_affine_surface(np, spec%pixel, spec%hurst, spec%rms, spec%seed, shape)
       case ("matrix")
-         call read_heights(spec%matrix_file, shape, status)
-         if (status%code /= 0) return
+         if (.not. present(heights)) then
+            call set_error(status, STATUS_BAD_INPUT, "mkdeck: a matrix scene needs its heights")
+            return
+         end if
+         shape = heights
          np = size(shape, 1)
       case default
          call set_error(status, STATUS_BAD_INPUT, "mkdeck: unknown kind '"//spec%kind//"'")
@@ -120,51 +123,50 @@ contains
          ! Rough surfaces: their lowest point at 0 nm, so heights read as protrusions.
          shape = shape - minval(shape)
       end if
-      deck%label = spec%label
-      deck%np = np
-      deck%pixel = spec%pixel
+      problem%label = spec%label
+      problem%np = np
+      problem%pixel = spec%pixel
       if (spec%maxcont > 0) then
-         deck%maxcont = spec%maxcont
+         problem%maxcont = spec%maxcont
       else if (npunch > 0) then
-         deck%maxcont = npunch
+         problem%maxcont = npunch
       else if (spec%kind == "flat") then
-         deck%maxcont = np*np
+         problem%maxcont = np*np
       else
          ! 5 % of the pixels: rough contacts rarely go further, and the legacy solver's
          ! skyline grows as MAXCONT**2.
-         deck%maxcont = max(1, np*np/20)
+         problem%maxcont = max(1, np*np/20)
       end if
-      deck%young = spec%young
-      deck%poisson = spec%poisson
+      problem%young = spec%young
+      problem%poisson = spec%poisson
       select case (spec%rigid)
       case ("upper")
-         deck%young(2) = spec%young*spec%rigid_factor
-         deck%young(3) = spec%young*spec%rigid_factor
+         problem%young(2) = spec%young*spec%rigid_factor
+         problem%young(3) = spec%young*spec%rigid_factor
       case ("lower")
-         deck%young(1) = spec%young*spec%rigid_factor
-         deck%young(3) = spec%young*spec%rigid_factor
+         problem%young(1) = spec%young*spec%rigid_factor
+         problem%young(3) = spec%young*spec%rigid_factor
       case ("none")
-         deck%young(3) = spec%young*spec%rigid_factor
+         problem%young(3) = spec%young*spec%rigid_factor
       case default
          call set_error(status, STATUS_BAD_INPUT, "mkdeck: --rigid must be upper, lower or none")
          return
       end select
-      allocate(deck%lower(np, np), deck%upper(np, np))
-      deck%lower = 0
-      deck%upper = 0
+      allocate(problem%lower(np, np), problem%upper(np, np))
+      problem%lower = 0
+      problem%upper = 0
       select case (spec%shape_on)
       case ("upper")
-         deck%upper = shape
+         problem%upper = shape
       case ("lower")
-         deck%lower = shape
+         problem%lower = shape
       case default
          call set_error(status, STATUS_BAD_INPUT, "mkdeck: --shape-on must be upper or lower")
          return
       end select
-      if (spec%kind == "matrix" .and. allocated(spec%second_file)) then
-         if (spec%second_file /= "") then
-            call read_heights(spec%second_file, shape, status)
-            if (status%code /= 0) return
+      if (spec%kind == "matrix" .and. present(second)) then
+         if (size(second) > 0) then
+            shape = second
             if (size(shape, 1) /= np) then
                call set_error(status, STATUS_BAD_INPUT, spec%second_file//": expected "//int_str(np)//" x "// &
                   int_str(np)//" heights as in "//spec%matrix_file//", found "//int_str(size(shape, 1))//" x "// &
@@ -174,25 +176,25 @@ contains
             if (spec%plane) call remove_plane(shape)
             shape = shape - minval(shape)
             if (spec%shape_on == "upper") then
-               deck%lower = shape
+               problem%lower = shape
             else
-               deck%upper = shape
+               problem%upper = shape
             end if
          end if
       end if
-      call validate_deck(deck, status)
+      call validate_problem(problem, status)
    contains
       pure real(dp) function pick(value, default)
          real(dp), intent(in) :: value, default
          pick = value
          if (value <= 0) pick = default
       end function pick
-   end subroutine build_deck
+   end subroutine build_problem
 
    !> The spec of a verification deck of input/ by name; an error for an unknown name.
    subroutine verification_spec(name, spec, status)
       character(len=*), intent(in) :: name
-      type(deck_spec), intent(out) :: spec
+      type(scene_spec), intent(out) :: spec
       type(status_type), intent(inout) :: status
       integer :: m
       spec%young = 200
@@ -274,158 +276,4 @@ contains
       end do
    end function pixels_within
 
-   !> Heights (nm) from `FILE` (an ASCII matrix) or `FILE.h5:/path` (a square 2-D HDF5
-   !> dataset, C order: data[i, j] is row i, column j; any numeric type).
-   subroutine read_heights(path, z, status)
-      character(len=*), intent(in) :: path
-      real(dp), allocatable, intent(out) :: z(:, :)
-      type(status_type), intent(inout) :: status
-      type(h5_file) :: file
-      integer :: colon
-      colon = index(path, ":/", back=.true.)
-      if (colon == 0) then
-         call read_ascii_matrix(path, z, status)
-         return
-      end if
-      associate(fname => path(1:colon - 1), dataset => path(colon + 1:))
-         if (path_is_directory(fname) .or. .not. path_exists(fname)) then
-            call set_error(status, STATUS_BAD_INPUT, fname//": expected an HDF5 file of heights, found none")
-            return
-         end if
-         call h5_open(fname, file, status, STATUS_BAD_INPUT)
-         call h5_read(file, dataset, z, status, STATUS_BAD_INPUT)
-         call h5_close(file, status)
-         if (status%code /= 0) return
-         if (size(z, 1) /= size(z, 2) .or. size(z) == 0) then
-            call set_error(status, STATUS_BAD_INPUT, path//": expected a square matrix of heights, found "// &
-               int_str(size(z, 1))//" x "//int_str(size(z, 2)))
-            return
-         end if
-         if (.not. all(ieee_is_finite(z))) then
-            call set_error(status, STATUS_BAD_INPUT, path//": expected finite heights (nm), found NaN or Inf")
-            return
-         end if
-      end associate
-   end subroutine read_heights
-
-   !> Read an ASCII height matrix (nm), one image row per line, values separated by
-   !> blanks, tabs or commas, lines starting with '#' ignored (Gwyddion export). The
-   !> matrix must be square.
-   subroutine read_ascii_matrix(path, z, status)
-      character(len=*), intent(in) :: path
-      real(dp), allocatable, intent(out) :: z(:, :)
-      type(status_type), intent(inout) :: status
-      character(len=:), allocatable :: line
-      real(dp), allocatable :: row(:), rows(:, :)
-      integer :: unit, ios, nrow, ncol, lineno
-      logical :: ok
-      if (path_is_directory(path) .or. .not. path_exists(path)) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected a height-matrix file, found none")
-         return
-      end if
-      open(newunit=unit, file=path, action="read", status="old", iostat=ios)
-      if (ios /= 0) then
-         call set_error(status, STATUS_BAD_INPUT, path//": cannot open the height matrix")
-         return
-      end if
-      nrow = 0
-      ncol = 0
-      lineno = 0
-      allocate(rows(0, 0))
-      do
-         call read_line(unit, line, ios)
-         if (ios /= 0) exit
-         lineno = lineno + 1
-         if (len_trim(line) == 0) cycle
-         if (adjustl(line(1:1)) == "#" .or. line(1:1) == "#") cycle
-         call split_reals(line, row, ok)
-         if (.not. ok) then
-            call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(lineno)// &
-               ": expected a row of finite numbers (nm), found '"//line(1:min(len(line), 40))//"'")
-            close(unit)
-            return
-         end if
-         if (nrow == 0) then
-            ncol = size(row)
-            deallocate(rows)
-            allocate(rows(ncol, ncol))
-         end if
-         if (size(row) /= ncol) then
-            call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(lineno)//": expected "// &
-               int_str(ncol)//" values as in the first row, found "//(int_str(size(row))))
-            close(unit)
-            return
-         end if
-         nrow = nrow + 1
-         if (nrow > ncol) then
-            call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(lineno)// &
-               ": expected a square matrix of "//int_str(ncol)//" rows, found more rows")
-            close(unit)
-            return
-         end if
-         rows(:, nrow) = row
-      end do
-      close(unit)
-      if (nrow == 0 .or. nrow /= ncol) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected a square matrix of heights, found "// &
-            int_str(nrow)//" rows of "//int_str(ncol)//" values")
-         return
-      end if
-      z = transpose(rows)
-   end subroutine read_ascii_matrix
-
-   !> Read one line of any length.
-   subroutine read_line(unit, line, ios)
-      integer, intent(in) :: unit
-      character(len=:), allocatable, intent(out) :: line
-      integer, intent(out) :: ios
-      character(len=4096) :: buf
-      integer :: nread
-      line = ""
-      do
-         read(unit, '(a)', advance="no", iostat=ios, size=nread) buf
-         line = line//buf(1:nread)
-         if (ios /= 0) exit
-      end do
-      if (is_iostat_eor(ios)) ios = 0
-      if (len(line) > 0) then
-         if (line(len(line):len(line)) == achar(13)) line = line(1:len(line) - 1)
-      end if
-   end subroutine read_line
-
-   !> Split a line into reals.
-   subroutine split_reals(line, values, ok)
-      character(len=*), intent(in) :: line
-      real(dp), allocatable, intent(out) :: values(:)
-      logical, intent(out) :: ok
-      integer :: i, start, n
-      real(dp) :: v
-      real(dp), allocatable :: tmp(:)
-      allocate(tmp(len(line)/2 + 1))
-      n = 0
-      ok = .true.
-      i = 1
-      do while (i <= len(line))
-         if (is_sep(line(i:i))) then
-            i = i + 1
-            cycle
-         end if
-         start = i
-         do while (i <= len(line))
-            if (is_sep(line(i:i))) exit
-            i = i + 1
-         end do
-         call parse_real(line(start:i - 1), v, ok)
-         if (.not. ok) return
-         n = n + 1
-         tmp(n) = v
-      end do
-      values = tmp(1:n)
-      ok = n > 0
-   contains
-      pure logical function is_sep(c)
-         character(len=1), intent(in) :: c
-         is_sep = c == " " .or. c == achar(9) .or. c == "," .or. c == achar(13)
-      end function is_sep
-   end subroutine split_reals
 end module femcod_generate

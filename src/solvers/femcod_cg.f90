@@ -47,9 +47,9 @@
 module femcod_cg
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
-   use femcod_deck, only: deck_type
+   use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
-   use femcod_boussinesq, only: offset_table, surface_compliance
+   use femcod_love, only: offset_table, surface_compliance
    use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
@@ -119,8 +119,8 @@ contains
 
    !> Solve at every requested load (ascending order of computation; results in the
    !> order given). `report(k)` holds the residuals at load k.
-   subroutine solve_cg(deck, options, tol, max_iterations, res, report, status, method)
-      type(deck_type), intent(in) :: deck
+   subroutine solve_cg(problem, options, tol, max_iterations, res, report, status, method)
+      type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       real(dp), intent(in) :: tol
       integer, intent(in) :: max_iterations
@@ -136,7 +136,7 @@ contains
       integer :: np, k, kk, m, i, j, nc
       call wall_clock(tstart)
       if (present(method)) how = method
-      np = deck%np
+      np = problem%np
       m = size(options%loads)
       allocate(report(m), res%states(m))
       res%states%load = options%loads
@@ -144,7 +144,7 @@ contains
          call set_error(status, STATUS_NUMERICAL, "cg: --solver cg needs --loads")
          return
       end if
-      call make_grid(fine, transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np])), deck, deck%pixel, how)
+      call make_grid(fine, transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np])), problem, problem%pixel, how)
       allocate(p(np, np))
       ! Ascending loads, each warm-started from the last.
       allocate(order(m))
@@ -168,7 +168,7 @@ contains
          else
             if (.not. sum(p) > 0) then
                if (how%nested) then
-                  call nested_start(fine, deck, load, how, p, report(k), status)
+                  call nested_start(fine, problem, load, how, p, report(k), status)
                else
                   call first_guess(fine, load, p)
                end if
@@ -188,8 +188,8 @@ contains
             st%contact_gap = report(k)%contact_gap
             st%load_error = report(k)%load_error
             st%contacts = count(p > 0)
-            st%max_pressure = maxval(p)/deck%pixel**2
-            st%n_above_hardness = count(p/deck%pixel**2 > options%hardness)
+            st%max_pressure = maxval(p)/problem%pixel**2
+            st%n_above_hardness = count(p/problem%pixel**2 > options%hardness)
             allocate(st%i(st%contacts), st%j(st%contacts), st%force(st%contacts))
             nc = 0
             do i = 1, np
@@ -219,18 +219,18 @@ contains
    end subroutine solve_cg
 
    !> A grid for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's materials.
-   subroutine make_grid(grid, g0, deck, pixel, how)
+   subroutine make_grid(grid, g0, problem, pixel, how)
       type(cg_grid), intent(inout) :: grid
       real(dp), intent(in) :: g0(:, :)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: pixel
       type(cg_method), intent(in) :: how
       grid%np = size(g0, 1)
       grid%pixel = pixel
       grid%g0 = g0
-      grid%c = surface_compliance(deck%young(1), deck%poisson(1), pixel) + &
-         surface_compliance(deck%young(2), deck%poisson(2), pixel)
-      grid%s = 3/spring_stiffness(deck%young(3), deck%poisson(3), pixel, pixel)
+      grid%c = surface_compliance(problem%young(1), problem%poisson(1), pixel) + &
+         surface_compliance(problem%young(2), problem%poisson(2), pixel)
+      grid%s = 3/spring_stiffness(problem%young(3), problem%poisson(3), pixel, pixel)
       grid%scale = max(maxval(g0) - minval(g0), tiny(1.0_dp))
       allocate(grid%table(0:grid%np - 1, 0:grid%np - 1))
       grid%table = offset_table(grid%np)
@@ -255,9 +255,9 @@ contains
    !> The first load's start from nested grids: halve while the side stays even and at
    !> least 2 * coarsest; solve the coarsest from the first guess, then each finer grid
    !> from the coarser solution, to coarse_tol; return the forces on the finest grid.
-   recursive subroutine nested_start(grid, deck, total_load, how, p, rep, status)
+   recursive subroutine nested_start(grid, problem, total_load, how, p, rep, status)
       type(cg_grid), intent(in) :: grid
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: total_load
       type(cg_method), intent(in) :: how
       real(dp), intent(out) :: p(:, :)
@@ -275,9 +275,9 @@ contains
       end if
       n = n/2
       call make_grid(coarse, (grid%g0(1::2, 1::2) + grid%g0(2::2, 1::2) + grid%g0(1::2, 2::2) + &
-         grid%g0(2::2, 2::2))/4, deck, 2*grid%pixel, how)
+         grid%g0(2::2, 2::2))/4, problem, 2*grid%pixel, how)
       allocate(pc(n, n))
-      call nested_start(coarse, deck, total_load, how, pc, rep, status)
+      call nested_start(coarse, problem, total_load, how, pc, rep, status)
       if (status%code == 0) call constrained_cg(coarse, total_load, how%coarse_tol, 10000, how, pc, approach, &
          coarse_rep, status)
       call convolution_free(coarse%conv)

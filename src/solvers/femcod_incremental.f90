@@ -23,9 +23,9 @@
 module femcod_incremental
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
-   use femcod_deck, only: deck_type
+   use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
-   use femcod_boussinesq, only: offset_table, surface_compliance, love_influence
+   use femcod_love, only: offset_table, surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_lapack, only: dtrsv, dtrsm, dpotrf
    use femcod_condensed, only: gap_and_rate
@@ -49,14 +49,14 @@ module femcod_incremental
 contains
 
    !> What the condensed model leaves out for this deck, one line each.
-   function scene_report(deck) result(lines)
-      type(deck_type), intent(in) :: deck
+   function scene_report(problem) result(lines)
+      type(contact_problem), intent(in) :: problem
       character(len=160), allocatable :: lines(:)
       real(dp) :: c1, c2, s, cself
       character(len=16) :: buf
-      c1 = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel)
-      c2 = surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
-      s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
+      c1 = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel)
+      c2 = surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
+      s = 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
       cself = (c1 + c2)*love_influence(0, 0)
       allocate(lines(0))
       lines = [character(len=160) :: "handles, substrate and surface nodes condensed: unknowns are the contact "// &
@@ -69,7 +69,7 @@ contains
          write(buf, '(es9.2)') c1/c2
          lines = [character(len=160) :: lines, "lower body rigid (compliance "//trim(adjustl(buf))// &
             " of the upper's): no element of its own, kept exactly in c = c1 + c2"]
-      else if (deck%young(1) == deck%young(2) .and. deck%poisson(1) == deck%poisson(2)) then
+      else if (problem%young(1) == problem%young(2) .and. problem%poisson(1) == problem%poisson(2)) then
          lines = [character(len=160) :: lines, "identical materials: one Love table, c = 2 c1"]
       else
          lines = [character(len=160) :: lines, "two elastic bodies: one Love table, c = c1 + c2"]
@@ -77,16 +77,16 @@ contains
       write(buf, '(es9.2)') s/cself
       lines = [character(len=160) :: lines, "interface and penalty springs: an exact diagonal compliance 3/k = "// &
          trim(adjustl(buf))//" of a pixel's self-compliance"]
-      if (all(deck%lower == deck%lower(1, 1))) lines = [character(len=160) :: lines, "lower surface flat"]
-      if (all(deck%upper == deck%upper(1, 1))) lines = [character(len=160) :: lines, "upper surface flat"]
+      if (all(problem%lower == problem%lower(1, 1))) lines = [character(len=160) :: lines, "lower surface flat"]
+      if (all(problem%upper == problem%upper(1, 1))) lines = [character(len=160) :: lines, "upper surface flat"]
    end function scene_report
 
    !> Run the event-exact algorithm on a deck (same outputs as the legacy solver).
    !> With `checkpoint`, the state is handed over every options%checkpoint_interval
    !> seconds; with `resume`, the run continues from such a state and ends exactly as
    !> the uninterrupted run would (the caller checks that deck and options match).
-   subroutine solve_incremental(deck, options, res, status, progress, checkpoint, resume)
-      type(deck_type), intent(in) :: deck
+   subroutine solve_incremental(problem, options, res, status, progress, checkpoint, resume)
+      type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       type(contact_result), intent(out) :: res
       type(status_type), intent(inout) :: status
@@ -114,16 +114,16 @@ contains
       integer :: np, npix, maxc, n, step, k, p, neval, njoin, krel, q, info, ld
 
       call wall_clock(tstart)
-      np = deck%np
+      np = problem%np
       npix = np*np
-      maxc = deck%maxcont
+      maxc = problem%maxcont
       if (options%max_contacts > 0) maxc = min(maxc, options%max_contacts)
       allocate(table(0:np - 1, 0:np - 1))
       table = offset_table(np)
-      g0 = initial_gaps(deck%lower, deck%upper)
-      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
-         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
-      s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
+      g0 = initial_gaps(problem%lower, problem%upper)
+      c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
+         surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
+      s = 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
       self = c*table(0, 0) + s
       ld = min(maxc, 256)
       allocate(u(ld, ld))
@@ -262,21 +262,21 @@ contains
          if (lam_best >= huge(1.0_dp)) then
             ! Nothing can close and nothing is released: linear for ever.
             call record_load_states(res, huge(1.0_dp), .false., total, approach, delta, ftot(1:n), funit(1:n), &
-               deck%pixel, options%hardness, ic(1:n), jc(1:n))
+               problem%pixel, options%hardness, ic(1:n), jc(1:n))
             res%stop_reason = STOP_NO_CONTACT
             if (size(loads) > 0) then
                if (max_load > total) call advance(max_load - total)
             end if
             call wall_clock(t1)
-            call append_step(res, n, count(ftot(1:n)/deck%pixel**2 > options%hardness), total, approach, t1 - t0)
+            call append_step(res, n, count(ftot(1:n)/problem%pixel**2 > options%hardness), total, approach, t1 - t0)
             exit
          end if
          lam_best = max(lam_best, 0.0_dp)
          call record_load_states(res, lam_best, .true., total, approach, delta, ftot(1:n), funit(1:n), &
-            deck%pixel, options%hardness, ic(1:n), jc(1:n))
+            problem%pixel, options%hardness, ic(1:n), jc(1:n))
          call advance(lam_best)
          call wall_clock(t1)
-         call append_step(res, n, count(ftot(1:n)/deck%pixel**2 > options%hardness), total, approach, t1 - t0)
+         call append_step(res, n, count(ftot(1:n)/problem%pixel**2 > options%hardness), total, approach, t1 - t0)
          if (present(progress)) call progress(step, n, total, t1 - tstart)
          if (size(loads) > 0) then
             if (max_load <= total) then

@@ -1,9 +1,9 @@
 !> Pressure and gap maps of the recorded load states (no I/O).
 module femcod_maps
    use femcod_kinds, only: dp
-   use femcod_deck, only: deck_type
+   use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
-   use femcod_boussinesq, only: offset_table, surface_compliance
+   use femcod_love, only: offset_table, surface_compliance
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: load_state
    implicit none
@@ -22,8 +22,8 @@ contains
    !> from one zero-padded FFT convolution, and 0 at the contacts (where the penalty
    !> springs' compression s F is the only remaining separation). The Love table and the
    !> FFT plans are made once for all states.
-   subroutine load_maps(deck, states, maps)
-      type(deck_type), intent(in) :: deck
+   subroutine load_maps(problem, states, maps)
+      type(contact_problem), intent(in) :: problem
       type(load_state), intent(in) :: states(:)
       type(state_maps), allocatable, intent(out) :: maps(:)
       type(love_convolution) :: conv
@@ -32,13 +32,13 @@ contains
       integer :: np, k, s
       allocate(maps(size(states)))
       if (.not. any(states%reached)) return
-      np = deck%np
+      np = problem%np
       allocate(force(np, np), disp(np, np), table(0:np - 1, 0:np - 1))
       table = offset_table(np)
-      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
-         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
+      c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
+         surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
       ! g0 is numbered pixel by pixel along rows: p = (i - 1) np + j.
-      g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
+      g0 = transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np]))
       call convolution_setup(conv, table)
       do s = 1, size(states)
          if (.not. states(s)%reached) cycle
@@ -46,7 +46,7 @@ contains
          do k = 1, size(states(s)%force)
             force(states(s)%i(k), states(s)%j(k)) = states(s)%force(k)
          end do
-         maps(s)%pressure = force/deck%pixel**2
+         maps(s)%pressure = force/problem%pixel**2
          call convolution_apply(conv, force, disp)
          maps(s)%gap = g0 - states(s)%approach + c*disp
          do k = 1, size(states(s)%force)

@@ -5,10 +5,10 @@
 module femcod_resolution_study
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE
-   use femcod_deck, only: deck_type, validate_deck
+   use femcod_problem, only: contact_problem, validate_problem
    use femcod_surfaces, only: downsample_subsample, downsample_average
    use femcod_scene, only: initial_gaps, flip_upper
-   use femcod_boussinesq, only: surface_compliance, love_influence
+   use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result, contact_options, progress_interface
    use femcod_incremental, only: solve_incremental
@@ -49,10 +49,10 @@ contains
    !> odd/odd pixels; "average": 2 x 2 means) until they have `np` pixels, pixel size
    !> doubled each time, MAXCONT scaled by the pixel count (the same area fraction).
    subroutine level_deck(deck, np, method, level, status)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       integer, intent(in) :: np
       character(len=*), intent(in) :: method
-      type(deck_type), intent(out) :: level
+      type(contact_problem), intent(out) :: level
       type(status_type), intent(inout) :: status
       character(len=:), allocatable :: chain
       if (status%code /= 0) return
@@ -87,19 +87,19 @@ contains
          return
       end if
       level%maxcont = max(1, min(np*np, nint(deck%maxcont*(real(np, dp)/deck%np)**2)))
-      call validate_deck(level, status)
+      call validate_problem(level, status)
    end subroutine level_deck
 
    !> Solve one level and compute its estimates.
    subroutine solve_level(deck, np, method, hardness, level, status, progress)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       integer, intent(in) :: np
       character(len=*), intent(in) :: method
       real(dp), intent(in) :: hardness
       type(resolution_level), intent(out) :: level
       type(status_type), intent(inout) :: status
       procedure(progress_interface), optional :: progress
-      type(deck_type) :: d
+      type(contact_problem) :: d
       type(contact_options) :: options
       real(dp), allocatable :: load(:), area(:), composite(:, :)
       logical, allocatable :: keep(:)

@@ -6,13 +6,13 @@ module femcod_stability
    use, intrinsic :: iso_fortran_env, only: real128
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: deck_type
-   use femcod_generate, only: deck_spec, build_deck, verification_spec
+   use femcod_problem, only: contact_problem
+   use femcod_generate, only: scene_spec, build_problem, verification_spec
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental
    use femcod_condensed, only: solve_active_set
-   use femcod_boussinesq, only: offset_table, surface_compliance, love_influence, love_influence_exact, &
+   use femcod_love, only: offset_table, surface_compliance, love_influence, love_influence_exact, &
       love_influence_far
    use femcod_spring, only: spring_stiffness
    use femcod_scene, only: initial_gaps
@@ -40,7 +40,7 @@ contains
 
    !> Run one solver on a deck at the given loads.
    subroutine solve(deck, solver, loads, res, status, max_contacts)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       character(len=*), intent(in) :: solver
       real(dp), intent(in) :: loads(:)
       type(contact_result), intent(out) :: res
@@ -65,13 +65,13 @@ contains
    subroutine stiffness_sweep(rows, status)
       type(stiffness_row), intent(out) :: rows(size(STIFFNESS_RATIOS))
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(contact_result) :: res
       real(dp) :: reference, inc
       integer :: k
       call verification_spec("sphere_d2", spec, status)
-      call build_deck(spec, deck, status)
+      call build_problem(spec, deck, status)
       if (status%code /= 0) return
       deck%young(3) = 1.0e300_dp
       call solve(deck, "incremental", [1000.0_dp], res, status)
@@ -98,9 +98,9 @@ contains
    !> (input/square_punch_n9), "sinusoid" (eq. 3.3, A = 1 nm, w = 10 nm, NP = 31).
    subroutine symmetric_scene(name, deck, status)
       character(len=*), intent(in) :: name
-      type(deck_type), intent(out) :: deck
+      type(contact_problem), intent(out) :: deck
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
+      type(scene_spec) :: spec
       select case (name)
       case ("sphere-centre")
          call verification_spec("sphere_d2", spec, status)
@@ -119,7 +119,7 @@ contains
          spec%scale = 10
          spec%maxcont = 120
       end select
-      call build_deck(spec, deck, status)
+      call build_problem(spec, deck, status)
    end subroutine symmetric_scene
 
    !> Largest asymmetry of the contact forces over the history: the deck is solved once,
@@ -129,7 +129,7 @@ contains
    !> the square: max |F - T(F)| / max F. `sets` counts states whose contact set is
    !> not symmetric.
    subroutine symmetry_defect(deck, solver, defect, sets, nstates, status)
-      type(deck_type), intent(in) :: deck
+      type(contact_problem), intent(in) :: deck
       character(len=*), intent(in) :: solver
       real(dp), intent(out) :: defect
       integer, intent(out) :: sets, nstates
@@ -213,8 +213,8 @@ contains
       integer, intent(out) :: first_contacts
       real(dp), intent(out) :: difference, condition
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(contact_result) :: res
       real(dp), allocatable :: table(:, :), forces(:)
       integer, allocatable :: ic(:), jc(:)
@@ -225,7 +225,7 @@ contains
       spec%matrix_file = ""
       spec%np = 8
       spec%pixel = 1
-      call build_deck(spec, deck, status)
+      call build_problem(spec, deck, status)
       call solve(deck, solver, [100.0_dp], res, status)
       if (status%code /= 0) return
       first_contacts = res%step_contacts(1)
@@ -253,7 +253,7 @@ contains
       real(dp), intent(in) :: nu
       real(dp), intent(out) :: difference
       type(status_type), intent(inout) :: status
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       type(contact_result) :: res
       real(dp) :: expected
       deck%label = "one pixel"
@@ -283,8 +283,8 @@ contains
       !> Pixels found penetrating by the final check (the legacy candidate list misses).
       integer, intent(out) :: missed
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(contact_result) :: res
       real(dp), allocatable :: table(:, :), g0(:)
       real(dp) :: c, self, best
@@ -296,7 +296,7 @@ contains
       spec%pixel = 10
       spec%rms = 1
       spec%shape_on = "lower"
-      call build_deck(spec, deck, status)
+      call build_problem(spec, deck, status)
       if (status%code /= 0) return
       deck%lower(7, 11) = deck%lower(7, 11) + 1000
       call solve(deck, solver, [real(dp) ::], res, status, max_contacts=3)
@@ -326,8 +326,8 @@ contains
    subroutine identical_surfaces(difference, status)
       real(dp), intent(out) :: difference
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
-      type(deck_type) :: twin, single
+      type(scene_spec) :: spec
+      type(contact_problem) :: twin, single
       type(contact_result) :: a, b
       spec%kind = "self-affine"
       spec%label = "identical rough surfaces"
@@ -337,7 +337,7 @@ contains
       spec%rms = 3
       spec%rigid = "none"
       spec%maxcont = 60
-      call build_deck(spec, twin, status)
+      call build_problem(spec, twin, status)
       if (status%code /= 0) return
       twin%lower = twin%upper
       single = twin
@@ -370,8 +370,8 @@ contains
    subroutine height_offset(difference, bound, status)
       real(dp), intent(out) :: difference, bound
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
-      type(deck_type) :: plain, offset
+      type(scene_spec) :: spec
+      type(contact_problem) :: plain, offset
       type(contact_result) :: a, b
       real(dp), allocatable :: g0(:)
       real(dp) :: gmin
@@ -384,7 +384,7 @@ contains
       spec%rms = 1.0e-3_dp
       spec%shape_on = "lower"
       spec%maxcont = 40
-      call build_deck(spec, plain, status)
+      call build_problem(spec, plain, status)
       if (status%code /= 0) return
       offset = plain
       offset%lower = plain%lower + 1.0e6_dp
@@ -411,8 +411,8 @@ contains
       real(dp), intent(in) :: factor
       real(dp), intent(out) :: difference
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
-      type(deck_type) :: base, scaled
+      type(scene_spec) :: spec
+      type(contact_problem) :: base, scaled
       type(contact_result) :: a, b
       spec%kind = "self-affine"
       spec%label = "scaling"
@@ -421,7 +421,7 @@ contains
       spec%pixel = 1
       spec%rms = 0.3_dp
       spec%maxcont = 40
-      call build_deck(spec, base, status)
+      call build_problem(spec, base, status)
       if (status%code /= 0) return
       scaled = base
       scaled%pixel = base%pixel*factor
@@ -440,12 +440,12 @@ contains
       character(len=*), intent(in) :: solver
       real(dp), intent(out) :: difference, condition
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(contact_result) :: res
       real(dp) :: reference
       call verification_spec("sphere_d2", spec, status)
-      call build_deck(spec, deck, status)
+      call build_problem(spec, deck, status)
       if (status%code /= 0) return
       deck%young(3) = 1.0e300_dp
       call solve(deck, "incremental", [1000.0_dp], res, status)
@@ -547,8 +547,8 @@ contains
       real(dp), intent(out) :: drift, seconds
       integer, intent(out) :: steps
       type(status_type), intent(inout) :: status
-      type(deck_spec) :: spec
-      type(deck_type) :: deck
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
       type(contact_result) :: res
       spec%kind = "self-affine"
       spec%label = "long run"
@@ -557,7 +557,7 @@ contains
       spec%pixel = 5
       spec%rms = 3
       spec%maxcont = events
-      call build_deck(spec, deck, status)
+      call build_problem(spec, deck, status)
       call solve(deck, "incremental", [real(dp) ::], res, status)
       if (status%code /= 0) return
       drift = res%final_check_difference

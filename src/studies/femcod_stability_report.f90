@@ -6,7 +6,7 @@ module femcod_stability_report
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_files, only: commit_file, temporary_name
    use femcod_strings, only: int_str, real_str
-   use femcod_deck, only: deck_type
+   use femcod_problem, only: contact_problem
    use femcod_stability, only: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, &
       single_pixel, first_spike_event, identical_surfaces, height_offset, length_scaling, poisson_limit, &
       love_precision, solve_precision, long_run_drift, STIFFNESS_RATIOS, INCOMPRESSIBLE_GAP
@@ -22,7 +22,7 @@ contains
       type(status_type), intent(inout) :: status
       logical, intent(in) :: progress
       type(stiffness_row) :: rows(size(STIFFNESS_RATIOS))
-      type(deck_type) :: deck
+      type(contact_problem) :: deck
       character(len=:), allocatable :: tmp
       character(len=*), parameter :: scenes(4) = [character(len=13) :: "sphere-centre", "sphere-corner", &
          "square-punch", "sinusoid"]

@@ -4,11 +4,12 @@
 module femcod_verification
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
-   use femcod_deck, only: deck_type, read_deck
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, format_real
    use femcod_contact_result, only: contact_result, contact_options
    use femcod_legacy, only: solve_legacy
-   use femcod_boussinesq, only: love_influence, love_influence_exact, love_influence_far, surface_compliance
+   use femcod_love, only: love_influence, love_influence_exact, love_influence_far, surface_compliance
    use femcod_richardson, only: convergence_rate, convergence_rate_known_limit, richardson_extrapolate, power_law_fit
    use femcod_files, only: commit_file, temporary_name
    use femcod_analytic, only: hertz_approach, segedin_sphere, flat_punch_approach
@@ -168,7 +169,7 @@ contains
          real(dp), intent(in) :: loads(:)
          real(dp), intent(out) :: first, second
          type(contact_result), intent(out) :: res
-         type(deck_type) :: deck
+         type(contact_problem) :: deck
          type(contact_options) :: options
          integer :: m, cc
          call read_deck("input/"//name//".deck", deck, status)
