@@ -6,12 +6,13 @@ module femcod_bench
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR
-   use femcod_contact_result, only: contact_result, contact_options
-   use femcod_legacy, only: solve_legacy
-   use femcod_incremental, only: solve_incremental
-   use femcod_cg, only: solve_cg, cg_residuals, cg_method
-   use femcod_strings, only: string_type, int_str, real_str, fixed_str, parse_integer, &
-      parse_real, parse_real_list, parse_integer_list
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver, only: solve_contact
+   use femcod_strings, only: string_type, int_str, real_str, fixed_str
+   use femcod_options, only: option_spec, parsed_options, parse_options, option_help, flag_option, real_option, &
+      integer_option, text_option, choice_option, real_list_option, integer_list_option, get_option, option_given
+   use femcod_thesis, only: TABLE_4_1_APPROACH, TABLE_4_2_APPROACH
    use femcod_analytic, only: segedin_sphere
    use femcod_scene, only: initial_gaps
    use femcod_wisdom, only: load_wisdom, save_wisdom
@@ -35,11 +36,11 @@ contains
       type(status_type) :: status
       type(contact_result) :: inc, leg
       type(contact_options) :: options
-      integer :: legacy_contacts, i, n, k
-      logical :: full, ok
+      type(parsed_options) :: parsed
+      integer :: legacy_contacts, n, k
+      logical :: full
       real(dp), allocatable :: cg_loads(:), cg_approach(:)
-      type(cg_residuals), allocatable :: cg_report(:)
-      real(dp) :: err, ref, peak
+      real(dp) :: err, peak
       code = 0
       if (size(args) > 0) then
          if (args(1)%s == "cg") then
@@ -53,34 +54,27 @@ contains
       end if
       legacy_contacts = 300
       full = .false.
-      i = 1
-      do while (i <= size(args))
-         select case (args(i)%s)
-         case ("-h", "--help")
-            write(output_unit, '(a)') "usage: femcod bench [--full] [--legacy-contacts N]", &
-               "       femcod bench cg [--np LIST] [--contact LIST] [--tol T] [--peers PYTHON]  (--help for more)", &
-               "       femcod bench convolution [--np LIST] [--repeat N]  (--help for more)", &
-               "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
-               "event, peak memory (resident, per case), error against the reference. The rough surface is", &
-               "the one of issue 4: self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa,", &
-               "nu = 0.25, against a rigid flat (seed 1). --full adds the run to 5 % contact (minutes).", &
-               "--legacy-contacts N (default 300): how far the legacy solver runs on that surface.", &
-               "Run it with the release build: fpm run --profile release -- bench"
-            return
-         case ("--full")
-            full = .true.
-         case ("--legacy-contacts")
-            if (i < size(args)) then
-               call parse_integer(args(i + 1)%s, legacy_contacts, ok)
-               i = i + 1
-            end if
-         case default
-            write(error_unit, '(a)') "femcod bench: unknown argument "//args(i)%s
-            code = 2
-            return
-         end select
-         i = i + 1
-      end do
+      if (wants_help(args)) then
+         write(output_unit, '(a)') "usage: femcod bench [--full] [--legacy-contacts N]", &
+            "       femcod bench cg [--np LIST] [--contact LIST] [--tol T] [--peers PYTHON]  (--help for more)", &
+            "       femcod bench convolution [--np LIST] [--repeat N]  (--help for more)", &
+            "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
+            "event, peak memory (resident, per case), error against the reference. The rough surface:", &
+            "self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa, nu = 0.25, against a", &
+            "rigid flat (seed 1).", ""
+         call put_lines(option_help(bench_table(), ""))
+         write(output_unit, '(a)') "Run it with the release build: fpm run --profile release -- bench"
+         return
+      end if
+      call parse_options(bench_table(), args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench: "//bad_arguments(status, parsed)//" (femcod bench --help)"
+         code = 2
+         return
+      end if
+      call get_option(parsed, "--full", full)
+      call get_option(parsed, "--legacy-contacts", legacy_contacts)
 
       spec%kind = "self-affine"
       spec%np = 512
@@ -114,10 +108,10 @@ contains
       options%max_contacts = legacy_contacts
       allocate(options%loads(0))
       call reset_peak()
-      call solve_incremental(rough, options, inc, status)
+      call solve_with("incremental", rough, options, inc)
       peak = peak_mb()
       call reset_peak()
-      call solve_legacy(rough, options, leg, status)
+      call solve_with("legacy", rough, options, leg)
       ! Contacts in order of joining: the first pixel where the two lists differ.
       n = 0
       do k = 1, min(size(inc%contact_i), size(leg%contact_i))
@@ -139,7 +133,7 @@ contains
       do k = 1, merge(2, 1, full)
          options%max_contacts = 2621*merge(1, 5, k == 1)
          call reset_peak()
-         call solve_incremental(rough, options, inc, status)
+         call solve_with("incremental", rough, options, inc)
          call row("self-affine 5 um, to "//int_str(merge(1, 5, k == 1))//" %", 512, inc, "incremental", &
             max(inc%final_check_difference, inc%max_penetration), "fresh solve of the final active set", peak_mb())
          ! Inside the last step (response linear there): the fixed-load solver's target.
@@ -149,18 +143,22 @@ contains
       ! The fixed-load solver at the same loads (warm-started from one load to the next).
       options%max_contacts = 0
       options%loads = cg_loads
+      options%cg%tol = 1.0e-8_dp
+      options%cg%max_iterations = 5000
       call reset_peak()
-      call solve_cg(rough, options, 1.0e-8_dp, 5000, inc, cg_report, status)
+      call solve_with("cg", rough, options, inc)
       call row("self-affine 5 um, at the "//trim(merge("1 and 5 % loads", "1 % load       ", full)), 512, inc, "cg", &
          maxval(abs(inc%states%approach - cg_approach)/cg_approach), "event-exact approach at the same loads; "// &
-         int_str(sum(cg_report%iterations))//" iterations in all, residual "// &
-         real_str(maxval(cg_report%residual), 2), peak_mb())
+         int_str(sum(inc%states%iterations))//" iterations in all, residual "// &
+         real_str(maxval(inc%states%residual), 2), peak_mb())
 
       ! Verification decks against their analytic or thesis values.
       if (allocated(options%loads)) deallocate(options%loads)
       options%max_contacts = 0
-      call verification_row("circle_punch_d9", 1.0_dp, 0.911e-3_dp, "Table 4.1 approach 0.911e-3 nm")
-      call verification_row("square_punch_n27", 1.0_dp, 0.412e-3_dp, "Table 4.2 approach 0.412e-3 nm")
+      call verification_row("circle_punch_d9", 1.0_dp, TABLE_4_1_APPROACH(3), "Table 4.1 approach "// &
+         real_str(TABLE_4_1_APPROACH(3), 3)//" nm")
+      call verification_row("square_punch_n27", 1.0_dp, TABLE_4_2_APPROACH(4), "Table 4.2 approach "// &
+         real_str(TABLE_4_2_APPROACH(4), 3)//" nm")
       call verification_row("sphere_d05", 18000.0_dp, segedin(18000.0_dp), "Segedin approach at 18000 nN")
    contains
       subroutine verification_row(name, load, reference, what)
@@ -173,13 +171,95 @@ contains
          end if
          options%loads = [load]
          call reset_peak()
-         call solve_incremental(deck, options, inc, status)
+         call solve_with("incremental", deck, options, inc)
          call row(name, deck%np, inc, "incremental", abs(inc%states(1)%approach/reference - 1), what, peak_mb())
          call reset_peak()
-         call solve_legacy(deck, options, leg, status)
+         call solve_with("legacy", deck, options, leg)
          call row(name, deck%np, leg, "legacy", abs(leg%states(1)%approach/reference - 1), what, peak_mb())
       end subroutine verification_row
+
+      !> One solver through the dispatcher; a failure is reported and the table goes on.
+      subroutine solve_with(solver, problem, opts, res)
+         character(len=*), intent(in) :: solver
+         type(contact_problem), intent(in) :: problem
+         type(contact_options), intent(inout) :: opts
+         type(contact_result), intent(out) :: res
+         opts%solver = solver
+         call solve_contact(problem, opts, res, status)
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod bench: "//solver//": "//status%message
+            status = status_type()
+         end if
+      end subroutine solve_with
    end subroutine bench_command
+
+   !> The options of `femcod bench`.
+   function bench_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [flag_option("--full", "add the run to 5 % contact (minutes)"), &
+         integer_option("--legacy-contacts", "N", "how far the legacy solver runs on the rough surface (default 300)", &
+            lower=1)]
+   end function bench_table
+
+   !> The options of `femcod bench cg`.
+   function bench_cg_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [integer_list_option("--np", "N1,...", "grid sizes (default 512,1024)", lower=2), &
+         real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,5,10)", lower=0.0_dp, &
+            upper=100.0_dp, closed="(]"), &
+         real_option("--tol", "T", "the cg tolerance (default 1e-8)", lower=0.0_dp, closed="()"), &
+         text_option("--peers", "PYTHON", "also run the peers installed in that Python (app/femcod_peers.py)"), &
+         text_option("--fftw-wisdom", "FILE", "measured FFTW plans kept in FILE"), &
+         choice_option("--nested", "on|off", "nested coarse-grid start (default on)"), &
+         integer_option("--coarsest", "N", "coarsest grid (default 64)", lower=2), &
+         real_option("--coarse-tol", "T", "tolerance of the coarse grids (default 1e-4)", lower=0.0_dp, closed="()"), &
+         real_option("--single-until", "R", "float32 transforms above this residual (default 1e-5; 0: never)", &
+            lower=0.0_dp), &
+         integer_option("--direct", "N", "projection changes corrected directly (default 32; 0: two convolutions "// &
+            "per iteration)", lower=0), &
+         choice_option("--restart", "on|off", "restart the directions when pixels enter (default off)"), &
+         choice_option("--precondition", "on|off", "the inverse-Love stencil (default on)"), &
+         choice_option("--polak-ribiere", "on|off", "PR+ beta (default on; off: Fletcher-Reeves)"), &
+         real_option("--powell", "NU", "Powell's restart when |z.g_old| >= NU z.g (default 0.2; 0: never)", &
+            lower=0.0_dp)]
+   end function bench_cg_table
+
+   !> The options of `femcod bench convolution`.
+   function bench_convolution_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [integer_list_option("--np", "N1,...", "grid sizes (default 512,1024,2048)", lower=2), &
+         integer_option("--repeat", "N", "convolutions timed per size and precision (default 5)", lower=1)]
+   end function bench_convolution_table
+
+   !> The message of a failed parse, or of an argument the bench takes no positional for.
+   function bad_arguments(status, parsed) result(text)
+      type(status_type), intent(in) :: status
+      type(parsed_options), intent(in) :: parsed
+      character(len=:), allocatable :: text
+      if (allocated(status%message)) then
+         text = status%message
+      else
+         text = "unknown argument "//parsed%positional(1)%s
+      end if
+   end function bad_arguments
+
+   !> Whether the arguments ask for help.
+   pure logical function wants_help(args)
+      type(string_type), intent(in) :: args(:)
+      integer :: k
+      wants_help = .false.
+      do k = 1, size(args)
+         if (args(k)%s == "--help" .or. args(k)%s == "-h") wants_help = .true.
+      end do
+   end function wants_help
+
+   subroutine put_lines(lines)
+      type(string_type), intent(in) :: lines(:)
+      integer :: k
+      do k = 1, size(lines)
+         write(output_unit, '(a)') lines(k)%s
+      end do
+   end subroutine put_lines
 
    !> `femcod bench cg`: the fixed-load solver on self-affine surfaces of growing size at
    !> the mean pressures that give about the requested contact fractions, side by side with
@@ -195,83 +275,62 @@ contains
       type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: res
-      type(cg_residuals), allocatable :: report(:)
-      type(cg_method) :: method
+      type(parsed_options) :: parsed
       real(dp) :: tol, estar, slope, pressure, load, length, peak
-      integer :: i, n, k, np, unit, ios, max_iterations
-      logical :: ok, loaded
+      integer :: i, n, k, np, unit, ios
+      logical :: loaded
       character(len=512) :: line
       character(len=*), parameter :: peers(2) = [character(len=16) :: "aspher", "contactmechanics"]
       sizes = [512, 1024]
       fractions = [1.0_dp, 5.0_dp, 10.0_dp]
       tol = 1.0e-8_dp
-      max_iterations = 5000
       python = ""
       wisdom = ""
-      i = 1
-      do while (i <= size(args))
-         ok = i < size(args)
-         select case (args(i)%s)
-         case ("-h", "--help")
-            write(output_unit, '(a)') &
-               "usage: femcod bench cg [--np 512,1024] [--contact 1,5,10] [--tol 1e-8] [--peers PYTHON]", &
-               "The fixed-load solver (--solver cg) on the self-affine surface of issue 5: Hurst 0.8, rms 3 nm,", &
-               "5 um square, E = 200 GPa, nu = 0.25, against a rigid flat (seed 1), at each NP of --np. The mean", &
-               "pressure for a contact fraction f (percent) is f/100 * E* h'rms / 2 (the linear law with", &
-               "kappa = 2, h'rms the surface's own rms slope); the fraction reached is printed. Each load is", &
-               "solved from a cold start. --peers PYTHON: also run the peers installed in that Python", &
-               "(app/femcod_peers.py; aspher at every NP, contactmechanics at NP <= 512) on the same gaps,", &
-               "pressures and tolerance. --fftw-wisdom FILE: measured FFTW plans kept in FILE (the first run", &
-               "on a size pays the planning inside its wall time). Method switches, for the speed/accuracy", &
-               "table: --nested on|off, --coarsest N, --coarse-tol T, --single-until R (0: no float32),", &
-               "--direct N (0: two convolutions per iteration), --restart on|off, --precondition on|off,", &
-               "--polak-ribiere on|off (off: Fletcher-Reeves beta), --powell NU (Powell's restart when", &
-               "|z.g_old| >= NU z.g; default 0.2, 0: never).", &
-               "Run it with the release build.", &
-               "Columns: NP, target %, solver, wall (s), iterations, residual, contact %, peak RSS (MB)."
-            return
-         case ("--np")
-            if (ok) call parse_integer_list(args(i + 1)%s, sizes, ok)
-         case ("--contact")
-            if (ok) call parse_real_list(args(i + 1)%s, fractions, ok)
-         case ("--tol")
-            if (ok) call parse_real(args(i + 1)%s, tol, ok)
-         case ("--peers")
-            if (ok) python = args(i + 1)%s
-         case ("--nested")
-            if (ok) method%nested = args(i + 1)%s == "on"
-         case ("--fftw-wisdom")
-            if (ok) then
-               wisdom = args(i + 1)%s
-               method%measure_plans = .true.
-               call load_wisdom(wisdom, loaded)
-            end if
-         case ("--restart")
-            if (ok) method%restart_on_entry = args(i + 1)%s == "on"
-         case ("--precondition")
-            if (ok) method%precondition = args(i + 1)%s == "on"
-         case ("--polak-ribiere")
-            if (ok) method%polak_ribiere = args(i + 1)%s == "on"
-         case ("--powell")
-            if (ok) call parse_real(args(i + 1)%s, method%powell_restart, ok)
-         case ("--coarsest")
-            if (ok) call parse_integer(args(i + 1)%s, method%coarsest, ok)
-         case ("--coarse-tol")
-            if (ok) call parse_real(args(i + 1)%s, method%coarse_tol, ok)
-         case ("--single-until")
-            if (ok) call parse_real(args(i + 1)%s, method%single_until, ok)
-         case ("--direct")
-            if (ok) call parse_integer(args(i + 1)%s, method%direct_corrections, ok)
-         case default
-            ok = .false.
-         end select
-         if (.not. ok) then
-            write(error_unit, '(a)') "femcod bench cg: bad or incomplete argument "//args(i)%s//" (--help)"
-            code = 2
-            return
+      if (wants_help(args)) then
+         write(output_unit, '(a)') &
+            "usage: femcod bench cg [--np 512,1024] [--contact 1,5,10] [--tol 1e-8] [--peers PYTHON]", &
+            "The fixed-load solver (--solver cg) on the benchmark surface: self-affine, Hurst 0.8, rms 3 nm,", &
+            "5 um square, E = 200 GPa, nu = 0.25, against a rigid flat (seed 1), at each NP of --np. The mean", &
+            "pressure for a contact fraction f (percent) is f/100 * E* h'rms / 2 (the linear law with", &
+            "kappa = 2, h'rms the surface's own rms slope); the fraction reached is printed. Each load is", &
+            "solved from a cold start. The peers (aspher at every NP, contactmechanics at NP <= 512) run on", &
+            "the same gaps, pressures and tolerance. --fftw-wisdom: the first run on a size pays the planning", &
+            "inside its wall time.", ""
+         call put_lines(option_help(bench_cg_table(), ""))
+         write(output_unit, '(a)') "Run it with the release build.", &
+            "Columns: NP, target %, solver, wall (s), iterations, residual, contact %, peak RSS (MB)."
+         return
+      end if
+      call parse_options(bench_cg_table(), args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench cg: "//bad_arguments(status, parsed)//" (--help)"
+         code = 2
+         return
+      end if
+      call get_option(parsed, "--np", sizes)
+      call get_option(parsed, "--contact", fractions)
+      call get_option(parsed, "--tol", tol)
+      call get_option(parsed, "--peers", python)
+      call get_option(parsed, "--fftw-wisdom", wisdom)
+      associate(method => options%cg)
+         if (option_given(parsed, "--nested")) method%nested = switch("--nested")
+         if (option_given(parsed, "--restart")) method%restart_on_entry = switch("--restart")
+         if (option_given(parsed, "--precondition")) method%precondition = switch("--precondition")
+         if (option_given(parsed, "--polak-ribiere")) method%polak_ribiere = switch("--polak-ribiere")
+         call get_option(parsed, "--powell", method%powell_restart)
+         call get_option(parsed, "--coarsest", method%coarsest)
+         call get_option(parsed, "--coarse-tol", method%coarse_tol)
+         call get_option(parsed, "--single-until", method%single_until)
+         call get_option(parsed, "--direct", method%direct_corrections)
+         method%tol = tol
+         method%max_iterations = 5000
+         if (len(wisdom) > 0) then
+            method%measure_plans = .true.
+            call load_wisdom(wisdom, loaded)
          end if
-         i = i + 2
-      end do
+      end associate
+      options%solver = "cg"
       write(output_unit, '(a)') "| NP | target % | solver | wall (s) | iterations | residual | contact % "// &
          "| peak RSS (MB) | status |"
       write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|"
@@ -313,7 +372,7 @@ contains
             options%loads = [load]
             options%max_contacts = 0
             call reset_peak()
-            call solve_cg(deck, options, tol, max_iterations, res, report, status, method)
+            call solve_contact(deck, options, res, status)
             peak = peak_mb()
             if (len(wisdom) > 0 .and. status%code == 0) call save_wisdom(wisdom, status)
             if (status%code /= 0) then
@@ -323,10 +382,10 @@ contains
                cycle
             end if
             write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | "// &
-               fixed_str(res%wall_seconds, 2)//" | "//int_str(report(1)%iterations)//" (+"// &
-               int_str(report(1)%coarse_iterations)//" coarse, "//int_str(report(1)%convolutions)//" fresh) | "// &
-               real_str(report(1)%residual, 2)//" | "//fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)// &
-               " | "//fixed_str(peak, 0)//" | "//trim(merge("converged  ", "not reached", report(1)%residual <= tol))//" |"
+               fixed_str(res%wall_seconds, 2)//" | "//int_str(res%states(1)%iterations)//" (+"// &
+               int_str(res%states(1)%coarse_iterations)//" coarse, "//int_str(res%states(1)%convolutions)// &
+               " fresh) | "//real_str(res%states(1)%residual, 2)//" | "// &
+               fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)//" | "//fixed_str(peak, 0)//" | converged |"
             flush(output_unit)
             if (len(python) == 0) cycle
             do i = 1, size(peers)
@@ -349,6 +408,14 @@ contains
             if (ios == 0) close(unit, status="delete")
          end if
       end do
+   contains
+      logical function switch(name)
+         character(len=*), intent(in) :: name
+         character(len=:), allocatable :: v
+         v = ""
+         call get_option(parsed, name, v)
+         switch = v == "on"
+      end function switch
    end subroutine bench_cg
 
    !> `femcod bench convolution`: one Love convolution on NP x NP (zero-padded (2NP)^2
@@ -365,40 +432,30 @@ contains
       type(love_convolution) :: conv
       type(random_stream) :: stream
       real(dp) :: t0, t1, setup, t_double, t_single, err_single, err_direct, direct, scale
-      integer :: i, n, np, repeat, k, plans, probe(2, 3), kk, l
-      logical :: ok
+      integer :: n, np, repeat, k, plans, probe(2, 3), kk, l
+      type(parsed_options) :: parsed
+      type(status_type) :: status
       sizes = [512, 1024, 2048]
       repeat = 5
-      i = 1
-      do while (i <= size(args))
-         if (args(i)%s == "-h" .or. args(i)%s == "--help") then
-            write(output_unit, '(a)') "usage: femcod bench convolution [--np 512,1024,2048] [--repeat 5]", &
-               "One Love-kernel convolution on NP x NP by zero-padded (2NP)^2 FFTs, with FFTW's estimated and", &
-               "measured plans (measured here, no wisdom): set-up time, time per convolution in double and", &
-               "float32 (mean of --repeat, after one untimed), float32's largest difference from double, and", &
-               "double's largest difference from the direct sum at three pixels, relative to the largest value.", &
-               "Run it with the release build."
-            return
-         end if
-         ok = i < size(args)
-         if (ok) then
-            select case (args(i)%s)
-            case ("--np")
-               call parse_integer_list(args(i + 1)%s, sizes, ok)
-            case ("--repeat")
-               call parse_integer(args(i + 1)%s, repeat, ok)
-               ok = ok .and. repeat >= 1
-            case default
-               ok = .false.
-            end select
-         end if
-         if (.not. ok .or. minval(sizes) < 2) then
-            write(error_unit, '(a)') "femcod bench convolution: bad or incomplete argument "//args(i)%s//" (--help)"
-            code = 2
-            return
-         end if
-         i = i + 2
-      end do
+      if (wants_help(args)) then
+         write(output_unit, '(a)') "usage: femcod bench convolution [--np 512,1024,2048] [--repeat 5]", &
+            "One Love-kernel convolution on NP x NP by zero-padded (2NP)^2 FFTs, with FFTW's estimated and", &
+            "measured plans (measured here, no wisdom): set-up time, time per convolution in double and", &
+            "float32 (mean of --repeat, after one untimed), float32's largest difference from double, and", &
+            "double's largest difference from the direct sum at three pixels, relative to the largest value.", ""
+         call put_lines(option_help(bench_convolution_table(), ""))
+         write(output_unit, '(a)') "Run it with the release build."
+         return
+      end if
+      call parse_options(bench_convolution_table(), args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench convolution: "//bad_arguments(status, parsed)//" (--help)"
+         code = 2
+         return
+      end if
+      call get_option(parsed, "--np", sizes)
+      call get_option(parsed, "--repeat", repeat)
       write(output_unit, '(a)') "| NP | plans | set-up (s) | double (s) | float32 (s) | float32 - double "// &
          "| double - direct sum |"
       write(output_unit, '(a)') "|---|---|---|---|---|---|---|"

@@ -1,5 +1,7 @@
 !> femcod test driver: runs every suite serially and closes with "N passed, N failed".
 !> `fpm test -- SUITE [TEST]` runs one suite or one test.
+!> `fpm test --profile release -- --stability-report FILE [--events N]` runs the hard cases
+!> of the stability suite with their references and writes doc/stability.md (FILE).
 program tester
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use testdrive, only: run_testsuite, run_selected, new_testsuite, testsuite_type, select_suite, count_tests, &
@@ -18,7 +20,9 @@ program tester
    use test_studies, only: collect_studies
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
-   use femcod_strings, only: string_type
+   use femcod_strings, only: string_type, parse_integer
+   use femcod_status, only: status_type
+   use stability_report, only: write_stability_report
    implicit none
    type(testsuite_type), allocatable :: suites(:)
    integer :: stat, is, total, nargs
@@ -52,6 +56,30 @@ program tester
             args = command_arguments()
             call run_femcod(args(2:), code)
             call exit_program(code)
+         end block
+      end if
+      if (suite_name == "--stability-report") then
+         block
+            type(string_type), allocatable :: args(:)
+            type(status_type) :: status
+            integer :: events
+            logical :: ok
+            args = command_arguments()
+            events = 5000
+            ok = size(args) == 2
+            if (size(args) == 4) then
+               ok = args(3)%s == "--events"
+               if (ok) call parse_integer(args(4)%s, events, ok)
+               ok = ok .and. events >= 2
+            end if
+            if (.not. ok) then
+               write(error_unit, '(a)') "usage: --stability-report FILE [--events N (>= 2)]"
+               call exit_program(2)
+            end if
+            call write_stability_report(args(2)%s, events, status, .true.)
+            if (status%code /= 0) write(error_unit, '(a)') status%message
+            if (status%code == 0) write(output_unit, '(a)') "wrote "//args(2)%s
+            call exit_program(status%code)
          end block
       end if
       is = select_suite(suites, trim(suite_name))

@@ -10,8 +10,8 @@ module test_boussinesq
    use femcod_trfact, only: trfact, TRFACT_FACTOR, TRFACT_SOLVE
    use femcod_lapack, only: dgesv
    use femcod_random, only: random_stream, seed_stream, uniform
-   use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, skyline_words, IPIADR
-   use femcod_legacy, only: legacy_unit_solution
+   use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, skyline_words, IPIADR, IPCONT, MPWORK
+   use femcod_legacy, only: legacy_unit_solution, legacy_materials
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -128,8 +128,9 @@ contains
       do n = 1, 5
          call workspace_layout(8, 5, ws, status)
          call allocate_workspace(ws, status)
-         call legacy_unit_solution([(1 + m, m = 1, n)], [(3, m = 1, n)], table, 0.01_dp, 1.0e-7_dp, 1.0e5_dp, &
-            ws, delta, f(1:n), status)
+         call set_contacts(ws, [(1 + m, m = 1, n)], [(3, m = 1, n)])
+         call legacy_unit_solution(ws, n, table, legacy_materials([0.01_dp, 1.0e-7_dp], [1.0e5_dp, 1.0e5_dp], &
+            1.0e5_dp), 1.0_dp, delta, status)
          neq = 4*n + 1
          call check(error, ws%ia(ws%ifirst(IPIADR) + neq - 1) == skyline_words(n), "skyline words, n = "// &
             to_string(n))
@@ -189,16 +190,27 @@ contains
       call workspace_layout(4, 2, ws, status)
       call allocate_workspace(ws, status)
       ! One contact: the two half-spaces and three springs in series.
-      call legacy_unit_solution([2], [2], table, c1, c2, k, ws, delta, f(1:1), status)
+      call set_contacts(ws, [2], [2])
+      call legacy_unit_solution(ws, 1, table, legacy_materials([c1, c2], [k, k], k), 1.0_dp, delta, status)
+      f(1) = ws%ra(ws%rfirst(MPWORK))
       call check(error, delta, (c1 + c2)*4*log(1 + sqrt(2.0_dp)) + 3/k, rel=.true., thr=1.0e-9_dp)
       if (allocated(error)) return
       call check(error, f(1), 1.0_dp, rel=.true., thr=1.0e-9_dp)
       if (allocated(error)) return
       ! Two neighbours: by symmetry 0.5 nN each, approach (c1+c2)(I00 + I01)/2 + 3/(2k).
-      call legacy_unit_solution([2, 2], [2, 3], table, c1, c2, k, ws, delta, f, status)
+      call set_contacts(ws, [2, 2], [2, 3])
+      call legacy_unit_solution(ws, 2, table, legacy_materials([c1, c2], [k, k], k), 1.0_dp, delta, status)
+      f = ws%ra(ws%rfirst(MPWORK):ws%rfirst(MPWORK) + 1)
       call check(error, delta, (c1 + c2)*(love_influence(0, 0) + love_influence(0, 1))/2 + 1.5_dp/k, rel=.true., &
          thr=1.0e-9_dp)
       if (allocated(error)) return
       call check(error, f(1), 0.5_dp, rel=.true., thr=1.0e-9_dp)
    end subroutine test_unit_solution
+
+   !> Contacts at rows `i`, columns `j` into IPCONT, as the legacy solver keeps them.
+   subroutine set_contacts(ws, i, j)
+      type(workspace_type), intent(inout) :: ws
+      integer, intent(in) :: i(:), j(:)
+      ws%ia(ws%ifirst(IPCONT):ws%ifirst(IPCONT) + size(i) - 1) = (i - 1)*ws%np + j
+   end subroutine set_contacts
 end module test_boussinesq

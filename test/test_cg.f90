@@ -7,9 +7,9 @@ module test_cg
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
-   use femcod_contact_result, only: contact_result, contact_options
-   use femcod_incremental, only: solve_incremental
-   use femcod_cg, only: solve_cg, cg_residuals, cg_method
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver, only: solve_contact
    use femcod_generate, only: VERIFICATION_DECKS, scene_spec, build_problem
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
@@ -46,7 +46,6 @@ contains
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, cg
-      type(cg_residuals), allocatable :: report(:)
       type(status_type) :: status
       integer :: d, k, n, m
       real(dp), allocatable :: loads(:)
@@ -54,7 +53,8 @@ contains
          if (index(VERIFICATION_DECKS(d), "d05") > 0 .or. index(VERIFICATION_DECKS(d), "d9") > 0) cycle
          call read_deck("input/"//trim(VERIFICATION_DECKS(d))//".deck", deck, status)
          options%loads = [real(dp) ::]
-         call solve_incremental(deck, options, inc, status)
+         options%solver = "incremental"
+         call solve_contact(deck, options, inc, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
          n = inc%nsteps
@@ -68,13 +68,18 @@ contains
             end associate
          end do
          options%loads = loads
-         call solve_incremental(deck, options, inc, status)
-         call solve_cg(deck, options, 1.0e-10_dp, 5000, cg, report, status)
+         options%solver = "incremental"
+         call solve_contact(deck, options, inc, status)
+         options%solver = "cg"
+         options%cg = cg_settings()
+         options%cg%tol = 1.0e-10_dp
+         options%cg%max_iterations = 5000
+         call solve_contact(deck, options, cg, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
          do k = 1, m
-            call check(error, report(k)%residual < 1.0e-10_dp, trim(VERIFICATION_DECKS(d))//": residual "// &
-               to_string(report(k)%residual))
+            call check(error, cg%states(k)%residual < 1.0e-10_dp, trim(VERIFICATION_DECKS(d))//": residual "// &
+               to_string(cg%states(k)%residual))
             if (allocated(error)) return
             call check(error, cg%states(k)%contacts, inc%states(k)%contacts, trim(VERIFICATION_DECKS(d))// &
                ": contacts at "//to_string(loads(k))//" nN")
@@ -94,12 +99,15 @@ contains
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: res
-      type(cg_residuals), allocatable :: report(:)
       type(status_type) :: status
       real(dp) :: estar, r, segedin, a
       call read_deck("input/sphere_d05.deck", deck, status)
       options%loads = [1000.0_dp, 18000.0_dp]
-      call solve_cg(deck, options, 1.0e-8_dp, 5000, res, report, status)
+      options%solver = "cg"
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-8_dp
+      options%cg%max_iterations = 5000
+      call solve_contact(deck, options, res, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       estar = 200/(1 - 0.25_dp**2)
@@ -236,8 +244,7 @@ contains
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, cg
-      type(cg_residuals), allocatable :: report(:)
-      type(cg_method) :: plain, how(8)
+      type(cg_settings) :: plain, how(8)
       type(status_type) :: status
       real(dp), allocatable :: loads(:)
       integer :: v, k, n, s
@@ -256,14 +263,16 @@ contains
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       options%loads = [real(dp) ::]
-      call solve_incremental(deck, options, inc, status)
+      options%solver = "incremental"
+      call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       n = inc%nsteps
       loads = [((inc%step_load(s) + inc%step_load(s + 1))/2, s=n/8, n - 1, n/4)]
       options%loads = loads
-      call solve_incremental(deck, options, inc, status)
-      plain = cg_method(nested=.false., single_until=0, direct_corrections=0, precondition=.false., &
+      options%solver = "incremental"
+      call solve_contact(deck, options, inc, status)
+      plain = cg_settings(nested=.false., single_until=0, direct_corrections=0, precondition=.false., &
          restart_on_entry=.true., polak_ribiere=.false., powell_restart=0.0_dp)
       how = plain
       how(1)%nested = .true.
@@ -274,18 +283,26 @@ contains
       how(5)%restart_on_entry = .false.
       how(6)%polak_ribiere = .true.
       how(7)%powell_restart = 0.2_dp
-      how(8) = cg_method(coarsest=16)
+      how(8) = cg_settings(coarsest=16)
       do v = 0, size(how)
          if (v == 0) then
-            call solve_cg(deck, options, 1.0e-10_dp, 5000, cg, report, status, plain)
+            options%solver = "cg"
+            options%cg = plain
+            options%cg%tol = 1.0e-10_dp
+            options%cg%max_iterations = 5000
+            call solve_contact(deck, options, cg, status)
          else
-            call solve_cg(deck, options, 1.0e-10_dp, 5000, cg, report, status, how(v))
+            options%solver = "cg"
+            options%cg = how(v)
+            options%cg%tol = 1.0e-10_dp
+            options%cg%max_iterations = 5000
+            call solve_contact(deck, options, cg, status)
          end if
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
          do k = 1, size(loads)
-            call check(error, report(k)%residual < 1.0e-10_dp, "variant "//to_string(v)//": residual "// &
-               to_string(report(k)%residual))
+            call check(error, cg%states(k)%residual < 1.0e-10_dp, "variant "//to_string(v)//": residual "// &
+               to_string(cg%states(k)%residual))
             if (allocated(error)) return
             call check(error, cg%states(k)%contacts, inc%states(k)%contacts, "variant "//to_string(v)// &
                ": contacts at "//to_string(loads(k))//" nN")

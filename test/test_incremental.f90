@@ -5,9 +5,9 @@ module test_incremental
    use femcod_status, only: status_type
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
-   use femcod_contact_result, only: contact_result, contact_options
-   use femcod_legacy, only: solve_legacy
-   use femcod_incremental, only: solve_incremental
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver, only: solve_contact
    use femcod_generate, only: VERIFICATION_DECKS
    use femcod_scene, only: initial_gaps
    use femcod_love, only: offset_table, surface_compliance
@@ -71,10 +71,12 @@ contains
          options%loads = [1.0_dp]
          if (index(VERIFICATION_DECKS(d), "sphere") > 0) options%loads = [3000.0_dp]
          if (index(VERIFICATION_DECKS(d), "rough") > 0) deallocate(options%loads)
-         call solve_incremental(deck, options, inc, status)
+         options%solver = "incremental"
+         call solve_contact(deck, options, inc, status)
          call check(error, status%code, 0)
          if (allocated(error)) return
-         call solve_legacy(deck, options, leg, status)
+         options%solver = "legacy"
+         call solve_contact(deck, options, leg, status)
          call check(error, status%code, 0)
          if (allocated(error)) return
          allocate(li(inc%nsteps), ci(inc%nsteps), ll(leg%nsteps), cl(leg%nsteps))
@@ -122,7 +124,8 @@ contains
       deck%young(3) = 1.0e25_dp
       np = deck%np
       options%loads = loads
-      call solve_incremental(deck, options, inc, status)
+      options%solver = "incremental"
+      call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
       g0 = initial_gaps(deck%lower, deck%upper)
@@ -191,7 +194,8 @@ contains
       do k = 1, 2
          call read_deck("input/"//trim(decks(k))//".deck", deck, status)
          options%loads = [1.0_dp]
-         call solve_incremental(deck, options, inc, status)
+         options%solver = "incremental"
+         call solve_contact(deck, options, inc, status)
          call check(error, status%code, 0)
          if (allocated(error)) return
          call check(error, inc%states(1)%approach, thesis(k), rel=.true., thr=5.0e-3_dp, message=trim(decks(k)))
@@ -214,7 +218,8 @@ contains
       deck%maxcont = deck%np**2
       options%max_contacts = 600
       allocate(options%loads(0))
-      call solve_incremental(deck, options, inc, status)
+      options%solver = "incremental"
+      call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
       call check(error, size(inc%contact_i) >= 590 .and. inc%missed_final_check == 0 .and. &
@@ -237,10 +242,12 @@ contains
       t1 = offset_table(64)
       call read_deck("input/rough_selfaffine_32.deck", deck, status)
       allocate(options%loads(0))
-      call solve_incremental(deck, options, one, status)
+      options%solver = "incremental"
+      call solve_contact(deck, options, one, status)
       call omp_set_num_threads(2)
       t2 = offset_table(64)
-      call solve_incremental(deck, options, two, status)
+      options%solver = "incremental"
+      call solve_contact(deck, options, two, status)
       call omp_set_num_threads(saved)
       call check(error, all(t1 == t2), "offset table bit for bit")
       if (allocated(error)) return
@@ -269,9 +276,11 @@ contains
          options%loads = [real(dp) ::]
          if (index(VERIFICATION_DECKS(d), "sphere") > 0) options%loads = [3000.0_dp]
          options%event_search = "bound"
-         call solve_incremental(deck, options, a, status)
+         options%solver = "incremental"
+         call solve_contact(deck, options, a, status)
          options%event_search = "fft"
-         call solve_incremental(deck, options, b, status)
+         options%solver = "incremental"
+         call solve_contact(deck, options, b, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
          n = a%nsteps
@@ -286,7 +295,8 @@ contains
          if (allocated(error)) return
       end do
       options%event_search = "auto"
-      call solve_incremental(deck, options, b, status)
+      options%solver = "incremental"
+      call solve_contact(deck, options, b, status)
       call check(error, b%fft_steps >= 0 .and. b%fft_steps <= b%nsteps, "auto reports its choice")
    end subroutine test_event_search
 end module test_incremental

@@ -5,8 +5,9 @@ module test_legacy
    use femcod_status, only: status_type
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
-   use femcod_contact_result, only: contact_result, contact_options
-   use femcod_legacy, only: solve_legacy
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver, only: solve_contact
    use femcod_richardson, only: convergence_rate, richardson_extrapolate
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
@@ -46,7 +47,8 @@ contains
       call read_deck("input/"//name//".deck", deck, status)
       if (status%code /= 0) return
       options%loads = [load]
-      call solve_legacy(deck, options, res, status)
+      options%solver = "legacy"
+      call solve_contact(deck, options, res, status)
       if (status%code /= 0) return
       approach = res%states(1)%approach
       c = (deck%np + 1)/2
@@ -129,7 +131,8 @@ contains
       real(dp) :: estar, r, hertz, segedin, a
       call read_deck("input/sphere_d05.deck", deck, status)
       options%loads = [1000.0_dp, 18000.0_dp]
-      call solve_legacy(deck, options, res, status)
+      options%solver = "legacy"
+      call solve_contact(deck, options, res, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
       estar = 200/(1 - 0.25_dp**2)
@@ -152,7 +155,8 @@ contains
       integer :: k
       call read_deck("input/rough_selfaffine_32.deck", deck, status)
       allocate(options%loads(0))
-      call solve_legacy(deck, options, res, status)
+      options%solver = "legacy"
+      call solve_contact(deck, options, res, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
       call check(error, res%step_contacts(1), 1, "one contact at the first step")

@@ -9,7 +9,7 @@ module test_stability
    use femcod_cli, only: run_femcod
    use femcod_contact_result, only: contact_result, STOP_MAXCONT
    use femcod_generate, only: scene_spec, build_problem, verification_spec
-   use femcod_stability, only: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, &
+   use stability_cases, only: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, &
       single_pixel, first_spike_event, identical_surfaces, height_offset, length_scaling, poisson_limit, &
       love_precision, solve_precision, long_run_drift, solve, STIFFNESS_RATIOS
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string

@@ -15,9 +15,9 @@ module test_studies
    use femcod_summits, only: summit_statistics, summit_search, summit_power_laws, profile_psd, psd_dimension, &
       structure_function, structure_dimension, paraboloid_fit
    use femcod_multiscale, only: roughness_template, multiscale_result, multiscale_hertz, hertz_area
-   use femcod_contact_result, only: contact_result, contact_options
-   use femcod_incremental, only: solve_incremental
-   use femcod_legacy, only: solve_legacy
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver, only: solve_contact
    use femcod_richardson, only: power_law_fit
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    use test_support, only: scratch_path, read_text, file_exists, remove_scratch, contains_text
@@ -231,8 +231,10 @@ contains
       options%hardness = 5
       options%max_contacts = 400
       allocate(options%loads(0))
-      call solve_incremental(deck, options, a, status)
-      call solve_legacy(deck, options, b, status)
+      options%solver = "incremental"
+      call solve_contact(deck, options, a, status)
+      options%solver = "legacy"
+      call solve_contact(deck, options, b, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       n = min(a%nsteps, b%nsteps)

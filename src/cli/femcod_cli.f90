@@ -1,12 +1,14 @@
 !> The femcod command line. `femcod_command` reads the process arguments;
 !> `run_femcod` takes them as a list, so tests drive the same code path. Returns the
-!> exit code: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O.
+!> exit code: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O. Every command
+!> parses its arguments against its option table (cli/femcod_options).
 module femcod_cli
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use femcod_kinds, only: dp, i8
-   use femcod_status, only: status_type, STATUS_USAGE, STATUS_BAD_INPUT
-   use femcod_deck, only: write_deck
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE
+   use femcod_strings, only: string_type, int_str, parse_integer
    use femcod_problem, only: contact_problem
+   use femcod_deck, only: write_deck
    use femcod_workspace, only: workspace_type, workspace_layout, workspace_table
    use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, KINDS
    use femcod_heights, only: load_scene
@@ -14,13 +16,11 @@ module femcod_cli
    use femcod_studies, only: resolution_command, summits_command, multiscale_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
-   use femcod_stability_report, only: write_stability_report
-   use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real
+   use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
+      real_option, integer_option, text_option, choice_option, get_option, option_given, refuse_options
    implicit none
    private
-   public :: femcod_command, run_femcod, command_arguments, FEMCOD_VERSION
-
-
+   public :: femcod_command, run_femcod, command_arguments, mkdeck_table, parse_mkdeck_arguments, FEMCOD_VERSION
 
 contains
 
@@ -72,8 +72,6 @@ contains
          call multiscale_command(args(2:), code)
       case ("verify")
          call verify_command(args(2:), code)
-      case ("stability")
-         call stability_command(args(2:), code)
       case default
          call usage_error("unknown command '"//args(1)%s//"'")
          code = STATUS_USAGE
@@ -94,7 +92,6 @@ contains
          "  multiscale FILE [options] the multiscale Hertz model of section 3.3", &
          "  workspace NP MAXCONT      print the Appendix B memory map (Tables B.1, B.2)", &
          "  verify [-o FILE]          recompute the thesis checks, write doc/verification.md", &
-         "  stability [-o FILE]       run the hard cases, write doc/stability.md", &
          "  bench [--full]            speed against error, one table (use the release build)", &
          "  --help, --version", &
          "", &
@@ -106,35 +103,61 @@ contains
       write(error_unit, '(a)') "femcod: "//message//" (femcod --help)"
    end subroutine usage_error
 
+   !> A command's usage error on standard error, and its exit code.
+   subroutine command_usage(command, status, code)
+      character(len=*), intent(in) :: command
+      type(status_type), intent(in) :: status
+      integer, intent(out) :: code
+      write(error_unit, '(a)') "femcod "//command//": "//status%message//" (femcod "//command//" --help)"
+      code = status%code
+   end subroutine command_usage
+
+   !> Whether the arguments ask for help.
+   pure logical function wants_help(args)
+      type(string_type), intent(in) :: args(:)
+      integer :: k
+      wants_help = .false.
+      do k = 1, size(args)
+         if (args(k)%s == "--help" .or. args(k)%s == "-h") wants_help = .true.
+      end do
+   end function wants_help
+
+   subroutine put_lines(lines)
+      type(string_type), intent(in) :: lines(:)
+      integer :: k
+      do k = 1, size(lines)
+         write(output_unit, '(a)') lines(k)%s
+      end do
+   end subroutine put_lines
+
    !> `femcod workspace NP MAXCONT`: one line per block, then the totals.
    subroutine workspace_command(args, code)
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(workspace_type) :: ws
       type(status_type) :: status
+      type(parsed_options) :: parsed
       integer :: np, maxcont, k
       logical :: ok1, ok2
       character(len=120), allocatable :: lines(:)
       code = 0
-      if (size(args) >= 1) then
-         if (args(1)%s == "--help" .or. args(1)%s == "-h") then
-            write(output_unit, '(a)') "usage: femcod workspace NP MAXCONT", &
-               "Prints the memory map of the integer and real work arrays of Appendix B (Tables B.1, B.2):", &
-               "block name, first address, size in words, contents; then IPEND, MPEND and the bytes they need.", &
-               "MAXNODE = 4*MAXCONT+2; MPSTIF is femcod's skyline size (7*MAXCONT+2)*(MAXCONT+1)/2 (doc/workspace.md)."
-            return
-         end if
-      end if
-      if (size(args) /= 2) then
-         call usage_error("workspace takes NP and MAXCONT")
-         code = STATUS_USAGE
+      if (wants_help(args)) then
+         write(output_unit, '(a)') "usage: femcod workspace NP MAXCONT", &
+            "Prints the memory map of the integer and real work arrays of Appendix B (Tables B.1, B.2):", &
+            "block name, first address, size in words, contents; then IPEND, MPEND and the bytes they need.", &
+            "MAXNODE = 4*MAXCONT+2; MPSTIF is femcod's skyline size (7*MAXCONT+2)*(MAXCONT+1)/2 (doc/workspace.md)."
          return
       end if
-      call parse_integer(args(1)%s, np, ok1)
-      call parse_integer(args(2)%s, maxcont, ok2)
-      if (.not. (ok1 .and. ok2)) then
-         call usage_error("workspace: NP and MAXCONT must be integers")
-         code = STATUS_USAGE
+      call parse_options([option_spec ::], args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) /= 2) &
+         call set_error(status, STATUS_USAGE, "workspace takes NP and MAXCONT")
+      if (status%code == 0) then
+         call parse_integer(parsed%positional(1)%s, np, ok1)
+         call parse_integer(parsed%positional(2)%s, maxcont, ok2)
+         if (.not. (ok1 .and. ok2)) call set_error(status, STATUS_USAGE, "NP and MAXCONT must be integers")
+      end if
+      if (status%code /= 0) then
+         call command_usage("workspace", status, code)
          return
       end if
       call workspace_layout(np, maxcont, ws, status)
@@ -149,47 +172,157 @@ contains
       end do
    end subroutine workspace_command
 
+   !> The options of `femcod mkdeck`; the mode of a kind's own options is the kind.
+   function mkdeck_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [ &
+         text_option("--output", "FILE", "output deck (written atomically)", alias="-o"), &
+         text_option("--verification", "NAME|all", "a verification deck of input/ by name, or all of them", &
+            mode="verification"), &
+         text_option("--dir", "DIR", "directory of the verification decks (default input/ for all, else .)", &
+            mode="verification"), &
+         integer_option("--np", "N", "pixels per side", lower=1, mode="circle-punch|square-punch|sphere|flat|sinusoid|"// &
+            "wm|self-affine"), &
+         choice_option("--shape-on", "upper|lower", "surface that carries the shape (default upper)", mode="kind"), &
+         scene_options("kind"), &
+         real_option("--radius", "R", "punch or sphere radius in nm", lower=0.0_dp, closed="()", &
+            mode="circle-punch|sphere"), &
+         real_option("--area", "A", "punch area in nm^2 (default pi R^2)", lower=0.0_dp, closed="()", &
+            mode="circle-punch"), &
+         real_option("--height", "H", "punch or flat height in nm (default: R for the circle, NP d/3 for the "// &
+            "square, 0 for a flat)", mode="circle-punch|square-punch|flat"), &
+         real_option("--amplitude", "A", "sinusoid amplitude in nm (default 1)", mode="sinusoid"), &
+         real_option("--scale", "W", "sinusoid length scale w in nm (default 10)", lower=0.0_dp, closed="()", &
+            mode="sinusoid"), &
+         real_option("--ds", "D", "fractal dimension of the surface (default 2.4)", lower=2.0_dp, upper=3.0_dp, &
+            closed="()", mode="wm"), &
+         real_option("--g", "G", "fractal roughness in nm (default 1.36e-2)", lower=0.0_dp, closed="()", mode="wm"), &
+         real_option("--gamma", "GAMMA", "frequency density (default 1.5)", lower=1.0_dp, closed="()", mode="wm"), &
+         real_option("--lmax", "L", "largest wavelength in nm (default 1000)", lower=0.0_dp, closed="()", mode="wm"), &
+         real_option("--lmin", "L", "smallest wavelength in nm (default 1)", lower=0.0_dp, closed="()", mode="wm"), &
+         integer_option("--ridges", "M", "number of ridges (default 10)", lower=1, mode="wm"), &
+         integer_option("--seed", "S", "random seed (default 1)", mode="wm|self-affine"), &
+         real_option("--hurst", "H", "Hurst exponent (default 0.8)", lower=0.0_dp, upper=1.0_dp, closed="(]", &
+            mode="self-affine"), &
+         real_option("--rms", "S", "rms height in nm (default 1)", lower=0.0_dp, closed="()", mode="self-affine"), &
+         text_option("--file", "FILE", "heights: an ASCII matrix (one row per line, '#' comments, Gwyddion export) "// &
+            "or FILE.h5:/dataset (square, C order)", mode="matrix")]
+   end function mkdeck_table
+
    subroutine mkdeck_help()
       write(output_unit, '(a)') &
          "usage: femcod mkdeck KIND -o FILE [options]", &
          "       femcod mkdeck --verification NAME|all [-o FILE | --dir DIR]", &
          "", &
          "Writes an input deck (doc/deck-format.md). The shape goes on one surface, the other is flat;", &
-         "a rigid body gets E five orders of magnitude above the elastic one (thesis section 4.4),", &
-         "and so do the contact/interface elements.", &
+         "a rigid body gets E --rigid-factor times the elastic one (default 1e10), and so do the", &
+         "contact/interface elements (thesis section 4.4 uses 1e5, as the decks of input/ do).", &
          "", &
          "kinds:", &
-         "  circle-punch  flat circular punch: the round(area/d^2) pixels nearest the centre pixel (NP odd);", &
-         "                --radius R [--area A (default pi R^2)] [--height H (default R)]", &
-         "  square-punch  central NP/3 x NP/3 pixels (NP divisible by 3) [--height H (default NP d/3)]", &
-         "  sphere        z = sqrt(R^2 - r^2) inside r < R, 0 outside; --radius R", &
-         "  flat          constant height [--height H (default 0)]", &
-         "  sinusoid      eq. 3.3: z = A cos(x/w) cos(y/w); [--amplitude A (1 nm)] [--scale w (10 nm)]", &
-         "  wm            Weierstrass-Mandelbrot eq. 3.6; [--ds 2.4] [--g 1.36e-2 nm] [--gamma 1.5]", &
-         "                [--lmax 1000 nm] [--lmin 1 nm] [--ridges 10] [--seed 1]", &
-         "  self-affine   Gaussian random surface by FFT filtering, C(q) ~ q^-2(1+H) from 2pi/L to pi/d;", &
-         "                [--hurst 0.8] [--rms 1 nm] [--seed 1]", &
-         "  matrix        heights from --file FILE: an ASCII matrix (one row per line, '#' comments,", &
-         "                Gwyddion export) or FILE.h5:/dataset (square, C order); [--remove-plane]", &
-         "                subtracts the least-squares plane", &
-         "", &
-         "common options:", &
-         "  -o FILE               output deck (written atomically)", &
-         "  --np N                pixels per side (not for matrix)", &
-         "  --pixel D             pixel size in nm", &
-         "  --maxcont M           maximum contacts (default: the punch pixels for punches, NP^2 for flat,", &
-         "                        else 5 % of NP^2)", &
-         "  --young E --poisson NU  the elastic body (default 200 GPa, 0.25)", &
-         "  --shape-on upper|lower  surface that carries the shape (default upper)", &
-         "  --rigid upper|lower|none  rigid body (default upper)", &
-         "  --rigid-factor R      modulus of the rigid body and of the contact/interface elements over", &
-         "                        the elastic one (default 1e10: penalty error ~4e-11, doc/stability.md;", &
-         "                        the thesis and input/ use 1e5; for --solver legacy 3e7 is best)", &
-         "  --label TEXT          first line of the deck", &
-         "", &
-         "verification decks (input/): circle_punch_d1 d3 d9 (Table 4.1), square_punch_n1 n3 n9 n27", &
-         "(Table 4.2), sphere_d4 d2 d1 d05 (Figs. 4.14-4.16), rough_selfaffine_32."
+         "  circle-punch  flat circular punch: the round(area/d^2) pixels nearest the centre pixel (NP odd)", &
+         "  square-punch  central NP/3 x NP/3 pixels (NP divisible by 3)", &
+         "  sphere        z = sqrt(R^2 - r^2) inside r < R, 0 outside", &
+         "  flat          constant height", &
+         "  sinusoid      eq. 3.3: z = A cos(x/w) cos(y/w)", &
+         "  wm            Weierstrass-Mandelbrot eq. 3.6", &
+         "  self-affine   Gaussian random surface by FFT filtering, C(q) ~ q^-2(1+H) from 2pi/L to pi/d", &
+         "  matrix        heights from --file", &
+         "", "options:"
+      call put_lines(option_help(mkdeck_table(), ""))
+      call put_lines(option_help(mkdeck_table(), "kind"))
+      call put_lines(option_help(mkdeck_table(), "circle-punch|square-punch|sphere|flat|sinusoid|wm|self-affine"))
+      write(output_unit, '(a)') "", "options of one or some kinds (refused with the others):"
+      call put_lines(option_help(mkdeck_table(), "circle-punch|sphere"))
+      call put_lines(option_help(mkdeck_table(), "circle-punch"))
+      call put_lines(option_help(mkdeck_table(), "circle-punch|square-punch|flat"))
+      call put_lines(option_help(mkdeck_table(), "sinusoid"))
+      call put_lines(option_help(mkdeck_table(), "wm"))
+      call put_lines(option_help(mkdeck_table(), "wm|self-affine"))
+      call put_lines(option_help(mkdeck_table(), "self-affine"))
+      call put_lines(option_help(mkdeck_table(), "matrix"))
+      write(output_unit, '(a)') "", "verification decks:"
+      call put_lines(option_help(mkdeck_table(), "verification"))
+      write(output_unit, '(a)') "  names: circle_punch_d1 d3 d9 (Table 4.1), square_punch_n1 n3 n9 n27 (Table 4.2),", &
+         "  sphere_d4 d2 d1 d05 (Figs. 4.14-4.16), rough_selfaffine_32."
    end subroutine mkdeck_help
+
+   !> The arguments of `femcod mkdeck` as a scene spec (or a verification request): no I/O.
+   subroutine parse_mkdeck_arguments(args, spec, output, verification, dir, status)
+      type(string_type), intent(in) :: args(:)
+      type(scene_spec), intent(out) :: spec
+      character(len=:), allocatable, intent(out) :: output, verification, dir
+      type(status_type), intent(inout) :: status
+      type(parsed_options) :: parsed
+      character(len=:), allocatable :: text
+      output = ""
+      verification = ""
+      dir = ""
+      spec%kind = ""
+      spec%label = ""
+      spec%matrix_file = ""
+      call parse_options(mkdeck_table(), args, parsed, status)
+      if (status%code /= 0) return
+      call get_option(parsed, "--output", output)
+      call get_option(parsed, "--verification", verification)
+      call get_option(parsed, "--dir", dir)
+      if (size(parsed%positional) > 1) then
+         call set_error(status, STATUS_USAGE, "one KIND only, found '"//parsed%positional(2)%s//"'")
+         return
+      end if
+      if (size(parsed%positional) == 1) spec%kind = parsed%positional(1)%s
+      if (verification /= "") then
+         if (spec%kind /= "") then
+            call set_error(status, STATUS_USAGE, "give a KIND or --verification, not both")
+            return
+         end if
+         call refuse_options(parsed, "verification", "", status)
+         return
+      end if
+      if (spec%kind == "") then
+         call set_error(status, STATUS_USAGE, "no KIND given (one of: "//kinds_list()//")")
+         return
+      end if
+      if (.not. any(KINDS == spec%kind)) then
+         call set_error(status, STATUS_USAGE, "unknown KIND '"//spec%kind//"' (one of: "//kinds_list()//")")
+         return
+      end if
+      call refuse_options(parsed, "kind|"//spec%kind, "verification=to --verification", status)
+      if (status%code /= 0) return
+      if (output == "") then
+         call set_error(status, STATUS_USAGE, "-o FILE is required")
+         return
+      end if
+      call get_option(parsed, "--label", spec%label)
+      call get_option(parsed, "--file", spec%matrix_file)
+      text = ""
+      call get_option(parsed, "--shape-on", text)
+      if (text /= "") spec%shape_on = text
+      text = ""
+      call get_option(parsed, "--rigid", text)
+      if (text /= "") spec%rigid = text
+      call get_option(parsed, "--remove-plane", spec%plane)
+      call get_option(parsed, "--np", spec%np)
+      call get_option(parsed, "--maxcont", spec%maxcont)
+      call get_option(parsed, "--seed", spec%seed)
+      call get_option(parsed, "--ridges", spec%ridges)
+      call get_option(parsed, "--pixel", spec%pixel)
+      call get_option(parsed, "--young", spec%young)
+      call get_option(parsed, "--poisson", spec%poisson)
+      call get_option(parsed, "--rigid-factor", spec%rigid_factor)
+      call get_option(parsed, "--radius", spec%radius)
+      call get_option(parsed, "--area", spec%area)
+      call get_option(parsed, "--height", spec%height)
+      call get_option(parsed, "--hurst", spec%hurst)
+      call get_option(parsed, "--rms", spec%rms)
+      call get_option(parsed, "--amplitude", spec%amplitude)
+      call get_option(parsed, "--scale", spec%scale)
+      call get_option(parsed, "--ds", spec%ds)
+      call get_option(parsed, "--g", spec%g)
+      call get_option(parsed, "--gamma", spec%gamma)
+      call get_option(parsed, "--lmax", spec%lmax)
+      call get_option(parsed, "--lmin", spec%lmin)
+      if (spec%label == "") spec%label = "femcod mkdeck "//spec%kind
+   end subroutine parse_mkdeck_arguments
 
    !> `femcod mkdeck`.
    subroutine mkdeck_command(args, code)
@@ -198,120 +331,18 @@ contains
       type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(status_type) :: status
-      character(len=:), allocatable :: output, verification, dir, key
-      integer :: i, k
-      logical :: ok
+      character(len=:), allocatable :: output, verification, dir
+      integer :: k
       code = 0
-      output = ""
-      verification = ""
-      dir = ""
-      spec%kind = ""
-      spec%label = ""
-      spec%matrix_file = ""
-      if (size(args) == 0) then
-         call usage_error("mkdeck needs a KIND or --verification NAME")
-         code = STATUS_USAGE
+      if (wants_help(args)) then
+         call mkdeck_help()
          return
       end if
-      i = 1
-      do while (i <= size(args))
-         key = args(i)%s
-         if (key == "--help" .or. key == "-h") then
-            call mkdeck_help()
-            return
-         end if
-         if (key == "--remove-plane") then
-            spec%plane = .true.
-            i = i + 1
-            cycle
-         end if
-         if (key(1:min(1, len(key))) /= "-") then
-            if (spec%kind /= "") then
-               call usage_error("mkdeck: one KIND only, found '"//key//"'")
-               code = STATUS_USAGE
-               return
-            end if
-            spec%kind = key
-            i = i + 1
-            cycle
-         end if
-         if (i == size(args)) then
-            call usage_error("mkdeck: option "//key//" needs a value")
-            code = STATUS_USAGE
-            return
-         end if
-         ok = .true.
-         associate(v => args(i + 1)%s)
-            select case (key)
-            case ("-o", "--output")
-               output = v
-            case ("--dir")
-               dir = v
-            case ("--verification")
-               verification = v
-            case ("--label")
-               spec%label = v
-            case ("--file")
-               spec%matrix_file = v
-            case ("--shape-on")
-               spec%shape_on = v
-            case ("--rigid")
-               spec%rigid = v
-            case ("--np")
-               call parse_integer(v, spec%np, ok)
-            case ("--maxcont")
-               call parse_integer(v, spec%maxcont, ok)
-            case ("--seed")
-               call parse_integer(v, spec%seed, ok)
-            case ("--ridges")
-               call parse_integer(v, spec%ridges, ok)
-            case ("--pixel")
-               call parse_real(v, spec%pixel, ok)
-            case ("--young")
-               call parse_real(v, spec%young, ok)
-            case ("--poisson")
-               call parse_real(v, spec%poisson, ok)
-            case ("--rigid-factor")
-               call parse_real(v, spec%rigid_factor, ok)
-               if (ok) ok = spec%rigid_factor >= 1
-            case ("--radius")
-               call parse_real(v, spec%radius, ok)
-            case ("--area")
-               call parse_real(v, spec%area, ok)
-            case ("--height")
-               call parse_real(v, spec%height, ok)
-            case ("--hurst")
-               call parse_real(v, spec%hurst, ok)
-            case ("--rms")
-               call parse_real(v, spec%rms, ok)
-            case ("--amplitude")
-               call parse_real(v, spec%amplitude, ok)
-            case ("--scale")
-               call parse_real(v, spec%scale, ok)
-            case ("--ds")
-               call parse_real(v, spec%ds, ok)
-            case ("--g")
-               call parse_real(v, spec%g, ok)
-            case ("--gamma")
-               call parse_real(v, spec%gamma, ok)
-            case ("--lmax")
-               call parse_real(v, spec%lmax, ok)
-            case ("--lmin")
-               call parse_real(v, spec%lmin, ok)
-            case default
-               call usage_error("mkdeck: unknown option "//key)
-               code = STATUS_USAGE
-               return
-            end select
-            if (.not. ok) then
-               call usage_error("mkdeck: option "//key//" expects a number (--rigid-factor: >= 1), found '"//v//"'")
-               code = STATUS_USAGE
-               return
-            end if
-         end associate
-         i = i + 2
-      end do
-
+      call parse_mkdeck_arguments(args, spec, output, verification, dir, status)
+      if (status%code /= 0) then
+         call command_usage("mkdeck", status, code)
+         return
+      end if
       if (verification /= "") then
          if (verification == "all") then
             if (dir == "") dir = "input"
@@ -328,18 +359,6 @@ contains
          end if
          return
       end if
-
-      if (spec%kind == "") then
-         call usage_error("mkdeck: no KIND given (one of: "//kinds_list()//")")
-         code = STATUS_USAGE
-         return
-      end if
-      if (output == "") then
-         call usage_error("mkdeck: -o FILE is required")
-         code = STATUS_USAGE
-         return
-      end if
-      if (spec%label == "") spec%label = "femcod mkdeck "//spec%kind
       call load_scene(spec, deck, status)
       if (status%code == 0) call write_deck(output, deck, status)
       if (status%code /= 0) then
@@ -371,30 +390,26 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(status_type) :: status
+      type(parsed_options) :: parsed
       character(len=:), allocatable :: output
       code = 0
-      output = "doc/verification.md"
-      if (size(args) >= 1) then
-         select case (args(1)%s)
-         case ("-h", "--help")
-            write(output_unit, '(a)') "usage: femcod verify [-o FILE]", &
-               "Runs the legacy solver on the decks of input/ (run from the package root) and writes the", &
-               "comparison with the thesis (Tables 4.1, 4.2, section 4.4.3, Fig. 5.2) to FILE", &
-               "(default doc/verification.md). Takes about two minutes with the release build."
-            return
-         case ("-o")
-            if (size(args) < 2) then
-               call usage_error("verify: -o needs a file")
-               code = STATUS_USAGE
-               return
-            end if
-            output = args(2)%s
-         case default
-            call usage_error("verify: unknown argument "//args(1)%s)
-            code = STATUS_USAGE
-            return
-         end select
+      if (wants_help(args)) then
+         write(output_unit, '(a)') "usage: femcod verify [-o FILE]", &
+            "Runs the legacy solver on the decks of input/ (run from the package root) and writes the", &
+            "comparison with the thesis (Tables 4.1, 4.2, section 4.4.3, Fig. 5.2) to FILE", &
+            "(default doc/verification.md). Takes about two minutes with the release build."
+         return
       end if
+      call parse_options([text_option("--output", "FILE", "the report (default doc/verification.md)", alias="-o")], &
+         args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) > 0) &
+         call set_error(status, STATUS_USAGE, "unknown argument "//parsed%positional(1)%s)
+      if (status%code /= 0) then
+         call command_usage("verify", status, code)
+         return
+      end if
+      output = "doc/verification.md"
+      call get_option(parsed, "--output", output)
       call write_verification_report(output, status, .true.)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod: "//status%message
@@ -403,58 +418,6 @@ contains
       end if
       write(output_unit, '(a)') "wrote "//output
    end subroutine verify_command
-
-   !> `femcod stability [-o FILE] [--events N]`.
-   subroutine stability_command(args, code)
-      type(string_type), intent(in) :: args(:)
-      integer, intent(out) :: code
-      type(status_type) :: status
-      character(len=:), allocatable :: output
-      integer :: i, events
-      logical :: ok
-      code = 0
-      output = "doc/stability.md"
-      events = 5000
-      i = 1
-      do while (i <= size(args))
-         select case (args(i)%s)
-         case ("-h", "--help")
-            write(output_unit, '(a)') "usage: femcod stability [-o FILE] [--events N]", &
-               "Runs the hard cases of doc/stability.md (stiff springs, ties and symmetry, degenerate scenes,", &
-               "precision, a long run of N events, default 5000) and writes the table to FILE (default", &
-               "doc/stability.md). About a minute with the release build."
-            return
-         case ("-o", "--events")
-            if (i == size(args)) then
-               call usage_error("stability: "//args(i)%s//" needs a value")
-               code = STATUS_USAGE
-               return
-            end if
-            if (args(i)%s == "-o") then
-               output = args(i + 1)%s
-            else
-               call parse_integer(args(i + 1)%s, events, ok)
-               if (.not. ok .or. events < 2) then
-                  call usage_error("stability: --events expects an integer >= 2, found '"//args(i + 1)%s//"'")
-                  code = STATUS_USAGE
-                  return
-               end if
-            end if
-            i = i + 2
-         case default
-            call usage_error("stability: unknown argument "//args(i)%s)
-            code = STATUS_USAGE
-            return
-         end select
-      end do
-      call write_stability_report(output, events, status, .true.)
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod: "//status%message
-         code = status%code
-         return
-      end if
-      write(output_unit, '(a)') "wrote "//output
-   end subroutine stability_command
 
    function kinds_list() result(s)
       character(len=:), allocatable :: s

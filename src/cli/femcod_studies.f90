@@ -12,7 +12,7 @@ module femcod_studies
       parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, read_heights
-   use femcod_run, only: default_prefix, file_part
+   use femcod_files, only: default_prefix, file_part
    use femcod_files, only: path_exists
    use femcod_results, only: write_file_set
    use femcod_svg, only: svg_series, svg_multi_plot, fmt_sig, add_series
@@ -24,9 +24,13 @@ module femcod_studies
    use femcod_scene, only: flip_upper
    use femcod_surfaces, only: remove_plane
    use femcod_richardson, only: power_law_fit
+   use femcod_observer, only: solver_observer
+   use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
+      real_option, integer_option, text_option, choice_option, real_list_option, integer_list_option, get_option, &
+      option_given, refuse_options
    implicit none
    private
-   public :: resolution_command, summits_command, multiscale_command
+   public :: resolution_command, summits_command, multiscale_command, resolution_table, surface_table
 
    !> Options shared by `summits` and `multiscale`.
    type :: surface_options
@@ -37,10 +41,29 @@ module femcod_studies
    end type surface_options
 
    !> Progress of the solve inside a level: a line on standard error every 10 s.
-   real(dp), save :: last_report = 0
-   logical, save :: progress_quiet = .false.
+   type, extends(solver_observer) :: level_observer
+      logical :: quiet = .false.
+      real(dp) :: last_report = 0
+   contains
+      procedure :: progress => level_progress
+   end type level_observer
 
 contains
+
+   !> The options of `femcod resolution`; "heights" ones apply to a height file only.
+   function resolution_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [ &
+         text_option("--output", "PREFIX", "output prefix (default: the input's name)", alias="-o"), &
+         integer_list_option("--levels", "L1,...", "NP of each level (default: NP, NP/2, NP/4, NP/8 down to 8 "// &
+            "pixels)", lower=1), &
+         choice_option("--method", "subsample|average", "odd/odd pixels (default) or 2 x 2 means"), &
+         real_option("--hardness", "H", "GPa, for the pixels above the hardness per step (default 11, polysilicon)", &
+            lower=0.0_dp, closed="()"), &
+         flag_option("--force", "replace existing result files"), &
+         flag_option("--quiet", "no summary, no progress lines", alias="-q"), &
+         scene_options("heights")]
+   end function resolution_table
 
    subroutine resolution_help()
       write(output_unit, '(a)') &
@@ -53,10 +76,11 @@ contains
          "pixels (subsample, default) or by averaging 2 x 2 blocks (average), the pixel size doubling at each", &
          "halving and MAXCONT scaled with the pixel count; the event-exact contact history at every level,", &
          "and beside it the estimates of Figs. 4.17, 4.18 and 4.21. FILE: heights (nm) as an ASCII matrix or", &
-         "FILE.h5:/dataset on an elastic lower body (default 200 GPa, 0.25) against a rigid flat.", &
-         "  --levels L1,...    NP of each level (default: NP, NP/2, NP/4, NP/8 down to 8 pixels)", &
-         "  --hardness H       GPa, for the pixels above the hardness per step (default 11, polysilicon)", &
-         "", &
+         "FILE.h5:/dataset on an elastic lower body (default 200 GPa, 0.25) against a rigid flat.", ""
+      call put_lines(option_help(resolution_table(), ""))
+      write(output_unit, '(a)') "with a height file (FILE --pixel D):"
+      call put_lines(option_help(resolution_table(), "heights"))
+      write(output_unit, '(a)') "", &
          "outputs: PREFIX.resolution.csv  np,method,load_nN,approach_nm,area_nm2 (one row per step and level)", &
          "         PREFIX.powerlaw.csv    np,exponent,prefactor (area = prefactor * load^exponent over the run)", &
          "         PREFIX.estimates.csv   np,model,load_nN,area_nm2 with model coupled (femcod), uncoupled", &
@@ -71,6 +95,24 @@ contains
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
    end subroutine resolution_help
 
+   subroutine put_lines(lines)
+      type(string_type), intent(in) :: lines(:)
+      integer :: k
+      do k = 1, size(lines)
+         write(output_unit, '(a)') lines(k)%s
+      end do
+   end subroutine put_lines
+
+   !> Whether the arguments ask for help.
+   pure logical function wants_help(args)
+      type(string_type), intent(in) :: args(:)
+      integer :: k
+      wants_help = .false.
+      do k = 1, size(args)
+         if (args(k)%s == "--help" .or. args(k)%s == "-h") wants_help = .true.
+      end do
+   end function wants_help
+
    !> `femcod resolution`.
    subroutine resolution_command(args, code)
       type(string_type), intent(in) :: args(:)
@@ -79,95 +121,46 @@ contains
       type(status_type) :: status
       type(resolution_level), allocatable :: levels(:)
       type(string_type), allocatable :: names(:), texts(:)
+      type(parsed_options) :: parsed
+      type(scene_spec) :: spec
+      type(level_observer) :: observer
       integer, allocatable :: nps(:)
-      character(len=:), allocatable :: input, prefix, method, key, v
-      real(dp) :: hardness, pixel, young, poisson, t0, t1
-      integer :: k, maxcont, n
-      logical :: ok, force, quiet, plane
+      character(len=:), allocatable :: input, prefix, method
+      real(dp) :: hardness, t0, t1
+      integer :: k, n
+      logical :: force, quiet
       code = 0
-      plane = .false.
-      input = ""
+      if (wants_help(args)) then
+         call resolution_help()
+         return
+      end if
+      call parse_options(resolution_table(), args, parsed, status)
+      if (status%code == 0) then
+         if (size(parsed%positional) == 0) call set_error(status, STATUS_USAGE, "no deck or height file given")
+         if (size(parsed%positional) > 1) call set_error(status, STATUS_USAGE, "one input only (found '"// &
+            parsed%positional(1)%s//"' and '"//parsed%positional(2)%s//"')")
+      end if
+      if (status%code == 0) call refuse_options(parsed, merge("heights", "       ", option_given(parsed, "--pixel")), &
+         "heights=to a height file (FILE --pixel D), not to a deck", status)
+      if (status%code /= 0) then
+         call usage(status%message)
+         return
+      end if
+      input = parsed%positional(1)%s
       prefix = ""
       method = "subsample"
       hardness = 11
-      pixel = 0
-      young = 200
-      poisson = 0.25_dp
-      maxcont = 0
       force = .false.
       quiet = .false.
       allocate(nps(0))
-      k = 0
-      do while (k < size(args))
-         k = k + 1
-         key = args(k)%s
-         select case (key)
-         case ("-h", "--help")
-            call resolution_help()
-            return
-         case ("--force")
-            force = .true.
-            cycle
-         case ("--remove-plane")
-            plane = .true.
-            cycle
-         case ("--quiet")
-            quiet = .true.
-            cycle
-         case ("-o", "--levels", "--method", "--hardness", "--pixel", "--young", "--poisson", "--maxcont")
-            if (k == size(args)) then
-               call usage(key//" needs a value")
-               return
-            end if
-            k = k + 1
-            v = args(k)%s
-         case default
-            if (key(1:1) == "-" .and. len(key) > 1) then
-               call usage("unknown option '"//key//"'")
-               return
-            end if
-            if (input /= "") then
-               call usage("one input only (found '"//input//"' and '"//key//"')")
-               return
-            end if
-            input = key
-            cycle
-         end select
-         ok = .true.
-         select case (key)
-         case ("-o")
-            prefix = v
-         case ("--method")
-            method = v
-            ok = v == "subsample" .or. v == "average"
-         case ("--levels")
-            call parse_integer_list(v, nps, ok)
-            if (ok) ok = all(nps >= 1)
-         case ("--hardness")
-            call parse_real(v, hardness, ok)
-            ok = ok .and. hardness > 0
-         case ("--pixel")
-            call parse_real(v, pixel, ok)
-            ok = ok .and. pixel > 0
-         case ("--young")
-            call parse_real(v, young, ok)
-            ok = ok .and. young > 0
-         case ("--poisson")
-            call parse_real(v, poisson, ok)
-         case ("--maxcont")
-            call parse_integer(v, maxcont, ok)
-            ok = ok .and. maxcont > 0
-         end select
-         if (.not. ok) then
-            call usage(key//": invalid value '"//v//"'")
-            return
-         end if
-      end do
-      if (input == "") then
-         call usage("no deck or height file given")
-         return
-      end if
-      call study_deck(input, pixel, young, poisson, maxcont, plane, deck, status)
+      call get_option(parsed, "--output", prefix)
+      call get_option(parsed, "--method", method)
+      call get_option(parsed, "--levels", nps)
+      call get_option(parsed, "--hardness", hardness)
+      call get_option(parsed, "--force", force)
+      call get_option(parsed, "--quiet", quiet)
+      call surface_scene(parsed, input, spec)
+      call study_deck(input, spec, deck, status)
       if (status%code /= 0) then
          call fail(status)
          return
@@ -195,12 +188,12 @@ contains
          call fail(status)
          return
       end if
-      progress_quiet = quiet
+      observer%quiet = quiet
       allocate(levels(size(nps)))
       do k = 1, size(nps)
          call wall_clock(t0)
-         last_report = 0
-         call solve_level(deck, nps(k), method, hardness, levels(k), status, level_progress)
+         observer%last_report = 0
+         call solve_level(deck, nps(k), method, hardness, levels(k), status, observer)
          if (status%code /= 0) then
             status%message = "level NP = "//int_str(nps(k))//": "//status%message
             call fail(status)
@@ -375,28 +368,37 @@ contains
       call power_law_fit(pack(x, keep), pack(y, keep), e, pre)
    end function fitted_exponent
 
-   !> The problem of a study: a deck, or (with --pixel) a height file on an elastic
-   !> lower body against a rigid flat.
-   subroutine study_deck(input, pixel, young, poisson, maxcont, plane, deck, status)
+   !> The scene of a height file for a study: the heights on an elastic lower body
+   !> (--young, --poisson; default 200 GPa, 0.25) against a rigid flat, as `run --lower`.
+   subroutine surface_scene(parsed, input, spec)
+      type(parsed_options), intent(in) :: parsed
       character(len=*), intent(in) :: input
-      real(dp), intent(in) :: pixel, young, poisson
-      integer, intent(in) :: maxcont
-      logical, intent(in) :: plane
+      type(scene_spec), intent(out) :: spec
+      character(len=:), allocatable :: text
+      spec%kind = "matrix"
+      spec%label = "heights from "//input
+      call get_option(parsed, "--label", spec%label)
+      spec%matrix_file = input
+      spec%second_file = ""
+      spec%shape_on = "lower"
+      call get_option(parsed, "--pixel", spec%pixel)
+      call get_option(parsed, "--young", spec%young)
+      call get_option(parsed, "--poisson", spec%poisson)
+      call get_option(parsed, "--maxcont", spec%maxcont)
+      call get_option(parsed, "--remove-plane", spec%plane)
+      call get_option(parsed, "--rigid-factor", spec%rigid_factor)
+      text = ""
+      call get_option(parsed, "--rigid", text)
+      if (text /= "") spec%rigid = text
+   end subroutine surface_scene
+
+   !> The problem of a study: a deck, or (a spec with a pixel size) a height file.
+   subroutine study_deck(input, spec, deck, status)
+      character(len=*), intent(in) :: input
+      type(scene_spec), intent(in) :: spec
       type(contact_problem), intent(out) :: deck
       type(status_type), intent(inout) :: status
-      type(scene_spec) :: spec
-      if (pixel > 0) then
-         spec%kind = "matrix"
-         spec%label = "heights from "//input
-         spec%matrix_file = input
-         spec%second_file = ""
-         ! The heights on the elastic lower body, the rigid flat above (as `run --lower`).
-         spec%shape_on = "lower"
-         spec%pixel = pixel
-         spec%young = young
-         spec%poisson = poisson
-         spec%maxcont = maxcont
-         spec%plane = plane
+      if (spec%pixel > 0) then
          call load_scene(spec, deck, status)
       else
          call read_deck(input, deck, status)
@@ -427,11 +429,12 @@ contains
    end subroutine check_outputs
 
    !> Progress within a level's solve, every 10 s on standard error.
-   subroutine level_progress(step, contacts, load, elapsed)
+   subroutine level_progress(self, step, contacts, load, elapsed)
+      class(level_observer), intent(inout) :: self
       integer, intent(in) :: step, contacts
       real(dp), intent(in) :: load, elapsed
-      if (progress_quiet .or. elapsed - last_report < 10) return
-      last_report = elapsed
+      if (self%quiet .or. elapsed - self%last_report < 10) return
+      self%last_report = elapsed
       write(error_unit, '(a)') "femcod resolution: event "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
          real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s"
       flush(error_unit)
@@ -489,79 +492,66 @@ contains
          "exit codes: 0 ok, 2 usage, 3 bad input, 5 I/O"
    end subroutine summits_help
 
-   !> Parse the options of `summits` and `multiscale`; others are handed back in `rest`
-   !> as key/value pairs.
-   subroutine parse_surface_options(command, args, opts, rest, code)
+   !> The options of `summits` (command "summits") and `multiscale` (its own besides).
+   function surface_table(command) result(table)
+      character(len=*), intent(in) :: command
+      type(option_spec), allocatable :: table(:)
+      table = [ &
+         text_option("--output", "PREFIX", "output prefix (default: the input's name)", alias="-o"), &
+         real_option("--pixel", "D", "pixel size in nm: FILE holds heights (nm), not a deck", lower=0.0_dp, &
+            closed="()"), &
+         integer_list_option("--sizes", "n1,...", "neighbourhood sizes (default 1, 2, 3, 4, 6, 8, 11, 16, ... up "// &
+            "to N/8)", lower=1), &
+         flag_option("--remove-plane", "subtract the least-squares plane"), &
+         flag_option("--force", "replace existing result files"), &
+         flag_option("--quiet", "no summary", alias="-q")]
+      if (command /= "multiscale") return
+      table = [table, &
+         integer_option("--template-size", "n", "neighbourhood size of the template (default: the size whose "// &
+            "summit count is nearest 100, as the thesis' template)", lower=1), &
+         real_list_option("--s", "s1,...", "length scaling constants (default 2.5,5,10)", lower=1.0_dp, closed="()"), &
+         real_option("--min-length", "L", "finest length scale in nm (default 4: ten atomic spacings, the limit of "// &
+            "the elastic solution)", lower=0.0_dp, closed="()"), &
+         integer_option("--scales", "K", "the number of scales instead of --min-length", lower=1, upper=60), &
+         real_option("--load", "F", "total load in nN (default 1e6, 1 mN)", lower=0.0_dp, closed="()"), &
+         real_option("--estar", "E", "composite modulus in GPa (default 200)", lower=0.0_dp, closed="()"), &
+         real_list_option("--exponents", "eh,eR,eN", "override the power laws of the summit search", length=3)]
+   end function surface_table
+
+   !> Parse the options of `summits` and `multiscale` (`code` -1: help asked).
+   subroutine parse_surface_options(command, args, opts, parsed, code)
       character(len=*), intent(in) :: command
       type(string_type), intent(in) :: args(:)
       type(surface_options), intent(out) :: opts
-      type(string_type), allocatable, intent(out) :: rest(:)
+      type(parsed_options), intent(out) :: parsed
       integer, intent(out) :: code
-      character(len=:), allocatable :: key, v
-      logical :: ok
-      integer :: k
+      type(status_type) :: status
       code = 0
-      opts%input = ""
-      opts%prefix = ""
-      allocate(opts%sizes(0), rest(0))
-      k = 0
-      do while (k < size(args))
-         k = k + 1
-         key = args(k)%s
-         select case (key)
-         case ("--remove-plane")
-            opts%plane = .true.
-            cycle
-         case ("--force")
-            opts%force = .true.
-            cycle
-         case ("--quiet")
-            opts%quiet = .true.
-            cycle
-         case ("-h", "--help")
-            code = -1
-            return
-         end select
-         if (key(1:1) /= "-" .or. len(key) == 1) then
-            if (opts%input /= "") then
-               call usage_line(command, "one input only (found '"//opts%input//"' and '"//key//"')")
-               code = STATUS_USAGE
-               return
-            end if
-            opts%input = key
-            cycle
-         end if
-         if (k == size(args)) then
-            call usage_line(command, key//" needs a value")
-            code = STATUS_USAGE
-            return
-         end if
-         k = k + 1
-         v = args(k)%s
-         ok = .true.
-         select case (key)
-         case ("-o")
-            opts%prefix = v
-         case ("--pixel")
-            call parse_real(v, opts%pixel, ok)
-            ok = ok .and. opts%pixel > 0
-         case ("--sizes")
-            call parse_integer_list(v, opts%sizes, ok)
-            if (ok) ok = all(opts%sizes >= 1)
-         case default
-            rest = [rest, string_type(key), string_type(v)]
-         end select
-         if (.not. ok) then
-            call usage_line(command, key//": invalid value '"//v//"'")
-            code = STATUS_USAGE
-            return
-         end if
-      end do
-      if (opts%input == "") then
-         call usage_line(command, "no deck or height file given")
-         code = STATUS_USAGE
+      if (wants_help(args)) then
+         code = -1
          return
       end if
+      opts%input = ""
+      opts%prefix = ""
+      allocate(opts%sizes(0))
+      call parse_options(surface_table(command), args, parsed, status)
+      if (status%code == 0) then
+         if (size(parsed%positional) == 0) call set_error(status, STATUS_USAGE, "no deck or height file given")
+         if (size(parsed%positional) > 1) call set_error(status, STATUS_USAGE, "one input only (found '"// &
+            parsed%positional(1)%s//"' and '"//parsed%positional(2)%s//"')")
+      end if
+      if (status%code /= 0) then
+         call usage_line(command, status%message)
+         code = status%code
+         return
+      end if
+      opts%input = parsed%positional(1)%s
+      call get_option(parsed, "--output", opts%prefix)
+      call get_option(parsed, "--pixel", opts%pixel)
+      call get_option(parsed, "--sizes", opts%sizes)
+      call get_option(parsed, "--remove-plane", opts%plane)
+      call get_option(parsed, "--force", opts%force)
+      call get_option(parsed, "--quiet", opts%quiet)
       if (opts%prefix == "") opts%prefix = default_prefix(file_part(opts%input))
    end subroutine parse_surface_options
 
@@ -575,7 +565,8 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(surface_options) :: opts
-      type(string_type), allocatable :: rest(:), names(:), texts(:)
+      type(string_type), allocatable :: names(:), texts(:)
+      type(parsed_options) :: parsed
       type(status_type) :: status
       type(summit_statistics), allocatable :: stats(:)
       real(dp), allocatable :: z(:, :), freq(:), power(:), tau(:), sf(:), e(:), p(:), box(:)
@@ -584,18 +575,13 @@ contains
       character(len=14), parameter :: quantity(3) = [character(len=14) :: "density", "mean_height", "mean_radius"]
       real(dp) :: d, side, dpsd, slope, dsf, g
       integer :: k, q
-      call parse_surface_options("summits", args, opts, rest, code)
+      call parse_surface_options("summits", args, opts, parsed, code)
       if (code == -1) then
          code = 0
          call summits_help()
          return
       end if
       if (code /= 0) return
-      if (size(rest) > 0) then
-         call usage_line("summits", "unknown option '"//rest(1)%s//"'")
-         code = STATUS_USAGE
-         return
-      end if
       call study_heights(opts%input, opts%pixel, opts%plane, z, d, status)
       if (status%code /= 0) then
          call fail_with("summits", status, code)
@@ -720,7 +706,8 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(surface_options) :: opts
-      type(string_type), allocatable :: rest(:), names(:), texts(:)
+      type(string_type), allocatable :: names(:), texts(:)
+      type(parsed_options) :: parsed
       type(status_type) :: status
       type(summit_statistics), allocatable :: stats(:)
       type(roughness_template) :: template
@@ -733,7 +720,7 @@ contains
       real(dp) :: d, load, estar, min_length, region, e3(3), p3(3)
       integer :: k, scales, tsize, ks, kc, m, best
       logical :: ok
-      call parse_surface_options("multiscale", args, opts, rest, code)
+      call parse_surface_options("multiscale", args, opts, parsed, code)
       if (code == -1) then
          code = 0
          call multiscale_help()
@@ -747,41 +734,13 @@ contains
       scales = 0
       tsize = 0
       allocate(ex(0))
-      do k = 1, size(rest), 2
-         ok = .true.
-         select case (rest(k)%s)
-         case ("--s")
-            call parse_real_list(rest(k + 1)%s, svals, ok)
-            if (ok) ok = all(svals > 1)
-         case ("--exponents")
-            call parse_real_list(rest(k + 1)%s, ex, ok)
-            if (ok) ok = size(ex) == 3
-         case ("--load")
-            call parse_real(rest(k + 1)%s, load, ok)
-            ok = ok .and. load > 0
-         case ("--estar")
-            call parse_real(rest(k + 1)%s, estar, ok)
-            ok = ok .and. estar > 0
-         case ("--min-length")
-            call parse_real(rest(k + 1)%s, min_length, ok)
-            ok = ok .and. min_length > 0
-         case ("--scales")
-            call parse_integer(rest(k + 1)%s, scales, ok)
-            ok = ok .and. scales >= 1 .and. scales <= 60
-         case ("--template-size")
-            call parse_integer(rest(k + 1)%s, tsize, ok)
-            ok = ok .and. tsize >= 1
-         case default
-            call usage_line("multiscale", "unknown option '"//rest(k)%s//"'")
-            code = STATUS_USAGE
-            return
-         end select
-         if (.not. ok) then
-            call usage_line("multiscale", rest(k)%s//": invalid value '"//rest(k + 1)%s//"'")
-            code = STATUS_USAGE
-            return
-         end if
-      end do
+      call get_option(parsed, "--s", svals)
+      call get_option(parsed, "--exponents", ex)
+      call get_option(parsed, "--load", load)
+      call get_option(parsed, "--estar", estar)
+      call get_option(parsed, "--min-length", min_length)
+      call get_option(parsed, "--scales", scales)
+      call get_option(parsed, "--template-size", tsize)
       call study_heights(opts%input, opts%pixel, opts%plane, z, d, status)
       if (status%code /= 0) then
          call fail_with("multiscale", status, code)

@@ -6,6 +6,7 @@ module femcod_files
    implicit none
    private
    public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, commit_file
+   public :: default_prefix, file_part
 
    interface
       function c_rename(from, to) bind(c, name="rename") result(rc)
@@ -76,4 +77,31 @@ contains
       character(len=:), allocatable :: tmp
       tmp = path//".part"
    end function temporary_name
+
+   !> The file part of `FILE.h5:/dataset` (the path itself for other files).
+   function file_part(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      integer :: colon
+      colon = index(path, ":/", back=.true.)
+      name = path
+      if (colon > 0) name = path(1:colon - 1)
+   end function file_part
+
+   !> The default output prefix of an input: its file name without directory and
+   !> without a known extension (.deck, .txt, .dat, .asc, .h5, .hdf5, .csv).
+   function default_prefix(path) result(prefix)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: prefix
+      integer :: slash
+      slash = index(path, "/", back=.true.)
+      prefix = path(slash + 1:)
+      slash = index(prefix, ".", back=.true.)
+      if (slash > 1) then
+         select case (prefix(slash:))
+         case (".deck", ".txt", ".dat", ".asc", ".h5", ".hdf5", ".csv")
+            prefix = prefix(1:slash - 1)
+         end select
+      end if
+   end function default_prefix
 end module femcod_files

@@ -1,22 +1,22 @@
-!> Checkpoint files (PREFIX.ckpt.h5) of the incremental solver: written atomically
-!> (temporary name, then rename), so a run killed at any moment leaves either the
-!> previous checkpoint or the new one, never a partial file. A checkpoint holds the
-!> whole deck and the options that shape the history, and is refused for any other.
+!> Checkpoint files (PREFIX.ckpt.h5): written atomically (temporary name, then rename),
+!> so a run killed at any moment leaves either the previous checkpoint or the new one,
+!> never a partial file. A checkpoint holds the whole problem and the options that
+!> shape the history, and is refused for any other; then the solver's state, stored
+!> field by field as the state's `visit` lists them (core/femcod_state_visitor): the
+!> writer and the reader here know no field of any state.
 !>
 !> Layout: /deck (label, NP, pixel, MAXCONT, young, poisson; lower, upper),
-!> /options (max_contacts, loads, tie_tolerance, hardness, final_check),
-!> /state (step, n, total, approach, phi, pix, cstep, ftot, ld, factor (the upper
-!> triangle packed by columns), y, x, cache_pixel, cache_l, cache_w, predicted,
-!> since_refill, last_neval, heap_key, heap_item),
-!> /history (contacts, load, approach, seconds), /states/<k> (the requested loads
-!> reached so far), /counters.
+!> /options (max_contacts, loads, tie_tolerance, hardness, final_check), then one group
+!> per group the state visits (for the incremental solver /state, /history,
+!> /states/<k>, /counters), a dataset per field with its name.
 module femcod_checkpoint
-   use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, format_real
    use femcod_files, only: atomic_rename, remove_file, temporary_name
-   use femcod_contact_result, only: contact_options, solver_state
+   use femcod_solver_options, only: contact_options
+   use femcod_state_visitor, only: state_visitor, visitable
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_read, h5_attribute, &
       h5_read_string_attribute, h5_exists
    use femcod_about, only: FEMCOD_VERSION
@@ -25,90 +25,86 @@ module femcod_checkpoint
    public :: write_checkpoint, read_checkpoint
 
    !> Marks a file as a femcod checkpoint (attribute /format).
-   character(len=*), parameter :: FORMAT_TAG = "femcod checkpoint 3"
+   character(len=*), parameter :: FORMAT_TAG = "femcod checkpoint 4"
+
+   !> Stores each visited field as a dataset of an open HDF5 file.
+   type, extends(state_visitor) :: h5_writer
+      type(h5_file) :: file
+      character(len=:), allocatable :: where
+   contains
+      procedure :: group => writer_group
+      procedure :: integer_value => write_integer
+      procedure :: long_value => write_long
+      procedure :: real_value => write_real
+      procedure :: logical_value => write_logical
+      procedure :: integer_array => write_integers
+      procedure :: real_array => write_reals
+      procedure :: integer_prefix => write_integer_prefix
+      procedure :: real_prefix => write_real_prefix
+      procedure :: real_rows => write_real_rows
+      procedure :: real_triangle => write_real_triangle
+   end type h5_writer
+
+   !> Reads each visited field back from the dataset of its name; every shape is checked
+   !> against the state's storage (a mismatch is a corrupted checkpoint).
+   type, extends(state_visitor) :: h5_reader
+      type(h5_file) :: file
+      character(len=:), allocatable :: where
+   contains
+      procedure :: group => reader_group
+      procedure :: integer_value => read_integer
+      procedure :: long_value => read_long
+      procedure :: real_value => read_real
+      procedure :: logical_value => read_logical
+      procedure :: integer_array => read_integers
+      procedure :: real_array => read_reals
+      procedure :: integer_prefix => read_integer_prefix
+      procedure :: real_prefix => read_real_prefix
+      procedure :: real_rows => read_real_rows
+      procedure :: real_triangle => read_real_triangle
+   end type h5_reader
 
 contains
 
-   !> Store `state` for `deck` and `options` in `path`, atomically.
+   !> Store `state` for `problem` and `options` in `path`, atomically.
    subroutine write_checkpoint(path, deck, options, state, status)
       character(len=*), intent(in) :: path
       type(contact_problem), intent(in) :: deck
       type(contact_options), intent(in) :: options
-      type(solver_state), intent(in) :: state
+      class(visitable), intent(inout) :: state
       type(status_type), intent(inout) :: status
-      type(h5_file) :: file
-      character(len=:), allocatable :: tmp, g
-      integer :: k, m
+      type(h5_writer) :: writer
+      character(len=:), allocatable :: tmp
       if (status%code /= 0) return
       tmp = temporary_name(path)
-      m = state%res%nsteps
-      call h5_create(tmp, file, status)
-      file%path = path
-      call h5_attribute(file, "/", "format", FORMAT_TAG, status)
-      call h5_attribute(file, "/", "femcod_version", FEMCOD_VERSION, status)
-      call h5_group(file, "/deck", status)
-      call h5_attribute(file, "/deck", "label", deck%label, status)
-      call h5_write(file, "/deck/NP", deck%np, "1", status)
-      call h5_write(file, "/deck/pixel", deck%pixel, "nm", status)
-      call h5_write(file, "/deck/MAXCONT", deck%maxcont, "1", status)
-      call h5_write(file, "/deck/young", deck%young, "GPa", status)
-      call h5_write(file, "/deck/poisson", deck%poisson, "1", status)
-      call h5_write(file, "/deck/lower", deck%lower, "nm", status)
-      call h5_write(file, "/deck/upper", deck%upper, "nm", status)
-      call h5_group(file, "/options", status)
-      call h5_write(file, "/options/max_contacts", options%max_contacts, "1", status)
-      call h5_write(file, "/options/loads", options%loads, "nN", status)
-      call h5_write(file, "/options/tie_tolerance", options%tie_tolerance, "1", status)
-      call h5_write(file, "/options/hardness", options%hardness, "GPa", status)
-      call h5_write(file, "/options/final_check", merge(1, 0, options%final_check), "1", status)
-      call h5_group(file, "/state", status)
-      call h5_write(file, "/state/step", state%step, "1", status)
-      call h5_write(file, "/state/n", state%n, "1", status)
-      call h5_write(file, "/state/total", state%total, "nN", status)
-      call h5_write(file, "/state/approach", state%approach, "nm", status)
-      call h5_write(file, "/state/phi", state%phi, "nm", status)
-      call h5_write(file, "/state/pix", state%pix, "1", status)
-      call h5_write(file, "/state/cstep", state%cstep, "1", status)
-      call h5_write(file, "/state/ftot", state%ftot, "nN", status)
-      call h5_write(file, "/state/ld", state%ld, "1", status)
-      call h5_write(file, "/state/factor", state%factor, "(nm/nN)^0.5", status)
-      call h5_write(file, "/state/y", state%y, "(nN/nm)^0.5", status)
-      call h5_write(file, "/state/x", state%x, "nN/nm", status)
-      call h5_write(file, "/state/cache_pixel", state%cache_pixel, "1", status)
-      call h5_write(file, "/state/cache_l", state%cache_l, "(nm/nN)^0.5", status)
-      call h5_write(file, "/state/cache_w", state%cache_w, "1", status)
-      call h5_write(file, "/state/predicted", state%predicted, "nN", status)
-      call h5_write(file, "/state/since_refill", state%since_refill, "1", status)
-      call h5_write(file, "/state/last_neval", state%last_neval, "1", status)
-      call h5_write(file, "/state/heap_key", state%heap_key, "nm", status)
-      call h5_write(file, "/state/heap_item", state%heap_item, "1", status)
-      call h5_group(file, "/history", status)
-      call h5_write(file, "/history/contacts", state%res%step_contacts(1:m), "1", status)
-      call h5_write(file, "/history/above_hardness", state%res%step_above_hardness(1:m), "1", status)
-      call h5_write(file, "/history/load", state%res%step_load(1:m), "nN", status)
-      call h5_write(file, "/history/approach", state%res%step_approach(1:m), "nm", status)
-      call h5_write(file, "/history/seconds", state%res%step_seconds(1:m), "s", status)
-      call h5_group(file, "/states", status)
-      do k = 1, size(state%res%states)
-         if (.not. state%res%states(k)%reached) cycle
-         g = "/states/"//int_str(k)
-         associate(s => state%res%states(k))
-            call h5_group(file, g, status)
-            call h5_write(file, g//"/load", s%load, "nN", status)
-            call h5_write(file, g//"/approach", s%approach, "nm", status)
-            call h5_write(file, g//"/contacts", s%contacts, "1", status)
-            call h5_write(file, g//"/max_pressure", s%max_pressure, "GPa", status)
-            call h5_write(file, g//"/n_above_hardness", s%n_above_hardness, "1", status)
-            call h5_write(file, g//"/i", s%i, "1", status)
-            call h5_write(file, g//"/j", s%j, "1", status)
-            call h5_write(file, g//"/force", s%force, "nN", status)
-         end associate
-      end do
-      call h5_group(file, "/counters", status)
-      call h5_write(file, "/counters/missed_during_run", state%res%missed_during_run, "1", status)
-      call h5_write(file, "/counters/releases", state%res%releases, "1", status)
-      call h5_write(file, "/counters/evaluations", real(state%res%evaluations, dp), "1", status)
-      call h5_close(file, status)
+      associate(file => writer%file)
+         call h5_create(tmp, file, status)
+         file%path = path
+         call h5_attribute(file, "/", "format", FORMAT_TAG, status)
+         call h5_attribute(file, "/", "femcod_version", FEMCOD_VERSION, status)
+         call h5_group(file, "/deck", status)
+         call h5_attribute(file, "/deck", "label", deck%label, status)
+         call h5_write(file, "/deck/NP", deck%np, "1", status)
+         call h5_write(file, "/deck/pixel", deck%pixel, "nm", status)
+         call h5_write(file, "/deck/MAXCONT", deck%maxcont, "1", status)
+         call h5_write(file, "/deck/young", deck%young, "GPa", status)
+         call h5_write(file, "/deck/poisson", deck%poisson, "1", status)
+         call h5_write(file, "/deck/lower", deck%lower, "nm", status)
+         call h5_write(file, "/deck/upper", deck%upper, "nm", status)
+         call h5_group(file, "/options", status)
+         call h5_write(file, "/options/max_contacts", options%max_contacts, "1", status)
+         call h5_write(file, "/options/loads", options%loads, "nN", status)
+         call h5_write(file, "/options/tie_tolerance", options%tie_tolerance, "1", status)
+         call h5_write(file, "/options/hardness", options%hardness, "GPa", status)
+         call h5_write(file, "/options/final_check", merge(1, 0, options%final_check), "1", status)
+         call h5_write(file, "/options/event_search", merge(1, 0, options%event_search == "fft") + &
+            2*merge(1, 0, options%event_search == "bound"), "1", status)
+         if (status%code == 0) then
+            call state%visit(writer)
+            if (writer%status%code /= 0) call set_error(status, writer%status%code, writer%status%message)
+         end if
+         call h5_close(file, status)
+      end associate
       if (status%code /= 0) then
          call remove_file(tmp)
          return
@@ -116,21 +112,24 @@ contains
       call atomic_rename(tmp, path, status)
    end subroutine write_checkpoint
 
-   !> Read the state stored in `path`, refusing it (STATUS_BAD_INPUT) unless it was
-   !> written for exactly this deck and these options.
+   !> Read the state stored in `path` into `state`, which the caller has set up for this
+   !> problem and these options (the reader fills the stored fields; derived ones are the
+   !> caller's to rebuild). Refused (STATUS_BAD_INPUT) unless the checkpoint was written
+   !> for exactly this problem and these options.
    subroutine read_checkpoint(path, deck, options, state, status)
       character(len=*), intent(in) :: path
       type(contact_problem), intent(in) :: deck
       type(contact_options), intent(in) :: options
-      type(solver_state), intent(out) :: state
+      class(visitable), intent(inout) :: state
       type(status_type), intent(inout) :: status
-      type(h5_file) :: file
-      character(len=:), allocatable :: tag, label, g
+      type(h5_reader) :: reader
+      character(len=:), allocatable :: tag, label
       real(dp), allocatable :: r1(:), r2(:, :)
       real(dp) :: r
-      integer :: i, k, m, final_check
+      integer :: i, final_check
       integer, parameter :: bad = STATUS_BAD_INPUT
       if (status%code /= 0) return
+      associate(file => reader%file)
       call h5_open(path, file, status, bad)
       call h5_read_string_attribute(file, "/", "format", len(FORMAT_TAG), tag, status, bad)
       if (status%code /= 0) then
@@ -211,79 +210,29 @@ contains
          call refuse("written with another --no-final-check setting")
          return
       end if
-      ! The state.
-      call h5_read(file, "/state/step", state%step, status, bad)
-      call h5_read(file, "/state/n", state%n, status, bad)
-      call h5_read(file, "/state/total", state%total, status, bad)
-      call h5_read(file, "/state/approach", state%approach, status, bad)
-      call h5_read(file, "/state/phi", state%phi, status, bad)
-      call h5_read(file, "/state/pix", state%pix, status, bad)
-      call h5_read(file, "/state/cstep", state%cstep, status, bad)
-      call h5_read(file, "/state/ftot", state%ftot, status, bad)
-      call h5_read(file, "/state/ld", state%ld, status, bad)
-      call h5_read(file, "/state/factor", state%factor, status, bad)
-      call h5_read(file, "/state/y", state%y, status, bad)
-      call h5_read(file, "/state/x", state%x, status, bad)
-      call h5_read(file, "/state/cache_pixel", state%cache_pixel, status, bad)
-      call h5_read(file, "/state/cache_l", r2, status, bad)
-      state%cache_l = r2
-      call h5_read(file, "/state/cache_w", r2, status, bad)
-      state%cache_w = r2
-      call h5_read(file, "/state/predicted", state%predicted, status, bad)
-      call h5_read(file, "/state/since_refill", state%since_refill, status, bad)
-      call h5_read(file, "/state/last_neval", state%last_neval, status, bad)
-      call h5_read(file, "/state/heap_key", state%heap_key, status, bad)
-      call h5_read(file, "/state/heap_item", state%heap_item, status, bad)
-      call h5_read(file, "/history/contacts", state%res%step_contacts, status, bad)
-      call h5_read(file, "/history/above_hardness", state%res%step_above_hardness, status, bad)
-      call h5_read(file, "/history/load", state%res%step_load, status, bad)
-      call h5_read(file, "/history/approach", state%res%step_approach, status, bad)
-      call h5_read(file, "/history/seconds", state%res%step_seconds, status, bad)
+      call h5_read(file, "/options/event_search", i, status, bad)
+      if (status%code == 0 .and. i /= merge(1, 0, options%event_search == "fft") + &
+         2*merge(1, 0, options%event_search == "bound")) then
+         call refuse("written with another --event-search")
+         return
+      end if
       if (status%code /= 0) then
          call h5_close(file, status)
          return
       end if
-      m = size(state%res%step_load)
-      state%res%nsteps = m
-      if (size(state%res%step_contacts) /= m .or. size(state%res%step_approach) /= m .or. &
-         size(state%res%step_above_hardness) /= m .or. &
-         size(state%res%step_seconds) /= m .or. m /= state%step .or. size(state%cstep) /= state%n .or. &
-         size(state%ftot) /= state%n .or. state%n < 1 .or. state%n > deck%maxcont .or. &
-         size(state%pix) /= state%n .or. size(state%y) /= state%n .or. size(state%x) /= state%n .or. &
-         size(state%cache_l, 1) /= state%n .or. size(state%cache_w, 1) /= state%n .or. &
-         size(state%heap_key) /= size(state%heap_item) .or. any(state%pix < 1) .or. &
-         any(state%pix > deck%np**2) .or. any(state%heap_item < 1) .or. any(state%heap_item > deck%np**2) .or. &
-         any(state%cache_pixel < 0) .or. any(state%cache_pixel > deck%np**2)) then
-         call refuse("its state is inconsistent (corrupted)")
+      ! The state, field by field.
+      call state%visit(reader)
+      if (reader%status%code /= 0) then
+         call refuse(reader%status%message)
          return
       end if
-      allocate(state%res%states(size(options%loads)))
-      state%res%states%load = options%loads
-      do k = 1, size(options%loads)
-         g = "/states/"//int_str(k)
-         if (.not. h5_exists(file, g)) cycle
-         associate(s => state%res%states(k))
-            s%reached = .true.
-            call h5_read(file, g//"/load", s%load, status, bad)
-            call h5_read(file, g//"/approach", s%approach, status, bad)
-            call h5_read(file, g//"/contacts", s%contacts, status, bad)
-            call h5_read(file, g//"/max_pressure", s%max_pressure, status, bad)
-            call h5_read(file, g//"/n_above_hardness", s%n_above_hardness, status, bad)
-            call h5_read(file, g//"/i", s%i, status, bad)
-            call h5_read(file, g//"/j", s%j, status, bad)
-            call h5_read(file, g//"/force", s%force, status, bad)
-         end associate
-      end do
-      call h5_read(file, "/counters/missed_during_run", state%res%missed_during_run, status, bad)
-      call h5_read(file, "/counters/releases", state%res%releases, status, bad)
-      call h5_read(file, "/counters/evaluations", r, status, bad)
-      state%res%evaluations = nint(r, kind(state%res%evaluations))
       call h5_close(file, status)
+      end associate
    contains
       subroutine refuse(why)
          character(len=*), intent(in) :: why
          type(status_type) :: ignore
-         call h5_close(file, ignore)
+         call h5_close(reader%file, ignore)
          call set_error(status, bad, path//": checkpoint refused: "//why// &
             " (delete it, or run without --restart)")
       end subroutine refuse
@@ -298,4 +247,237 @@ contains
          if (same2) same2 = all(a == b)
       end function same2
    end subroutine read_checkpoint
+
+   ! ---- the writer ---------------------------------------------------------------
+
+   !> Datasets of the sub-object `name` go to the group /name (created with its parents).
+   subroutine writer_group(self, name)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer :: k
+      self%where = "/"//name
+      do k = 2, len(self%where)
+         if (self%where(k:k) == "/") call make(self%where(1:k - 1))
+      end do
+      call make(self%where)
+   contains
+      subroutine make(group)
+         character(len=*), intent(in) :: group
+         if (.not. h5_exists(self%file, group)) call h5_group(self%file, group, self%status)
+      end subroutine make
+   end subroutine writer_group
+
+   subroutine write_integer(self, name, value)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(inout) :: value
+      call h5_write(self%file, self%where//"/"//name, value, "1", self%status)
+   end subroutine write_integer
+
+   !> 64-bit counters as doubles (exact below 2**53).
+   subroutine write_long(self, name, value)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(i8), intent(inout) :: value
+      call h5_write(self%file, self%where//"/"//name, real(value, dp), "1", self%status)
+   end subroutine write_long
+
+   subroutine write_real(self, name, value)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), intent(inout) :: value
+      call h5_write(self%file, self%where//"/"//name, value, "", self%status)
+   end subroutine write_real
+
+   subroutine write_logical(self, name, value)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      logical, intent(inout) :: value
+      call h5_write(self%file, self%where//"/"//name, merge(1, 0, value), "1", self%status)
+   end subroutine write_logical
+
+   subroutine write_integers(self, name, values)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, allocatable, intent(inout) :: values(:)
+      call h5_write(self%file, self%where//"/"//name, values, "1", self%status)
+   end subroutine write_integers
+
+   subroutine write_reals(self, name, values)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), allocatable, intent(inout) :: values(:)
+      call h5_write(self%file, self%where//"/"//name, values, "", self%status)
+   end subroutine write_reals
+
+   subroutine write_integer_prefix(self, name, values, n)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(inout) :: values(:)
+      integer, intent(in) :: n
+      call h5_write(self%file, self%where//"/"//name, values(1:n), "1", self%status)
+   end subroutine write_integer_prefix
+
+   subroutine write_real_prefix(self, name, values, n)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), intent(inout) :: values(:)
+      integer, intent(in) :: n
+      call h5_write(self%file, self%where//"/"//name, values(1:n), "", self%status)
+   end subroutine write_real_prefix
+
+   subroutine write_real_rows(self, name, values, n)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), intent(inout) :: values(:, :)
+      integer, intent(in) :: n
+      call h5_write(self%file, self%where//"/"//name, values(1:n, :), "", self%status)
+   end subroutine write_real_rows
+
+   !> The upper triangle of values(1:n, 1:n), packed column by column.
+   subroutine write_real_triangle(self, name, values, n)
+      class(h5_writer), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), intent(inout) :: values(:, :)
+      integer, intent(in) :: n
+      real(dp), allocatable :: packed(:)
+      integer :: j, at
+      allocate(packed(int(n, i8)*(n + 1)/2))
+      at = 0
+      do j = 1, n
+         packed(at + 1:at + j) = values(1:j, j)
+         at = at + j
+      end do
+      call h5_write(self%file, self%where//"/"//name, packed, "", self%status)
+   end subroutine write_real_triangle
+
+   ! ---- the reader ---------------------------------------------------------------
+
+   subroutine reader_group(self, name)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      self%where = "/"//name
+   end subroutine reader_group
+
+   subroutine read_integer(self, name, value)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(inout) :: value
+      call h5_read(self%file, self%where//"/"//name, value, self%status, STATUS_BAD_INPUT)
+   end subroutine read_integer
+
+   subroutine read_long(self, name, value)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(i8), intent(inout) :: value
+      real(dp) :: r
+      call h5_read(self%file, self%where//"/"//name, r, self%status, STATUS_BAD_INPUT)
+      if (self%status%code == 0) value = nint(r, i8)
+   end subroutine read_long
+
+   subroutine read_real(self, name, value)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), intent(inout) :: value
+      call h5_read(self%file, self%where//"/"//name, value, self%status, STATUS_BAD_INPUT)
+   end subroutine read_real
+
+   subroutine read_logical(self, name, value)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      logical, intent(inout) :: value
+      integer :: i
+      call h5_read(self%file, self%where//"/"//name, i, self%status, STATUS_BAD_INPUT)
+      if (self%status%code == 0) value = i == 1
+   end subroutine read_logical
+
+   subroutine read_integers(self, name, values)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, allocatable, intent(inout) :: values(:)
+      call h5_read(self%file, self%where//"/"//name, values, self%status, STATUS_BAD_INPUT)
+   end subroutine read_integers
+
+   subroutine read_reals(self, name, values)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), allocatable, intent(inout) :: values(:)
+      call h5_read(self%file, self%where//"/"//name, values, self%status, STATUS_BAD_INPUT)
+   end subroutine read_reals
+
+   subroutine read_integer_prefix(self, name, values, n)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(inout) :: values(:)
+      integer, intent(in) :: n
+      integer, allocatable :: stored(:)
+      call h5_read(self%file, self%where//"/"//name, stored, self%status, STATUS_BAD_INPUT)
+      if (.not. fits(self, name, size(stored), n, size(values))) return
+      values(1:n) = stored
+   end subroutine read_integer_prefix
+
+   subroutine read_real_prefix(self, name, values, n)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), intent(inout) :: values(:)
+      integer, intent(in) :: n
+      real(dp), allocatable :: stored(:)
+      call h5_read(self%file, self%where//"/"//name, stored, self%status, STATUS_BAD_INPUT)
+      if (.not. fits(self, name, size(stored), n, size(values))) return
+      values(1:n) = stored
+   end subroutine read_real_prefix
+
+   subroutine read_real_rows(self, name, values, n)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), intent(inout) :: values(:, :)
+      integer, intent(in) :: n
+      real(dp), allocatable :: stored(:, :)
+      call h5_read(self%file, self%where//"/"//name, stored, self%status, STATUS_BAD_INPUT)
+      if (self%status%code /= 0) return
+      if (size(stored, 2) /= size(values, 2)) then
+         call set_error(self%status, STATUS_BAD_INPUT, self%where//"/"//name//": "//int_str(size(stored, 2))// &
+            " columns stored, "//int_str(size(values, 2))//" expected (corrupted)")
+         return
+      end if
+      if (.not. fits(self, name, size(stored, 1), n, size(values, 1))) return
+      values(1:n, :) = stored
+   end subroutine read_real_rows
+
+   subroutine read_real_triangle(self, name, values, n)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(dp), intent(inout) :: values(:, :)
+      integer, intent(in) :: n
+      real(dp), allocatable :: packed(:)
+      integer :: j, at
+      call h5_read(self%file, self%where//"/"//name, packed, self%status, STATUS_BAD_INPUT)
+      if (self%status%code /= 0) return
+      if (n < 0 .or. n > min(size(values, 1), size(values, 2)) .or. size(packed, kind=i8) /= int(n, i8)*(n + 1)/2) then
+         call set_error(self%status, STATUS_BAD_INPUT, self%where//"/"//name//": not the triangle of "// &
+            int_str(n)//" columns (corrupted)")
+         return
+      end if
+      at = 0
+      do j = 1, n
+         values(1:j, j) = packed(at + 1:at + j)
+         at = at + j
+      end do
+   end subroutine read_real_triangle
+
+   !> Whether `stored` entries are the n the state expects, within its storage of
+   !> `room`; an error naming the field otherwise.
+   logical function fits(self, name, stored, n, room)
+      class(h5_reader), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: stored, n, room
+      fits = .false.
+      if (self%status%code /= 0) return
+      if (n < 0 .or. n > room .or. stored /= n) then
+         call set_error(self%status, STATUS_BAD_INPUT, self%where//"/"//name//": "//int_str(stored)// &
+            " entries stored, "//int_str(n)//" expected (corrupted)")
+         return
+      end if
+      fits = .true.
+   end function fits
 end module femcod_checkpoint

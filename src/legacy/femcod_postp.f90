@@ -9,12 +9,16 @@
 !> candidate within `tie_tolerance` times the total load of it joins in the same step.
 !> A candidate whose gap is already negative was missed earlier: it joins at once
 !> (lambda = 0), as the thesis corrects late-found contacts.
+!>
+!> Whether a candidate is in contact comes from IPSITU, the situation flags of the
+!> first 5 MAXCONT gaps in IPSORT order; a pixel further down the order (reached only
+!> by the search over every pixel) is looked up in IPCONT.
 module femcod_postp
    use femcod_kinds, only: dp
    use femcod_condensed, only: gap_and_rate
    implicit none
    private
-   public :: candidate_count, postp_search
+   public :: candidate_count, postp_search, in_contact_at
 
 contains
 
@@ -29,32 +33,50 @@ contains
       candidate_count = min(candidate_count, npixels)
    end function candidate_count
 
-   !> Search the first `ncand` pixels of `order` (not in contact) for the next contact.
-   !> Gaps are recomputed from the total forces `ftot` and approach `atot`, so no gap is
-   !> ever stale. Returns the winning multiplier `lambda` (huge() when no candidate
-   !> closes), the joining pixels and how many of them had already penetrated.
-   pure subroutine postp_search(np, order, ncand, in_contact, g0, table, csum, ic, jc, ftot, atot, funit, delta, &
-      total_load, tie_tolerance, lambda, joiners, njoin, nmissed, gaps)
-      integer, intent(in) :: np, order(:), ncand, ic(:), jc(:)
-      logical, intent(in) :: in_contact(:)
+   !> Whether the pixel of gap rank `rank` (IPSORT order), pixel number `pixel`, is in
+   !> contact: IPSITU(rank) within its 5 MAXCONT flags, else a look-up in IPCONT.
+   pure logical function in_contact_at(rank, pixel, situ, contacts)
+      integer, intent(in) :: rank, pixel, situ(:), contacts(:)
+      if (rank <= size(situ)) then
+         in_contact_at = situ(rank) == 1
+      else
+         in_contact_at = any(contacts == pixel)
+      end if
+   end function in_contact_at
+
+   !> Search the first `ncand` pixels of `order` (IPSORT) not in contact for the next
+   !> contact. Gaps are recomputed from the initial gaps g0 (MPGAPS), the total forces
+   !> `ftot` (MPFORCE) and the approach `atot`, so no gap is ever stale. Returns the
+   !> winning multiplier `lambda` (huge() when no candidate closes), the joining pixels
+   !> with their ranks in `order`, and how many of them had already penetrated.
+   pure subroutine postp_search(np, order, ncand, situ, contacts, g0, table, csum, ftot, atot, funit, delta, &
+      total_load, tie_tolerance, lambda, joiners, joiner_ranks, njoin, nmissed)
+      integer, intent(in) :: np, order(:), ncand, situ(:), contacts(:)
       real(dp), intent(in) :: g0(:), table(0:, 0:), csum, ftot(:), atot, funit(:), delta, total_load, tie_tolerance
       real(dp), intent(out) :: lambda
-      integer, intent(out) :: joiners(:), njoin, nmissed
-      real(dp), intent(inout) :: gaps(:)
-      real(dp) :: lam(ncand), rate, bound
+      integer, intent(out) :: joiners(:), joiner_ranks(:), njoin, nmissed
+      real(dp), allocatable :: lam(:), gap(:)
+      logical, allocatable :: candidate(:)
+      integer, allocatable :: ic(:), jc(:)
+      real(dp) :: rate, bound
       integer :: pos, p, ip, jp
+      ! Heap arrays: the search over every pixel has NP**2 candidates.
+      allocate(lam(ncand), gap(ncand), candidate(ncand))
+      ic = (contacts - 1)/np + 1
+      jc = contacts - (ic - 1)*np
       lambda = huge(1.0_dp)
       lam = huge(1.0_dp)
       do pos = 1, ncand
          p = order(pos)
-         if (in_contact(p)) cycle
+         candidate(pos) = .not. in_contact_at(pos, p, situ, contacts)
+         if (.not. candidate(pos)) cycle
          ip = (p - 1)/np + 1
          jp = p - (ip - 1)*np
-         call gap_and_rate(g0(p), atot, delta, csum, table, ip, jp, ic, jc, ftot, funit, gaps(p), rate)
-         if (gaps(p) <= 0) then
-            lam(pos) = min(0.0_dp, gaps(p))
+         call gap_and_rate(g0(p), atot, delta, csum, table, ip, jp, ic, jc, ftot, funit, gap(pos), rate)
+         if (gap(pos) <= 0) then
+            lam(pos) = min(0.0_dp, gap(pos))
          else if (rate > 0) then
-            lam(pos) = gaps(p)/rate
+            lam(pos) = gap(pos)/rate
          end if
          lambda = min(lambda, lam(pos))
       end do
@@ -63,12 +85,14 @@ contains
       if (lambda == huge(1.0_dp)) return
       bound = max(lambda, 0.0_dp) + tie_tolerance*(total_load + max(lambda, 0.0_dp))
       do pos = 1, ncand
-         p = order(pos)
-         if (in_contact(p)) cycle
+         if (.not. candidate(pos)) cycle
          if (lam(pos) <= bound) then
             njoin = njoin + 1
-            if (njoin <= size(joiners)) joiners(njoin) = p
-            if (gaps(p) < -tie_tolerance*atot) nmissed = nmissed + 1
+            if (njoin <= size(joiners)) then
+               joiners(njoin) = order(pos)
+               joiner_ranks(njoin) = pos
+            end if
+            if (gap(pos) < -tie_tolerance*atot) nmissed = nmissed + 1
          end if
       end do
       lambda = max(lambda, 0.0_dp)

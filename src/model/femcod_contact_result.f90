@@ -2,34 +2,14 @@
 !> the contact pixels with their forces, and what was checked.
 module femcod_contact_result
    use femcod_kinds, only: dp, i8
+   use femcod_state_visitor, only: state_visitor
+   use femcod_strings, only: int_str
    implicit none
    private
-   public :: contact_result, load_state, contact_options, append_step, progress_interface
+   public :: contact_result, load_state, append_step, visit_result
    public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text, record_load_states, finish_contacts
-   public :: solver_state, checkpoint_interface
 
    integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3
-
-   !> What the user asked of a run.
-   type :: contact_options
-      !> Stop after this many contacts (0: the deck's MAXCONT).
-      integer :: max_contacts = 0
-      !> Requested total loads (nN); empty: run to MAXCONT.
-      real(dp), allocatable :: loads(:)
-      !> Hardness (GPa) for the count of pixels above it (thesis polysilicon: 11 GPa).
-      real(dp) :: hardness = 11
-      !> Candidates whose closing load is within this fraction of the total load of the
-      !> smallest one join in the same step (ties).
-      real(dp) :: tie_tolerance = 1.0e-9_dp
-      !> Check every pixel for penetration at the end, and correct (Appendix B).
-      logical :: final_check = .true.
-      !> Event search of the incremental solver: "auto" (the cheaper of the two, from
-      !> measured costs), "bound" (gap bound and exact evaluations) or "fft" (full field).
-      character(len=5) :: event_search = "auto"
-      !> Hand the solver state to the checkpoint procedure every this many seconds of
-      !> wall time (0: after every step; negative: never).
-      real(dp) :: checkpoint_interval = -1
-   end type contact_options
 
    !> The contact state at one requested load.
    type :: load_state
@@ -42,12 +22,16 @@ module femcod_contact_result
       !> penetration (nm), largest |gap| on contact (nm), relative load error.
       integer :: iterations = 0
       real(dp) :: residual = 0, penetration = 0, contact_gap = 0, load_error = 0
+      !> Fixed-load solver only: iterations on all coarser grids together, and fresh
+      !> convolutions of the forces on the finest grid.
+      integer :: coarse_iterations = 0, convolutions = 0
       !> The contact pixels (row, column) and their forces (nN) at this load.
       integer, allocatable :: i(:), j(:)
       real(dp), allocatable :: force(:)
    end type load_state
 
-   !> Results of a run. Units: nN, nm, GPa.
+   !> Results of a run. Units: nN, nm, GPa. What continues a run (the history, the
+   !> states reached, the counters) is listed once in `visit_result` for checkpoints.
    type :: contact_result
       integer :: nsteps = 0
       !> Per step: contacts carrying load, total load and approach at the end of the step,
@@ -90,57 +74,55 @@ module femcod_contact_result
       real(dp) :: wall_seconds = 0
    end type contact_result
 
-   !> Everything the incremental solver needs to continue a run exactly where it was,
-   !> bit for bit: the contacts, the Cholesky factor and the vectors derived from it,
-   !> the candidate cache and the event heap, the accumulated load, approach and forces.
-   type :: solver_state
-      integer :: step = 0, n = 0
-      real(dp) :: total = 0, approach = 0, phi = 0
-      !> The current contacts: pixel (row-wise number), step joined, force (nN).
-      integer, allocatable :: pix(:), cstep(:)
-      real(dp), allocatable :: ftot(:)
-      !> Leading dimension of the factor's storage and the factor's upper triangle,
-      !> packed column by column; y = U^-T 1 and x = M^-1 1.
-      integer :: ld = 0
-      real(dp), allocatable :: factor(:), y(:), x(:)
-      !> Candidate cache: pixel per slot (0: empty), columns l and w (n x slots), the
-      !> predicted closing loads, contacts joined since the last refill.
-      integer, allocatable :: cache_pixel(:)
-      real(dp), allocatable :: cache_l(:, :), cache_w(:, :), predicted(:)
-      integer :: since_refill = 0
-      !> Exact evaluations of the last bound search (the event-search choice).
-      integer :: last_neval = 0
-      !> The event heap: keys and items in heap order.
-      real(dp), allocatable :: heap_key(:)
-      integer, allocatable :: heap_item(:)
-      !> The results so far (history, states reached, counters).
-      type(contact_result) :: res
-   end type solver_state
-
-   abstract interface
-      !> Called by a solver after every step, so that a program can report progress
-      !> (the solver itself does no I/O): step, contacts, total load (nN), elapsed (s).
-      subroutine progress_interface(step, contacts, load, elapsed)
-         import :: dp
-         integer, intent(in) :: step, contacts
-         real(dp), intent(in) :: load, elapsed
-      end subroutine progress_interface
-      !> Called by a solver every `checkpoint_interval` seconds with its complete state
-      !> at the end of a step; the program stores it (the solver does no I/O).
-      subroutine checkpoint_interface(state)
-         import :: solver_state
-         type(solver_state), intent(in) :: state
-      end subroutine checkpoint_interface
-   end interface
-
 contains
 
-   !> Append one history row: contacts carrying load, how many of them press harder
-   !> than the hardness, total load (nN), approach (nm), seconds the step took.
-   pure subroutine append_step(res, contacts, above_hardness, load, approach, seconds)
+   !> The fields that continue an event-path run (femcod_state_visitor): the history,
+   !> the requested load states (reached or not), the counters. The timing and the
+   !> final checks are not kept: they belong to the run that finishes.
+   subroutine visit_result(self, visitor)
+      type(contact_result), intent(inout) :: self
+      class(state_visitor), intent(inout) :: visitor
+      integer :: k, m
+      call visitor%group("history")
+      call visitor%integer_value("steps", self%nsteps)
+      m = self%nsteps
+      call grow_history(self, m)
+      call visitor%integer_prefix("contacts", self%step_contacts, m)
+      call visitor%integer_prefix("above_hardness", self%step_above_hardness, m)
+      call visitor%real_prefix("load", self%step_load, m)
+      call visitor%real_prefix("approach", self%step_approach, m)
+      call visitor%real_prefix("seconds", self%step_seconds, m)
+      do k = 1, size(self%states)
+         call visitor%group("states/"//int_str(k))
+         associate(s => self%states(k))
+            call visitor%logical_value("reached", s%reached)
+            call visitor%real_value("load", s%load)
+            call visitor%real_value("approach", s%approach)
+            call visitor%integer_value("contacts", s%contacts)
+            call visitor%real_value("max_pressure", s%max_pressure)
+            call visitor%integer_value("n_above_hardness", s%n_above_hardness)
+            if (.not. allocated(s%i)) allocate(s%i(0), s%j(0), s%force(0))
+            call visitor%integer_array("i", s%i)
+            call visitor%integer_array("j", s%j)
+            call visitor%real_array("force", s%force)
+         end associate
+      end do
+      call visitor%group("counters")
+      call visitor%integer_value("missed_during_run", self%missed_during_run)
+      call visitor%integer_value("releases", self%releases)
+      call visitor%long_value("evaluations", self%evaluations)
+      call visitor%integer_value("cache_hits", self%cache_hits)
+      call visitor%integer_value("cache_misses", self%cache_misses)
+      call visitor%integer_value("cache_refills", self%cache_refills)
+      call visitor%integer_value("cache_columns", self%cache_columns)
+      call visitor%integer_value("fft_steps", self%fft_steps)
+   end subroutine visit_result
+
+   !> Room for at least `m` history rows: 64 at first, doubled as needed (amortised O(1)
+   !> per appended row).
+   pure subroutine grow_history(res, m)
       type(contact_result), intent(inout) :: res
-      integer, intent(in) :: contacts, above_hardness
-      real(dp), intent(in) :: load, approach, seconds
+      integer, intent(in) :: m
       integer, allocatable :: itmp(:)
       real(dp), allocatable :: rtmp(:)
       integer :: cap
@@ -148,8 +130,8 @@ contains
          allocate(res%step_contacts(64), res%step_above_hardness(64), res%step_load(64), res%step_approach(64), &
             res%step_seconds(64))
       end if
-      cap = size(res%step_contacts)
-      if (res%nsteps == cap) then
+      do while (size(res%step_contacts) < m)
+         cap = size(res%step_contacts)
          allocate(itmp(2*cap))
          itmp(1:cap) = res%step_contacts
          call move_alloc(itmp, res%step_contacts)
@@ -165,7 +147,16 @@ contains
          allocate(rtmp(2*cap))
          rtmp(1:cap) = res%step_seconds
          call move_alloc(rtmp, res%step_seconds)
-      end if
+      end do
+   end subroutine grow_history
+
+   !> Append one history row: contacts carrying load, how many of them press harder
+   !> than the hardness, total load (nN), approach (nm), seconds the step took.
+   pure subroutine append_step(res, contacts, above_hardness, load, approach, seconds)
+      type(contact_result), intent(inout) :: res
+      integer, intent(in) :: contacts, above_hardness
+      real(dp), intent(in) :: load, approach, seconds
+      call grow_history(res, res%nsteps + 1)
       res%nsteps = res%nsteps + 1
       res%step_contacts(res%nsteps) = contacts
       res%step_above_hardness(res%nsteps) = above_hardness

@@ -7,7 +7,7 @@
 !> Keer (Wear 231, 1999, 206-219). I * F is a zero-padded (2NP)^2 FFT convolution (FFTW,
 !> plans made once, femcod_convolution).
 !>
-!> What makes it fast without changing the answer (each can be switched off, cg_method):
+!> What makes it fast without changing the answer (each can be switched off, cg_settings):
 !> - Nested grids: the first load starts from the solution on grids of NP/2, NP/4, ...
 !>   (2 x 2 averages of the gaps, twice the pixel, the same total load), each solved to a
 !>   loose tolerance and handed down with every coarse force split equally over its four
@@ -53,11 +53,14 @@ module femcod_cg
    use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
-   use femcod_contact_result, only: contact_result, contact_options, append_step, STOP_LOADS
+   use femcod_contact_result, only: contact_result, append_step, STOP_LOADS
+   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_observer, only: solver_observer
+   use femcod_strings, only: int_str, real_str, format_real
    use femcod_clock, only: wall_clock
    implicit none
    private
-   public :: solve_cg, cg_residuals, cg_method
+   public :: solve_cg
 
    !> What the CG solver reached at one load.
    type :: cg_residuals
@@ -69,39 +72,6 @@ module femcod_cg
       integer :: convolutions = 0
       real(dp) :: penetration = 0, contact_gap = 0, load_error = 0, residual = 0
    end type cg_residuals
-
-   !> How the solver accelerates (defaults: all on).
-   type :: cg_method
-      !> Start the first load from nested coarser grids (down to `coarsest` pixels a side).
-      logical :: nested = .true.
-      integer :: coarsest = 64
-      !> Relative residual to which the coarser grids are solved.
-      real(dp) :: coarse_tol = 1.0e-4_dp
-      !> float32 transforms while the residual is above this (0: never).
-      real(dp) :: single_until = 1.0e-5_dp
-      !> Precondition the search direction with the 13-point stencil of the inverse Love
-      !> operator (a discrete |q|), applied on the contact set.
-      logical :: precondition = .true.
-      !> Restart the conjugate directions (beta = 0) after overlapping pixels enter the
-      !> contact, as Polonsky and Keer do (off: keep them; at NP = 2048 on: 97 instead of
-      !> 43 iterations at 1 %, 302 instead of 69 at 10 %, doc/performance.md).
-      logical :: restart_on_entry = .false.
-      !> beta by Polak-Ribiere, clipped at 0 (PR+: z.(g - g_old)/(z_old.g_old)), which
-      !> restarts by itself when the contact set has moved the gradient; off: Fletcher-
-      !> Reeves (z.g/(z_old.g_old)), as Polonsky and Keer.
-      logical :: polak_ribiere = .true.
-      !> Powell's restart (1977): beta = 0 when successive gradients are far from
-      !> orthogonal, |z.g_old| >= powell_restart * z.g (z the preconditioned gradient);
-      !> 0: never. It stops the contact set's swings after the coarse start on large grids
-      !> (NP = 4096, 10 %: 99 instead of 141 iterations, doc/performance.md).
-      real(dp) :: powell_restart = 0.2_dp
-      !> Largest number of projection changes corrected directly (0: a fresh convolution
-      !> every iteration, i.e. two per iteration as in Polonsky and Keer).
-      integer :: direct_corrections = 32
-      !> Let FFTW time its plans (FFTW_MEASURE) instead of estimating them; worth it
-      !> with a wisdom file (`femcod run --fftw-wisdom`), which keeps the plans.
-      logical :: measure_plans = .false.
-   end type cg_method
 
    !> One grid of the problem: gaps (nm), pixel (nm), compliance c (nm/nN) and spring
    !> compliance s (nm/nN), the Love table and its convolution.
@@ -118,24 +88,23 @@ module femcod_cg
 contains
 
    !> Solve at every requested load (ascending order of computation; results in the
-   !> order given). `report(k)` holds the residuals at load k.
-   subroutine solve_cg(problem, options, tol, max_iterations, res, report, status, method)
+   !> order given, with the residuals reached in each load state). A load whose residual
+   !> stays above options%cg%tol after options%cg%max_iterations is a numerical failure.
+   subroutine solve_cg(problem, options, res, status, observer)
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
-      real(dp), intent(in) :: tol
-      integer, intent(in) :: max_iterations
       type(contact_result), intent(out) :: res
-      type(cg_residuals), allocatable, intent(out) :: report(:)
       type(status_type), intent(inout) :: status
-      type(cg_method), intent(in), optional :: method
-      type(cg_method) :: how
+      !> Told of every load solved (progress).
+      class(solver_observer), intent(inout) :: observer
+      type(cg_residuals), allocatable :: report(:)
       type(cg_grid) :: fine
       real(dp), allocatable :: p(:, :)
       integer, allocatable :: order(:)
       real(dp) :: load, tstart, t0, t1, approach
       integer :: np, k, kk, m, i, j, nc
       call wall_clock(tstart)
-      if (present(method)) how = method
+      associate(how => options%cg, tol => options%cg%tol, max_iterations => options%cg%max_iterations)
       np = problem%np
       m = size(options%loads)
       allocate(report(m), res%states(m))
@@ -187,6 +156,8 @@ contains
             st%penetration = report(k)%penetration
             st%contact_gap = report(k)%contact_gap
             st%load_error = report(k)%load_error
+            st%coarse_iterations = report(k)%coarse_iterations
+            st%convolutions = report(k)%convolutions
             st%contacts = count(p > 0)
             st%max_pressure = maxval(p)/problem%pixel**2
             st%n_above_hardness = count(p/problem%pixel**2 > options%hardness)
@@ -203,6 +174,7 @@ contains
                end do
             end do
             call append_step(res, st%contacts, st%n_above_hardness, load, st%approach, t1 - t0)
+            call observer%progress(kk, st%contacts, load, t1 - tstart)
             if (load == maxval(options%loads)) then
                res%contact_i = st%i
                res%contact_j = st%j
@@ -216,6 +188,16 @@ contains
       res%stop_reason = STOP_LOADS
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
+      if (status%code /= 0) return
+      do k = 1, m
+         if (report(k)%residual > tol) then
+            call set_error(status, STATUS_NUMERICAL, "cg: load "//format_real(options%loads(k))//" nN: residual "// &
+               real_str(report(k)%residual, 2)//" after "//int_str(report(k)%iterations)// &
+               " iterations, above --tol "//real_str(tol, 2)//" (raise --max-iterations)")
+            return
+         end if
+      end do
+      end associate
    end subroutine solve_cg
 
    !> A grid for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's materials.
@@ -224,7 +206,7 @@ contains
       real(dp), intent(in) :: g0(:, :)
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: pixel
-      type(cg_method), intent(in) :: how
+      type(cg_settings), intent(in) :: how
       grid%np = size(g0, 1)
       grid%pixel = pixel
       grid%g0 = g0
@@ -259,7 +241,7 @@ contains
       type(cg_grid), intent(in) :: grid
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: total_load
-      type(cg_method), intent(in) :: how
+      type(cg_settings), intent(in) :: how
       real(dp), intent(out) :: p(:, :)
       type(cg_residuals), intent(inout) :: rep
       type(status_type), intent(inout) :: status
@@ -297,7 +279,7 @@ contains
       type(cg_grid), intent(inout) :: grid
       real(dp), intent(in) :: total_load, tol
       integer, intent(in) :: max_iterations
-      type(cg_method), intent(in) :: how
+      type(cg_settings), intent(in) :: how
       real(dp), intent(inout) :: p(:, :)
       real(dp), intent(out) :: approach
       type(cg_residuals), intent(inout) :: rep

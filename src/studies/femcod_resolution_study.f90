@@ -10,8 +10,10 @@ module femcod_resolution_study
    use femcod_scene, only: initial_gaps, flip_upper
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
-   use femcod_contact_result, only: contact_result, contact_options, progress_interface
-   use femcod_incremental, only: solve_incremental
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options
+   use femcod_observer, only: solver_observer
+   use femcod_solver, only: solve_contact
    use femcod_richardson, only: power_law_fit
    use femcod_resolution, only: uncoupled_curve, mccool_parameters, mccool_surface, mccool_area, &
       richardson_area, composite_modulus
@@ -91,14 +93,15 @@ contains
    end subroutine level_deck
 
    !> Solve one level and compute its estimates.
-   subroutine solve_level(deck, np, method, hardness, level, status, progress)
+   subroutine solve_level(deck, np, method, hardness, level, status, observer)
       type(contact_problem), intent(in) :: deck
       integer, intent(in) :: np
       character(len=*), intent(in) :: method
       real(dp), intent(in) :: hardness
       type(resolution_level), intent(out) :: level
       type(status_type), intent(inout) :: status
-      procedure(progress_interface), optional :: progress
+      !> Told of the solve's progress.
+      class(solver_observer), intent(inout), optional :: observer
       type(contact_problem) :: d
       type(contact_options) :: options
       real(dp), allocatable :: load(:), area(:), composite(:, :)
@@ -110,7 +113,7 @@ contains
       level%pixel = d%pixel
       options%hardness = hardness
       allocate(options%loads(0))
-      call solve_incremental(d, options, level%res, status, progress)
+      call solve_contact(d, options, level%res, status, observer)
       if (status%code /= 0) return
       n = level%res%nsteps
       load = level%res%step_load(1:n)

@@ -7,8 +7,14 @@ module femcod_verification
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, format_real
-   use femcod_contact_result, only: contact_result, contact_options
-   use femcod_legacy, only: solve_legacy
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options
+   use femcod_solver, only: solve_contact
+   use femcod_thesis, only: TABLE_4_1_DECKS, TABLE_4_1_PIXELS, TABLE_4_1_MESH, TABLE_4_1_APPROACH, &
+      TABLE_4_1_CENTRE_PRESSURE, TABLE_4_1_RATE, TABLE_4_1_ANALYTIC_APPROACH, TABLE_4_2_DECKS, TABLE_4_2_APPROACH, &
+      TABLE_4_2_CENTRE_OVER_MEAN, TABLE_4_2_RATE_13, TABLE_4_2_RATE_24, TABLE_4_2_EXTRAPOLATED_APPROACH, &
+      TABLE_4_2_EXTRAPOLATED_RATIO, BORODACHEV_APPROACH, BORODACHEV_RATIO, SPHERE_FIT_EXPONENT, PIXEL_COMPLIANCE, &
+      FIG_5_2_PERCENT, FIG_5_2_PERMILLE
    use femcod_love, only: love_influence, love_influence_exact, love_influence_far, surface_compliance
    use femcod_richardson, only: convergence_rate, convergence_rate_known_limit, richardson_extrapolate, power_law_fit
    use femcod_files, only: commit_file, temporary_name
@@ -32,16 +38,12 @@ contains
       real(dp) :: p13, p24, ext, extr, delta0, rc, pc_known, pc_three, pc_thesis_three
       real(dp) :: estar, hertz, segedin, aseg, expo, pref, c
       type(contact_result) :: res
-      character(len=*), parameter :: circle(3) = [character(len=15) :: "circle_punch_d1", "circle_punch_d3", &
-         "circle_punch_d9"]
-      character(len=*), parameter :: square(4) = [character(len=16) :: "square_punch_n1", "square_punch_n3", &
-         "square_punch_n9", "square_punch_n27"]
-      real(dp), parameter :: th_circ_a(3) = [0.955_dp, 0.920_dp, 0.911_dp], th_circ_p(3) = [0.0261_dp, 0.0245_dp, &
-         0.0240_dp]
-      real(dp), parameter :: th_sq_a(4) = [0.526_dp, 0.451_dp, 0.422_dp, 0.412_dp], th_sq_r(4) = [1.0_dp, 0.511_dp, &
-         0.519_dp, 0.498_dp]
-      integer, parameter :: circle_pixels(3) = [21, 189, 1701], offsets(5) = [5, 10, 20, 40, 283]
-      character(len=*), parameter :: circle_d(3) = [character(len=3) :: "1", "1/3", "1/9"]
+      ! The thesis' values (femcod_thesis), approaches in units of 1e-3 nm as it prints them.
+      character(len=*), parameter :: circle(3) = TABLE_4_1_DECKS, square(4) = TABLE_4_2_DECKS
+      real(dp), parameter :: th_circ_a(3) = TABLE_4_1_APPROACH*1e3_dp, th_circ_p(3) = TABLE_4_1_CENTRE_PRESSURE
+      real(dp), parameter :: th_sq_a(4) = TABLE_4_2_APPROACH*1e3_dp, th_sq_r(4) = TABLE_4_2_CENTRE_OVER_MEAN
+      integer, parameter :: circle_pixels(3) = TABLE_4_1_PIXELS, offsets(5) = [5, 10, 20, 40, FIG_5_2_PERMILLE]
+      character(len=*), parameter :: circle_d(3) = TABLE_4_1_MESH
       real(dp), allocatable :: area(:), load(:)
       real(dp) :: worst
 
@@ -90,10 +92,12 @@ contains
       delta0 = flat_punch_approach(1.0_dp, rc, 200.0_dp, 0.25_dp)
       pc_known = convergence_rate_known_limit(acirc(1), acirc(2), delta0, 3.0_dp)
       pc_three = convergence_rate(acirc(1), acirc(2), acirc(3), 3.0_dp)
-      pc_thesis_three = convergence_rate(0.955_dp, 0.920_dp, 0.911_dp, 3.0_dp)
+      pc_thesis_three = convergence_rate(th_circ_a(1), th_circ_a(2), th_circ_a(3), 3.0_dp)
       write(u, '(a)') "", "Analytic displacement (eq. 4.10) with the radius of the discretised area, R = sqrt(21/pi) = "// &
-         fmt(rc, 5)//" nm: "//fmt(delta0*1e3_dp, 5)//"e-3 nm (the thesis quotes 0.907e-3).", "", &
-         "Richardson rate for the circle (the thesis gives 1.15 for displacements): with the analytic", &
+         fmt(rc, 5)//" nm: "//fmt(delta0*1e3_dp, 5)//"e-3 nm (the thesis quotes "// &
+         fmt(TABLE_4_1_ANALYTIC_APPROACH*1e3_dp, 3)//"e-3).", "", &
+         "Richardson rate for the circle (the thesis gives "//fmt(TABLE_4_1_RATE, 3)// &
+         " for displacements): with the analytic", &
          "limit and the two coarsest meshes femcod gives "//fmt(pc_known, 3)//", which reproduces it. From three", &
          "meshes femcod gives "//fmt(pc_three, 3)//"; the thesis' own rounded table gives "//fmt(pc_thesis_three, 3)// &
          " the same way, because rounding", "to three digits moves a three-mesh rate by several percent.", ""
@@ -112,11 +116,13 @@ contains
       ext = richardson_extrapolate(a(3), a(4), 3.0_dp, p24)
       extr = richardson_extrapolate(ratio(3), ratio(4), 3.0_dp, p24)
       write(u, '(a)') "", "| Richardson (section 4.4.2) | thesis | femcod |", "|---|---|---|", &
-         "| rate, meshes 1-3 | 0.874 | "//fmt(p13, 4)//" |", &
-         "| rate, meshes 2-4 | 0.973 | "//fmt(p24, 4)//" |", &
-         "| extrapolated approach (1e-3 nm) | 0.407 | "//fmt(ext*1e3_dp, 5)//" |", &
-         "| extrapolated centre/mean pressure | 0.486 | "//fmt(extr, 5)//" |", &
-         "| Borodachev's approximate solution | 0.400 / 0.456 | (an approximation, not the limit of this model) |", ""
+         "| rate, meshes 1-3 | "//fmt(TABLE_4_2_RATE_13, 3)//" | "//fmt(p13, 4)//" |", &
+         "| rate, meshes 2-4 | "//fmt(TABLE_4_2_RATE_24, 3)//" | "//fmt(p24, 4)//" |", &
+         "| extrapolated approach (1e-3 nm) | "//fmt(TABLE_4_2_EXTRAPOLATED_APPROACH*1e3_dp, 3)//" | "// &
+         fmt(ext*1e3_dp, 5)//" |", &
+         "| extrapolated centre/mean pressure | "//fmt(TABLE_4_2_EXTRAPOLATED_RATIO, 3)//" | "//fmt(extr, 5)//" |", &
+         "| Borodachev's approximate solution | "//fmt(BORODACHEV_APPROACH*1e3_dp, 3)//" / "// &
+         fmt(BORODACHEV_RATIO, 3)//" | (an approximation, not the limit of this model) |", ""
 
       estar = 200/(1 - 0.25_dp**2)
       hertz = hertz_approach(1000.0_dp, 15.0_dp, estar)
@@ -135,18 +141,22 @@ contains
          "the contact radius is a = "//fmt(aseg, 4)//" nm. Run: "//int_str(res%nsteps)//" steps, "// &
          int_str(res%step_contacts(res%nsteps))//" contacts, "//secs(res%wall_seconds)//".", "", &
          "Power-law fit A = c F^m over every step of this run (0 to 18000 nN): m = "//fmt(expo, 4)// &
-         ". The thesis reports 0.68 for", "its fit 'in the full range shown'; the exponent depends on the fitted range and on", &
-         "how the staircase of Fig. 4.16b is sampled (femcod fits every step end), so 0.68 is not reproduced", &
+         ". The thesis reports "//fmt(SPHERE_FIT_EXPONENT, 2)//" for", &
+         "its fit 'in the full range shown'; the exponent depends on the fitted range and on", &
+         "how the staircase of Fig. 4.16b is sampled (femcod fits every step end), so "// &
+         fmt(SPHERE_FIT_EXPONENT, 2)//" is not reproduced", &
          "to its digits; Hertz gives 2/3 and the exact rigid sphere bends the curve upward at large loads.", ""
 
       c = surface_compliance(200.0_dp, 0.25_dp, 5000.0_dp/512)*love_influence(0, 0)
       i0 = 0
       write(u, '(a)') "## Boussinesq element (section 4.2.1, section 4.5, Fig. 5.2)", "", &
          "| check | thesis | femcod |", "|---|---|---|", &
-         "| single-pixel compliance, E = 200 GPa, nu = 0.25, d = 5000/512 nm (nm/nN) | 5.39e-4 | "// &
-         fmt(c*1e4_dp, 5)//"e-4 |", &
-         "| first pixel where u(n d, 0)/u(0,0) < 1/100 | between 28 and 29 | "//int_str(crossing(100.0_dp))//" |", &
-         "| first pixel where u(n d, 0)/u(0,0) < 1/1000 | between 283 and 284 | "//int_str(crossing(1000.0_dp))//" |", &
+         "| single-pixel compliance, E = 200 GPa, nu = 0.25, d = 5000/512 nm (nm/nN) | "// &
+         fmt(PIXEL_COMPLIANCE*1e4_dp, 3)//"e-4 | "//fmt(c*1e4_dp, 5)//"e-4 |", &
+         "| first pixel where u(n d, 0)/u(0,0) < 1/100 | between "//int_str(FIG_5_2_PERCENT)//" and "// &
+         int_str(FIG_5_2_PERCENT + 1)//" | "//int_str(crossing(100.0_dp))//" |", &
+         "| first pixel where u(n d, 0)/u(0,0) < 1/1000 | between "//int_str(FIG_5_2_PERMILLE)//" and "// &
+         int_str(FIG_5_2_PERMILLE + 1)//" | "//int_str(crossing(1000.0_dp))//" |", &
          "", "The four-corner sum of eq. 4.4 cancels at large offsets; femcod switches to the far-field expansion", &
          "(femcod_boussinesq) beyond 20 pixels. Relative difference between the two:", "", &
          "| offset (pixels) | exact four-corner sum | far-field expansion | relative difference |", "|---|---|---|---|"
@@ -175,7 +185,8 @@ contains
          call read_deck("input/"//name//".deck", deck, status)
          if (status%code /= 0) return
          options%loads = loads
-         call solve_legacy(deck, options, res, status)
+         options%solver = "legacy"
+         call solve_contact(deck, options, res, status)
          if (status%code /= 0) return
          first = res%states(1)%approach
          second = -1

@@ -1,13 +1,13 @@
 !> `femcod stability`: run the hard cases of femcod_stability and write
 !> doc/stability.md (atomically), every number measured by this run.
-module femcod_stability_report
+module stability_report
    use, intrinsic :: iso_fortran_env, only: output_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_files, only: commit_file, temporary_name
    use femcod_strings, only: int_str, real_str
    use femcod_problem, only: contact_problem
-   use femcod_stability, only: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, &
+   use stability_cases, only: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, &
       single_pixel, first_spike_event, identical_surfaces, height_offset, length_scaling, poisson_limit, &
       love_precision, solve_precision, long_run_drift, STIFFNESS_RATIOS, INCOMPRESSIBLE_GAP
    implicit none
@@ -218,4 +218,4 @@ contains
       write(buf, '(es9.1e3)') v
       s = trim(adjustl(buf))
    end function sci
-end module femcod_stability_report
+end module stability_report

@@ -2,15 +2,15 @@
 !> runs the solvers and returns the measured error against an expected value from
 !> analysis or an independent computation. The test suite asserts bounds on these
 !> numbers; `femcod stability` tabulates them. No I/O here.
-module femcod_stability
+module stability_cases
    use, intrinsic :: iso_fortran_env, only: real128
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem, verification_spec
-   use femcod_contact_result, only: contact_result, contact_options
-   use femcod_legacy, only: solve_legacy
-   use femcod_incremental, only: solve_incremental
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options
+   use femcod_solver, only: solve_contact
    use femcod_condensed, only: solve_active_set
    use femcod_love, only: offset_table, surface_compliance, love_influence, love_influence_exact, &
       love_influence_far
@@ -49,11 +49,8 @@ contains
       type(contact_options) :: options
       options%loads = loads
       if (present(max_contacts)) options%max_contacts = max_contacts
-      if (solver == "legacy") then
-         call solve_legacy(deck, options, res, status)
-      else
-         call solve_incremental(deck, options, res, status)
-      end if
+      options%solver = solver
+      call solve_contact(deck, options, res, status)
    end subroutine solve
 
    !> The rigid sphere of Fig. 4.15 at d = 2 nm (input/sphere_d2.deck) with the contact
@@ -564,4 +561,4 @@ contains
       steps = res%nsteps
       seconds = res%wall_seconds
    end subroutine long_run_drift
-end module femcod_stability
+end module stability_cases

@@ -1,0 +1,40 @@
+!> How a solver reports while it runs, without doing I/O itself: it calls the
+!> type-bound procedures of an observer object, which carries its own context (where
+!> to write a checkpoint, when it last printed a progress line). The base type does
+!> nothing; a program extends it (cli/femcod_run's run_observer, the studies' progress).
+module femcod_observer
+   use femcod_kinds, only: dp
+   use femcod_problem, only: contact_problem
+   use femcod_solver_options, only: contact_options
+   use femcod_state_visitor, only: visitable
+   implicit none
+   private
+   public :: solver_observer
+
+   !> An observer that ignores everything: the default of every solver.
+   type :: solver_observer
+   contains
+      !> After every step of an event path (or every load of the cg solver).
+      procedure :: progress => ignore_progress
+      !> Every options%checkpoint_interval seconds, with the solver's complete state.
+      procedure :: checkpoint => ignore_checkpoint
+   end type solver_observer
+
+contains
+
+   !> step, contacts carrying load, total load (nN) and seconds since the solve began.
+   subroutine ignore_progress(self, step, contacts, load, elapsed)
+      class(solver_observer), intent(inout) :: self
+      integer, intent(in) :: step, contacts
+      real(dp), intent(in) :: load, elapsed
+   end subroutine ignore_progress
+
+   !> The state that continues the run exactly where it is, with the problem and the
+   !> options it belongs to (a checkpoint stores all three).
+   subroutine ignore_checkpoint(self, problem, options, state)
+      class(solver_observer), intent(inout) :: self
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      class(visitable), intent(inout) :: state
+   end subroutine ignore_checkpoint
+end module femcod_observer

@@ -1,0 +1,77 @@
+!> What a run asks of a solver: the options every solver takes, and each solver's own
+!> (the incremental solver's event search, the cg solver's tolerance and accelerations).
+!> `femcod run` fills one `contact_options` from its command line; solvers/femcod_solver
+!> dispatches on `solver`.
+module femcod_solver_options
+   use femcod_kinds, only: dp
+   implicit none
+   private
+   public :: contact_options, cg_settings, SOLVER_NAMES
+
+   !> The solvers by name: the event-exact incremental solver, the Appendix B program,
+   !> and the fixed-load constrained conjugate gradients.
+   character(len=*), parameter :: SOLVER_NAMES(3) = [character(len=11) :: "incremental", "legacy", "cg"]
+
+   !> The cg solver's own options (solvers/femcod_cg). The accelerations default to on;
+   !> each can be switched off.
+   type :: cg_settings
+      !> Stop when the relative complementarity residual (the largest gap violation over
+      !> the height range) is below `tol`, or after `max_iterations` on the finest grid.
+      real(dp) :: tol = 1.0e-8_dp
+      integer :: max_iterations = 2000
+      !> Start the first load from nested coarser grids (down to `coarsest` pixels a side).
+      logical :: nested = .true.
+      integer :: coarsest = 64
+      !> Relative residual to which the coarser grids are solved.
+      real(dp) :: coarse_tol = 1.0e-4_dp
+      !> float32 transforms while the residual is above this (0: never).
+      real(dp) :: single_until = 1.0e-5_dp
+      !> Precondition the search direction with the 13-point stencil of the inverse Love
+      !> operator (a discrete |q|), applied on the contact set.
+      logical :: precondition = .true.
+      !> Restart the conjugate directions (beta = 0) after overlapping pixels enter the
+      !> contact, as Polonsky and Keer do (off: keep them; at NP = 2048 on: 97 instead of
+      !> 43 iterations at 1 %, 302 instead of 69 at 10 %, doc/performance.md).
+      logical :: restart_on_entry = .false.
+      !> beta by Polak-Ribiere, clipped at 0 (PR+: z.(g - g_old)/(z_old.g_old)), which
+      !> restarts by itself when the contact set has moved the gradient; off: Fletcher-
+      !> Reeves (z.g/(z_old.g_old)), as Polonsky and Keer.
+      logical :: polak_ribiere = .true.
+      !> Powell's restart (1977): beta = 0 when successive gradients are far from
+      !> orthogonal, |z.g_old| >= powell_restart * z.g (z the preconditioned gradient);
+      !> 0: never. It stops the contact set's swings after the coarse start on large grids
+      !> (NP = 4096, 10 %: 99 instead of 141 iterations, doc/performance.md).
+      real(dp) :: powell_restart = 0.2_dp
+      !> Largest number of projection changes corrected directly (0: a fresh convolution
+      !> every iteration, i.e. two per iteration as in Polonsky and Keer).
+      integer :: direct_corrections = 32
+      !> Let FFTW time its plans (FFTW_MEASURE) instead of estimating them; worth it
+      !> with a wisdom file (`femcod run --fftw-wisdom`), which keeps the plans.
+      logical :: measure_plans = .false.
+   end type cg_settings
+
+   !> The options of a run. Units: nN, GPa, s.
+   type :: contact_options
+      !> One of SOLVER_NAMES.
+      character(len=11) :: solver = "incremental"
+      !> Stop after this many contacts (0: the deck's MAXCONT; the event solvers only).
+      integer :: max_contacts = 0
+      !> Requested total loads (nN); empty: the event solvers run to MAXCONT.
+      real(dp), allocatable :: loads(:)
+      !> Hardness (GPa) for the count of pixels above it (thesis polysilicon: 11 GPa).
+      real(dp) :: hardness = 11
+      !> Candidates whose closing load is within this fraction of the total load of the
+      !> smallest one join in the same step (ties).
+      real(dp) :: tie_tolerance = 1.0e-9_dp
+      !> Check every pixel for penetration at the end, and correct (Appendix B).
+      logical :: final_check = .true.
+      !> Hand the solver state to the observer's checkpoint procedure every this many
+      !> seconds of wall time (0: after every step; negative: never). Incremental solver.
+      real(dp) :: checkpoint_interval = -1
+      !> Incremental solver: how the next event is found: "auto" (the cheaper of the two
+      !> by a cost model), "bound" (gap bound and exact evaluations) or "fft" (full field).
+      character(len=5) :: event_search = "auto"
+      !> The cg solver's own options.
+      type(cg_settings) :: cg
+   end type contact_options
+end module femcod_solver_options

@@ -1,0 +1,232 @@
+!> The event search of the incremental solver: the smallest load increment at which a
+!> pixel closes or a contact force reaches zero, and every pixel tied with it, found
+!> exactly.
+!>
+!> Releases: contact k releases at ftot_k / (-funit_k) when funit_k < 0.
+!> Closing events, by one of two searches:
+!> - the gap bound: every pixel not in contact sits in a heap keyed by a lower bound on
+!>   its gap. Since F >= 0, a gap never shrinks faster than delta_max per unit load
+!>   (femcod_incremental_state%unit_load), so a pixel whose bound exceeds
+!>   lambda_best * delta_max cannot close before the best candidate: only the pixels that
+!>   can are popped and evaluated exactly (O(n) each);
+!> - the full field: gaps and closing rates of every pixel from two zero-padded FFT
+!>   convolutions; every pixel within the FFT's error bound of the smallest closing load
+!>   is then evaluated exactly.
+!> "auto" chooses the cheaper from a cost model of both that depends on the state only,
+!> so runs and restarts repeat bit for bit.
+module femcod_event_search
+   use femcod_kinds, only: dp
+   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
+   use femcod_heap, only: heap_pop, heap_push, heap_top_key
+   use femcod_sort, only: merge_sort_index
+   use femcod_solver_options, only: contact_options
+   use femcod_incremental_state, only: incremental_state
+   implicit none
+   private
+   public :: event_search
+
+   !> One step's search and what it found; the FFT plans and fields are made on the
+   !> first full-field search and kept for the run.
+   type :: event_search
+      !> Pixels evaluated exactly this step, with their gaps (nm) and closing loads (nN).
+      integer :: neval = 0
+      integer, allocatable :: eval_pix(:)
+      real(dp), allocatable :: gap_eval(:), lam_eval(:)
+      !> The smallest load increment of any event (huge: none), the smallest of the
+      !> releases and the contact it releases (0: none).
+      real(dp) :: lam_best = 0, lam_release = 0
+      integer :: krel = 0
+      !> The pixels that close at lam_best (ties within the tie tolerance), in pixel order.
+      integer :: njoin = 0
+      integer, allocatable :: joiners(:)
+      !> Whether this step searched the full field.
+      logical :: used_fft = .false.
+      type(love_convolution) :: conv
+      real(dp), allocatable :: field_f(:, :), field_u(:, :), disp_f(:, :), disp_u(:, :)
+   contains
+      procedure :: next_event
+      procedure :: free
+   end type event_search
+
+contains
+
+   !> Find the next event of `state` (its unit-load solution current). The pixels the
+   !> bound search evaluated but that do not join go back into the heap with their exact
+   !> gaps as bounds.
+   subroutine next_event(search, state, options)
+      class(event_search), intent(inout) :: search
+      type(incremental_state), intent(inout) :: state
+      type(contact_options), intent(in) :: options
+      integer, allocatable :: order(:)
+      real(dp) :: tie, bound, key
+      integer :: k, p, q
+      if (.not. allocated(search%eval_pix)) then
+         allocate(search%eval_pix(state%npix), search%gap_eval(state%npix), search%lam_eval(state%npix), &
+            search%joiners(state%npix))
+      end if
+      associate(n => state%n, total => state%path%total)
+         ! Releases: a contact force reaching zero.
+         search%lam_release = huge(1.0_dp)
+         search%krel = 0
+         do k = 1, n
+            if (state%funit(k) < 0) then
+               if (state%ftot(k)/(-state%funit(k)) < search%lam_release) then
+                  search%lam_release = state%ftot(k)/(-state%funit(k))
+                  search%krel = k
+               end if
+            end if
+         end do
+
+         ! Closing events.
+         search%lam_best = search%lam_release
+         search%neval = 0
+         search%used_fft = choose_fft(state, options)
+         if (search%used_fft) then
+            call fft_search(search, state, options)
+            state%res%fft_steps = state%res%fft_steps + 1
+         else
+            do
+               tie = options%tie_tolerance*(total + max(search%lam_best, 0.0_dp))
+               if (search%lam_best < huge(1.0_dp)) then
+                  bound = (search%lam_best + tie)*state%delta_max
+               else
+                  bound = huge(1.0_dp)
+               end if
+               if (state%heap%size == 0) exit
+               if (heap_top_key(state%heap) - state%phi > bound) exit
+               call heap_pop(state%heap, key, p)
+               if (state%slot(p) /= 0) cycle
+               call record_evaluation(search, state, p)
+               if (search%neval == state%npix) exit
+            end do
+            state%last_neval = search%neval
+         end if
+
+         ! The pixels that close at the smallest load (within the tie tolerance of the
+         ! total load) join; the bound search's others go back into the heap.
+         tie = options%tie_tolerance*(total + max(search%lam_best, 0.0_dp))
+         search%njoin = 0
+         do q = 1, search%neval
+            if (search%lam_eval(q) <= search%lam_best + tie .and. search%lam_eval(q) < huge(1.0_dp)) then
+               search%njoin = search%njoin + 1
+               search%joiners(search%njoin) = search%eval_pix(q)
+            else if (.not. search%used_fft) then
+               ! The FFT search pops nothing: the heap's bounds stay valid as they are.
+               call heap_push(state%heap, search%gap_eval(q) + state%phi, search%eval_pix(q))
+            end if
+         end do
+         if (search%njoin > 1) then
+            ! Tied contacts join in pixel order, so that the factor (and every result bit)
+            ! does not depend on the order the heap handed them out.
+            allocate(order(search%njoin))
+            call merge_sort_index(real(search%joiners(1:search%njoin), dp), order)
+            search%joiners(1:search%njoin) = search%joiners(order)
+         end if
+         state%res%missed_during_run = state%res%missed_during_run + &
+            count(search%gap_eval(1:search%neval) < -options%tie_tolerance*state%path%approach)
+      end associate
+   end subroutine next_event
+
+   !> Evaluate a pixel exactly and record it for this step's event: its gap, the load
+   !> increment that closes it, the best so far, and its predicted closing load (for the
+   !> candidate cache).
+   subroutine record_evaluation(search, state, pixel)
+      type(event_search), intent(inout) :: search
+      type(incremental_state), intent(inout) :: state
+      integer, intent(in) :: pixel
+      real(dp) :: gp, rp
+      call state%evaluate(pixel, gp, rp)
+      state%res%evaluations = state%res%evaluations + 1
+      search%neval = search%neval + 1
+      associate(q => search%neval)
+         search%eval_pix(q) = pixel
+         search%gap_eval(q) = gp
+         if (gp <= 0) then
+            search%lam_eval(q) = 0
+         else if (rp > 0) then
+            search%lam_eval(q) = gp/rp
+         else
+            search%lam_eval(q) = huge(1.0_dp)
+         end if
+         search%lam_best = min(search%lam_best, search%lam_eval(q))
+         state%pred(pixel) = huge(1.0_dp)
+         if (search%lam_eval(q) < huge(1.0_dp)) state%pred(pixel) = state%path%total + search%lam_eval(q)
+      end associate
+   end subroutine record_evaluation
+
+   !> Full-field search this step? options%event_search: "fft", "bound" or "auto".
+   !> Auto compares the last bound search's exact evaluations (neval n table look-ups,
+   !> about 2 ns each here) with two convolutions on the (2NP)^2 grid (about 5 ns per
+   !> point and level each), and tries the bound search again every 16th step. The rule
+   !> depends on the state only, never on timings, so runs and restarts repeat bit for bit.
+   logical function choose_fft(state, options)
+      type(incremental_state), intent(in) :: state
+      type(contact_options), intent(in) :: options
+      real(dp) :: m2
+      select case (options%event_search)
+      case ("fft")
+         choose_fft = state%n > 0
+      case ("bound")
+         choose_fft = .false.
+      case default
+         m2 = real(2*state%np, dp)**2
+         choose_fft = state%n > 0 .and. mod(state%step, 16) /= 0 .and. &
+            2.0e-9_dp*real(state%last_neval, dp)*state%n > 2*5.0e-9_dp*m2*log(m2)/log(2.0_dp)
+      end select
+   end function choose_fft
+
+   !> Gaps and closing rates of every pixel from two zero-padded FFT convolutions
+   !> (accumulated and unit-load forces); every pixel whose closing load lies within the
+   !> FFT's error bound of the smallest (1e-9 of the displacement scale, far above the
+   !> transforms' round-off) is evaluated exactly, so the event is exact.
+   subroutine fft_search(search, state, options)
+      type(event_search), intent(inout) :: search
+      type(incremental_state), intent(inout) :: state
+      type(contact_options), intent(in) :: options
+      real(dp) :: lam_min, margin, gq, rq
+      real(dp), allocatable :: lam(:)
+      integer :: qq, iq, jq, np
+      np = state%np
+      if (search%conv%m == 0) then
+         call convolution_setup(search%conv, state%table)
+         allocate(search%field_f(np, np), search%field_u(np, np), search%disp_f(np, np), search%disp_u(np, np))
+      end if
+      search%field_f = 0
+      search%field_u = 0
+      do qq = 1, state%n
+         search%field_f(state%ic(qq), state%jc(qq)) = state%ftot(qq)
+         search%field_u(state%ic(qq), state%jc(qq)) = state%funit(qq)
+      end do
+      call convolution_apply(search%conv, search%field_f, search%disp_f)
+      call convolution_apply(search%conv, search%field_u, search%disp_u)
+      allocate(lam(state%npix))
+      lam_min = search%lam_release
+      do qq = 1, state%npix
+         lam(qq) = huge(1.0_dp)
+         if (state%slot(qq) /= 0) cycle
+         iq = (qq - 1)/np + 1
+         jq = qq - (iq - 1)*np
+         gq = state%g0(qq) - state%path%approach + state%c*search%disp_f(iq, jq)
+         rq = state%delta - state%c*search%disp_u(iq, jq)
+         if (gq <= 0) then
+            lam(qq) = 0
+         else if (rq > 0) then
+            lam(qq) = gq/rq
+         end if
+         lam_min = min(lam_min, lam(qq))
+      end do
+      if (lam_min >= huge(1.0_dp)) return
+      margin = options%tie_tolerance*(state%path%total + lam_min) + &
+         1.0e-9_dp*(abs(state%path%approach) + maxval(abs(state%g0)))/state%delta
+      do qq = 1, state%npix
+         if (lam(qq) > lam_min + 2*margin) cycle
+         call record_evaluation(search, state, qq)
+      end do
+   end subroutine fft_search
+
+   !> Free the FFT plans.
+   subroutine free(search)
+      class(event_search), intent(inout) :: search
+      call convolution_free(search%conv)
+   end subroutine free
+end module femcod_event_search

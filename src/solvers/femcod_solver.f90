@@ -1,0 +1,166 @@
+!> One interface to the three solvers: a problem and its options in, one result out,
+!> with an optional observer for progress and checkpoints. `femcod run`, the studies,
+!> the stability cases and the benchmarks all solve through `solve_contact`. What each
+!> solver left out of the model, and what it checked, comes back as text lines for
+!> the summary and the run record (no I/O here).
+module femcod_solver
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE
+   use femcod_strings, only: string_type, int_str, real_str
+   use femcod_problem, only: contact_problem
+   use femcod_love, only: surface_compliance, love_influence
+   use femcod_spring, only: spring_stiffness
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options
+   use femcod_observer, only: solver_observer
+   use femcod_legacy, only: solve_legacy
+   use femcod_incremental, only: solve_incremental
+   use femcod_incremental_state, only: incremental_state
+   use femcod_cg, only: solve_cg
+   implicit none
+   private
+   public :: solve_contact, model_notes, report_lines, report_line
+
+   !> A line of the summary: a label ("checked", "cg", ...) and its text.
+   type :: report_line
+      character(len=:), allocatable :: label, text
+   end type report_line
+
+contains
+
+   !> Solve `problem` with the solver options%solver names. `resume` (incremental solver
+   !> only) continues a run from a stored state.
+   subroutine solve_contact(problem, options, res, status, observer, resume)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(contact_result), intent(out) :: res
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout), optional :: observer
+      type(incremental_state), intent(inout), optional :: resume
+      type(solver_observer) :: nobody
+      if (status%code /= 0) return
+      if (present(resume) .and. options%solver /= "incremental") then
+         call set_error(status, STATUS_USAGE, "only the incremental solver continues from a stored state")
+         return
+      end if
+      select case (options%solver)
+      case ("incremental")
+         if (present(observer)) then
+            call solve_incremental(problem, options, res, status, observer, resume)
+         else
+            call solve_incremental(problem, options, res, status, nobody, resume)
+         end if
+      case ("legacy")
+         if (present(observer)) then
+            call solve_legacy(problem, options, res, status, observer)
+         else
+            call solve_legacy(problem, options, res, status, nobody)
+         end if
+      case ("cg")
+         if (present(observer)) then
+            call solve_cg(problem, options, res, status, observer)
+         else
+            call solve_cg(problem, options, res, status, nobody)
+         end if
+      case default
+         call set_error(status, STATUS_USAGE, "unknown solver '"//trim(options%solver)// &
+            "' (available: incremental, legacy, cg)")
+      end select
+   end subroutine solve_contact
+
+   !> What the solver's model leaves out for this problem, one line each (the summary's
+   !> "model" lines and /run/scene_left_out).
+   function model_notes(problem, options) result(lines)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(string_type), allocatable :: lines(:)
+      real(dp) :: c1, c2, s, cself
+      select case (options%solver)
+      case ("legacy")
+         lines = [string_type("nothing: the legacy solver models every node and spring of Appendix B")]
+         return
+      case ("cg")
+         lines = [string_type("handles and springs condensed: one composite compliance c1 + c2 with the springs' "// &
+            "3/k on the diagonal, one composite gap")]
+         return
+      end select
+      c1 = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel)
+      c2 = surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
+      s = 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
+      cself = (c1 + c2)*love_influence(0, 0)
+      lines = [string_type("handles, substrate and surface nodes condensed: unknowns are the contact forces and "// &
+         "the approach")]
+      if (c2 < c1*1.0e-3_dp) then
+         lines = [lines, string_type("upper body rigid (compliance "//es(c2/c1)//" of the lower's): no element of "// &
+            "its own, kept exactly in c = c1 + c2")]
+      else if (c1 < c2*1.0e-3_dp) then
+         lines = [lines, string_type("lower body rigid (compliance "//es(c1/c2)//" of the upper's): no element of "// &
+            "its own, kept exactly in c = c1 + c2")]
+      else if (problem%young(1) == problem%young(2) .and. problem%poisson(1) == problem%poisson(2)) then
+         lines = [lines, string_type("identical materials: one Love table, c = 2 c1")]
+      else
+         lines = [lines, string_type("two elastic bodies: one Love table, c = c1 + c2")]
+      end if
+      lines = [lines, string_type("interface and penalty springs: an exact diagonal compliance 3/k = "//es(s/cself)// &
+         " of a pixel's self-compliance")]
+      if (all(problem%lower == problem%lower(1, 1))) lines = [lines, string_type("lower surface flat")]
+      if (all(problem%upper == problem%upper(1, 1))) lines = [lines, string_type("upper surface flat")]
+   contains
+      !> es9.2 without blanks, as the summary has always printed these ratios.
+      function es(x) result(text)
+         real(dp), intent(in) :: x
+         character(len=:), allocatable :: text
+         character(len=16) :: buf
+         write(buf, '(es9.2)') x
+         text = trim(adjustl(buf))
+      end function es
+   end function model_notes
+
+   !> What the solver did and checked, for the summary: the model notes, then the
+   !> solver's own lines, labelled.
+   function report_lines(problem, options, res) result(lines)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(contact_result), intent(in) :: res
+      type(report_line), allocatable :: lines(:)
+      type(string_type), allocatable :: model(:)
+      integer :: k
+      allocate(lines(0))
+      select case (options%solver)
+      case ("cg")
+         do k = 1, size(res%states)
+            call add("cg", "load "//real_str(res%states(k)%load, 6)//" nN: "// &
+               int_str(res%states(k)%iterations)//" iterations, residual "//real_str(res%states(k)%residual, 2)// &
+               ", penetration "//real_str(res%states(k)%penetration, 2)//" nm, |gap| on contact "// &
+               real_str(res%states(k)%contact_gap, 2)//" nm, load error "//real_str(res%states(k)%load_error, 2))
+         end do
+      case ("incremental")
+         model = model_notes(problem, options)
+         do k = 1, size(model)
+            call add("model", model(k)%s)
+         end do
+         call add("checked", "every pixel by FFT convolution at the end: "// &
+            int_str(res%missed_final_check)//" penetrating (deepest "//real_str(res%max_penetration, 2)// &
+            " nm); "//int_str(res%releases)//" releases; "//real_str(real(res%evaluations, dp), 3)// &
+            " exact pixel evaluations; exact re-solve differs by "//real_str(res%final_check_difference, 2))
+         call add("search", int_str(res%fft_steps)//" of "//int_str(res%nsteps)// &
+            " steps by full-field FFT, the others by the gap bound (--event-search "//trim(options%event_search)//")")
+         call add("cache", int_str(res%cache_hits)//" contacts bordered from the candidate "// &
+            "cache, "//int_str(res%cache_misses)//" by their own triangular solves; "//int_str(res%cache_refills)// &
+            " refills ("//int_str(res%cache_columns)//" columns by BLAS-3 solves)")
+      case default
+         call add("checked", int_str(res%missed_during_run)//" contacts found late by the candidate search, "// &
+            int_str(res%missed_final_check)//" found by the final check of all pixels; exact re-solve differs by "// &
+            real_str(res%final_check_difference, 2))
+         call add("TRFACT", "condition estimate "//real_str(res%condition, 2)// &
+            " (LAPACK dlacn2): relative errors up to about "//real_str(epsilon(1.0_dp)*res%condition, 1))
+         if (epsilon(1.0_dp)*res%condition > 1.0e-8_dp) call add("warning", "the stiff springs and rigid body cost "// &
+            "the legacy solver digits; the incremental solver is immune (doc/stability.md)")
+      end select
+   contains
+      subroutine add(label, text)
+         character(len=*), intent(in) :: label, text
+         lines = [lines, report_line(label, text)]
+      end subroutine add
+   end function report_lines
+end module femcod_solver
