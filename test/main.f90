@@ -18,6 +18,8 @@ program tester
    use test_stability, only: collect_stability
    use test_cg, only: collect_cg
    use test_studies, only: collect_studies
+   use test_options, only: collect_options
+   use test_architecture, only: collect_architecture
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
    use femcod_strings, only: string_type, parse_integer
@@ -40,7 +42,9 @@ program tester
       new_testsuite("hostile", collect_hostile), &
       new_testsuite("stability", collect_stability), &
       new_testsuite("cg", collect_cg), &
-      new_testsuite("studies", collect_studies) &
+      new_testsuite("studies", collect_studies), &
+      new_testsuite("options", collect_options), &
+      new_testsuite("architecture", collect_architecture) &
       ]
    stat = 0
    total = 0

@@ -1,7 +1,8 @@
 !> Numerical stability on hard cases (doc/stability.md): each routine builds a scene,
 !> runs the solvers and returns the measured error against an expected value from
-!> analysis or an independent computation. The test suite asserts bounds on these
-!> numbers; `femcod stability` tabulates them. No I/O here.
+!> analysis or an independent computation (test/oracles; never femcod's own checks of
+!> itself). The stability suite asserts bounds on these numbers; the test driver's
+!> --stability-report tabulates them. No I/O here.
 module stability_cases
    use, intrinsic :: iso_fortran_env, only: real128
    use femcod_kinds, only: dp
@@ -12,10 +13,9 @@ module stability_cases
    use femcod_solver_options, only: contact_options
    use femcod_solver, only: solve_contact
    use femcod_condensed, only: solve_active_set
-   use femcod_love, only: offset_table, surface_compliance, love_influence, love_influence_exact, &
-      love_influence_far
-   use femcod_spring, only: spring_stiffness
-   use femcod_scene, only: initial_gaps
+   use femcod_love, only: offset_table, love_influence, love_influence_exact, love_influence_far
+   use oracles, only: love_quad, love_table, composite_compliance, spring_compliance, reference_gaps, exact_state, &
+      appendix_b_condition
    implicit none
    private
    public :: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, single_pixel, &
@@ -86,9 +86,26 @@ contains
          rows(k)%legacy = (res%states(1)%approach - reference)/reference
          rows(k)%legacy_roundoff = abs(res%states(1)%approach - inc)/inc
          rows(k)%pivot_loss = res%pivot_loss
-         rows(k)%condition = res%condition
+         rows(k)%condition = legacy_condition(deck, res)
       end do
    end subroutine stiffness_sweep
+
+   !> The largest exact condition number of the Appendix B systems the legacy solver
+   !> factorised for `res`: at step s the contacts that joined up to s (test/oracles).
+   function legacy_condition(deck, res) result(kappa)
+      type(contact_problem), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      real(dp) :: kappa
+      real(dp), allocatable :: table(:, :)
+      logical, allocatable :: joined(:)
+      integer :: s
+      table = love_table(deck%np)
+      kappa = 0
+      do s = 1, maxval(res%contact_step)
+         joined = res%contact_step <= s
+         kappa = max(kappa, appendix_b_condition(deck, table, pack(res%contact_i, joined), pack(res%contact_j, joined)))
+      end do
+   end function legacy_condition
 
    !> Scenes with the symmetry of the square (D4): "sphere-centre" (apex on a pixel
    !> centre, NP = 15), "sphere-corner" (apex on a pixel corner, NP = 16), "square-punch"
@@ -203,8 +220,8 @@ contains
 
    !> Flat on flat: every pixel touches at zero load, so the first step holds all NP^2
    !> contacts and the scene is the rigid square punch covering the grid. Returns the
-   !> contacts of the first step and the relative difference of the approach at 100 nN
-   !> from an independent dense solve (LAPACK dsysv of the bordered system).
+   !> contacts of the first step, the relative difference of the approach at 100 nN from
+   !> an independent dense solve (test/oracles), and the legacy system's exact condition.
    subroutine flat_on_flat(solver, first_contacts, difference, condition, status)
       character(len=*), intent(in) :: solver
       integer, intent(out) :: first_contacts
@@ -213,10 +230,10 @@ contains
       type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(contact_result) :: res
-      real(dp), allocatable :: table(:, :), forces(:)
+      real(dp), allocatable :: forces(:)
       integer, allocatable :: ic(:), jc(:)
-      real(dp) :: approach, c, s
-      integer :: i, j, np
+      real(dp) :: approach
+      integer :: i, j, np, info
       spec%kind = "flat"
       spec%label = "flat on flat"
       spec%matrix_file = ""
@@ -226,20 +243,16 @@ contains
       call solve(deck, solver, [100.0_dp], res, status)
       if (status%code /= 0) return
       first_contacts = res%step_contacts(1)
-      condition = res%condition
+      condition = legacy_condition(deck, res)
       np = deck%np
-      allocate(ic(np*np), jc(np*np), forces(np*np), table(0:np - 1, 0:np - 1))
+      allocate(ic(np*np), jc(np*np), forces(np*np))
       do i = 1, np
          do j = 1, np
             ic((i - 1)*np + j) = i
             jc((i - 1)*np + j) = j
          end do
       end do
-      table = offset_table(np)
-      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
-         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
-      s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
-      call solve_active_set(ic, jc, [(0.0_dp, i = 1, np*np)], c, s, table, 100.0_dp, forces, approach, status)
+      call exact_state(deck, love_table(np), ic, jc, 100.0_dp, forces, approach, info)
       difference = abs(res%states(1)%approach - approach)/approach
    end subroutine flat_on_flat
 
@@ -264,9 +277,9 @@ contains
       deck%upper = 0
       call solve(deck, solver, [7.0_dp], res, status)
       if (status%code /= 0) return
-      expected = 7*((surface_compliance(deck%young(1), nu, deck%pixel) + &
-         surface_compliance(deck%young(2), nu, deck%pixel))*love_influence(0, 0) + &
-         3/spring_stiffness(deck%young(3), nu, deck%pixel, deck%pixel))
+      ! The closed forms of test/oracles: c I(0,0) + 3/k per nN.
+      expected = 7*(composite_compliance(deck)*real(love_quad(0.0_real128, 0.0_real128), dp) + &
+         3*spring_compliance(deck))
       difference = abs(res%states(1)%approach - expected)/expected
    end subroutine single_pixel
 
@@ -283,9 +296,9 @@ contains
       type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(contact_result) :: res
-      real(dp), allocatable :: table(:, :), g0(:)
+      real(dp), allocatable :: table(:, :), g0(:, :)
       real(dp) :: c, self, best
-      integer :: p, i, j, np
+      integer :: i, j, np
       spec%kind = "self-affine"
       spec%label = "spike"
       spec%matrix_file = ""
@@ -300,18 +313,18 @@ contains
       if (status%code /= 0) return
       missed = res%missed_final_check
       np = deck%np
+      ! The closed form with the oracles' coefficients and gaps (test/oracles).
       allocate(table(0:np - 1, 0:np - 1))
-      table = offset_table(np)
-      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
-         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
-      self = c*table(0, 0) + 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
-      g0 = initial_gaps(deck%lower, deck%upper)
+      table = love_table(np)
+      c = composite_compliance(deck)
+      self = c*table(0, 0) + 3*spring_compliance(deck)
+      g0 = reference_gaps(deck)
       best = huge(1.0_dp)
-      do p = 1, np*np
-         i = (p - 1)/np + 1
-         j = p - (i - 1)*np
-         if (i == 7 .and. j == 11) cycle
-         best = min(best, g0(p)/(self - c*table(abs(i - 7), abs(j - 11))))
+      do j = 1, np
+         do i = 1, np
+            if (i == 7 .and. j == 11) cycle
+            best = min(best, g0(i, j)/(self - c*table(abs(i - 7), abs(j - 11))))
+         end do
       end do
       difference = abs(res%step_load(1) - best)/best
    end subroutine first_spike_event
@@ -370,9 +383,9 @@ contains
       type(scene_spec) :: spec
       type(contact_problem) :: plain, offset
       type(contact_result) :: a, b
-      real(dp), allocatable :: g0(:)
+      real(dp), allocatable :: g0(:, :)
       real(dp) :: gmin
-      integer :: k, p
+      integer :: k
       spec%kind = "self-affine"
       spec%label = "1e-3 nm roughness"
       spec%matrix_file = ""
@@ -392,11 +405,12 @@ contains
       difference = history_difference(a, b, 1.0_dp, 1.0_dp)
       ! Four rounded heights per gap (two per surface), each off by up to half an ulp of
       ! 1e6; the loads scale with the gaps that close, the smallest of which is g_min.
-      g0 = initial_gaps(plain%lower, plain%upper)
+      g0 = reference_gaps(plain)
       gmin = huge(1.0_dp)
       do k = 1, size(a%contact_i)
-         p = (a%contact_i(k) - 1)*plain%np + a%contact_j(k)
-         if (g0(p) > 0) gmin = min(gmin, g0(p))
+         associate(g => g0(a%contact_i(k), a%contact_j(k)))
+            if (g > 0) gmin = min(gmin, g)
+         end associate
       end do
       bound = 4*(spacing(1.0e6_dp)/2)/gmin
    end subroutine height_offset
@@ -453,7 +467,7 @@ contains
       call solve(deck, solver, [1000.0_dp], res, status)
       if (status%code /= 0) return
       difference = abs(res%states(1)%approach - reference)/reference
-      condition = res%condition
+      condition = legacy_condition(deck, res)
    end subroutine poisson_limit
 
    !> The Love coefficient at offset (p, q) in double (femcod's choice, the four-corner
@@ -471,21 +485,6 @@ contains
       if (p /= 0 .or. q /= 0) &
          far = real(abs(love_influence_far(real(min(p, q), dp), real(max(p, q), dp)) - exact)/exact, dp)
    end subroutine love_precision
-
-   !> Eq. 4.4's four-corner sum in quadruple precision (33 digits: the cancellation at
-   !> 1000 pixels costs about 6, leaving the reference exact to double precision).
-   pure real(real128) function love_quad(x, y)
-      real(real128), intent(in) :: x, y
-      real(real128), parameter :: h = 0.5_real128
-      love_quad = f(x + h, y + h) - f(x + h, y - h) - f(x - h, y + h) + f(x - h, y - h)
-   contains
-      pure real(real128) function f(a, b)
-         real(real128), intent(in) :: a, b
-         f = 0
-         if (a /= 0) f = f + a*asinh(b/abs(a))
-         if (b /= 0) f = f + b*asinh(a/abs(b))
-      end function f
-   end function love_quad
 
    !> A contact cluster (`n` pixels in a compact block) under unit load: the forces
    !> from the double-precision dsysv solve of femcod's active-set system against a
@@ -537,8 +536,8 @@ contains
    end subroutine solve_precision
 
    !> A long run: `events` contacts on a 100 x 100 self-affine surface (rms 3 nm, 5 nm
-   !> pixels); the accumulated load, approach and forces at the end against a fresh
-   !> solve of the final active set (femcod's final check: res%final_check_difference).
+   !> pixels); the accumulated approach and forces at the end against the exact state of
+   !> the final contact set (test/oracles' dense solve).
    subroutine long_run_drift(events, drift, steps, seconds, status)
       integer, intent(in) :: events
       real(dp), intent(out) :: drift, seconds
@@ -547,6 +546,9 @@ contains
       type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(contact_result) :: res
+      real(dp), allocatable :: forces(:)
+      real(dp) :: approach
+      integer :: info
       spec%kind = "self-affine"
       spec%label = "long run"
       spec%matrix_file = ""
@@ -557,7 +559,12 @@ contains
       call build_problem(spec, deck, status)
       call solve(deck, "incremental", [real(dp) ::], res, status)
       if (status%code /= 0) return
-      drift = res%final_check_difference
+      ! The accumulated end state against the oracles' dense solve of its contact set.
+      allocate(forces(size(res%contact_i)))
+      call exact_state(deck, love_table(deck%np), res%contact_i, res%contact_j, res%reported_load, forces, approach, &
+         info)
+      drift = max(abs(res%step_approach(res%nsteps) - approach)/approach, &
+         maxval(abs(res%contact_force - forces))/maxval(abs(forces)))
       steps = res%nsteps
       seconds = res%wall_seconds
    end subroutine long_run_drift

@@ -12,6 +12,7 @@ module test_boussinesq
    use femcod_random, only: random_stream, seed_stream, uniform
    use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, skyline_words, IPIADR, IPCONT, MPWORK
    use femcod_legacy, only: legacy_unit_solution, legacy_materials
+   use femcod_thesis, only: PIXEL_COMPLIANCE, FIG_5_2_PERCENT, FIG_5_2_PERMILLE
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -40,19 +41,23 @@ contains
       real(dp) :: c
       call check(error, love_influence(0, 0), 4*log(1 + sqrt(2.0_dp)), rel=.true., thr=1.0e-15_dp)
       if (allocated(error)) return
-      ! Section 4.5: E = 200 GPa, nu = 0.25, d = 5000/512 nm gives 5.39e-4 (3 digits).
+      ! Section 4.5 (femcod_thesis): E = 200 GPa, nu = 0.25, d = 5000/512 nm gives 5.39e-4
+      ! nm/nN, printed to three digits.
       c = surface_compliance(200.0_dp, 0.25_dp, 5000.0_dp/512)*love_influence(0, 0)
-      call check(error, c, 5.39e-4_dp, thr=0.005e-4_dp)
+      call check(error, c, PIXEL_COMPLIANCE, thr=0.005e-4_dp)
    end subroutine test_self_term
 
    subroutine test_decay(error)
       type(error_type), allocatable, intent(out) :: error
       real(dp) :: i0
       i0 = love_influence(0, 0)
-      ! Thesis Fig. 5.2 / issue: below 1/100 between pixels 28 and 29, 1/1000 between 283 and 284.
-      call check(error, love_influence(28, 0) > i0/100 .and. love_influence(29, 0) < i0/100, "1/100 crossing")
-      if (allocated(error)) return
-      call check(error, love_influence(283, 0) > i0/1000 .and. love_influence(284, 0) < i0/1000, "1/1000 crossing")
+      ! Thesis Fig. 5.2 (femcod_thesis): below 1/100 between pixels 28 and 29, below 1/1000
+      ! between 283 and 284.
+      associate(n => FIG_5_2_PERCENT, m => FIG_5_2_PERMILLE)
+         call check(error, love_influence(n, 0) > i0/100 .and. love_influence(n + 1, 0) < i0/100, "1/100 crossing")
+         if (allocated(error)) return
+         call check(error, love_influence(m, 0) > i0/1000 .and. love_influence(m + 1, 0) < i0/1000, "1/1000 crossing")
+      end associate
    end subroutine test_decay
 
    subroutine test_far_field(error)

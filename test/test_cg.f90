@@ -337,6 +337,9 @@ contains
          if (allocated(error)) return
          approach(pass) = loads_approach(prefix//".loads.csv")
       end do
+      ! An approach of the sphere at 5000 nN is positive; a failed read gives -1.
+      call check(error, approach(1) > 0 .and. approach(2) > 0, "loads.csv read back")
+      if (allocated(error)) return
       call check(error, abs(approach(2) - approach(1)) <= 1.0e-12_dp*abs(approach(1)), "approach "// &
          to_string(approach(1))//" then "//to_string(approach(2)))
    end subroutine test_wisdom

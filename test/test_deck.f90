@@ -1,4 +1,5 @@
-!> Deck reading, writing and validation (issue: foundation, "Bad input").
+!> Deck reading, writing and validation: every bad deck is refused with its file, line
+!> and what was expected (doc/deck-format.md).
 module test_deck
    use femcod_kinds, only: dp
    use femcod_status, only: status_type

@@ -6,13 +6,13 @@ module test_incremental
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options
    use femcod_solver, only: solve_contact
-   use femcod_generate, only: VERIFICATION_DECKS
-   use femcod_scene, only: initial_gaps
-   use femcod_love, only: offset_table, surface_compliance
-   use femcod_condensed, only: solve_active_set, gap_at
-   use femcod_spring, only: spring_stiffness
+   use femcod_generate, only: VERIFICATION_DECKS, scene_spec, build_problem
+   use femcod_love, only: offset_table
+   use femcod_event_search, only: fft_search_pays
+   use femcod_thesis, only: TABLE_4_1_APPROACH, TABLE_4_2_APPROACH
+   use oracles, only: love_table, exact_state, gaps_at_state, reference_gaps
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
    implicit none
@@ -26,9 +26,9 @@ contains
       testsuite = [ &
          new_unittest("same events as legacy on every input/ deck", test_same_events), &
          new_unittest("rigid springs: equals a fixed-load active-set solution", test_active_set), &
-         new_unittest("Table 4.1 and 4.2 values, with no missed contact", test_tables), &
-         new_unittest("a deck whose MAXCONT is NP^2 runs (the factor grows)", test_growth), &
-         new_unittest("OpenMP: 1 and 2 threads give the same results", test_threads), &
+         new_unittest("Tables 4.1, 4.2; the state against an exact solve and every gap", test_tables), &
+         new_unittest("MAXCONT = NP^2: the factor grows; the end state against an exact solve", test_growth), &
+         new_unittest("OpenMP: 1 and 2 threads, FFT event search and cg", test_threads), &
          new_unittest("event search: full-field FFT and gap bound find the same events", test_event_search) &
          ]
    end subroutine collect_incremental
@@ -90,7 +90,8 @@ contains
          do k = 1, mi
             if (ll(k) > 0) worst = max(worst, abs(li(k) - ll(k))/ll(k))
          end do
-         ! The issue asks 1e-9; legacy with its refinement step agrees to about 1e-10.
+         ! Two solvers of one model: the legacy skyline with its refinement step agrees with
+         ! the condensed factor to ~1e-10 (doc/stability.md); 1e-9 leaves a decade.
          call check(error, worst < 1.0e-9_dp, trim(VERIFICATION_DECKS(d))//": loads within 1e-9, worst "// &
             to_string(worst))
          if (allocated(error)) return
@@ -103,21 +104,21 @@ contains
       end do
    end subroutine test_same_events
 
-   !> Independent reference: Kalker-style fixed-load active-set iteration on the dense
-   !> condensed system (LAPACK dsysv): start from the pixels the rigid approach would
-   !> touch, drop the most tensile contact or add the most penetrating pixel until
-   !> neither exists. A different algorithm from the event stepping.
+   !> Independent reference: Kalker-style fixed-load active-set iteration with the
+   !> oracles' dense LU solve and direct-sum gaps (test/oracles): start from the pixels
+   !> that touch first, drop the most tensile contact or add the most penetrating pixel
+   !> until neither exists. A different algorithm from the event stepping.
    subroutine test_active_set(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc
       type(status_type) :: status
-      real(dp), allocatable :: g0(:), table(:, :), f(:)
+      real(dp), allocatable :: g0(:, :), table(:, :), f(:), gap(:, :)
       integer, allocatable :: ic(:), jc(:), pix(:)
-      logical, allocatable :: active(:)
-      real(dp) :: c, s, a, gap, worst_gap, load
-      integer :: np, p, n, it, k, worst_pix, idx, l
+      logical, allocatable :: active(:, :)
+      real(dp) :: a, load
+      integer :: np, p, n, it, k, idx, l, info, worst(2)
       real(dp), parameter :: loads(3) = [300.0_dp, 2000.0_dp, 8000.0_dp]
       call read_deck("input/rough_selfaffine_32.deck", deck, status)
       ! Rigid springs: contact modulus so large that 3/k is below round-off of c.
@@ -128,48 +129,35 @@ contains
       call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
-      g0 = initial_gaps(deck%lower, deck%upper)
-      allocate(table(0:np - 1, 0:np - 1))
-      table = offset_table(np)
-      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
-         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
-      s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
+      g0 = reference_gaps(deck)
+      table = love_table(np)
       do l = 1, size(loads)
          load = loads(l)
-         allocate(active(np*np))
          active = g0 <= minval(g0) + 1.0e-9_dp
          do it = 1, 10*np*np
             n = count(active)
-            pix = pack([(p, p = 1, np*np)], active)
+            pix = pack([(p, p = 1, np*np)], reshape(transpose(active), [np*np]))
             ic = (pix - 1)/np + 1
             jc = pix - (ic - 1)*np
             if (allocated(f)) deallocate(f)
             allocate(f(n))
-            call solve_active_set(ic, jc, g0(pix), c, s, table, load, f, a, status)
+            call exact_state(deck, table, ic, jc, load, f, a, info)
             if (minval(f) < 0) then
                idx = minloc(f, 1)
-               active(pix(idx)) = .false.
+               active(ic(idx), jc(idx)) = .false.
                cycle
             end if
-            worst_gap = 0
-            worst_pix = 0
-            do p = 1, np*np
-               if (active(p)) cycle
-               gap = gap_at(g0(p), a, c, table, (p - 1)/np + 1, p - ((p - 1)/np)*np, ic, jc, f)
-               if (gap < worst_gap) then
-                  worst_gap = gap
-                  worst_pix = p
-               end if
-            end do
-            if (worst_pix == 0) exit
-            active(worst_pix) = .true.
+            gap = gaps_at_state(deck, table, ic, jc, f, a)
+            where (active) gap = 0
+            if (minval(gap) >= 0) exit
+            worst = minloc(gap)
+            active(worst(1), worst(2)) = .true.
          end do
          call check(error, inc%states(l)%contacts, n, "contacts at "//to_string(nint(load))//" nN")
          if (allocated(error)) return
          call check(error, inc%states(l)%approach, a, rel=.true., thr=1.0e-10_dp, &
             message="approach at "//to_string(nint(load))//" nN")
          if (allocated(error)) return
-         deallocate(active)
       end do
       ! Forces at the largest load, pixel by pixel.
       do k = 1, size(inc%contact_i)
@@ -181,6 +169,11 @@ contains
       end do
    end subroutine test_active_set
 
+   !> Tables 4.1 and 4.2 (finest meshes, femcod_thesis) within the thesis' printing
+   !> (0.5 %), and the state at 1 nN against the oracles: the exact forces and approach of
+   !> the solver's contact set (a dense LU solve, test/oracles) to 1e-10, and no pixel
+   !> outside it penetrating by more than 1e-12 of the height range (direct sums with
+   !> quadruple-precision Love coefficients).
    subroutine test_tables(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_problem) :: deck
@@ -188,8 +181,7 @@ contains
       type(contact_result) :: inc
       type(status_type) :: status
       character(len=*), parameter :: decks(2) = [character(len=16) :: "circle_punch_d9", "square_punch_n27"]
-      ! Thesis Tables 4.1 and 4.2, finest meshes: 0.911e-3 and 0.412e-3 nm at 1 nN.
-      real(dp), parameter :: thesis(2) = [0.911e-3_dp, 0.412e-3_dp]
+      real(dp), parameter :: thesis(2) = [TABLE_4_1_APPROACH(3), TABLE_4_2_APPROACH(4)]
       integer :: k
       do k = 1, 2
          call read_deck("input/"//trim(decks(k))//".deck", deck, status)
@@ -200,14 +192,46 @@ contains
          if (allocated(error)) return
          call check(error, inc%states(1)%approach, thesis(k), rel=.true., thr=5.0e-3_dp, message=trim(decks(k)))
          if (allocated(error)) return
-         call check(error, inc%missed_final_check, 0, "no pixel penetrates at the end")
-         if (allocated(error)) return
-         call check(error, inc%final_check_difference < 1.0e-10_dp, "drift against a fresh solve: "// &
-            to_string(inc%final_check_difference))
+         call check_against_oracles(error, trim(decks(k)), deck, inc, 1.0_dp)
          if (allocated(error)) return
       end do
    end subroutine test_tables
 
+   !> The contacts and forces a result reports at `load` (its largest requested load, or
+   !> the end of the run) against test/oracles: the same contact set solved exactly, and
+   !> every other pixel's gap under the reported forces.
+   subroutine check_against_oracles(error, name, deck, res, load)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: name
+      type(contact_problem), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      real(dp), intent(in) :: load
+      real(dp), allocatable :: table(:, :), forces(:), gap(:, :)
+      real(dp) :: approach, reported, range
+      integer :: info, k
+      table = love_table(deck%np)
+      allocate(forces(size(res%contact_i)))
+      call exact_state(deck, table, res%contact_i, res%contact_j, load, forces, approach, info)
+      call check(error, info, 0, name//": the oracle's solve")
+      if (allocated(error)) return
+      call check(error, maxval(abs(res%contact_force - forces)) <= 1.0e-10_dp*maxval(abs(forces)), name// &
+         ": forces against the exact solve, "//to_string(maxval(abs(res%contact_force - forces))/maxval(abs(forces))))
+      if (allocated(error)) return
+      reported = res%step_approach(res%nsteps)
+      if (size(res%states) > 0) reported = res%states(size(res%states))%approach
+      call check(error, reported, approach, rel=.true., thr=1.0e-10_dp, message=name//": approach")
+      if (allocated(error)) return
+      gap = gaps_at_state(deck, table, res%contact_i, res%contact_j, res%contact_force, reported)
+      do k = 1, size(res%contact_i)
+         gap(res%contact_i(k), res%contact_j(k)) = huge(1.0_dp)
+      end do
+      range = maxval(deck%lower) - minval(deck%lower) + maxval(deck%upper) - minval(deck%upper)
+      call check(error, minval(gap) >= -1.0e-12_dp*range, name//": deepest penetration outside the contacts "// &
+         to_string(-minval(gap)))
+   end subroutine check_against_oracles
+
+   !> MAXCONT = NP^2: the factor's storage doubles from 256 to 1024 columns on the way to
+   !> 600 contacts; the end state against the oracles, no tensile force.
    subroutine test_growth(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_problem) :: deck
@@ -222,42 +246,68 @@ contains
       call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
-      call check(error, size(inc%contact_i) >= 590 .and. inc%missed_final_check == 0 .and. &
-         inc%final_check_difference < 1.0e-10_dp, "600 of 1024 pixels in contact, none missed, no drift: "// &
-         to_string(size(inc%contact_i))//" "//to_string(inc%final_check_difference))
+      call check(error, size(inc%contact_i) > 512, "more contacts than two doublings: "//to_string(size(inc%contact_i)))
+      if (allocated(error)) return
+      call check_against_oracles(error, "600 contacts", deck, inc, inc%reported_load)
       if (allocated(error)) return
       call check(error, all(inc%contact_force >= 0), "no tensile force")
    end subroutine test_growth
 
+   !> OpenMP with 1 and 2 threads on a 64 x 64 rough surface: the incremental solver
+   !> with the full-field event search (the convolution's three passes run in parallel
+   !> blocks, each line's transform on its own) gives the same events bit for bit; the
+   !> cg solver (parallel loops with reductions, whose order changes with the threads)
+   !> the same contacts and the approach to 1e-10.
    subroutine test_threads(error)
       type(error_type), allocatable, intent(out) :: error
+      type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(contact_options) :: options
-      type(contact_result) :: one, two
+      type(contact_result) :: res(2), cg(2)
       type(status_type) :: status
-      real(dp), allocatable :: t1(:, :), t2(:, :)
+      real(dp), allocatable :: t(:, :, :)
       integer :: saved, k
+      spec%kind = "self-affine"
+      spec%np = 64
+      spec%pixel = 10
+      spec%rms = 3
+      spec%seed = 3
+      spec%shape_on = "lower"
+      spec%label = "threads"
+      spec%matrix_file = ""
+      spec%maxcont = 150
+      call build_problem(spec, deck, status)
       saved = omp_get_max_threads()
-      call omp_set_num_threads(1)
-      t1 = offset_table(64)
-      call read_deck("input/rough_selfaffine_32.deck", deck, status)
-      allocate(options%loads(0))
-      options%solver = "incremental"
-      call solve_contact(deck, options, one, status)
-      call omp_set_num_threads(2)
-      t2 = offset_table(64)
-      options%solver = "incremental"
-      call solve_contact(deck, options, two, status)
-      call omp_set_num_threads(saved)
-      call check(error, all(t1 == t2), "offset table bit for bit")
-      if (allocated(error)) return
-      call check(error, one%nsteps == two%nsteps .and. all(one%step_contacts(1:one%nsteps) == &
-         two%step_contacts(1:two%nsteps)), "same events")
-      if (allocated(error)) return
-      do k = 1, one%nsteps
-         call check(error, two%step_load(k), one%step_load(k), rel=.true., thr=1.0e-12_dp)
-         if (allocated(error)) return
+      allocate(t(0:63, 0:63, 2))
+      do k = 1, 2
+         call omp_set_num_threads(k)
+         call check(error, omp_get_max_threads(), k, "threads set")
+         if (allocated(error)) exit
+         t(:, :, k) = offset_table(64)
+         options%solver = "incremental"
+         options%event_search = "fft"
+         allocate(options%loads(0))
+         call solve_contact(deck, options, res(k), status)
+         options%solver = "cg"
+         options%loads = [res(k)%step_load(res(k)%nsteps)/2]
+         call solve_contact(deck, options, cg(k), status)
+         deallocate(options%loads)
       end do
+      call omp_set_num_threads(saved)
+      if (allocated(error)) return
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, all(t(:, :, 1) == t(:, :, 2)), "offset table bit for bit")
+      if (allocated(error)) return
+      call check(error, res(1)%nsteps == res(2)%nsteps .and. res(1)%fft_steps == res(1)%nsteps, "full-field steps")
+      if (allocated(error)) return
+      call check(error, all(res(1)%step_contacts(1:res(1)%nsteps) == res(2)%step_contacts(1:res(1)%nsteps)) .and. &
+         all(res(1)%step_load(1:res(1)%nsteps) == res(2)%step_load(1:res(1)%nsteps)), "same events, bit for bit")
+      if (allocated(error)) return
+      call check(error, cg(1)%states(1)%contacts, cg(2)%states(1)%contacts, "cg: contacts")
+      if (allocated(error)) return
+      call check(error, cg(2)%states(1)%approach, cg(1)%states(1)%approach, rel=.true., thr=1.0e-10_dp, &
+         message="cg: approach")
    end subroutine test_threads
 
    !> Two independent event searches: the heap of gap bounds with exact evaluations, and
@@ -294,9 +344,26 @@ contains
             trim(VERIFICATION_DECKS(d))//": loads")
          if (allocated(error)) return
       end do
+      ! Auto: the same events as the bound search on the last deck.
       options%event_search = "auto"
       options%solver = "incremental"
       call solve_contact(deck, options, b, status)
-      call check(error, b%fft_steps >= 0 .and. b%fft_steps <= b%nsteps, "auto reports its choice")
+      call check(error, b%nsteps == a%nsteps, "auto: steps")
+      if (allocated(error)) return
+      call check(error, all(a%step_contacts(1:n) == b%step_contacts(1:n)) .and. &
+         maxval(abs(a%step_load(1:n) - b%step_load(1:n))) <= 1.0e-12_dp*maxval(a%step_load(1:n)), "auto: events")
+      if (allocated(error)) return
+      ! Auto's rule against its cost model, worked by hand at NP = 512 (M = 1024,
+      ! M^2 log2 M^2 = 2.10e7 point-levels, two convolutions 0.210 s): 2e-9 s per
+      ! evaluation and contact, so with n = 2000 contacts the bound search costs
+      ! 4e-6 s per evaluated pixel: 20000 evaluations (0.08 s) keep it, 100000 (0.4 s) do
+      ! not; every 16th step, and with no contacts, the bound search runs.
+      call check(error, .not. fft_search_pays(512, 2000, 20000, 5), "auto keeps the bound search when it is cheap")
+      if (allocated(error)) return
+      call check(error, fft_search_pays(512, 2000, 100000, 5), "auto takes the full field when it is cheaper")
+      if (allocated(error)) return
+      call check(error, .not. fft_search_pays(512, 2000, 100000, 32), "every 16th step by the bound")
+      if (allocated(error)) return
+      call check(error, .not. fft_search_pays(512, 0, 100000, 5), "no contacts: no full field")
    end subroutine test_event_search
 end module test_incremental

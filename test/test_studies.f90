@@ -19,6 +19,7 @@ module test_studies
    use femcod_solver_options, only: contact_options, cg_settings
    use femcod_solver, only: solve_contact
    use femcod_richardson, only: power_law_fit
+   use femcod_thesis, only: PIXEL_COMPLIANCE
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    use test_support, only: scratch_path, read_text, file_exists, remove_scratch, contains_text
    implicit none
@@ -59,7 +60,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(dp) :: c
       c = surface_compliance(200.0_dp, 0.25_dp, 5000.0_dp/512)*love_influence(0, 0)
-      call check(error, abs(c - 5.39e-4_dp) < 0.005e-4_dp, "compliance "//to_string(c))
+      call check(error, abs(c - PIXEL_COMPLIANCE) < 0.005e-4_dp, "compliance "//to_string(c))
    end subroutine test_pixel_compliance
 
    !> The sorted-prefix evaluation against the definition, pixel by pixel.
@@ -247,8 +248,9 @@ contains
       call check(error, a%step_above_hardness(a%nsteps), count(a%contact_force/deck%pixel**2 > 5))
    end subroutine test_hardness_steps
 
-   !> The command on a 32 x 32 deck, levels 32 and 16: every file, the headers of the
-   !> issue, and the fitted exponent equal to an independent fit of the coupled rows.
+   !> The command on a 32 x 32 deck, levels 32 and 16: every file, the headers of its
+   !> help (femcod resolution --help), and the fitted exponent equal to an independent fit
+   !> of the coupled rows.
    subroutine test_resolution_command(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix, text
@@ -528,7 +530,8 @@ contains
    end subroutine test_close_packed
 
    !> Both commands on the 32 x 32 rough deck and on an ASCII matrix: files written, the
-   !> summit table's header of the issue; a bad size is a usage error with no files.
+   !> summit table's header of its help (femcod summits --help); a bad size is a usage
+   !> error with no files.
    subroutine test_surface_commands(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix, text

@@ -56,8 +56,8 @@ contains
          if (allocated(error)) return
          deallocate(z)
       end do
-      ! At d = 1/3 the ring at distance sqrt(61)/3 nm is split 4 of 8 (issue text): check
-      ! that exactly 4 of the 8 pixels with offsets p^2 + q^2 = 61 are in the punch.
+      ! At d = 1/3 Table 4.1 has 189 pixels; the whole rings p^2 + q^2 < 61 hold 185 (counted
+      ! by hand), so exactly 4 of the 8 pixels with p^2 + q^2 = 61 are in the punch.
       allocate(z(33, 33))
       call circle_punch(33, 1.0_dp/3, 21.0_dp, 1.0_dp, z, npunch, status)
       call check(error, count([z(17 + 5, 17 + 6), z(17 + 6, 17 + 5), z(17 - 5, 17 + 6), z(17 - 6, 17 + 5), &

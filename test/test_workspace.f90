@@ -5,7 +5,9 @@ module test_workspace
    use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, skyline_words, workspace_table, &
       MPSURF, MPGAPS, MPCORD, MPFEXT, MPDISP, MPDISP2, MPFORCE, MPWORK, MPSTIF, IPSORT, IPSITU, IPCONT
    use test_support, only: contains_text
-   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use femcod_thesis, only: TABLE_B_NP, TABLE_B_MAXCONT, TABLE_B_1_SIZES, TABLE_B_1_STIFFNESS, TABLE_B_1_MPEND, &
+      TABLE_B_2_IPEND
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
    public :: collect_workspace
@@ -28,25 +30,24 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(workspace_type) :: ws
       type(status_type) :: status
-      call workspace_layout(512, 1000, ws, status)
-      ! Thesis Table B.2: "IPEND = 284156 for 1000 contact problem".
-      call check(error, int(ws%ipend), 284156)
+      ! Thesis Table B.2 (femcod_thesis): "IPEND = 284156 for 1000 contact problem".
+      call workspace_layout(TABLE_B_NP, TABLE_B_MAXCONT, ws, status)
+      call check(error, int(ws%ipend), int(TABLE_B_2_IPEND))
    end subroutine test_ipend
 
    subroutine test_real_blocks(error)
       type(error_type), allocatable, intent(out) :: error
       type(workspace_type) :: ws
       type(status_type) :: status
-      integer(i8), parameter :: thesis(8) = [524288_i8, 262144_i8, 12008_i8, 4002_i8, 4002_i8, 1048578_i8, &
-         1000_i8, 4002_i8]
       integer :: k
-      ! Thesis Table B.1 with its largest stiffness block, 2121244 words: MPEND = 3981268.
-      call workspace_layout(512, 1000, ws, status, stiffness_words=2121244_i8)
+      ! Thesis Table B.1 (femcod_thesis) with its largest stiffness block: the printed block
+      ! sizes and MPEND.
+      call workspace_layout(TABLE_B_NP, TABLE_B_MAXCONT, ws, status, stiffness_words=TABLE_B_1_STIFFNESS)
       do k = MPSURF, MPWORK
-         call check(error, int(ws%real_blocks(k)%size), int(thesis(k)), "size of "//ws%real_blocks(k)%name)
+         call check(error, int(ws%real_blocks(k)%size), int(TABLE_B_1_SIZES(k)), "size of "//ws%real_blocks(k)%name)
          if (allocated(error)) return
       end do
-      call check(error, int(ws%mpend), 3981268, "MPEND as printed in Table B.1")
+      call check(error, int(ws%mpend), int(TABLE_B_1_MPEND), "MPEND as printed in Table B.1")
    end subroutine test_real_blocks
 
    subroutine test_contiguous(error)
@@ -118,19 +119,22 @@ contains
       character(len=120), allocatable :: lines(:)
       integer :: k
       logical :: found(4)
-      call workspace_layout(512, 1000, ws, status)
+      call workspace_layout(TABLE_B_NP, TABLE_B_MAXCONT, ws, status)
       lines = workspace_table(ws)
       found = .false.
-      do k = 1, size(lines)
-         ! Table B.2: IPSORT first at 1 with NP^2 = 262144 words; IPEND = 284156.
-         if (index(lines(k), "IPSORT") == 1 .and. index(lines(k), " 1 ") > 0 .and. index(lines(k), "262144") > 0) &
-            found(1) = .true.
-         if (index(lines(k), "IPEND") == 1 .and. index(lines(k), "284156") > 0) found(2) = .true.
-         ! 284156 default integers of 4 bytes, by hand: 1136624 bytes.
-         if (index(lines(k), "total integer: 284156 words, 1136624 bytes") == 1) found(3) = .true.
-         ! MPCORD as the thesis prints it: 12008 words.
-         if (index(lines(k), "MPCORD") == 1 .and. index(lines(k), "12008") > 0) found(4) = .true.
-      end do
+      associate(ipend => int(TABLE_B_2_IPEND), np2 => TABLE_B_NP**2, mpcord => int(TABLE_B_1_SIZES(3)))
+         do k = 1, size(lines)
+            ! Table B.2 (femcod_thesis): IPSORT first at 1 with NP^2 words; IPEND.
+            if (index(lines(k), "IPSORT") == 1 .and. index(lines(k), " 1 ") > 0 .and. &
+               index(lines(k), to_string(np2)) > 0) found(1) = .true.
+            if (index(lines(k), "IPEND") == 1 .and. index(lines(k), to_string(ipend)) > 0) found(2) = .true.
+            ! IPEND default integers of 4 bytes each.
+            if (index(lines(k), "total integer: "//to_string(ipend)//" words, "//to_string(4*ipend)//" bytes") == 1) &
+               found(3) = .true.
+            ! MPCORD as the thesis prints it (Table B.1).
+            if (index(lines(k), "MPCORD") == 1 .and. index(lines(k), to_string(mpcord)) > 0) found(4) = .true.
+         end do
+      end associate
       call check(error, all(found), "IPSORT, IPEND, integer total and MPCORD lines as expected")
    end subroutine test_printed_table
 end module test_workspace

@@ -23,7 +23,7 @@ module femcod_event_search
    use femcod_incremental_state, only: incremental_state
    implicit none
    private
-   public :: event_search
+   public :: event_search, fft_search_pays
 
    !> One step's search and what it found; the FFT plans and fields are made on the
    !> first full-field search and kept for the run.
@@ -154,26 +154,34 @@ contains
       end associate
    end subroutine record_evaluation
 
-   !> Full-field search this step? options%event_search: "fft", "bound" or "auto".
-   !> Auto compares the last bound search's exact evaluations (neval n table look-ups,
-   !> about 2 ns each here) with two convolutions on the (2NP)^2 grid (about 5 ns per
-   !> point and level each), and tries the bound search again every 16th step. The rule
-   !> depends on the state only, never on timings, so runs and restarts repeat bit for bit.
+   !> Full-field search this step? options%event_search: "fft", "bound" or "auto" (the
+   !> cost model of fft_search_pays).
    logical function choose_fft(state, options)
       type(incremental_state), intent(in) :: state
       type(contact_options), intent(in) :: options
-      real(dp) :: m2
       select case (options%event_search)
       case ("fft")
          choose_fft = state%n > 0
       case ("bound")
          choose_fft = .false.
       case default
-         m2 = real(2*state%np, dp)**2
-         choose_fft = state%n > 0 .and. mod(state%step, 16) /= 0 .and. &
-            2.0e-9_dp*real(state%last_neval, dp)*state%n > 2*5.0e-9_dp*m2*log(m2)/log(2.0_dp)
+         choose_fft = fft_search_pays(state%np, state%n, state%last_neval, state%step)
       end select
    end function choose_fft
+
+   !> The "auto" rule: the full field pays at step `step` with n contacts on an NP x NP
+   !> grid when the last bound search's exact evaluations (last_neval n table look-ups,
+   !> about 2 ns each here) cost more than two convolutions on the (2NP)^2 grid (about
+   !> 5 ns per point and level each); every 16th step tries the bound search again. The
+   !> rule depends on the state only, never on timings, so runs and restarts repeat bit
+   !> for bit.
+   pure logical function fft_search_pays(np, n, last_neval, step)
+      integer, intent(in) :: np, n, last_neval, step
+      real(dp) :: m2
+      m2 = real(2*np, dp)**2
+      fft_search_pays = n > 0 .and. mod(step, 16) /= 0 .and. &
+         2.0e-9_dp*real(last_neval, dp)*n > 2*5.0e-9_dp*m2*log(m2)/log(2.0_dp)
+   end function fft_search_pays
 
    !> Gaps and closing rates of every pixel from two zero-padded FFT convolutions
    !> (accumulated and unit-load forces); every pixel whose closing load lies within the
