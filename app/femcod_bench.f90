@@ -10,6 +10,7 @@ module femcod_bench
    use femcod_solver_options, only: contact_options, cg_settings
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type, int_str, real_str, fixed_str
+   use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, flag_option, real_option, &
       integer_option, text_option, choice_option, real_list_option, integer_list_option, get_option, option_given
    use femcod_thesis, only: TABLE_4_1_APPROACH, TABLE_4_2_APPROACH
@@ -54,7 +55,7 @@ contains
       end if
       legacy_contacts = 300
       full = .false.
-      if (wants_help(args)) then
+      if (help_requested(args)) then
          write(output_unit, '(a)') "usage: femcod bench [--full] [--legacy-contacts N]", &
             "       femcod bench cg [--np LIST] [--contact LIST] [--tol T] [--peers PYTHON]  (--help for more)", &
             "       femcod bench convolution [--np LIST] [--repeat N]  (--help for more)", &
@@ -62,7 +63,7 @@ contains
             "event, peak memory (resident, per case), error against the reference. The rough surface:", &
             "self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa, nu = 0.25, against a", &
             "rigid flat (seed 1).", ""
-         call put_lines(option_help(bench_table(), ""))
+         call print_lines(option_help(bench_table(), ""))
          write(output_unit, '(a)') "Run it with the release build: fpm run --profile release -- bench"
          return
       end if
@@ -243,23 +244,7 @@ contains
       end if
    end function bad_arguments
 
-   !> Whether the arguments ask for help.
-   pure logical function wants_help(args)
-      type(string_type), intent(in) :: args(:)
-      integer :: k
-      wants_help = .false.
-      do k = 1, size(args)
-         if (args(k)%s == "--help" .or. args(k)%s == "-h") wants_help = .true.
-      end do
-   end function wants_help
 
-   subroutine put_lines(lines)
-      type(string_type), intent(in) :: lines(:)
-      integer :: k
-      do k = 1, size(lines)
-         write(output_unit, '(a)') lines(k)%s
-      end do
-   end subroutine put_lines
 
    !> `femcod bench cg`: the fixed-load solver on self-affine surfaces of growing size at
    !> the mean pressures that give about the requested contact fractions, side by side with
@@ -286,7 +271,7 @@ contains
       tol = 1.0e-8_dp
       python = ""
       wisdom = ""
-      if (wants_help(args)) then
+      if (help_requested(args)) then
          write(output_unit, '(a)') &
             "usage: femcod bench cg [--np 512,1024] [--contact 1,5,10] [--tol 1e-8] [--peers PYTHON]", &
             "The fixed-load solver (--solver cg) on the benchmark surface: self-affine, Hurst 0.8, rms 3 nm,", &
@@ -296,7 +281,7 @@ contains
             "solved from a cold start. The peers (aspher at every NP, contactmechanics at NP <= 512) run on", &
             "the same gaps, pressures and tolerance. --fftw-wisdom: the first run on a size pays the planning", &
             "inside its wall time.", ""
-         call put_lines(option_help(bench_cg_table(), ""))
+         call print_lines(option_help(bench_cg_table(), ""))
          write(output_unit, '(a)') "Run it with the release build.", &
             "Columns: NP, target %, solver, wall (s), iterations, residual, contact %, peak RSS (MB)."
          return
@@ -437,13 +422,13 @@ contains
       type(status_type) :: status
       sizes = [512, 1024, 2048]
       repeat = 5
-      if (wants_help(args)) then
+      if (help_requested(args)) then
          write(output_unit, '(a)') "usage: femcod bench convolution [--np 512,1024,2048] [--repeat 5]", &
             "One Love-kernel convolution on NP x NP by zero-padded (2NP)^2 FFTs, with FFTW's estimated and", &
             "measured plans (measured here, no wisdom): set-up time, time per convolution in double and", &
             "float32 (mean of --repeat, after one untimed), float32's largest difference from double, and", &
             "double's largest difference from the direct sum at three pixels, relative to the largest value.", ""
-         call put_lines(option_help(bench_convolution_table(), ""))
+         call print_lines(option_help(bench_convolution_table(), ""))
          write(output_unit, '(a)') "Run it with the release build."
          return
       end if

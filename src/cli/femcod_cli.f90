@@ -16,6 +16,7 @@ module femcod_cli
    use femcod_studies, only: resolution_command, summits_command, multiscale_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
+   use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
       real_option, integer_option, text_option, choice_option, get_option, option_given, refuse_options
    implicit none
@@ -112,23 +113,7 @@ contains
       code = status%code
    end subroutine command_usage
 
-   !> Whether the arguments ask for help.
-   pure logical function wants_help(args)
-      type(string_type), intent(in) :: args(:)
-      integer :: k
-      wants_help = .false.
-      do k = 1, size(args)
-         if (args(k)%s == "--help" .or. args(k)%s == "-h") wants_help = .true.
-      end do
-   end function wants_help
 
-   subroutine put_lines(lines)
-      type(string_type), intent(in) :: lines(:)
-      integer :: k
-      do k = 1, size(lines)
-         write(output_unit, '(a)') lines(k)%s
-      end do
-   end subroutine put_lines
 
    !> `femcod workspace NP MAXCONT`: one line per block, then the totals.
    subroutine workspace_command(args, code)
@@ -141,7 +126,7 @@ contains
       logical :: ok1, ok2
       character(len=120), allocatable :: lines(:)
       code = 0
-      if (wants_help(args)) then
+      if (help_requested(args)) then
          write(output_unit, '(a)') "usage: femcod workspace NP MAXCONT", &
             "Prints the memory map of the integer and real work arrays of Appendix B (Tables B.1, B.2):", &
             "block name, first address, size in words, contents; then IPEND, MPEND and the bytes they need.", &
@@ -228,20 +213,20 @@ contains
          "  self-affine   Gaussian random surface by FFT filtering, C(q) ~ q^-2(1+H) from 2pi/L to pi/d", &
          "  matrix        heights from --file", &
          "", "options:"
-      call put_lines(option_help(mkdeck_table(), ""))
-      call put_lines(option_help(mkdeck_table(), "kind"))
-      call put_lines(option_help(mkdeck_table(), "circle-punch|square-punch|sphere|flat|sinusoid|wm|self-affine"))
+      call print_lines(option_help(mkdeck_table(), ""))
+      call print_lines(option_help(mkdeck_table(), "kind"))
+      call print_lines(option_help(mkdeck_table(), "circle-punch|square-punch|sphere|flat|sinusoid|wm|self-affine"))
       write(output_unit, '(a)') "", "options of one or some kinds (refused with the others):"
-      call put_lines(option_help(mkdeck_table(), "circle-punch|sphere"))
-      call put_lines(option_help(mkdeck_table(), "circle-punch"))
-      call put_lines(option_help(mkdeck_table(), "circle-punch|square-punch|flat"))
-      call put_lines(option_help(mkdeck_table(), "sinusoid"))
-      call put_lines(option_help(mkdeck_table(), "wm"))
-      call put_lines(option_help(mkdeck_table(), "wm|self-affine"))
-      call put_lines(option_help(mkdeck_table(), "self-affine"))
-      call put_lines(option_help(mkdeck_table(), "matrix"))
+      call print_lines(option_help(mkdeck_table(), "circle-punch|sphere"))
+      call print_lines(option_help(mkdeck_table(), "circle-punch"))
+      call print_lines(option_help(mkdeck_table(), "circle-punch|square-punch|flat"))
+      call print_lines(option_help(mkdeck_table(), "sinusoid"))
+      call print_lines(option_help(mkdeck_table(), "wm"))
+      call print_lines(option_help(mkdeck_table(), "wm|self-affine"))
+      call print_lines(option_help(mkdeck_table(), "self-affine"))
+      call print_lines(option_help(mkdeck_table(), "matrix"))
       write(output_unit, '(a)') "", "verification decks:"
-      call put_lines(option_help(mkdeck_table(), "verification"))
+      call print_lines(option_help(mkdeck_table(), "verification"))
       write(output_unit, '(a)') "  names: circle_punch_d1 d3 d9 (Table 4.1), square_punch_n1 n3 n9 n27 (Table 4.2),", &
          "  sphere_d4 d2 d1 d05 (Figs. 4.14-4.16), rough_selfaffine_32."
    end subroutine mkdeck_help
@@ -334,7 +319,7 @@ contains
       character(len=:), allocatable :: output, verification, dir
       integer :: k
       code = 0
-      if (wants_help(args)) then
+      if (help_requested(args)) then
          call mkdeck_help()
          return
       end if
@@ -393,7 +378,7 @@ contains
       type(parsed_options) :: parsed
       character(len=:), allocatable :: output
       code = 0
-      if (wants_help(args)) then
+      if (help_requested(args)) then
          write(output_unit, '(a)') "usage: femcod verify [-o FILE]", &
             "Runs the legacy solver on the decks of input/ (run from the package root) and writes the", &
             "comparison with the thesis (Tables 4.1, 4.2, section 4.4.3, Fig. 5.2) to FILE", &

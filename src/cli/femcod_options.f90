@@ -484,16 +484,16 @@ contains
 
    ! ---- help ---------------------------------------------------------------------
 
-   !> One help line per option: "  --name VALUE   help", the help aligned in column 24
-   !> (a long name gets its help on the next line); options of a mode only when `mode`
-   !> names it ("" for the options that always apply).
+   !> The help of a table's options: "  --name VALUE   help", the help in column 25 and
+   !> wrapped at 100 columns (a long name gets its help on the next line); the options of
+   !> one mode (`mode` "" for those that always apply).
    function option_help(table, mode) result(lines)
       type(option_spec), intent(in) :: table(:)
       character(len=*), intent(in) :: mode
       type(string_type), allocatable :: lines(:)
-      character(len=:), allocatable :: head
-      integer, parameter :: column = 24
-      integer :: k
+      character(len=:), allocatable :: head, rest
+      integer, parameter :: column = 24, width = 100
+      integer :: k, cut
       allocate(lines(0))
       do k = 1, size(table)
          if (table(k)%mode /= mode) cycle
@@ -501,10 +501,20 @@ contains
          if (len(table(k)%alias) > 0) head = "  "//table(k)%alias//", "//table(k)%name
          if (table(k)%kind /= FLAG) head = head//" "//table(k)%value_name
          if (len(head) < column - 1) then
-            lines = [lines, string_type(head//repeat(" ", column - len(head))//table(k)%help)]
+            head = head//repeat(" ", column - len(head))
          else
-            lines = [lines, string_type(head), string_type(repeat(" ", column)//table(k)%help)]
+            lines = [lines, string_type(head)]
+            head = repeat(" ", column)
          end if
+         rest = table(k)%help
+         do while (len(head) + len(rest) > width)
+            cut = index(rest(1:width - len(head) + 1), " ", back=.true.)
+            if (cut <= 1) exit
+            lines = [lines, string_type(head//rest(1:cut - 1))]
+            rest = rest(cut + 1:)
+            head = repeat(" ", column)
+         end do
+         lines = [lines, string_type(head//rest)]
       end do
    end function option_help
 end module femcod_options

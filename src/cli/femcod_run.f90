@@ -28,6 +28,7 @@ module femcod_run
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_results, only: write_results, run_info, result_files
    use femcod_about, only: FEMCOD_VERSION
+   use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
       real_option, integer_option, text_option, choice_option, real_list_option, get_option, option_given, &
       refuse_options
@@ -107,8 +108,6 @@ contains
    end function run_table
 
    subroutine run_help()
-      type(string_type), allocatable :: lines(:)
-      integer :: k
       write(output_unit, '(a)') &
          "usage: femcod run DECK [DECK ...] [-o PREFIX] [--solver incremental|legacy|cg] [--loads F1,F2,...] [options]", &
          "       femcod run --lower FILE [--upper FILE] --pixel D [scene options] [options]", &
@@ -121,16 +120,16 @@ contains
          "COLHT, TRFACT, POSTP); cg: the state at each requested load only, by constrained conjugate", &
          "gradients (Polonsky-Keer) with FFT convolutions.", &
          ""
-      call put(option_help(run_table(), ""))
+      call print_lines(option_help(run_table(), ""))
       write(output_unit, '(a)') "", "event solvers (incremental, legacy):"
-      call put(option_help(run_table(), "event"))
+      call print_lines(option_help(run_table(), "event"))
       write(output_unit, '(a)') "", "incremental solver:"
-      call put(option_help(run_table(), "incremental"))
+      call print_lines(option_help(run_table(), "incremental"))
       write(output_unit, '(a)') "", "cg solver (needs --loads):"
-      call put(option_help(run_table(), "cg"))
-      write(output_unit, '(a)') "", "scene options, with --lower/--upper only (one scene; -o defaults to the first file's "// &
-         "name; the elastic body carries the heights, the other is rigid):"
-      call put(option_help(run_table(), "heights"))
+      call print_lines(option_help(run_table(), "cg"))
+      write(output_unit, '(a)') "", "scene options, with --lower/--upper only (one scene; -o defaults to the first", &
+         "file's name; the elastic body carries the heights, the other is rigid):"
+      call print_lines(option_help(run_table(), "heights"))
       write(output_unit, '(a)') "", &
          "outputs: PREFIX.history.csv (step,contacts,load_nN,approach_nm,area_nm2,area_fraction,", &
          "         n_above_hardness),", &
@@ -140,13 +139,6 @@ contains
          "         maps at each requested load; doc/results.md), PREFIX.xdmf (the maps for ParaView),", &
          "         PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg", &
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
-   contains
-      subroutine put(help)
-         type(string_type), intent(in) :: help(:)
-         do k = 1, size(help)
-            write(output_unit, '(a)') help(k)%s
-         end do
-      end subroutine put
    end subroutine run_help
 
    !> The arguments of `femcod run` as settings: parsed against run_table, the options
@@ -275,12 +267,10 @@ contains
       type(string_type), allocatable :: failed(:)
       integer :: d, rc
       code = 0
-      do d = 1, size(args)
-         if (args(d)%s == "--help" .or. args(d)%s == "-h") then
-            call run_help()
-            return
-         end if
-      end do
+      if (help_requested(args)) then
+         call run_help()
+         return
+      end if
       call parse_run_arguments(args, settings, status)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod run: "//status%message//" (femcod run --help)"

@@ -25,6 +25,7 @@ module femcod_studies
    use femcod_surfaces, only: remove_plane
    use femcod_richardson, only: power_law_fit
    use femcod_observer, only: solver_observer
+   use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
       real_option, integer_option, text_option, choice_option, real_list_option, integer_list_option, get_option, &
       option_given, refuse_options
@@ -77,9 +78,9 @@ contains
          "halving and MAXCONT scaled with the pixel count; the event-exact contact history at every level,", &
          "and beside it the estimates of Figs. 4.17, 4.18 and 4.21. FILE: heights (nm) as an ASCII matrix or", &
          "FILE.h5:/dataset on an elastic lower body (default 200 GPa, 0.25) against a rigid flat.", ""
-      call put_lines(option_help(resolution_table(), ""))
+      call print_lines(option_help(resolution_table(), ""))
       write(output_unit, '(a)') "with a height file (FILE --pixel D):"
-      call put_lines(option_help(resolution_table(), "heights"))
+      call print_lines(option_help(resolution_table(), "heights"))
       write(output_unit, '(a)') "", &
          "outputs: PREFIX.resolution.csv  np,method,load_nN,approach_nm,area_nm2 (one row per step and level)", &
          "         PREFIX.powerlaw.csv    np,exponent,prefactor (area = prefactor * load^exponent over the run)", &
@@ -95,23 +96,7 @@ contains
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
    end subroutine resolution_help
 
-   subroutine put_lines(lines)
-      type(string_type), intent(in) :: lines(:)
-      integer :: k
-      do k = 1, size(lines)
-         write(output_unit, '(a)') lines(k)%s
-      end do
-   end subroutine put_lines
 
-   !> Whether the arguments ask for help.
-   pure logical function wants_help(args)
-      type(string_type), intent(in) :: args(:)
-      integer :: k
-      wants_help = .false.
-      do k = 1, size(args)
-         if (args(k)%s == "--help" .or. args(k)%s == "-h") wants_help = .true.
-      end do
-   end function wants_help
 
    !> `femcod resolution`.
    subroutine resolution_command(args, code)
@@ -130,7 +115,7 @@ contains
       integer :: k, n
       logical :: force, quiet
       code = 0
-      if (wants_help(args)) then
+      if (help_requested(args)) then
          call resolution_help()
          return
       end if
@@ -480,10 +465,10 @@ contains
          "  region common to all sizes; at each summit the least-squares elliptic paraboloid with axes along x", &
          "  and y and its maximum at the summit pixel gives Rx, Ry; the radius is sqrt(Rx Ry). Heights are", &
          "  measured from the image's mean.", &
-         "  --sizes n1,...     neighbourhood sizes (default 1, 2, 3, 4, 6, 8, 11, 16, ... up to N/8)", &
          "  Profile PSD (eq. 2.12) over rows and columns, fractal dimension D = (5 + slope)/2 (eq. 3.1) fitted", &
-         "  from 4/L to 1/(4d); structure function (eq. 2.14), D = 2 - slope/2 (eq. 2.15) from d to L/16.", &
-         "", &
+         "  from 4/L to 1/(4d); structure function (eq. 2.14), D = 2 - slope/2 (eq. 2.15) from d to L/16.", ""
+      call print_lines(option_help(surface_table("summits"), ""))
+      write(output_unit, '(a)') "", &
          "outputs: PREFIX.summits.csv  box_nm,n,density_per_um2,mean_height_nm,mean_radius_nm", &
          "         PREFIX.summit_exponents.csv  quantity,exponent,prefactor (power laws against the box in nm)", &
          "         PREFIX.psd.csv  frequency_per_nm,power_nm3;  PREFIX.structure.csv  tau_nm,structure_nm2", &
@@ -527,7 +512,7 @@ contains
       integer, intent(out) :: code
       type(status_type) :: status
       code = 0
-      if (wants_help(args)) then
+      if (help_requested(args)) then
          code = -1
          return
       end if
@@ -686,16 +671,9 @@ contains
          "`femcod summits` gives the power laws of summit height, radius and density against the box size", &
          "and the roughness template (the summits of one size); the template is scaled to the finer length", &
          "scales d1/s^(k-1), and the load is shared down the scales by Hertz contacts (eqs. 3.9-3.13), with", &
-         "the close-packed and the asperity-density constraints on the asperities a host carries (3.3.1).", &
-         "  --template-size n  neighbourhood size of the template (default: the size whose summit count is", &
-         "                     nearest 100, as the thesis' template)", &
-         "  --s s1,...         length scaling constants (default 2.5,5,10)", &
-         "  --min-length L     finest length scale in nm (default 4: ten atomic spacings, the limit of", &
-         "                     the elastic solution); --scales K fixes the number of scales instead", &
-         "  --load F           total load in nN (default 1e6, 1 mN);  --estar E  composite modulus in GPa", &
-         "                     (default 200)", &
-         "  --exponents eh,eR,eN  override the power laws of the summit search", &
-         "", &
+         "the close-packed and the asperity-density constraints on the asperities a host carries (3.3.1).", ""
+      call print_lines(option_help(surface_table("multiscale"), ""))
+      write(output_unit, '(a)') "", &
          "outputs: PREFIX.multiscale.csv  s,constraint,scale,length_nm,load_nN,area_nm2,contacts", &
          "         PREFIX.multiscale.svg (area against the smallest length scale, Fig. 3.10)", &
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
