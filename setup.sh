@@ -1,19 +1,34 @@
 #!/usr/bin/env bash
-# femcod set-up for a fresh Debian 12 machine (root; reaches Debian's packages and PyPI).
-# Installs only what is missing, builds femcod, and runs the main job on the default deck.
-# Idempotent and quiet: a re-run that finds everything installed spends its time in the
-# build check and the run only.
-#   bash setup.sh            install + build + run input/sphere_d1.deck
-#   bash setup.sh --no-run   install + build only (used by .ci/run)
+# femcod set-up for a fresh Debian 12 machine (reaches Debian's packages and PyPI).
+# Installs only what is missing, builds femcod, installs it onto PATH and runs the main
+# job on the default deck. Idempotent and quiet: a re-run that finds everything installed
+# spends its time in the build check and the run only.
+#   bash setup.sh                 install + build + install femcod + run input/sphere_d1.deck
+#   bash setup.sh --no-run        the same without the run (CI)
+#   bash setup.sh --prefix DIR    install femcod into DIR/bin (default: /usr/local as root,
+#                                 ~/.local otherwise)
+# fpm comes from PyPI into its own virtual environment (Debian's pip refuses system
+# installs, PEP 668), linked into PREFIX/bin.
 set -euo pipefail
 cd "$(dirname "$0")"
 
 run_main=1
-[ "${1:-}" = "--no-run" ] && run_main=0
+if [ "$(id -u)" -eq 0 ]; then prefix=/usr/local; else prefix="$HOME/.local"; fi
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --no-run) run_main=0; shift ;;
+    --prefix) [ $# -ge 2 ] || { echo "setup: --prefix needs a directory" >&2; exit 2; }; prefix=$2; shift 2 ;;
+    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "setup: unknown argument $1 (setup.sh --help)" >&2; exit 2 ;;
+  esac
+done
+mkdir -p "$prefix/bin"
+prefix=$(cd "$prefix" && pwd)
 
 sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 
-debian_packages=(gfortran liblapack-dev libopenblas-dev libhdf5-dev libfftw3-dev pkg-config hdf5-tools)
+debian_packages=(gfortran liblapack-dev libopenblas-dev libhdf5-dev libfftw3-dev pkg-config hdf5-tools zlib1g-dev
+  python3-venv)
 missing=()
 for p in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -26,15 +41,23 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 if ! command -v fpm >/dev/null 2>&1; then
-  echo "setup: installing fpm 0.12.0 from PyPI"
-  python3 -m pip install -q --disable-pip-version-check --root-user-action=ignore fpm==0.12.0
-  fpm_bin=$(python3 -c 'import fpm,os;print(os.path.join(os.path.dirname(fpm.__file__),"fpm"))')
-  sudo_if_needed ln -sf "$fpm_bin" /usr/local/bin/fpm
+  venv="$prefix/lib/femcod-fpm"
+  echo "setup: installing fpm 0.12.0 from PyPI into $venv"
+  python3 -m venv "$venv"
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check fpm==0.12.0
+  fpm_bin=$("$venv/bin/python" -c 'import fpm,os;print(os.path.join(os.path.dirname(fpm.__file__),"fpm"))')
+  ln -sf "$fpm_bin" "$prefix/bin/fpm"
+  export PATH="$prefix/bin:$PATH"
 fi
 
 fpm build --profile release >/dev/null 2>build.log || { cat build.log >&2; exit 1; }
 rm -f build.log
+fpm install --profile release --prefix "$prefix" >/dev/null 2>&1 || { echo "setup: fpm install into $prefix failed" >&2; exit 1; }
+case ":$(printenv PATH):" in
+  *":$prefix/bin:"*) ;;
+  *) echo "setup: femcod is installed in $prefix/bin; add it to PATH (export PATH=\"$prefix/bin:\$PATH\")" ;;
+esac
 if [ "$run_main" -eq 1 ]; then
   mkdir -p out
-  fpm run --profile release femcod -- run input/sphere_d1.deck -o out/sphere_d1 --loads 100,1000,5000 --force
+  "$prefix/bin/femcod" run input/sphere_d1.deck -o out/sphere_d1 --loads 100,1000,5000 --force
 fi
