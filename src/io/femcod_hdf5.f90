@@ -13,8 +13,9 @@ module femcod_hdf5
       h5gcreate_f, h5gclose_f, h5screate_simple_f, h5screate_f, h5sclose_f, h5dcreate_f, h5dopen_f, h5dclose_f, &
       h5dwrite_f, h5dread_f, h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
       h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, h5oopen_f, h5oclose_f, h5tcopy_f, h5tset_size_f, &
-      h5tclose_f, h5lexists_f, h5aexists_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5S_SCALAR_F, H5T_NATIVE_DOUBLE, &
-      H5T_NATIVE_INTEGER, H5T_FORTRAN_S1
+      h5tclose_f, h5lexists_f, h5aexists_f, h5dget_type_f, h5tget_class_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
+      H5S_SCALAR_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_INTEGER_F, H5T_FLOAT_F, H5T_STRING_F, &
+      H5T_COMPOUND_F, H5T_ENUM_F
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    implicit none
@@ -459,7 +460,7 @@ contains
       dataset_path_exists = h5_exists(file, name)
    end function dataset_path_exists
 
-   !> Check rank and size, then read.
+   !> Check rank and type (integers or floating point only), then open for reading.
    subroutine read_checked(file, name, rank_wanted, dset, fdims, status, code)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name
@@ -467,8 +468,9 @@ contains
       integer(hid_t), intent(out) :: dset
       integer(hsize_t), intent(out) :: fdims(7)
       type(status_type), intent(inout) :: status
-      integer :: rank
+      integer :: rank, type_class, error
       integer(hsize_t) :: dims(7)
+      integer(hid_t) :: dtype
       dset = -1
       call h5_rank_and_dims(file, name, rank, dims, status, code)
       if (status%code /= 0) return
@@ -480,7 +482,46 @@ contains
       fdims = 0
       fdims(1:rank) = dims(rank:1:-1)
       call open_dataset(file, name, dset, status, code)
+      if (status%code /= 0) return
+      call h5dget_type_f(dset, dtype, error)
+      type_class = -1
+      if (error == 0) call h5tget_class_f(dtype, type_class, error)
+      if (error == 0) call h5tclose_f(dtype, error)
+      if (type_class /= H5T_INTEGER_F .and. type_class /= H5T_FLOAT_F) then
+         call h5dclose_f(dset, error)
+         dset = -1
+         call set_error(status, code, file%path//":"//name//": expected a numeric dataset (integers or floating "// &
+            "point), found "//type_name(type_class))
+      end if
    end subroutine read_checked
+
+   !> An HDF5 type class in words.
+   function type_name(type_class) result(name)
+      integer, intent(in) :: type_class
+      character(len=:), allocatable :: name
+      if (type_class == H5T_STRING_F) then
+         name = "strings"
+      else if (type_class == H5T_COMPOUND_F) then
+         name = "a compound type (complex numbers or records)"
+      else if (type_class == H5T_ENUM_F) then
+         name = "an enumeration (booleans)"
+      else
+         name = "a type of class "//char(48 + max(0, min(type_class, 9)))
+      end if
+   end function type_name
+
+   !> Close a dataset after reading; an error of the read or of the close is reported.
+   subroutine finish_read(file, name, dset, read_error, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(inout) :: dset
+      integer, intent(in) :: read_error, code
+      type(status_type), intent(inout) :: status
+      integer :: close_error
+      call h5dclose_f(dset, close_error)
+      if (read_error /= 0 .or. close_error /= 0) call set_error(status, code, file%path//":"//name// &
+         ": cannot read the dataset")
+   end subroutine finish_read
 
    subroutine read_real0(file, name, value, status, code)
       type(h5_file), intent(in) :: file
@@ -496,8 +537,7 @@ contains
       call read_checked(file, name, 0, dset, fdims, status, code)
       if (status%code /= 0) return
       call h5dread_f(dset, H5T_NATIVE_DOUBLE, value, fdims(1:0), error)
-      call h5dclose_f(dset, error)
-      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+      call finish_read(file, name, dset, error, status, code)
    end subroutine read_real0
 
    subroutine read_int0(file, name, value, status, code)
@@ -514,8 +554,7 @@ contains
       call read_checked(file, name, 0, dset, fdims, status, code)
       if (status%code /= 0) return
       call h5dread_f(dset, H5T_NATIVE_INTEGER, value, fdims(1:0), error)
-      call h5dclose_f(dset, error)
-      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+      call finish_read(file, name, dset, error, status, code)
    end subroutine read_int0
 
    subroutine read_real1(file, name, values, status, code)
@@ -534,8 +573,7 @@ contains
       deallocate(values)
       allocate(values(fdims(1)))
       call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, fdims(1:1), error)
-      call h5dclose_f(dset, error)
-      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+      call finish_read(file, name, dset, error, status, code)
    end subroutine read_real1
 
    subroutine read_int1(file, name, values, status, code)
@@ -554,8 +592,7 @@ contains
       deallocate(values)
       allocate(values(fdims(1)))
       call h5dread_f(dset, H5T_NATIVE_INTEGER, values, fdims(1:1), error)
-      call h5dclose_f(dset, error)
-      if (error /= 0) call set_error(status, code, file%path//":"//name//": cannot read the dataset")
+      call finish_read(file, name, dset, error, status, code)
    end subroutine read_int1
 
    !> A 2-D dataset as map(i, j) with i the C-order first index (the row).
@@ -575,11 +612,8 @@ contains
       if (status%code /= 0) return
       allocate(stored(fdims(1), fdims(2)))
       call h5dread_f(dset, H5T_NATIVE_DOUBLE, stored, fdims(1:2), error)
-      call h5dclose_f(dset, error)
-      if (error /= 0) then
-         call set_error(status, code, file%path//":"//name//": cannot read the dataset")
-         return
-      end if
+      call finish_read(file, name, dset, error, status, code)
+      if (status%code /= 0) return
       map = transpose(stored)
    end subroutine read_real2
 end module femcod_hdf5
