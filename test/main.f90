@@ -19,6 +19,7 @@ program tester
    use test_cg, only: collect_cg
    use test_studies, only: collect_studies
    use test_options, only: collect_options
+   use test_heights, only: collect_heights
    use test_architecture, only: collect_architecture
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
@@ -44,6 +45,7 @@ program tester
       new_testsuite("cg", collect_cg), &
       new_testsuite("studies", collect_studies), &
       new_testsuite("options", collect_options), &
+      new_testsuite("heights", collect_heights), &
       new_testsuite("architecture", collect_architecture) &
       ]
    stat = 0

@@ -51,7 +51,8 @@ contains
          new_unittest("bad deck: "//"binary content", bad_21), &
          new_unittest("bad deck: "//"header cut short", bad_22), &
          new_unittest("missing file, directory, empty file", test_bad_files), &
-         new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck) &
+         new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck), &
+         new_unittest("a UTF-8 byte order mark is not part of the label", test_bom) &
          ]
    end subroutine collect_deck
 
@@ -413,4 +414,19 @@ contains
       call check(error, .not. (file_exists(prefix//".history.csv") .or. file_exists(prefix//".loads.csv") .or. &
          file_exists(prefix//".contacts.csv")), "no result file is written")
    end subroutine test_run_bad_deck
+
+   !> Editors on some systems start a UTF-8 file with the bytes EF BB BF: the deck reads,
+   !> and its label is the text after them.
+   subroutine test_bom(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      character(len=*), parameter :: nl = new_line("a")
+      call write_text(scratch_path("bom.deck"), achar(239)//achar(187)//achar(191)//"with a BOM"//nl//"1 1 1"//nl// &
+         "200 0.25"//nl//"200 0.25"//nl//"200 0.25"//nl//"0"//nl//"0"//nl)
+      call read_deck(scratch_path("bom.deck"), deck, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, deck%label, "with a BOM")
+   end subroutine test_bom
 end module test_deck

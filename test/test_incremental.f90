@@ -277,6 +277,8 @@ contains
       spec%matrix_file = ""
       spec%maxcont = 150
       call build_problem(spec, deck, status)
+      call check(error, status%code, 0, "the scene: "//status%message)
+      if (allocated(error)) return
       saved = omp_get_max_threads()
       allocate(t(0:63, 0:63, 2))
       do k = 1, 2
@@ -288,6 +290,8 @@ contains
          options%event_search = "fft"
          allocate(options%loads(0))
          call solve_contact(deck, options, res(k), status)
+         call check(error, status%code, 0, "incremental, "//to_string(k)//" threads: "//status%message)
+         if (allocated(error)) exit
          options%solver = "cg"
          options%loads = [res(k)%step_load(res(k)%nsteps)/2]
          call solve_contact(deck, options, cg(k), status)

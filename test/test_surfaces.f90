@@ -7,7 +7,7 @@ module test_surfaces
    use femcod_surfaces, only: circle_punch, square_punch, sphere_cap, wm_terms, self_affine_surface, remove_plane, &
       rms_height, sinusoid_surface, downsample_average, downsample_subsample
    use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS
-   use femcod_heights, only: read_ascii_matrix
+   use femcod_heights, only: read_heights
    use femcod_scene, only: initial_gaps, flip_upper
    use test_support, only: write_text, read_text, scratch_path, contains_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
@@ -146,18 +146,18 @@ contains
       character(len=*), parameter :: nl = new_line("a")
       call write_text(scratch_path("m.txt"), "# Channel: Height"//nl//"# Unit: nm"//nl//"1"//achar(9)//"2"//nl// &
          "3 4"//achar(13)//nl)
-      call read_ascii_matrix(scratch_path("m.txt"), z, status)
+      call read_heights(scratch_path("m.txt"), z, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
       call check(error, z(1, 2) == 2 .and. z(2, 1) == 3, "row i, column j as in the file")
       if (allocated(error)) return
       call write_text(scratch_path("m.txt"), "1 2"//nl//"3"//nl)
-      call read_ascii_matrix(scratch_path("m.txt"), z, status)
+      call read_heights(scratch_path("m.txt"), z, status)
       call check(error, status%code == 3 .and. contains_text(status%message, ":2:"), "ragged row: "//status%message)
       if (allocated(error)) return
       status%code = 0
       call write_text(scratch_path("m.txt"), "1 2"//nl//"3 x"//nl)
-      call read_ascii_matrix(scratch_path("m.txt"), z, status)
+      call read_heights(scratch_path("m.txt"), z, status)
       call check(error, status%code == 3 .and. contains_text(status%message, ":2:"), "bad number: "//status%message)
    end subroutine test_matrix
 

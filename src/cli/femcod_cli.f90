@@ -286,6 +286,9 @@ contains
       call get_option(parsed, "--rigid", text)
       if (text /= "") spec%rigid = text
       call get_option(parsed, "--remove-plane", spec%plane)
+      text = ""
+      call get_option(parsed, "--height-unit", text)
+      if (text /= "") spec%height_unit = text
       call get_option(parsed, "--np", spec%np)
       call get_option(parsed, "--maxcont", spec%maxcont)
       call get_option(parsed, "--seed", spec%seed)

@@ -5,7 +5,8 @@
 !> come back as a status (STATUS_USAGE) with the message the command prints.
 !>
 !> The scene options shared by `run`, `mkdeck` and the studies (`--pixel`, `--young`,
-!> `--poisson`, `--rigid`, `--rigid-factor`, `--maxcont`, `--remove-plane`, `--label`)
+!> `--poisson`, `--rigid`, `--rigid-factor`, `--maxcont`, `--remove-plane`,
+!> `--height-unit`, `--label`)
 !> are declared once (scene_options), so they are validated the same way everywhere.
 module femcod_options
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -134,7 +135,8 @@ contains
       character(len=*), intent(in) :: mode
       type(option_spec), allocatable :: specs(:)
       specs = [ &
-         real_option("--pixel", "D", "pixel size in nm", lower=0.0_dp, closed="()", mode=mode), &
+         real_option("--pixel", "D", "pixel size in nm (height files that give theirs need none)", lower=0.0_dp, &
+            upper=1.0e6_dp, closed="(]", mode=mode), &
          real_option("--young", "E", "Young's modulus of the elastic body in GPa (default 200)", lower=0.0_dp, &
             closed="()", mode=mode), &
          real_option("--poisson", "NU", "Poisson's ratio of the elastic body (default 0.25)", lower=-1.0_dp, &
@@ -144,6 +146,8 @@ contains
             "elastic one (default 1e10)", lower=1.0_dp, mode=mode), &
          integer_option("--maxcont", "M", "maximum contacts (default 5 % of the pixels)", lower=1, mode=mode), &
          flag_option("--remove-plane", "subtract each surface's least-squares plane", mode=mode), &
+         choice_option("--height-unit", "m|mm|um|nm|A|pm", "unit of the heights in files that do not state theirs "// &
+            "(default nm; Gwyddion and NanoScope files do)", mode=mode), &
          text_option("--label", "TEXT", "the problem's label (first line of a deck)", mode=mode)]
    end function scene_options
 

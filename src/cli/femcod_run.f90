@@ -101,8 +101,9 @@ contains
          integer_option("--max-iterations", "N", "iterations on the finest grid (default 2000)", lower=1, mode="cg"), &
          text_option("--fftw-wisdom", "FILE", "FFTW measures its plans once and keeps them in FILE and FILE.float32 "// &
             "(seconds of planning the first time, faster transforms)", mode="cg"), &
-         text_option("--lower", "FILE", "lower surface heights (nm): an ASCII matrix, or FILE.h5:/dataset (square, "// &
-            "C order: data[i, j] is row i, column j)"), &
+         text_option("--lower", "FILE", "lower surface heights: an ASCII matrix (a Gwyddion export with its "// &
+            "units and width), FILE.h5:/dataset (square, C order: data[i, j] is row i, column j), or a NanoScope "// &
+            "file FILE[:CHANNEL] (.di, .spm, .000; the height channel by default)"), &
          text_option("--upper", "FILE", "upper surface heights, the same formats (missing: flat)"), &
          scene_options("heights")]
    end function run_table
@@ -110,7 +111,7 @@ contains
    subroutine run_help()
       write(output_unit, '(a)') &
          "usage: femcod run DECK [DECK ...] [-o PREFIX] [--solver incremental|legacy|cg] [--loads F1,F2,...] [options]", &
-         "       femcod run --lower FILE [--upper FILE] --pixel D [scene options] [options]", &
+         "       femcod run --lower FILE [--upper FILE] [--pixel D] [scene options] [options]", &
          "", &
          "Contact history of each deck, step by step (thesis chapter 4, Appendix B). With several decks", &
          "(batch) each gets its own outputs named after it; a bad deck is reported and the others still", &
@@ -207,10 +208,6 @@ contains
             call set_error(status, STATUS_USAGE, "give either DECK files or --lower/--upper height files, not both")
             return
          end if
-         if (.not. option_given(parsed, "--pixel")) then
-            call set_error(status, STATUS_USAGE, "--lower/--upper need --pixel D, the pixel size in nm")
-            return
-         end if
          associate(spec => settings%scene)
             spec%kind = "matrix"
             spec%label = ""
@@ -222,6 +219,7 @@ contains
             call get_option(parsed, "--rigid-factor", spec%rigid_factor)
             call get_option(parsed, "--maxcont", spec%maxcont)
             call get_option(parsed, "--remove-plane", spec%plane)
+            if (option_given(parsed, "--height-unit")) spec%height_unit = option_value(parsed, "--height-unit")
             ! The surface given alone carries the shape, on the lower body; with both, the
             ! upper file is the shape and the lower the other surface.
             if (len(upper) == 0) then
@@ -313,13 +311,18 @@ contains
       type(incremental_state) :: resume
       type(state_maps), allocatable :: maps(:)
       type(run_info) :: info
+      type(string_type), allocatable :: inputs(:), warnings(:)
       logical :: resuming, ok
       integer :: k
       rc = 0
       if (deck_path == "") then
-         call load_scene(settings%scene, problem, st)
+         call load_scene(settings%scene, problem, st, inputs, warnings)
+         do k = 1, size(warnings)
+            write(error_unit, '(a)') "femcod: warning: "//warnings(k)%s
+         end do
       else
          call read_deck(deck_path, problem, st)
+         inputs = [string_type(deck_path//": femcod deck")]
       end if
       associate(options => settings%solve)
          ! With --restart, result files are leftovers of the interrupted run while its
@@ -376,6 +379,7 @@ contains
             info%solver = trim(options%solver)
             info%options = settings%command_line
             info%scene = model_notes(problem, options)
+            info%inputs = inputs
             call load_maps(problem, res%states, maps)
             call write_results(prefix, problem, res, maps, info, st)
          end if

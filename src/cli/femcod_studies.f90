@@ -11,7 +11,7 @@ module femcod_studies
    use femcod_strings, only: string_type, int_str, real_str, split_list, text_builder, add_line, built_text, &
       parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
    use femcod_generate, only: scene_spec
-   use femcod_heights, only: load_scene, read_heights
+   use femcod_heights, only: load_scene, read_height_map, height_map, is_height_file
    use femcod_files, only: default_prefix, file_part
    use femcod_files, only: path_exists
    use femcod_results, only: write_file_set
@@ -35,7 +35,7 @@ module femcod_studies
 
    !> Options shared by `summits` and `multiscale`.
    type :: surface_options
-      character(len=:), allocatable :: input, prefix
+      character(len=:), allocatable :: input, prefix, height_unit
       real(dp) :: pixel = 0
       logical :: plane = .false., force = .false., quiet = .false.
       integer, allocatable :: sizes(:)
@@ -125,7 +125,8 @@ contains
          if (size(parsed%positional) > 1) call set_error(status, STATUS_USAGE, "one input only (found '"// &
             parsed%positional(1)%s//"' and '"//parsed%positional(2)%s//"')")
       end if
-      if (status%code == 0) call refuse_options(parsed, merge("heights", "       ", option_given(parsed, "--pixel")), &
+      if (status%code == 0) call refuse_options(parsed, merge("heights", "       ", option_given(parsed, "--pixel") .or. &
+         is_height_file(parsed%positional(1)%s)), &
          "heights=to a height file (FILE --pixel D), not to a deck", status)
       if (status%code /= 0) then
          call usage(status%message)
@@ -372,6 +373,11 @@ contains
       call get_option(parsed, "--maxcont", spec%maxcont)
       call get_option(parsed, "--remove-plane", spec%plane)
       call get_option(parsed, "--rigid-factor", spec%rigid_factor)
+      if (option_given(parsed, "--height-unit")) then
+         text = ""
+         call get_option(parsed, "--height-unit", text)
+         spec%height_unit = text
+      end if
       text = ""
       call get_option(parsed, "--rigid", text)
       if (text /= "") spec%rigid = text
@@ -383,7 +389,7 @@ contains
       type(scene_spec), intent(in) :: spec
       type(contact_problem), intent(out) :: deck
       type(status_type), intent(inout) :: status
-      if (spec%pixel > 0) then
+      if (spec%pixel > 0 .or. is_height_file(input)) then
          call load_scene(spec, deck, status)
       else
          call read_deck(input, deck, status)
@@ -427,17 +433,30 @@ contains
 
    !> Heights for the surface studies: a height file (with --pixel) or a deck, whose
    !> composite roughness (lower surface plus the upper as it faces it) is analysed.
-   subroutine study_heights(input, pixel, plane, z, d, status)
+   subroutine study_heights(input, pixel, plane, z, d, status, height_unit)
       character(len=*), intent(in) :: input
       real(dp), intent(in) :: pixel
       logical, intent(in) :: plane
       real(dp), allocatable, intent(out) :: z(:, :)
       real(dp), intent(out) :: d
       type(status_type), intent(inout) :: status
+      character(len=*), intent(in) :: height_unit
       type(contact_problem) :: deck
-      if (pixel > 0) then
-         call read_heights(input, z, status)
+      type(height_map) :: map
+      integer :: k
+      if (pixel > 0 .or. is_height_file(input)) then
+         call read_height_map(input, map, status, height_unit)
+         if (status%code /= 0) return
+         do k = 1, size(map%warnings)
+            write(error_unit, '(a)') "femcod: warning: "//map%warnings(k)%s
+         end do
          d = pixel
+         if (.not. d > 0) d = map%pixel_x
+         if (.not. d > 0) then
+            call set_error(status, STATUS_USAGE, input//" does not give its pixel size: give --pixel D (nm)")
+            return
+         end if
+         call move_alloc(map%z, z)
       else
          call read_deck(input, deck, status)
          if (status%code /= 0) return
@@ -445,6 +464,11 @@ contains
          d = deck%pixel
       end if
       if (status%code /= 0) return
+      if (size(z, 1) /= size(z, 2)) then
+         call set_error(status, STATUS_BAD_INPUT, input//": expected a square matrix of heights, found "// &
+            int_str(size(z, 1))//" rows of "//int_str(size(z, 2))//" values")
+         return
+      end if
       if (size(z, 1) < 5) then
          call set_error(status, STATUS_BAD_INPUT, input//": expected at least 5 x 5 heights for a surface study, found "// &
             int_str(size(z, 1))//" x "//int_str(size(z, 2)))
@@ -458,8 +482,8 @@ contains
          "usage: femcod summits FILE [--pixel D] [--sizes 1,2,3,...] [--remove-plane] [-o PREFIX] [--force] [--quiet]", &
          "", &
          "The surface analysis of the thesis, chapter 3. FILE is a deck (its composite roughness: the lower", &
-         "surface plus the upper one as it faces it) or, with --pixel D (nm), heights (nm) as an ASCII matrix", &
-         "or FILE.h5:/dataset.", &
+         "surface plus the upper one as it faces it) or a height file: an ASCII matrix (with --pixel D, nm),", &
+         "a Gwyddion export, FILE.h5:/dataset, or a NanoScope file FILE[:CHANNEL].", &
          "  Summit search (section 3.2): for each neighbourhood size n the box is d_n = (2n+1) L/N (eq. 3.2);", &
          "  a summit is higher than its 8 neighbours and the highest pixel of its box, searched in the central", &
          "  region common to all sizes; at each summit the least-squares elliptic paraboloid with axes along x", &
@@ -488,6 +512,8 @@ contains
          integer_list_option("--sizes", "n1,...", "neighbourhood sizes (default 1, 2, 3, 4, 6, 8, 11, 16, ... up "// &
             "to N/8)", lower=1), &
          flag_option("--remove-plane", "subtract the least-squares plane"), &
+         choice_option("--height-unit", "m|mm|um|nm|A|pm", "unit of the heights in files that do not state theirs "// &
+            "(default nm)"), &
          flag_option("--force", "replace existing result files"), &
          flag_option("--quiet", "no summary", alias="-q")]
       if (command /= "multiscale") return
@@ -518,6 +544,7 @@ contains
       end if
       opts%input = ""
       opts%prefix = ""
+      opts%height_unit = ""
       allocate(opts%sizes(0))
       call parse_options(surface_table(command), args, parsed, status)
       if (status%code == 0) then
@@ -535,6 +562,7 @@ contains
       call get_option(parsed, "--pixel", opts%pixel)
       call get_option(parsed, "--sizes", opts%sizes)
       call get_option(parsed, "--remove-plane", opts%plane)
+      call get_option(parsed, "--height-unit", opts%height_unit)
       call get_option(parsed, "--force", opts%force)
       call get_option(parsed, "--quiet", opts%quiet)
       if (opts%prefix == "") opts%prefix = default_prefix(file_part(opts%input))
@@ -567,7 +595,7 @@ contains
          return
       end if
       if (code /= 0) return
-      call study_heights(opts%input, opts%pixel, opts%plane, z, d, status)
+      call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
       if (status%code /= 0) then
          call fail_with("summits", status, code)
          return
@@ -719,7 +747,7 @@ contains
       call get_option(parsed, "--min-length", min_length)
       call get_option(parsed, "--scales", scales)
       call get_option(parsed, "--template-size", tsize)
-      call study_heights(opts%input, opts%pixel, opts%plane, z, d, status)
+      call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
       if (status%code /= 0) then
          call fail_with("multiscale", status, code)
          return

@@ -2,11 +2,12 @@
 !> atomic replacement of a file by a temporary one, removal, existence and kind.
 module femcod_files
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
-   use femcod_status, only: status_type, set_error, STATUS_IO
+   use femcod_kinds, only: i8
+   use femcod_status, only: status_type, set_error, STATUS_IO, STATUS_BAD_INPUT
    implicit none
    private
    public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, commit_file
-   public :: default_prefix, file_part
+   public :: default_prefix, file_part, read_file
 
    interface
       function c_rename(from, to) bind(c, name="rename") result(rc)
@@ -104,4 +105,49 @@ contains
          end select
       end if
    end function default_prefix
+
+   !> The bytes of a whole input file. `what` names the file in messages ("a deck
+   !> file"); a missing file, a directory, an unreadable or empty file is an error
+   !> (STATUS_BAD_INPUT) saying which.
+   subroutine read_file(path, what, text, status)
+      character(len=*), intent(in) :: path, what
+      character(len=:), allocatable, intent(out) :: text
+      type(status_type), intent(inout) :: status
+      integer :: unit, ios
+      integer(i8) :: nbytes
+      if (path_is_directory(path)) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected "//what//", found a directory")
+         return
+      end if
+      if (.not. path_exists(path)) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected "//what//", found no such file")
+         return
+      end if
+      open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected "//what//", cannot open it")
+         return
+      end if
+      inquire(unit=unit, size=nbytes)
+      if (nbytes <= 0) then
+         close(unit)
+         call set_error(status, STATUS_BAD_INPUT, path//":1: expected "//what//", found an empty file")
+         return
+      end if
+      allocate(character(len=nbytes) :: text, stat=ios)
+      if (ios /= 0) then
+         close(unit)
+         call set_error(status, STATUS_BAD_INPUT, path//": cannot hold its "//trim(i8_text(nbytes))//" bytes in memory")
+         return
+      end if
+      read(unit, iostat=ios) text
+      close(unit)
+      if (ios /= 0) call set_error(status, STATUS_BAD_INPUT, path//": expected "//what//", reading failed")
+   contains
+      function i8_text(v) result(t)
+         integer(i8), intent(in) :: v
+         character(len=24) :: t
+         write(t, '(i0)') v
+      end function i8_text
+   end subroutine read_file
 end module femcod_files

@@ -13,9 +13,10 @@
 !> and what was expected and found (doc/deck-format.md).
 module femcod_deck
    use femcod_kinds, only: dp, i8
-   use femcod_problem, only: contact_problem, validate_problem, MAX_NP
+   use femcod_problem, only: contact_problem, validate_problem, MAX_NP, MIN_PIXEL, MAX_PIXEL, MAX_HEIGHT, &
+      MIN_YOUNG, MAX_YOUNG
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
-   use femcod_files, only: commit_file, temporary_name, path_exists, path_is_directory
+   use femcod_files, only: commit_file, temporary_name, read_file
    use femcod_strings, only: int_str, parse_real, parse_integer, format_real, is_digit
    implicit none
    private
@@ -40,8 +41,12 @@ contains
       character(len=24) :: count_text
       integer :: ln_first(2:5), ln_count(2:5)
 
-      call read_whole_file(path, text, status)
-      if (status%code /= 0) return
+      call read_file(path, "a deck file", text, status)
+      if (status%code /= 0) then
+         if (index(status%message, "empty file") > 0) status%message = path//":1: expected a label line, found an "// &
+            "empty file"
+         return
+      end if
       call check_text(path, text, status)
       if (status%code /= 0) return
       call tokenize(text, ntok, tok_first, tok_last, tok_line, last_line)
@@ -69,10 +74,10 @@ contains
          call bad(2, "NP, an integer from 1 to "//int_str(MAX_NP), tok(ln_first(2)))
          return
       end if
-      call get_real(ln_first(2) + 1, "PIXEL, the pixel size in nm (> 0)", deck%pixel)
+      call get_real(ln_first(2) + 1, "PIXEL, the pixel size in nm (1e-6 to 1e6)", deck%pixel)
       if (status%code /= 0) return
-      if (.not. deck%pixel > 0) then
-         call bad(2, "PIXEL, the pixel size in nm (> 0)", tok(ln_first(2) + 1))
+      if (.not. (deck%pixel >= MIN_PIXEL .and. deck%pixel <= MAX_PIXEL)) then
+         call bad(2, "PIXEL, the pixel size in nm (1e-6 to 1e6)", tok(ln_first(2) + 1))
          return
       end if
       call get_int(ln_first(2) + 2, "MAXCONT, a positive integer", deck%maxcont)
@@ -84,10 +89,10 @@ contains
       do i = 1, 3
          call expect_count(2 + i, 2, "E"//int_str(i)//" NU"//int_str(i)//" of the "//trim(material_names(i)))
          if (status%code /= 0) return
-         call get_real(ln_first(2 + i), "E"//int_str(i)//", Young's modulus in GPa (> 0)", deck%young(i))
+         call get_real(ln_first(2 + i), "E"//int_str(i)//", Young's modulus in GPa (1e-12 to 1e300)", deck%young(i))
          if (status%code /= 0) return
-         if (.not. deck%young(i) > 0) then
-            call bad(2 + i, "E"//int_str(i)//", Young's modulus in GPa (> 0)", tok(ln_first(2 + i)))
+         if (.not. (deck%young(i) >= MIN_YOUNG .and. deck%young(i) <= MAX_YOUNG)) then
+            call bad(2 + i, "E"//int_str(i)//", Young's modulus in GPa (1e-12 to 1e300)", tok(ln_first(2 + i)))
             return
          end if
          call get_real(ln_first(2 + i) + 1, "NU"//int_str(i)//", Poisson's ratio in (-1, 0.5)", deck%poisson(i))
@@ -120,6 +125,10 @@ contains
             call get_real(k, "a lower-surface height in nm (row "//int_str(i)//", column "//int_str(j)//")", &
                deck%lower(i, j))
             if (status%code /= 0) return
+            if (abs(deck%lower(i, j)) > MAX_HEIGHT) then
+               call bad(tok_line(k), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", tok(k))
+               return
+            end if
             k = k + 1
          end do
       end do
@@ -128,6 +137,10 @@ contains
             call get_real(k, "an upper-surface height in nm (row "//int_str(i)//", column "//int_str(j)//")", &
                deck%upper(i, j))
             if (status%code /= 0) return
+            if (abs(deck%upper(i, j)) > MAX_HEIGHT) then
+               call bad(tok_line(k), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", tok(k))
+               return
+            end if
             k = k + 1
          end do
       end do
@@ -228,43 +241,26 @@ contains
 
 
 
-   !> Read a whole file as bytes.
-   subroutine read_whole_file(path, text, status)
-      character(len=*), intent(in) :: path
-      character(len=:), allocatable, intent(out) :: text
-      type(status_type), intent(inout) :: status
-      integer :: unit, ios
-      integer(i8) :: nbytes
-      if (path_is_directory(path)) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected a deck file, found a directory")
-         return
-      end if
-      if (.not. path_exists(path)) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected a deck file, found no such file")
-         return
-      end if
-      open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
-      if (ios /= 0) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected a readable deck file, cannot open it")
-         return
-      end if
-      inquire(unit=unit, size=nbytes)
-      if (nbytes <= 0) then
-         close(unit)
-         call set_error(status, STATUS_BAD_INPUT, path//":1: expected a label line, found an empty file")
-         return
-      end if
-      allocate(character(len=nbytes) :: text)
-      read(unit, iostat=ios) text
-      close(unit)
-      if (ios /= 0) call set_error(status, STATUS_BAD_INPUT, path//": expected a readable deck file, reading failed")
-   end subroutine read_whole_file
-
-   !> Refuse binary content: control bytes other than TAB, LF, CR and FF, or NUL.
+   !> Refuse what is not a text deck: UTF-16 (a byte order mark, or NUL bytes between
+   !> the characters), and binary content (control bytes other than TAB, LF, CR and FF).
+   !> A UTF-8 byte order mark is dropped (editors on some systems write one).
    subroutine check_text(path, text, status)
-      character(len=*), intent(in) :: path, text
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable, intent(inout) :: text
       type(status_type), intent(inout) :: status
       integer :: i, line, c
+      if (len(text) >= 3) then
+         if (text(1:3) == achar(239)//achar(187)//achar(191)) text = text(4:)
+      end if
+      if (len(text) >= 2) then
+         if (text(1:2) == achar(255)//achar(254) .or. text(1:2) == achar(254)//achar(255) .or. &
+            (len(text) >= 4 .and. (text(2:2) == achar(0) .and. text(4:4) == achar(0) .or. &
+            text(1:1) == achar(0) .and. text(3:3) == achar(0)))) then
+            call set_error(status, STATUS_BAD_INPUT, path//":1: expected a text deck in ASCII or UTF-8, found "// &
+               "UTF-16 text (convert it, for example: iconv -f UTF-16 -t UTF-8 "//path//" > deck.txt)")
+            return
+         end if
+      end if
       line = 1
       do i = 1, len(text)
          c = iachar(text(i:i))
@@ -272,7 +268,8 @@ contains
             line = line + 1
          else if ((c < 32 .and. c /= 9 .and. c /= 13 .and. c /= 12) .or. c == 127) then
             call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(line)// &
-               ": expected a text deck, found binary content (byte "//int_str(c)//")")
+               ": expected a text deck, found a binary control character (code "//int_str(c)//") at byte "// &
+               int_str(i))
             return
          end if
       end do

@@ -26,6 +26,9 @@ module femcod_results
       character(len=:), allocatable :: version, solver, options
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
+      !> The input files, one line each: the deck, or what each height file gave
+      !> (format, channel, instrument, grid, scan and pixel size).
+      type(string_type), allocatable :: inputs(:)
    end type run_info
 
 contains
@@ -314,6 +317,7 @@ contains
          if (k < size(info%scene)) scene = scene//"; "
       end do
       call h5_attribute(file, "/run", "scene_left_out", scene, local)
+      if (allocated(info%inputs)) call h5_attribute(file, "/run", "inputs", joined(info%inputs), local)
       call h5_write(file, "/run/missed_during_run", res%missed_during_run, "1", local)
       call h5_write(file, "/run/missed_final_check", res%missed_final_check, "1", local)
       call h5_write(file, "/run/max_penetration", res%max_penetration, "nm", local)
@@ -411,4 +415,16 @@ contains
       character(len=:), allocatable :: name
       name = path(index(path, "/", back=.true.) + 1:)
    end function base_name
+
+   !> Lines joined by "; ".
+   function joined(lines) result(text)
+      type(string_type), intent(in) :: lines(:)
+      character(len=:), allocatable :: text
+      integer :: k
+      text = ""
+      do k = 1, size(lines)
+         text = text//lines(k)%s
+         if (k < size(lines)) text = text//"; "
+      end do
+   end function joined
 end module femcod_results

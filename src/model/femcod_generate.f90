@@ -35,8 +35,10 @@ module femcod_generate
    !> What to generate. Lengths in nm, moduli in GPa.
    type :: scene_spec
       character(len=:), allocatable :: kind, label, matrix_file
-      !> With kind "matrix": heights of the other surface from a second file ("": flat).
+      !> With kind "matrix": heights of the other surface from a second file ("": flat),
+      !> and the unit of heights in files that do not state theirs ("": nm).
       character(len=:), allocatable :: second_file
+      character(len=8) :: height_unit = ""
       integer :: np = 0, maxcont = 0, seed = 1, ridges = 10
       real(dp) :: pixel = 0
       real(dp) :: young = 200, poisson = 0.25_dp

@@ -13,10 +13,15 @@ module femcod_problem
    use femcod_strings, only: int_str
    implicit none
    private
-   public :: contact_problem, validate_problem, MAX_NP
+   public :: contact_problem, validate_problem, MAX_NP, MIN_PIXEL, MAX_PIXEL, MAX_HEIGHT, MIN_YOUNG, MAX_YOUNG
 
    !> Largest NP accepted: NP**2 must fit a default integer.
    integer, parameter :: MAX_NP = 46340
+   !> The ranges femcod computes in without overflow (compliances 1/(pi E d), areas
+   !> NP^2 d^2, gaps of heights): pixels from 1e-6 nm to 1 mm, heights within 1 km,
+   !> moduli from 1e-12 GPa (1 mPa) to 1e300 GPa (a rigid body's stand-in).
+   real(dp), parameter :: MIN_PIXEL = 1.0e-6_dp, MAX_PIXEL = 1.0e6_dp, MAX_HEIGHT = 1.0e12_dp
+   real(dp), parameter :: MIN_YOUNG = 1.0e-12_dp, MAX_YOUNG = 1.0e300_dp
 
    !> A contact problem: what a deck (or a pair of height files) describes.
    type :: contact_problem
@@ -46,8 +51,8 @@ contains
       integer :: i
       if (deck%np <= 0 .or. deck%np > MAX_NP) then
          call set_error(status, STATUS_BAD_INPUT, "NP must be from 1 to "//int_str(MAX_NP))
-      else if (.not. (deck%pixel > 0 .and. ieee_is_finite(deck%pixel))) then
-         call set_error(status, STATUS_BAD_INPUT, "PIXEL must be a finite positive size in nm")
+      else if (.not. (deck%pixel >= MIN_PIXEL .and. deck%pixel <= MAX_PIXEL)) then
+         call set_error(status, STATUS_BAD_INPUT, "PIXEL must be a size from 1e-6 to 1e6 nm")
       else if (deck%maxcont <= 0 .or. deck%maxcont > deck%np**2) then
          call set_error(status, STATUS_BAD_INPUT, "MAXCONT must be from 1 to NP**2")
       else if (index(deck%label, new_line("a")) > 0) then
@@ -55,8 +60,8 @@ contains
       end if
       if (status%code /= 0) return
       do i = 1, 3
-         if (.not. (deck%young(i) > 0 .and. ieee_is_finite(deck%young(i)))) then
-            call set_error(status, STATUS_BAD_INPUT, "E"//int_str(i)//" must be a finite positive modulus in GPa")
+         if (.not. (deck%young(i) >= MIN_YOUNG .and. deck%young(i) <= MAX_YOUNG)) then
+            call set_error(status, STATUS_BAD_INPUT, "E"//int_str(i)//" must be a modulus from 1e-12 to 1e300 GPa")
             return
          end if
          if (.not. (deck%poisson(i) > -1 .and. deck%poisson(i) < 0.5_dp)) then
@@ -70,6 +75,8 @@ contains
          call set_error(status, STATUS_BAD_INPUT, "the height maps must be NP x NP")
       else if (.not. (all(ieee_is_finite(deck%lower)) .and. all(ieee_is_finite(deck%upper)))) then
          call set_error(status, STATUS_BAD_INPUT, "heights must be finite")
+      else if (maxval(abs(deck%lower)) > MAX_HEIGHT .or. maxval(abs(deck%upper)) > MAX_HEIGHT) then
+         call set_error(status, STATUS_BAD_INPUT, "heights must lie within 1e12 nm (1 km)")
       end if
    end subroutine validate_problem
 end module femcod_problem
