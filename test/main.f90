@@ -20,6 +20,7 @@ program tester
    use test_studies, only: collect_studies
    use test_options, only: collect_options
    use test_heights, only: collect_heights
+   use test_safety, only: collect_safety
    use test_architecture, only: collect_architecture
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
@@ -46,6 +47,7 @@ program tester
       new_testsuite("studies", collect_studies), &
       new_testsuite("options", collect_options), &
       new_testsuite("heights", collect_heights), &
+      new_testsuite("safety", collect_safety), &
       new_testsuite("architecture", collect_architecture) &
       ]
    stat = 0

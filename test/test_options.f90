@@ -152,12 +152,12 @@ contains
       type(run_settings) :: settings
       type(status_type) :: status
       call parse_run_arguments(args_of("a.deck --solver cg --loads 1,2 --tol 1e-9 --max-iterations 50 --hardness 5 "// &
-         "-o out"), settings, status)
+         "-o options_out"), settings, status)
       call check(error, status%code, 0, "parsed")
       if (allocated(error)) return
       associate(o => settings%solve)
          call check(error, o%solver == "cg" .and. all(o%loads == [1.0_dp, 2.0_dp]) .and. o%cg%tol == 1.0e-9_dp .and. &
-            o%cg%max_iterations == 50 .and. o%hardness == 5 .and. settings%prefix == "out", "cg options")
+            o%cg%max_iterations == 50 .and. o%hardness == 5 .and. settings%prefix == "options_out", "cg options")
          if (allocated(error)) return
       end associate
       call parse_run_arguments(args_of("--lower h.txt --pixel 2 --young 70 --poisson 0.3 --rigid-factor 1e6 "// &

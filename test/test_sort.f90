@@ -1,8 +1,9 @@
-!> Stable merge sort of the gaps (Appendix B).
+!> Core algorithms: the stable merge sort of the gaps (Appendix B), and SHA-256.
 module test_sort
    use femcod_kinds, only: dp
    use femcod_sort, only: merge_sort_index
    use femcod_random, only: random_stream, seed_stream, uniform
+   use femcod_sha256, only: sha256_hex
    use testdrive, only: new_unittest, unittest_type, error_type, check
    implicit none
    private
@@ -15,7 +16,8 @@ contains
       testsuite = [ &
          new_unittest("ties keep row-wise order", test_ties), &
          new_unittest("sorted and reversed input", test_sorted_reversed), &
-         new_unittest("random input against insertion sort", test_random) &
+         new_unittest("random input against insertion sort", test_random), &
+         new_unittest("SHA-256 of the FIPS 180-4 examples", test_sha256) &
          ]
    end subroutine collect_sort
 
@@ -70,4 +72,20 @@ contains
       end do
       call check(error, all(order == ref), "merge sort equals a stable insertion sort")
    end subroutine test_random
+
+   !> The example digests of FIPS 180-4 (NIST's examples document): the empty string,
+   !> "abc", and the 448-bit message of two blocks; a million "a" (padding crossing
+   !> many blocks).
+   subroutine test_sha256(error)
+      type(error_type), allocatable, intent(out) :: error
+      call check(error, sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855", "empty")
+      if (allocated(error)) return
+      call check(error, sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad", "abc")
+      if (allocated(error)) return
+      call check(error, sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"), &
+         "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1", "two blocks")
+      if (allocated(error)) return
+      call check(error, sha256_hex(repeat("a", 1000000)), &
+         "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0", "a million a")
+   end subroutine test_sha256
 end module test_sort

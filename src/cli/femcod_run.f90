@@ -10,13 +10,16 @@
 module femcod_run
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO
-   use femcod_strings, only: string_type, int_str, real_str, format_real
-   use femcod_files, only: remove_file, path_exists, default_prefix, file_part
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
+   use femcod_strings, only: string_type, int_str, real_str, format_real, append_string
+   use femcod_files, only: remove_file, path_exists, path_is_directory, default_prefix, file_part, canonical_path, &
+      acquire_lock, release_lock, read_file, make_directories
+   use femcod_process, only: catch_stop_signals, stop_signal, signal_name
+   use femcod_sha256, only: sha256_hex
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec
-   use femcod_heights, only: load_scene
+   use femcod_heights, only: load_scene, height_file_path
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_solver_options, only: contact_options
    use femcod_observer, only: solver_observer
@@ -26,7 +29,7 @@ module femcod_run
    use femcod_maps, only: load_maps, state_maps
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
    use femcod_wisdom, only: load_wisdom, save_wisdom
-   use femcod_results, only: write_results, run_info, result_files
+   use femcod_results, only: write_results, run_info, result_files, stored_fingerprint
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
@@ -38,10 +41,12 @@ module femcod_run
 
    !> Everything `femcod run` was asked, after parsing.
    type :: run_settings
-      !> The decks, in order ("" for the one scene of --lower/--upper).
-      type(string_type), allocatable :: decks(:)
-      !> Output prefix ("": each deck's name), FFTW wisdom file ("": none).
-      character(len=:), allocatable :: prefix, wisdom
+      !> The decks, in order ("" for the one scene of --lower/--upper), and the output
+      !> prefix of each.
+      type(string_type), allocatable :: decks(:), prefixes(:)
+      !> Output prefix ("": each deck's name), directory of the outputs ("": here), FFTW
+      !> wisdom file ("": none).
+      character(len=:), allocatable :: prefix, outdir, wisdom
       logical :: quiet = .false., force = .false., restart = .false.
       !> The scene of --lower/--upper (kind "matrix").
       type(scene_spec) :: scene
@@ -62,12 +67,14 @@ module femcod_run
       !> for the incremental solver, n^4 for the legacy one).
       integer :: target_contacts = 0
       real(dp) :: target_load = 0, growth = 3
-      !> Where checkpoints go; whether a failure to write one was reported already.
+      !> Where checkpoints go; whether a failure to write one was reported already, and
+      !> whether one was stored.
       character(len=:), allocatable :: checkpoint_path
-      logical :: warned = .false.
+      logical :: warned = .false., stored = .false.
    contains
       procedure :: progress => report_progress
       procedure :: checkpoint => store_checkpoint
+      procedure :: stop_requested => signal_arrived
    end type run_observer
 
 contains
@@ -78,6 +85,7 @@ contains
       type(option_spec), allocatable :: table(:)
       table = [ &
          text_option("--output", "PREFIX", "output prefix (default: the deck's name without .deck, here)", alias="-o"), &
+         text_option("--outdir", "DIR", "write each deck's outputs into DIR (made if missing), named after the deck"), &
          choice_option("--solver", "incremental|legacy|cg", "the solver (default incremental; doc/solver.md)"), &
          real_list_option("--loads", "F1,...", "total loads in nN at which to report the state (PREFIX.loads.csv); "// &
             "the run stops once the largest is reached", lower=0.0_dp), &
@@ -159,8 +167,10 @@ contains
          if (k < size(args)) settings%command_line = settings%command_line//" "
       end do
       settings%prefix = ""
+      settings%outdir = ""
       settings%wisdom = ""
       call get_option(parsed, "--output", settings%prefix)
+      call get_option(parsed, "--outdir", settings%outdir)
       call get_option(parsed, "--fftw-wisdom", settings%wisdom)
       call get_option(parsed, "--quiet", settings%quiet)
       call get_option(parsed, "--force", settings%force)
@@ -194,15 +204,6 @@ contains
          "incremental=to the incremental solver only|cg=to --solver cg only", status)
       if (status%code /= 0) return
       settings%decks = parsed%positional
-      do d = 2, size(settings%decks)
-         do k = 1, d - 1
-            if (settings%decks(k)%s == settings%decks(d)%s) then
-               call set_error(status, STATUS_USAGE, "the deck '"//settings%decks(d)%s// &
-                  "' is given twice (its results would overwrite each other)")
-               return
-            end if
-         end do
-      end do
       if (settings%from_files) then
          if (size(settings%decks) > 0) then
             call set_error(status, STATUS_USAGE, "give either DECK files or --lower/--upper height files, not both")
@@ -231,7 +232,7 @@ contains
                spec%second_file = lower
                spec%shape_on = "upper"
             end if
-            if (spec%label == "") spec%label = "femcod run "//settings%command_line
+            if (spec%label == "") spec%label = "femcod run"//scene_arguments(args)
             if (settings%prefix == "") settings%prefix = default_prefix(file_part(spec%matrix_file))
          end associate
          settings%decks = [string_type("")]
@@ -242,11 +243,66 @@ contains
          call set_error(status, STATUS_USAGE, "--restart: checkpoints are written by the incremental solver only")
       else if (settings%solve%solver == "cg" .and. size(settings%solve%loads) == 0) then
          call set_error(status, STATUS_USAGE, "--solver cg solves at given loads: add --loads F1,F2,...")
-      else if (size(settings%decks) > 1 .and. settings%prefix /= "") then
+      else if (size(settings%decks) > 1 .and. settings%prefix /= "" .and. .not. settings%from_files) then
          call set_error(status, STATUS_USAGE, "-o PREFIX names the outputs of one deck; with several decks each "// &
-            "deck's outputs are named after it, in the current directory")
+            "deck's outputs are named after it (--outdir DIR puts them in DIR)")
+      else if (settings%prefix /= "" .and. settings%outdir /= "") then
+         call set_error(status, STATUS_USAGE, "give -o PREFIX or --outdir DIR, not both")
+      else if (settings%prefix /= "") then
+         if (settings%prefix(len(settings%prefix):) == "/" .or. path_is_directory(settings%prefix)) &
+            call set_error(status, STATUS_USAGE, "-o takes a prefix such as "//settings%prefix//"/name, not a "// &
+            "directory (or use --outdir DIR)")
       end if
+      if (status%code /= 0) return
+      ! Each deck's prefix; two decks may not write the same files.
+      allocate(settings%prefixes(size(settings%decks)))
+      do d = 1, size(settings%decks)
+         if (settings%prefix /= "") then
+            settings%prefixes(d)%s = settings%prefix
+         else if (settings%outdir /= "") then
+            settings%prefixes(d)%s = settings%outdir//"/"//default_prefix(settings%decks(d)%s)
+         else
+            settings%prefixes(d)%s = default_prefix(settings%decks(d)%s)
+         end if
+         do k = 1, d - 1
+            if (canonical_path(settings%decks(k)%s) == canonical_path(settings%decks(d)%s)) then
+               call set_error(status, STATUS_USAGE, "the deck '"//settings%decks(d)%s//"' is given twice (as '"// &
+                  settings%decks(k)%s//"'; its results would overwrite each other)")
+               return
+            end if
+            if (canonical_path(settings%prefixes(k)%s) == canonical_path(settings%prefixes(d)%s)) then
+               call set_error(status, STATUS_USAGE, settings%decks(k)%s//" and "//settings%decks(d)%s// &
+                  " would both write "//settings%prefixes(d)%s//".*: run them apart, each with its -o")
+               return
+            end if
+         end do
+      end do
    contains
+      !> The arguments that define a height-file scene (the files and the scene options),
+      !> for its label: not -o, --restart, --force and the like, so that a restart with
+      !> other operational options finds its checkpoint.
+      function scene_arguments(list) result(text)
+         type(string_type), intent(in) :: list(:)
+         character(len=:), allocatable :: text
+         type(option_spec), allocatable :: scene(:)
+         integer :: i, j
+         scene = [scene_options("heights"), text_option("--lower", "FILE", ""), text_option("--upper", "FILE", "")]
+         text = ""
+         i = 1
+         do while (i <= size(list))
+            do j = 1, size(scene)
+               if (list(i)%s == scene(j)%name) then
+                  text = text//" "//list(i)%s
+                  if (scene(j)%value_name /= "" .and. i < size(list)) then
+                     i = i + 1
+                     text = text//" "//list(i)%s
+                  end if
+                  exit
+               end if
+            end do
+            i = i + 1
+         end do
+      end function scene_arguments
       function option_value(p, name) result(v)
          type(parsed_options), intent(in) :: p
          character(len=*), intent(in) :: name
@@ -256,7 +312,8 @@ contains
       end function option_value
    end subroutine parse_run_arguments
 
-   !> `femcod run ARGS`: `code` is the exit code (of the first failing deck in a batch).
+   !> `femcod run ARGS`: `code` is the exit code (of the first failing deck in a batch;
+   !> 128 + the signal's number after SIGTERM, SIGINT or SIGUSR1).
    subroutine run_command(args, code)
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
@@ -275,20 +332,30 @@ contains
          code = status%code
          return
       end if
+      if (settings%outdir /= "") then
+         call make_directories(settings%outdir, status)
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod: "//status%message
+            code = status%code
+            return
+         end if
+      end if
+      ! A batch system's stop signals end the run between two steps, with a checkpoint.
+      call catch_stop_signals()
       ! Batch: every deck runs; a failed deck is reported and the others go on.
       allocate(failed(0))
       do d = 1, size(settings%decks)
-         associate(deck_path => settings%decks(d)%s)
-            if (settings%prefix /= "") then
-               call run_one(deck_path, settings%prefix, settings, rc)
-            else
-               call run_one(deck_path, default_prefix(deck_path), settings, rc)
-            end if
-            if (rc /= 0) then
-               failed = [failed, string_type(deck_path)]
-               if (code == 0) code = rc
-            end if
-         end associate
+         call run_one(settings%decks(d)%s, settings%prefixes(d)%s, settings, rc)
+         if (rc /= 0) then
+            call append_string(failed, settings%decks(d)%s)
+            if (code == 0) code = rc
+         end if
+         if (stop_signal() /= 0) then
+            code = 128 + stop_signal()
+            if (d < size(settings%decks)) write(error_unit, '(a)') "femcod: "//signal_name(stop_signal())// &
+               ": the batch stops; "//int_str(size(settings%decks) - d)//" decks not run"
+            exit
+         end if
       end do
       if (size(settings%decks) > 1) then
          write(output_unit, '(a)') "femcod run: "//int_str(size(settings%decks))//" decks, "//int_str(size(failed))// &
@@ -299,20 +366,16 @@ contains
       end if
    end subroutine run_command
 
-   !> One deck ("" for the height files): read, solve, write, report. `rc` is its exit code.
+   !> One deck ("" for the height files): read, lock its prefix, solve, write, report.
+   !> `rc` is its exit code.
    subroutine run_one(deck_path, prefix, settings, rc)
       character(len=*), intent(in) :: deck_path, prefix
       type(run_settings), intent(in) :: settings
       integer, intent(out) :: rc
       type(contact_problem) :: problem
-      type(contact_result) :: res
       type(status_type) :: st
-      type(run_observer) :: observer
-      type(incremental_state) :: resume
-      type(state_maps), allocatable :: maps(:)
-      type(run_info) :: info
-      type(string_type), allocatable :: inputs(:), warnings(:)
-      logical :: resuming, ok
+      type(string_type), allocatable :: inputs(:), warnings(:), files(:)
+      character(len=:), allocatable :: notice
       integer :: k
       rc = 0
       if (deck_path == "") then
@@ -320,26 +383,103 @@ contains
          do k = 1, size(warnings)
             write(error_unit, '(a)') "femcod: warning: "//warnings(k)%s
          end do
+         allocate(files(0))
+         if (st%code == 0) then
+            call append_string(files, height_file_path(settings%scene%matrix_file))
+            if (settings%scene%second_file /= "") call append_string(files, height_file_path(settings%scene%second_file))
+         end if
       else
          call read_deck(deck_path, problem, st)
          inputs = [string_type(deck_path//": femcod deck")]
+         files = [string_type(deck_path)]
       end if
+      ! No output may ever replace an input.
+      if (st%code == 0) call refuse_input_as_output(prefix, size(settings%solve%loads), files, st)
+      if (st%code == 0) then
+         call acquire_lock(prefix//".lock", st, notice)
+         if (notice /= "" .and. .not. settings%quiet) write(error_unit, '(a)') "femcod: "//notice
+         if (st%code == 0) then
+            call run_locked(deck_path, prefix, settings, problem, inputs, files, st)
+            call release_lock(prefix//".lock")
+         end if
+      end if
+      if (st%code /= 0) then
+         if (st%code == STATUS_INTERRUPTED) then
+            write(error_unit, '(a)') "femcod: "//signal_name(stop_signal())//": "//st%message
+            rc = 128 + stop_signal()
+         else
+            write(error_unit, '(a)') "femcod: "//st%message
+            rc = st%code
+         end if
+      end if
+   end subroutine run_one
+
+   !> The result files of `prefix` (and its checkpoint and lock) may not be one of the
+   !> input files, with or without --force.
+   subroutine refuse_input_as_output(prefix, nloads, inputs, st)
+      character(len=*), intent(in) :: prefix
+      integer, intent(in) :: nloads
+      type(string_type), intent(in) :: inputs(:)
+      type(status_type), intent(inout) :: st
+      type(string_type), allocatable :: names(:)
+      integer :: m, i
+      names = [result_files(prefix, nloads), string_type(prefix//".ckpt.h5"), string_type(prefix//".lock")]
+      do m = 1, size(names)
+         do i = 1, size(inputs)
+            if (canonical_path(names(m)%s) == canonical_path(inputs(i)%s)) then
+               call set_error(st, STATUS_USAGE, names(m)%s//" would replace the input "//inputs(i)%s// &
+                  ": give another -o PREFIX")
+               return
+            end if
+         end do
+      end do
+   end subroutine refuse_input_as_output
+
+   !> A deck with its prefix locked: the checks of existing files, the solve, the results.
+   subroutine run_locked(deck_path, prefix, settings, problem, inputs, files, st)
+      character(len=*), intent(in) :: deck_path, prefix
+      type(run_settings), intent(in) :: settings
+      type(contact_problem), intent(in) :: problem
+      type(string_type), intent(in) :: inputs(:), files(:)
+      type(status_type), intent(inout) :: st
+      type(contact_result) :: res
+      type(run_observer) :: observer
+      type(incremental_state) :: resume
+      type(state_maps), allocatable :: maps(:)
+      type(run_info) :: info
+      character(len=:), allocatable :: fingerprint, stored
+      logical :: resuming, ok, have_checkpoint
+      integer :: k
       associate(options => settings%solve)
+         fingerprint = run_fingerprint(problem, options)
+         have_checkpoint = path_exists(prefix//".ckpt.h5")
          ! With --restart, result files are leftovers of the interrupted run while its
-         ! checkpoint exists, or while PREFIX.h5 (renamed last) does not; a complete set
-         ! without a checkpoint means the run had finished: nothing to do.
-         if (st%code == 0 .and. settings%restart .and. .not. settings%force) then
-            if (path_exists(prefix//".h5") .and. .not. path_exists(prefix//".ckpt.h5")) then
+         ! checkpoint exists, or while PREFIX.h5 (renamed last) does not. A complete set
+         ! without a checkpoint means the run had finished: nothing to do, if it is the
+         ! run of these inputs and options.
+         if (settings%restart .and. .not. settings%force .and. .not. have_checkpoint .and. &
+            path_exists(prefix//".h5")) then
+            stored = stored_fingerprint(prefix//".h5")
+            if (stored == fingerprint) then
                if (.not. settings%quiet) write(error_unit, '(a)') "femcod: "//prefix//".h5: the run of "// &
                   deck_label(deck_path)//" is complete; nothing to restart"
                return
             end if
+            call set_error(st, STATUS_IO, prefix//".h5 holds the results of other inputs or options; "// &
+               "--force replaces them, or give another -o")
+            return
          end if
-         if (st%code == 0) call check_writable(prefix, st)
+         if (have_checkpoint .and. .not. settings%restart .and. .not. settings%force) then
+            call set_error(st, STATUS_IO, prefix//".ckpt.h5: the checkpoint of an interrupted run; continue it "// &
+               "with --restart, or start afresh with --force")
+            return
+         end if
+         call check_writable(prefix, st)
          if (st%code == 0 .and. .not. settings%force) then
-            if (.not. (settings%restart .and. (path_exists(prefix//".ckpt.h5") .or. .not. path_exists(prefix//".h5")))) &
+            if (.not. (settings%restart .and. (have_checkpoint .or. .not. path_exists(prefix//".h5")))) &
                call refuse_overwrite(prefix, size(options%loads), st)
          end if
+         if (st%code /= 0) return
          observer%quiet = settings%quiet
          observer%target_contacts = problem%maxcont
          if (options%max_contacts > 0) observer%target_contacts = min(observer%target_contacts, options%max_contacts)
@@ -347,56 +487,125 @@ contains
          observer%growth = merge(4.0_dp, 3.0_dp, options%solver == "legacy")
          observer%checkpoint_path = prefix//".ckpt.h5"
          resuming = .false.
-         if (st%code == 0 .and. settings%restart) then
-            if (path_exists(observer%checkpoint_path)) then
+         if (settings%restart) then
+            if (have_checkpoint) then
                call resume%init(problem, options)
                call read_checkpoint(observer%checkpoint_path, problem, options, resume, st)
                if (st%code == 0) call resume%rebuild(st)
                if (st%code /= 0 .and. index(st%message, observer%checkpoint_path) == 0) &
                   st%message = observer%checkpoint_path//": checkpoint refused: "//st%message
-               resuming = st%code == 0
-               if (resuming .and. .not. settings%quiet) write(error_unit, '(a)') "femcod: resuming "// &
+               if (st%code /= 0) return
+               resuming = .true.
+               if (.not. settings%quiet) write(error_unit, '(a)') "femcod: resuming "// &
                   deck_label(deck_path)//" from "//observer%checkpoint_path//" at step "//int_str(resume%step)//" ("// &
                   int_str(resume%n)//" contacts)"
             else if (.not. settings%quiet) then
                write(error_unit, '(a)') "femcod: no checkpoint "//observer%checkpoint_path//": starting "// &
                   deck_label(deck_path)//" from the beginning"
             end if
+         else if (have_checkpoint) then
+            ! --force: the old checkpoint is not this run's.
+            call remove_file(prefix//".ckpt.h5")
          end if
-         if (st%code == 0 .and. options%solver == "cg" .and. len(settings%wisdom) > 0) &
-            call load_wisdom(settings%wisdom, ok)
-         if (st%code == 0) then
-            if (resuming) then
-               call solve_contact(problem, options, res, st, observer, resume)
+         if (options%solver == "cg" .and. len(settings%wisdom) > 0) call load_wisdom(settings%wisdom, ok)
+         if (resuming) then
+            call solve_contact(problem, options, res, st, observer, resume)
+         else
+            call solve_contact(problem, options, res, st, observer)
+         end if
+         if (st%code == STATUS_INTERRUPTED) then
+            if (path_exists(observer%checkpoint_path) .and. observer%stored) then
+               st%message = st%message//"; the state is in "//observer%checkpoint_path//" (continue with --restart)"
             else
-               call solve_contact(problem, options, res, st, observer)
+               st%message = st%message//"; nothing was written"
             end if
+            return
          end if
          if (st%code == 0 .and. options%solver == "cg" .and. len(settings%wisdom) > 0) &
             call save_wisdom(settings%wisdom, st)
-         if (st%code == 0) then
-            info%version = FEMCOD_VERSION
-            info%solver = trim(options%solver)
-            info%options = settings%command_line
-            info%scene = model_notes(problem, options)
-            info%inputs = inputs
-            call load_maps(problem, res%states, maps)
-            call write_results(prefix, problem, res, maps, info, st)
-         end if
-         if (st%code /= 0) then
-            write(error_unit, '(a)') "femcod: "//st%message
-            rc = st%code
-            return
-         end if
-         ! The results are safe: the checkpoint has served its purpose.
-         if (options%solver == "incremental") call remove_file(prefix//".ckpt.h5")
+         if (st%code /= 0) return
+         info%version = FEMCOD_VERSION
+         info%solver = trim(options%solver)
+         info%options = settings%command_line
+         info%scene = model_notes(problem, options)
+         info%inputs = inputs
+         info%fingerprint = fingerprint
+         call input_digests(files, info%digests)
+         call load_maps(problem, res%states, maps)
+         call write_results(prefix, problem, res, maps, info, st)
+         if (st%code /= 0) return
+         ! The set is replaced as a whole: what an earlier run left beside it goes, and the
+         ! checkpoint has served its purpose.
+         call remove_stale_results(prefix, size(options%loads))
          do k = 1, size(res%states)
             if (.not. res%states(k)%reached) write(error_unit, '(a)') "femcod: warning: load "// &
                format_real(res%states(k)%load)//" nN not reached ("//stop_reason_text(res%stop_reason)//")"
          end do
          if (.not. settings%quiet) call print_summary(deck_path, prefix, problem, options, res)
       end associate
-   end subroutine run_one
+   end subroutine run_locked
+
+   !> Remove what an earlier run of this prefix left beside the new set: pressure maps of
+   !> loads beyond the new ones, a loads file when none were asked, the checkpoint.
+   subroutine remove_stale_results(prefix, nloads)
+      character(len=*), intent(in) :: prefix
+      integer, intent(in) :: nloads
+      integer :: k
+      k = nloads + 1
+      do while (path_exists(prefix//".pressure_"//int_str(k)//".svg"))
+         call remove_file(prefix//".pressure_"//int_str(k)//".svg")
+         k = k + 1
+      end do
+      if (nloads == 0) call remove_file(prefix//".loads.csv")
+      call remove_file(prefix//".ckpt.h5")
+      call remove_file(prefix//".ckpt.h5.part")
+   end subroutine remove_stale_results
+
+   !> SHA-256 of what decides a run's results: the problem (label, grid, materials,
+   !> heights) and the options that shape them.
+   function run_fingerprint(problem, options) result(hex)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      character(len=64) :: hex
+      character(len=:), allocatable :: text
+      text = problem%label//"|"//int_str(problem%np)//"|"//format_real(problem%pixel)//"|"// &
+         int_str(problem%maxcont)//"|"//reals(problem%young)//reals(problem%poisson)//trim(options%solver)//"|"// &
+         reals(options%loads)//int_str(options%max_contacts)//"|"//format_real(options%hardness)//"|"// &
+         format_real(options%tie_tolerance)//"|"//merge("T", "F", options%final_check)//"|"// &
+         trim(options%event_search)//"|"//format_real(options%cg%tol)//"|"//int_str(options%cg%max_iterations)//"|"
+      hex = sha256_hex(text//transfer(problem%lower, repeat(" ", 8*size(problem%lower)))// &
+         transfer(problem%upper, repeat(" ", 8*size(problem%upper))))
+   contains
+      function reals(v) result(t)
+         real(dp), intent(in) :: v(:)
+         character(len=:), allocatable :: t
+         integer :: m
+         t = ""
+         do m = 1, size(v)
+            t = t//format_real(v(m))//","
+         end do
+         t = t//"|"
+      end function reals
+   end function run_fingerprint
+
+   !> "FILE sha256 HEX" for each input file.
+   subroutine input_digests(files, digests)
+      type(string_type), intent(in) :: files(:)
+      type(string_type), allocatable, intent(out) :: digests(:)
+      character(len=:), allocatable :: bytes
+      type(status_type) :: st
+      integer :: k
+      allocate(digests(size(files)))
+      do k = 1, size(files)
+         call read_file(files(k)%s, "an input file", bytes, st)
+         if (st%code == 0) then
+            digests(k)%s = files(k)%s//" sha256 "//sha256_hex(bytes)
+         else
+            digests(k)%s = files(k)%s//" (unreadable)"
+            st = status_type()
+         end if
+      end do
+   end subroutine input_digests
 
    !> Before a long solve: can the results be written there at all?
    subroutine check_writable(prefix, st)
@@ -500,12 +709,19 @@ contains
       class(visitable), intent(inout) :: state
       type(status_type) :: st
       call write_checkpoint(self%checkpoint_path, problem, options, state, st)
+      self%stored = self%stored .or. st%code == 0
       if (st%code /= 0 .and. .not. self%warned) then
          write(error_unit, '(a)') "femcod: warning: checkpoint not written: "//st%message
          flush(error_unit)
          self%warned = .true.
       end if
    end subroutine store_checkpoint
+
+   !> A stop signal (SIGTERM, SIGINT, SIGUSR1) has arrived.
+   logical function signal_arrived(self)
+      class(run_observer), intent(inout) :: self
+      signal_arrived = stop_signal() /= 0
+   end function signal_arrived
 
    !> How a deck is named in messages.
    function deck_label(path) result(name)

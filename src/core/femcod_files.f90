@@ -1,13 +1,15 @@
 !> Small file-system helpers used by the I/O modules (never by the numerical core):
 !> atomic replacement of a file by a temporary one, removal, existence and kind.
 module femcod_files
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_ptr, c_associated
    use femcod_kinds, only: i8
    use femcod_status, only: status_type, set_error, STATUS_IO, STATUS_BAD_INPUT
+   use femcod_process, only: process_id, host_name, process_alive
+   use femcod_strings, only: int_str
    implicit none
    private
    public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, commit_file
-   public :: default_prefix, file_part, read_file
+   public :: default_prefix, file_part, read_file, canonical_path, acquire_lock, release_lock, make_directories
 
    interface
       function c_rename(from, to) bind(c, name="rename") result(rc)
@@ -15,6 +17,18 @@ module femcod_files
          character(kind=c_char), intent(in) :: from(*), to(*)
          integer(c_int) :: rc
       end function c_rename
+      function c_realpath(path, resolved) bind(c, name="realpath") result(p)
+         import :: c_char, c_ptr
+         character(kind=c_char), intent(in) :: path(*)
+         character(kind=c_char), intent(out) :: resolved(*)
+         type(c_ptr) :: p
+      end function c_realpath
+      function c_mkdir(path, mode) bind(c, name="mkdir") result(rc)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value :: mode
+         integer(c_int) :: rc
+      end function c_mkdir
       function c_remove(path) bind(c, name="remove") result(rc)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: path(*)
@@ -150,4 +164,97 @@ contains
          write(t, '(i0)') v
       end function i8_text
    end subroutine read_file
+
+   !> The absolute path of a file with every link and "." or ".." resolved, also for a
+   !> file that does not exist yet (its directory resolved, its name appended); the path
+   !> as given when even the directory cannot be resolved.
+   function canonical_path(path) result(full)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: full
+      character(kind=c_char, len=4096) :: buf
+      integer :: slash, k
+      full = path
+      if (c_associated(c_realpath(path//c_null_char, buf))) then
+         k = index(buf, c_null_char)
+         full = buf(1:k - 1)
+         return
+      end if
+      slash = index(path, "/", back=.true.)
+      if (slash == 0) then
+         if (.not. c_associated(c_realpath("."//c_null_char, buf))) return
+         k = index(buf, c_null_char)
+         full = buf(1:k - 1)//"/"//path
+      else if (c_associated(c_realpath(path(1:max(slash - 1, 1))//c_null_char, buf))) then
+         k = index(buf, c_null_char)
+         full = buf(1:k - 1)//"/"//path(slash + 1:)
+         if (slash == 1) full = "/"//path(2:)
+      end if
+   end function canonical_path
+
+   !> Take the lock file `path` for this process: created only if it does not exist
+   !> (atomically), holding "PID HOST". A lock of a process that no longer runs on this
+   !> host is taken over (`notice` says so); a live one is an error naming its holder.
+   subroutine acquire_lock(path, status, notice)
+      character(len=*), intent(in) :: path
+      type(status_type), intent(inout) :: status
+      character(len=:), allocatable, intent(out) :: notice
+      integer :: unit, ios, pid, attempt
+      character(len=256) :: holder_host
+      notice = ""
+      if (status%code /= 0) return
+      do attempt = 1, 2
+         open(newunit=unit, file=path, status="new", action="write", iostat=ios)
+         if (ios == 0) then
+            write(unit, '(i0,1x,a)', iostat=ios) process_id(), host_name()
+            close(unit)
+            return
+         end if
+         if (.not. path_exists(path)) exit
+         ! Held: by whom?
+         pid = 0
+         holder_host = ""
+         open(newunit=unit, file=path, status="old", action="read", iostat=ios)
+         if (ios == 0) then
+            read(unit, *, iostat=ios) pid, holder_host
+            close(unit)
+         end if
+         if (trim(holder_host) == host_name() .and. .not. process_alive(pid)) then
+            call remove_file(path)
+            notice = path//": taken over from process "//int_str(pid)//", which no longer runs"
+            cycle
+         end if
+         call set_error(status, STATUS_IO, path//": another run writes these results (process "//int_str(pid)// &
+            " on "//trim(holder_host)//"); wait for it, or remove the lock if that run is gone")
+         return
+      end do
+      call set_error(status, STATUS_IO, path//": cannot write the lock file (directory missing or not writable); "// &
+         "nothing was run")
+   end subroutine acquire_lock
+
+   !> Remove this process's lock file (a lock of another process is left alone).
+   subroutine release_lock(path)
+      character(len=*), intent(in) :: path
+      integer :: unit, ios, pid
+      open(newunit=unit, file=path, status="old", action="read", iostat=ios)
+      if (ios /= 0) return
+      read(unit, *, iostat=ios) pid
+      close(unit)
+      if (ios == 0 .and. pid == process_id()) call remove_file(path)
+   end subroutine release_lock
+
+   !> Make the directory `path` and its missing parents (mode 0777 less the umask).
+   subroutine make_directories(path, status)
+      character(len=*), intent(in) :: path
+      type(status_type), intent(inout) :: status
+      integer :: k
+      integer(c_int) :: rc
+      if (status%code /= 0 .or. path_is_directory(path)) return
+      do k = 2, len(path) + 1
+         if (k <= len(path)) then
+            if (path(k:k) /= "/") cycle
+         end if
+         if (.not. path_is_directory(path(1:k - 1))) rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'777', c_int))
+      end do
+      if (.not. path_is_directory(path)) call set_error(status, STATUS_IO, path//": cannot make the directory")
+   end subroutine make_directories
 end module femcod_files

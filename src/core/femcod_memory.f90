@@ -1,6 +1,9 @@
-!> The machine's physical memory, so that a run that cannot fit is refused with the
-!> bytes it needs before it starts (Linux over-commits: a huge allocation may
-!> "succeed" and the process be killed later when the pages are touched).
+!> The memory a run may use, so that a run that cannot fit is refused with the bytes it
+!> needs before it starts (Linux over-commits: a huge allocation may "succeed" and the
+!> process be killed later when the pages are touched). On a cluster that is the job's
+!> limit, not the machine's: the smaller of the physical memory and the memory limit of
+!> the process's control group (cgroup v2 memory.max, v1 memory.limit_in_bytes), which
+!> is where Slurm and container runtimes put a job's --mem.
 module femcod_memory
    use, intrinsic :: iso_c_binding, only: c_int, c_long
    use femcod_kinds, only: i8
@@ -21,15 +24,59 @@ module femcod_memory
 
 contains
 
-   !> Physical memory in bytes (0 when the system does not say).
+   !> The memory this process may use, in bytes (0 when the system does not say).
    function physical_memory() result(bytes)
       integer(i8) :: bytes
+      integer(i8) :: limit
       integer(c_long) :: pages, page
       pages = c_sysconf(SC_PHYS_PAGES)
       page = c_sysconf(SC_PAGESIZE)
       bytes = 0
       if (pages > 0 .and. page > 0) bytes = int(pages, i8)*int(page, i8)
+      limit = cgroup_limit()
+      if (limit > 0 .and. (bytes == 0 .or. limit < bytes)) bytes = limit
    end function physical_memory
+
+   !> The memory limit of this process's cgroup in bytes (0: none found, or unlimited).
+   function cgroup_limit() result(bytes)
+      integer(i8) :: bytes
+      character(len=512) :: line
+      integer :: unit, ios, colon2
+      bytes = 0
+      open(newunit=unit, file="/proc/self/cgroup", action="read", status="old", iostat=ios)
+      if (ios /= 0) return
+      do
+         read(unit, '(a)', iostat=ios) line
+         if (ios /= 0) exit
+         colon2 = index(line, ":", back=.true.)
+         if (colon2 == 0) cycle
+         if (index(line, "0::") == 1) then
+            call smaller(read_limit("/sys/fs/cgroup"//trim(line(colon2 + 1:))//"/memory.max"))
+         else if (index(line, ":memory:") > 0) then
+            call smaller(read_limit("/sys/fs/cgroup/memory"//trim(line(colon2 + 1:))//"/memory.limit_in_bytes"))
+            call smaller(read_limit("/sys/fs/cgroup/memory/memory.limit_in_bytes"))
+         end if
+      end do
+      close(unit)
+   contains
+      subroutine smaller(v)
+         integer(i8), intent(in) :: v
+         if (v > 0 .and. (bytes == 0 .or. v < bytes)) bytes = v
+      end subroutine smaller
+   end function cgroup_limit
+
+   !> A limit file's number of bytes; 0 for "max", a huge value (no limit), or none.
+   function read_limit(path) result(bytes)
+      character(len=*), intent(in) :: path
+      integer(i8) :: bytes
+      integer :: unit, ios
+      bytes = 0
+      open(newunit=unit, file=path, action="read", status="old", iostat=ios)
+      if (ios /= 0) return
+      read(unit, *, iostat=ios) bytes
+      close(unit)
+      if (ios /= 0 .or. bytes >= 2_i8**60) bytes = 0
+   end function read_limit
 
    !> "N bytes (X GiB)".
    function memory_text(bytes) result(text)

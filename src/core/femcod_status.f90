@@ -5,7 +5,7 @@ module femcod_status
    implicit none
    private
    public :: status_type, set_error, status_ok
-   public :: STATUS_OK_CODE, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_NUMERICAL, STATUS_IO
+   public :: STATUS_OK_CODE, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_NUMERICAL, STATUS_IO, STATUS_INTERRUPTED
 
    !> Success.
    integer, parameter :: STATUS_OK_CODE = 0
@@ -17,6 +17,9 @@ module femcod_status
    integer, parameter :: STATUS_NUMERICAL = 4
    !> Input/output failure (cannot write a result file, ...).
    integer, parameter :: STATUS_IO = 5
+   !> Stopped by a stop signal (SIGTERM, SIGINT, SIGUSR1) at the observer's request; the
+   !> program exits with 128 + the signal's number.
+   integer, parameter :: STATUS_INTERRUPTED = 6
 
    !> A status: `code` is 0 on success, otherwise one of the codes above,
    !> `message` says what went wrong and where.

@@ -7,7 +7,7 @@ module femcod_strings
    implicit none
    private
    public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, built_text, without_trailing_zeros
-   public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, is_digit
+   public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, is_digit, append_string
 
    !> A string of any length, for lists of arguments.
    type :: string_type
@@ -275,4 +275,20 @@ contains
       character(len=1), intent(in) :: c
       is_digit = c >= "0" .and. c <= "9"
    end function is_digit
+
+   !> Append `text` to a list of strings (the elements are moved, not copied; gfortran 12
+   !> mishandles [list, string_type(text)] for some selectors).
+   pure subroutine append_string(list, text)
+      type(string_type), allocatable, intent(inout) :: list(:)
+      character(len=*), intent(in) :: text
+      type(string_type), allocatable :: longer(:)
+      integer :: k
+      if (.not. allocated(list)) allocate(list(0))
+      allocate(longer(size(list) + 1))
+      do k = 1, size(list)
+         call move_alloc(list(k)%s, longer(k)%s)
+      end do
+      longer(size(list) + 1)%s = text
+      call move_alloc(longer, list)
+   end subroutine append_string
 end module femcod_strings

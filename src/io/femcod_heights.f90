@@ -15,7 +15,7 @@ module femcod_heights
    use, intrinsic :: iso_fortran_env, only: int16, int32
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_USAGE
-   use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real
+   use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real, append_string
    use femcod_files, only: path_exists, path_is_directory, read_file
    use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close, h5_rank_and_dims
    use femcod_memory, only: physical_memory, memory_text
@@ -24,6 +24,7 @@ module femcod_heights
    implicit none
    private
    public :: height_map, read_height_map, read_heights, read_ascii_matrix, load_scene, is_height_file, unit_in_nm
+   public :: height_file_path
    public :: HEIGHT_UNITS
 
    !> The units --height-unit takes.
@@ -65,6 +66,19 @@ contains
          unit_in_nm = 0
       end select
    end function unit_in_nm
+
+   !> The file a height path reads: FILE of FILE.h5:/dataset and of FILE:CHANNEL.
+   function height_file_path(path) result(file)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: file, channel
+      integer :: colon
+      colon = index(path, ":/", back=.true.)
+      if (colon > 0) then
+         file = path(1:colon - 1)
+      else
+         call split_channel(path, file, channel)
+      end if
+   end function height_file_path
 
    !> Whether `path` names heights rather than a deck: an HDF5 dataset (FILE.h5:/path), a
    !> NanoScope file (by its first bytes, with or without :CHANNEL) or a Gwyddion export.
@@ -173,14 +187,14 @@ contains
       call read_height_map(spec%matrix_file, first, status, trim(spec%height_unit))
       if (status%code /= 0) return
       if (present(warnings)) warnings = first%warnings
-      call append(lines, describe(spec%matrix_file, first))
+      call append_string(lines, describe(spec%matrix_file, first))
       warned = [warned, first%warnings]
       allocate(second(0, 0))
       if (allocated(spec%second_file)) then
          if (spec%second_file /= "") then
             call read_height_map(spec%second_file, other, status, trim(spec%height_unit))
             if (status%code /= 0) return
-            call append(lines, describe(spec%second_file, other))
+            call append_string(lines, describe(spec%second_file, other))
             warned = [warned, other%warnings]
             call move_alloc(other%z, second)
          end if
@@ -195,10 +209,10 @@ contains
          end if
          used%pixel = first%pixel_x
       else if (first%pixel_x > 0 .and. abs(used%pixel/max(first%pixel_x, tiny(1.0_dp)) - 1) > 1.0e-6_dp) then
-         call append(warned, "--pixel "//format_real(used%pixel)//" nm replaces the "//format_real(first%pixel_x)// &
+         call append_string(warned, "--pixel "//format_real(used%pixel)//" nm replaces the "//format_real(first%pixel_x)// &
             " nm of "//spec%matrix_file)
       end if
-      if (used%pixel < 1.0e-3_dp) call append(warned, "a pixel of "//format_real(used%pixel)// &
+      if (used%pixel < 1.0e-3_dp) call append_string(warned, "a pixel of "//format_real(used%pixel)// &
          " nm: if that is metres, give the size in nm")
       call build_problem(used, problem, status, first%z, second)
       if (present(notes)) notes = lines
@@ -235,22 +249,8 @@ contains
    subroutine warn(map, text)
       type(height_map), intent(inout) :: map
       character(len=*), intent(in) :: text
-      call append(map%warnings, text)
+      call append_string(map%warnings, text)
    end subroutine warn
-
-   !> Append a line to a list.
-   subroutine append(lines, text)
-      type(string_type), allocatable, intent(inout) :: lines(:)
-      character(len=*), intent(in) :: text
-      type(string_type), allocatable :: longer(:)
-      integer :: k
-      allocate(longer(size(lines) + 1))
-      do k = 1, size(lines)
-         call move_alloc(lines(k)%s, longer(k)%s)
-      end do
-      longer(size(lines) + 1)%s = text
-      call move_alloc(longer, lines)
-   end subroutine append
 
    !> FILE[:CHANNEL]: the channel is what follows the last colon when what precedes it is
    !> an existing file ("" otherwise).
@@ -318,7 +318,7 @@ contains
             int_str(MAX_NP)//" heights, found "//i8_text(rows)//" x "//i8_text(cols))
       else if (physical_memory() > 0 .and. 16*rows*cols > physical_memory()) then
          call set_error(status, STATUS_BAD_INPUT, path//": "//i8_text(rows)//" x "//i8_text(cols)//" heights need "// &
-            memory_text(16*rows*cols)//", this machine has "//memory_text(physical_memory()))
+            memory_text(16*rows*cols)//", this run may use "//memory_text(physical_memory()))
       end if
    end subroutine check_size
 

@@ -13,13 +13,14 @@ module femcod_results
    use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists
    use femcod_contact_result, only: contact_result, stop_reason_text
-   use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_write, h5_attribute
+   use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
+      h5_read_string_attribute
    use femcod_maps, only: state_maps
    use femcod_svg, only: svg_plot, svg_pressure_map, fmt_sig
    use femcod_richardson, only: power_law_fit
    implicit none
    private
-   public :: write_results, run_info, result_files, write_file_set
+   public :: write_results, run_info, result_files, write_file_set, stored_fingerprint
 
    !> What the run was, for /run in the HDF5 file.
    type :: run_info
@@ -27,8 +28,10 @@ module femcod_results
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
       !> The input files, one line each: the deck, or what each height file gave
-      !> (format, channel, instrument, grid, scan and pixel size).
-      type(string_type), allocatable :: inputs(:)
+      !> (format, channel, instrument, grid, scan and pixel size); each file's SHA-256;
+      !> the fingerprint of the problem and options (a restart's check).
+      type(string_type), allocatable :: inputs(:), digests(:)
+      character(len=:), allocatable :: fingerprint
    end type run_info
 
 contains
@@ -318,6 +321,8 @@ contains
       end do
       call h5_attribute(file, "/run", "scene_left_out", scene, local)
       if (allocated(info%inputs)) call h5_attribute(file, "/run", "inputs", joined(info%inputs), local)
+      if (allocated(info%digests)) call h5_attribute(file, "/run", "input_sha256", joined(info%digests), local)
+      if (allocated(info%fingerprint)) call h5_attribute(file, "/run", "fingerprint", info%fingerprint, local)
       call h5_write(file, "/run/missed_during_run", res%missed_during_run, "1", local)
       call h5_write(file, "/run/missed_final_check", res%missed_final_check, "1", local)
       call h5_write(file, "/run/max_penetration", res%max_penetration, "nm", local)
@@ -427,4 +432,18 @@ contains
          if (k < size(lines)) text = text//"; "
       end do
    end function joined
+
+   !> The fingerprint a result file records in /run ("" when it has none or cannot be
+   !> read).
+   function stored_fingerprint(path) result(hex)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: hex
+      type(h5_file) :: file
+      type(status_type) :: local
+      hex = ""
+      call h5_open(path, file, local, STATUS_IO)
+      call h5_read_string_attribute(file, "/run", "fingerprint", 64, hex, local, STATUS_IO)
+      call h5_close(file, local)
+      if (local%code /= 0) hex = ""
+   end function stored_fingerprint
 end module femcod_results

@@ -25,7 +25,8 @@
 !> estimate, and the step at which each contact joined (for the results).
 module femcod_legacy
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
+   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED
+   use femcod_strings, only: int_str
    use femcod_problem, only: contact_problem
    use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, MPSURF, MPGAPS, MPCORD, &
       MPFEXT, MPDISP, MPDISP2, MPFORCE, MPWORK, MPSTIF, IPSORT, IPKFIX, IPMAT, IPMAT2, IPMAT3, IPIADR, IPNOD1, &
@@ -123,6 +124,11 @@ contains
 
          step = 0
          do
+            if (observer%stop_requested()) then
+               call set_error(status, STATUS_INTERRUPTED, "stopped at step "//int_str(step)//" ("//int_str(n)// &
+                  " contacts); the legacy solver keeps no checkpoint")
+               return
+            end if
             step = step + 1
             call wall_clock(t0)
             call legacy_unit_solution(ws, n, table, mat, problem%pixel, delta, status, loss, kappa)

@@ -174,7 +174,7 @@ contains
       end if
       if (physical_memory() > 0 .and. 8*ws%mpend + 4*ws%ipend > physical_memory()) then
          call set_error(status, STATUS_NUMERICAL, "workspace: needs "//memory_text(8*ws%mpend + 4*ws%ipend)// &
-            ", this machine has "//memory_text(physical_memory()))
+            ", this run may use "//memory_text(physical_memory()))
          return
       end if
       allocate(ws%ra(ws%mpend), ws%ia(ws%ipend), stat=stat)

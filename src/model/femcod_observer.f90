@@ -18,6 +18,10 @@ module femcod_observer
       procedure :: progress => ignore_progress
       !> Every options%checkpoint_interval seconds, with the solver's complete state.
       procedure :: checkpoint => ignore_checkpoint
+      !> Asked between steps (iterations of the cg solver): should the solver stop now?
+      !> The incremental solver then hands over a checkpoint first; every solver returns
+      !> STATUS_INTERRUPTED.
+      procedure :: stop_requested => never_stop
    end type solver_observer
 
 contains
@@ -37,4 +41,9 @@ contains
       type(contact_options), intent(in) :: options
       class(visitable), intent(inout) :: state
    end subroutine ignore_checkpoint
+
+   logical function never_stop(self)
+      class(solver_observer), intent(inout) :: self
+      never_stop = .false.
+   end function never_stop
 end module femcod_observer

@@ -46,7 +46,7 @@
 !> are returned: max penetration (nm), largest |gap| on contact (nm), load error, r.
 module femcod_cg
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
+   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
    use femcod_love, only: offset_table, surface_compliance
@@ -137,13 +137,13 @@ contains
          else
             if (.not. sum(p) > 0) then
                if (how%nested) then
-                  call nested_start(fine, problem, load, how, p, report(k), status)
+                  call nested_start(fine, problem, load, how, p, report(k), status, observer)
                else
                   call first_guess(fine, load, p)
                end if
                if (status%code /= 0) exit
             end if
-            call constrained_cg(fine, load, tol, max_iterations, how, p, approach, report(k), status)
+            call constrained_cg(fine, load, tol, max_iterations, how, p, approach, report(k), status, observer)
             if (status%code /= 0) exit
          end if
          call wall_clock(t1)
@@ -237,7 +237,7 @@ contains
    !> The first load's start from nested grids: halve while the side stays even and at
    !> least 2 * coarsest; solve the coarsest from the first guess, then each finer grid
    !> from the coarser solution, to coarse_tol; return the forces on the finest grid.
-   recursive subroutine nested_start(grid, problem, total_load, how, p, rep, status)
+   recursive subroutine nested_start(grid, problem, total_load, how, p, rep, status, observer)
       type(cg_grid), intent(in) :: grid
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: total_load
@@ -245,6 +245,7 @@ contains
       real(dp), intent(out) :: p(:, :)
       type(cg_residuals), intent(inout) :: rep
       type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
       type(cg_grid) :: coarse
       type(cg_residuals) :: coarse_rep
       real(dp), allocatable :: pc(:, :)
@@ -259,9 +260,9 @@ contains
       call make_grid(coarse, (grid%g0(1::2, 1::2) + grid%g0(2::2, 1::2) + grid%g0(1::2, 2::2) + &
          grid%g0(2::2, 2::2))/4, problem, 2*grid%pixel, how)
       allocate(pc(n, n))
-      call nested_start(coarse, problem, total_load, how, pc, rep, status)
+      call nested_start(coarse, problem, total_load, how, pc, rep, status, observer)
       if (status%code == 0) call constrained_cg(coarse, total_load, how%coarse_tol, 10000, how, pc, approach, &
-         coarse_rep, status)
+         coarse_rep, status, observer)
       call convolution_free(coarse%conv)
       if (status%code /= 0) return
       rep%coarse_iterations = rep%coarse_iterations + coarse_rep%iterations + coarse_rep%coarse_iterations
@@ -275,7 +276,7 @@ contains
    !> Polonsky-Keer constrained CG on `grid` at total load P from the forces p (nN, any
    !> positive start; returned: the solution). `approach` (nm) is the mean gap of the
    !> contact pixels before the rigid shift, i.e. the approach from first touch.
-   subroutine constrained_cg(grid, total_load, tol, max_iterations, how, p, approach, rep, status)
+   subroutine constrained_cg(grid, total_load, tol, max_iterations, how, p, approach, rep, status, observer)
       type(cg_grid), intent(inout) :: grid
       real(dp), intent(in) :: total_load, tol
       integer, intent(in) :: max_iterations
@@ -284,6 +285,8 @@ contains
       real(dp), intent(out) :: approach
       type(cg_residuals), intent(inout) :: rep
       type(status_type), intent(inout) :: status
+      !> Asked every iteration whether to stop (a stop signal).
+      class(solver_observer), intent(inout) :: observer
       real(dp), allocatable :: w(:, :), g(:, :), t(:, :), r(:, :), gm(:, :), z(:, :), g_old(:, :)
       integer, allocatable :: changed(:, :)
       real(dp), allocatable :: delta(:)
@@ -321,6 +324,11 @@ contains
       fresh_double = .false.
       stalled = .false.
       do
+         if (observer%stop_requested()) then
+            call set_error(status, STATUS_INTERRUPTED, "stopped after "//int_str(it)//" iterations on the "// &
+               int_str(np)//" x "//int_str(np)//" grid; the cg solver keeps no checkpoint")
+            return
+         end if
          if (fresh) then
             call displacements(p, w)
             fresh = .false.

@@ -11,7 +11,8 @@
 !> contact problem; a full-field check by FFT convolution closes the run.
 module femcod_incremental
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type
+   use femcod_status, only: status_type, set_error, STATUS_INTERRUPTED
+   use femcod_strings, only: int_str, real_str
    use femcod_problem, only: contact_problem
    use femcod_lapack, only: dtrsv
    use femcod_heap, only: heap_pop, heap_push, heap_top_key
@@ -49,7 +50,7 @@ contains
          call event_loop(resume, problem, options, res, status, observer, tstart)
       else
          call fresh%init(problem, options)
-         call first_contacts(fresh, options, status)
+         call first_contacts(fresh, options, status, observer, tstart)
          if (status%code /= 0) return
          call event_loop(fresh, problem, options, res, status, observer, tstart)
       end if
@@ -71,6 +72,13 @@ contains
       call wall_clock(last_checkpoint)
 
       do
+         if (observer%stop_requested()) then
+            ! Stop between two steps: the state is complete, so a checkpoint continues it.
+            if (options%checkpoint_interval >= 0) call observer%checkpoint(problem, options, state)
+            call set_error(status, STATUS_INTERRUPTED, "stopped at step "//int_str(state%step)//" ("// &
+               int_str(state%n)//" contacts, load "//real_str(state%path%total, 6)//" nN)")
+            return
+         end if
          if (options%checkpoint_interval >= 0 .and. state%step > 0) then
             call wall_clock(t1)
             if (t1 - last_checkpoint >= options%checkpoint_interval) then
@@ -143,10 +151,13 @@ contains
 
    !> The first step's contacts: the smallest gap and every pixel tied with it (within
    !> the tie tolerance of the gaps' range; the load scale is still zero), in pixel order.
-   subroutine first_contacts(state, options, status)
+   subroutine first_contacts(state, options, status, observer, tstart)
       type(incremental_state), intent(inout) :: state
       type(contact_options), intent(in) :: options
       type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      real(dp), intent(in) :: tstart
+      real(dp) :: now
       integer, allocatable :: joiners(:), order(:)
       real(dp) :: key, limit
       integer :: p, njoin, q
@@ -168,6 +179,16 @@ contains
       do q = 1, njoin
          call state%add_contact(joiners(q), 1, status)
          if (status%code /= 0) return
+         if (mod(q, 1024) == 0) then
+            ! A tie of many pixels (a flat punch) borders the factor O(n^2) each: report.
+            call wall_clock(now)
+            call observer%progress(0, q, 0.0_dp, now - tstart)
+            if (observer%stop_requested()) then
+               call set_error(status, STATUS_INTERRUPTED, "stopped in the first step, after "//int_str(q)//" of "// &
+                  int_str(njoin)//" tied contacts")
+               return
+            end if
+         end if
       end do
    end subroutine first_contacts
 

@@ -230,7 +230,7 @@ contains
          grown = min(2*self%ld, self%maxc)
          if (physical_memory() > 0 .and. 8*grown**2 > physical_memory()) then
             call set_error(status, STATUS_NUMERICAL, "incremental: the factor for "// &
-               int_str(int(grown))//" contacts needs "//memory_text(8*grown**2)//", this machine has "// &
+               int_str(int(grown))//" contacts needs "//memory_text(8*grown**2)//", this run may use "// &
                memory_text(physical_memory())//"; lower MAXCONT or --max-contacts")
             return
          end if

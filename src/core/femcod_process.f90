@@ -1,0 +1,116 @@
+!> The process femcod runs in: its id and host (for locks and the run record), whether
+!> another process is alive, and the signals a batch system sends (SIGTERM at a time
+!> limit, SIGINT for Ctrl-C, SIGUSR1 as a warning before the limit). A signal only sets
+!> a flag here; the solvers look at it between steps (through their observer) and end
+!> cleanly. The flag is the one piece of process-wide state in src/: a signal handler
+!> has no other way to speak.
+module femcod_process
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_size_t, c_null_char, c_funptr, c_funloc
+   implicit none
+   private
+   public :: process_id, host_name, process_alive, catch_stop_signals, stop_signal, signal_name
+   public :: SIGINT, SIGTERM, SIGUSR1
+
+   !> Linux signal numbers.
+   integer, parameter :: SIGINT = 2, SIGUSR1 = 10, SIGTERM = 15
+
+   !> The last stop signal caught (0: none).
+   integer(c_int), volatile :: caught = 0
+
+   interface
+      function c_getpid() bind(c, name="getpid") result(pid)
+         import :: c_int
+         integer(c_int) :: pid
+      end function c_getpid
+      function c_gethostname(name, length) bind(c, name="gethostname") result(rc)
+         import :: c_char, c_size_t, c_int
+         character(kind=c_char), intent(out) :: name(*)
+         integer(c_size_t), value :: length
+         integer(c_int) :: rc
+      end function c_gethostname
+      function c_signal(sig, handler) bind(c, name="signal") result(old)
+         import :: c_int, c_funptr
+         integer(c_int), value :: sig
+         type(c_funptr), value :: handler
+         type(c_funptr) :: old
+      end function c_signal
+   end interface
+
+contains
+
+   !> This process's id.
+   integer function process_id()
+      process_id = int(c_getpid())
+   end function process_id
+
+   !> This machine's host name ("" if unknown).
+   function host_name() result(name)
+      character(len=:), allocatable :: name
+      character(kind=c_char, len=256) :: buf
+      integer :: k
+      name = ""
+      buf = repeat(c_null_char, len(buf))
+      if (c_gethostname(buf, int(len(buf), c_size_t)) /= 0) return
+      k = index(buf, c_null_char)
+      if (k == 0) k = len(buf) + 1
+      name = buf(1:k - 1)
+   end function host_name
+
+   !> Whether process `pid` runs on this machine (Linux: /proc/PID/stat exists and its
+   !> state is not Z, a zombie, or X, dead: a killed process whose parent is gone stays a
+   !> zombie where no init reaps it, as in some containers).
+   logical function process_alive(pid)
+      integer, intent(in) :: pid
+      character(len=32) :: path
+      character(len=512) :: line
+      integer :: unit, ios, paren
+      process_alive = .false.
+      if (pid <= 0) return
+      write(path, '("/proc/",i0,"/stat")') pid
+      open(newunit=unit, file=trim(path), action="read", status="old", iostat=ios)
+      if (ios /= 0) return
+      read(unit, '(a)', iostat=ios) line
+      close(unit)
+      if (ios /= 0) return
+      ! "PID (name) S ...": the state follows the last parenthesis.
+      paren = index(line, ")", back=.true.)
+      if (paren == 0) return
+      process_alive = index("ZX", line(paren + 2:paren + 2)) == 0
+   end function process_alive
+
+   !> From now on SIGTERM, SIGINT and SIGUSR1 set the flag stop_signal() reads instead
+   !> of ending the process.
+   subroutine catch_stop_signals()
+      type(c_funptr) :: old
+      old = c_signal(int(SIGTERM, c_int), c_funloc(on_signal))
+      old = c_signal(int(SIGINT, c_int), c_funloc(on_signal))
+      old = c_signal(int(SIGUSR1, c_int), c_funloc(on_signal))
+   end subroutine catch_stop_signals
+
+   !> The handler: remember the signal, nothing else (async-signal-safe).
+   subroutine on_signal(sig) bind(c)
+      integer(c_int), value :: sig
+      caught = sig
+   end subroutine on_signal
+
+   !> The stop signal caught so far, 0 if none.
+   integer function stop_signal()
+      stop_signal = int(caught)
+   end function stop_signal
+
+   !> "SIGTERM", "SIGINT", "SIGUSR1".
+   function signal_name(sig) result(name)
+      integer, intent(in) :: sig
+      character(len=:), allocatable :: name
+      select case (sig)
+      case (SIGTERM)
+         name = "SIGTERM"
+      case (SIGINT)
+         name = "SIGINT"
+      case (SIGUSR1)
+         name = "SIGUSR1"
+      case default
+         name = "signal"
+      end select
+   end function signal_name
+end module femcod_process

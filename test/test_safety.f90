@@ -1,0 +1,256 @@
+!> Results are never lost, mixed or destroyed (cli/femcod_run): stop signals write a
+!> checkpoint that --restart continues to the same bytes, a prefix is locked while a run
+!> writes it, --force replaces a set as a whole, a checkpoint or a finished run of other
+!> inputs is not overwritten or reused silently, batch runs keep their outputs apart.
+!> Every run here is this test program run as femcod in its own process.
+module test_safety
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type
+   use femcod_deck, only: write_deck
+   use femcod_problem, only: contact_problem
+   use femcod_generate, only: scene_spec, build_problem
+   use femcod_process, only: process_id, host_name
+   use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
+   use test_results, only: self_command
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   implicit none
+   private
+   public :: collect_safety
+
+contains
+
+   subroutine collect_safety(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest("SIGTERM: exit 143, a checkpoint, no result; --restart gives the same bytes", test_sigterm), &
+         new_unittest("a prefix is locked: a live holder refuses the run, a dead one is taken over", test_lock), &
+         new_unittest("--force replaces the set as a whole (no stale pressure maps)", test_force_set), &
+         new_unittest("a checkpoint is not overwritten without --restart or --force", test_checkpoint_kept), &
+         new_unittest("--restart on finished results: nothing to do only for the same inputs", test_restart_finished), &
+         new_unittest("--restart works for height-file runs", test_restart_heights), &
+         new_unittest("batch: --outdir; decks that would write the same files are refused", test_batch_outputs) &
+         ]
+   end subroutine collect_safety
+
+   !> A 64 x 64 rough deck that takes long enough to be stopped midway.
+   subroutine make_deck(path, maxcont)
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: maxcont
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
+      type(status_type) :: st
+      spec%kind = "self-affine"
+      spec%label = "safety test: self-affine 64 x 64"
+      spec%matrix_file = ""
+      spec%np = 64
+      spec%pixel = 10
+      spec%rms = 3
+      spec%maxcont = maxcont
+      call build_problem(spec, deck, st)
+      call write_deck(path, deck, st)
+   end subroutine make_deck
+
+   !> Run femcod with `args` in a shell; its exit code.
+   integer function femcod(args)
+      character(len=*), intent(in) :: args
+      call execute_command_line(self_command()//" "//args//" 2> "//scratch_path("safety.stderr"), exitstat=femcod)
+   end function femcod
+
+   !> Run femcod in the background and send it SIGTERM after `delay` seconds; its exit code.
+   integer function femcod_terminated(args, delay)
+      character(len=*), intent(in) :: args
+      real(dp), intent(in) :: delay
+      character(len=16) :: d
+      character(len=:), allocatable :: rc, text
+      integer :: ios
+      write(d, '(f0.3)') delay
+      rc = scratch_path("safety.rc")
+      call execute_command_line("( "//self_command()//" "//args//" 2> "//scratch_path("safety.stderr")// &
+         " & pid=$!; sleep "//trim(d)//"; kill -TERM $pid 2>/dev/null; wait $pid; echo $? > "//rc//" )", exitstat=ios)
+      femcod_terminated = -1
+      text = read_text(rc)
+      read(text, *, iostat=ios) femcod_terminated
+   end function femcod_terminated
+
+   !> SIGTERM between two steps: exit 128 + 15, the state in the checkpoint, no result file,
+   !> no lock, no temporary file; --restart then ends with the bytes of an uninterrupted run.
+   subroutine test_sigterm(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, args
+      integer(8) :: c0, c1, rate
+      real(dp) :: duration
+      integer :: code, k
+      real(dp), parameter :: fractions(*) = [0.5_dp, 0.3_dp, 0.7_dp, 0.15_dp]
+      dir = scratch_path("sigterm")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call make_deck(dir//"/scene.deck", 1200)
+      args = "run "//dir//"/scene.deck --loads 5e4,1e9 --quiet "
+      call system_clock(c0, rate)
+      code = femcod(args//"-o "//dir//"/ref")
+      call system_clock(c1)
+      duration = real(c1 - c0, dp)/rate
+      call check(error, code, 0, "the uninterrupted run")
+      if (allocated(error)) return
+      ! The signal must arrive while the run solves: try a few moments.
+      do k = 1, size(fractions)
+         call execute_command_line("rm -f "//dir//"/ck.*")
+         code = femcod_terminated(args//"-o "//dir//"/ck --checkpoint-interval 300", fractions(k)*duration)
+         if (code /= 0) exit
+      end do
+      call check(error, code, 143, "exit 128 + SIGTERM (stderr: "//read_text(scratch_path("safety.stderr"))//")")
+      if (allocated(error)) return
+      call check(error, contains_text(read_text(scratch_path("safety.stderr")), "SIGTERM: stopped at step") .and. &
+         contains_text(read_text(scratch_path("safety.stderr")), "continue with --restart"), "what was saved is said")
+      if (allocated(error)) return
+      call check(error, file_exists(dir//"/ck.ckpt.h5") .and. .not. file_exists(dir//"/ck.h5") .and. &
+         .not. file_exists(dir//"/ck.history.csv") .and. .not. file_exists(dir//"/ck.lock") .and. &
+         .not. file_exists(dir//"/ck.ckpt.h5.part") .and. .not. file_exists(dir//"/ck.history.csv.part"), &
+         "a checkpoint, and no result, lock or temporary file")
+      if (allocated(error)) return
+      code = femcod(args//"-o "//dir//"/ck --restart")
+      call check(error, code, 0, "the restart")
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/ck.history.csv") == read_text(dir//"/ref.history.csv") .and. &
+         read_text(dir//"/ck.contacts.csv") == read_text(dir//"/ref.contacts.csv") .and. &
+         read_text(dir//"/ck.loads.csv") == read_text(dir//"/ref.loads.csv"), "the same bytes as the uninterrupted run")
+      if (allocated(error)) return
+      call check(error, .not. file_exists(dir//"/ck.ckpt.h5"), "the checkpoint is removed at the end")
+   end subroutine test_sigterm
+
+   subroutine test_lock(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir
+      integer :: code
+      dir = scratch_path("lock")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call make_deck(dir//"/scene.deck", 20)
+      ! This test program is alive: its lock holds.
+      call write_text(dir//"/out.lock", to_string(process_id())//" "//host_name()//new_line("a"))
+      code = femcod("run "//dir//"/scene.deck -o "//dir//"/out --quiet")
+      call check(error, code, 5, "a live holder refuses the run")
+      if (allocated(error)) return
+      call check(error, contains_text(read_text(scratch_path("safety.stderr")), "another run writes these results") &
+         .and. .not. file_exists(dir//"/out.h5"), "said, and nothing written")
+      if (allocated(error)) return
+      ! A process number beyond Linux's pid_max (4194304) never runs: taken over.
+      call write_text(dir//"/out.lock", "99999999 "//host_name()//new_line("a"))
+      code = femcod("run "//dir//"/scene.deck -o "//dir//"/out")
+      call check(error, code, 0, "a stale lock is taken over")
+      if (allocated(error)) return
+      call check(error, contains_text(read_text(scratch_path("safety.stderr")), "taken over from process 99999999") &
+         .and. file_exists(dir//"/out.h5") .and. .not. file_exists(dir//"/out.lock"), "said, written, released")
+   end subroutine test_lock
+
+   subroutine test_force_set(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir
+      integer :: code
+      dir = scratch_path("force_set")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call make_deck(dir//"/scene.deck", 50)
+      code = femcod("run "//dir//"/scene.deck -o "//dir//"/out --loads 100,200,300 --quiet")
+      call check(error, code == 0 .and. file_exists(dir//"/out.pressure_3.svg"), "three loads")
+      if (allocated(error)) return
+      code = femcod("run "//dir//"/scene.deck -o "//dir//"/out --quiet --force")
+      call check(error, code, 0, "replaced, no loads")
+      if (allocated(error)) return
+      call check(error, .not. file_exists(dir//"/out.pressure_1.svg") .and. .not. file_exists(dir// &
+         "/out.pressure_3.svg") .and. .not. file_exists(dir//"/out.loads.csv"), "no file of the earlier set is left")
+   end subroutine test_force_set
+
+   subroutine test_checkpoint_kept(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir
+      integer :: code
+      dir = scratch_path("ckpt_kept")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call make_deck(dir//"/scene.deck", 1200)
+      code = femcod_terminated("run "//dir//"/scene.deck -o "//dir//"/out --quiet", 0.3_dp)
+      if (code == 0) then
+         ! The run was faster than the signal: make a checkpoint-like file to protect.
+         call execute_command_line("cp "//dir//"/out.h5 "//dir//"/out.ckpt.h5")
+      end if
+      call check(error, file_exists(dir//"/out.ckpt.h5"), "a checkpoint")
+      if (allocated(error)) return
+      code = femcod("run "//dir//"/scene.deck -o "//dir//"/out --quiet")
+      call check(error, code, 5, "without --restart or --force")
+      if (allocated(error)) return
+      call check(error, contains_text(read_text(scratch_path("safety.stderr")), "the checkpoint of an interrupted run") &
+         .and. file_exists(dir//"/out.ckpt.h5"), "said, and kept")
+   end subroutine test_checkpoint_kept
+
+   subroutine test_restart_finished(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, before
+      integer :: code
+      dir = scratch_path("restart_finished")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call make_deck(dir//"/scene.deck", 40)
+      code = femcod("run "//dir//"/scene.deck -o "//dir//"/out --loads 100 --quiet")
+      call check(error, code, 0, "the run")
+      if (allocated(error)) return
+      before = read_text(dir//"/out.loads.csv")
+      code = femcod("run "//dir//"/scene.deck -o "//dir//"/out --loads 100 --restart")
+      call check(error, code == 0 .and. contains_text(read_text(scratch_path("safety.stderr")), "is complete"), &
+         "the same run: complete, nothing to do")
+      if (allocated(error)) return
+      code = femcod("run "//dir//"/scene.deck -o "//dir//"/out --loads 200 --restart --quiet")
+      call check(error, code, 5, "other loads: refused")
+      if (allocated(error)) return
+      call check(error, contains_text(read_text(scratch_path("safety.stderr")), "other inputs or options") .and. &
+         read_text(dir//"/out.loads.csv") == before, "said, and the results kept")
+   end subroutine test_restart_finished
+
+   !> A height-file run stopped by SIGTERM continues with --restart (the scene's label no
+   !> longer holds the operational options, so the checkpoint matches).
+   subroutine test_restart_heights(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, heights, args
+      integer :: code, i, j
+      character(len=*), parameter :: nl = new_line("a")
+      dir = scratch_path("restart_heights")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      heights = ""
+      do i = 1, 64
+         do j = 1, 64
+            heights = heights//to_string(modulo(i*37 + j*101 + i*j*7, 97))//" "
+         end do
+         heights = heights//nl
+      end do
+      call write_text(dir//"/scan.txt", heights)
+      args = "run --lower "//dir//"/scan.txt --pixel 5 --maxcont 1500 --quiet -o "//dir//"/out "
+      code = femcod_terminated(args, 0.2_dp)
+      if (code /= 0) then
+         call check(error, code == 143 .and. file_exists(dir//"/out.ckpt.h5"), "stopped with a checkpoint")
+         if (allocated(error)) return
+      end if
+      code = femcod(args//"--restart")
+      call check(error, code, 0, "--restart of a height-file run: "//read_text(scratch_path("safety.stderr")))
+   end subroutine test_restart_heights
+
+   subroutine test_batch_outputs(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir
+      integer :: code
+      dir = scratch_path("batch_outputs")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir//"/a "//dir//"/b")
+      call make_deck(dir//"/a/scene.deck", 20)
+      call make_deck(dir//"/b/scene.deck", 20)
+      call make_deck(dir//"/b/other.deck", 20)
+      code = femcod("run "//dir//"/a/scene.deck "//dir//"/b/scene.deck --quiet")
+      call check(error, code == 2 .and. contains_text(read_text(scratch_path("safety.stderr")), "would both write"), &
+         "two decks named alike: refused")
+      if (allocated(error)) return
+      code = femcod("run "//dir//"/b/scene.deck "//dir//"/b/./scene.deck --quiet")
+      call check(error, code == 2 .and. contains_text(read_text(scratch_path("safety.stderr")), "given twice"), &
+         "one deck by two paths: refused")
+      if (allocated(error)) return
+      code = femcod("run "//dir//"/b/scene.deck -o "//dir//"/b --quiet")
+      call check(error, code == 2 .and. contains_text(read_text(scratch_path("safety.stderr")), "not a directory"), &
+         "-o naming a directory: refused")
+      if (allocated(error)) return
+      code = femcod("run "//dir//"/a/scene.deck "//dir//"/b/other.deck --outdir "//dir//"/results/x --quiet")
+      call check(error, code == 0 .and. file_exists(dir//"/results/x/scene.h5") .and. &
+         file_exists(dir//"/results/x/other.h5"), "--outdir made and filled")
+   end subroutine test_batch_outputs
+end module test_safety
