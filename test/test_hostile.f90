@@ -4,7 +4,8 @@
 module test_hostile
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
-   use test_support, only: scratch_path, read_text, file_exists, contains_text
+   use test_support, only: scratch_path, read_text, file_exists, contains_text, write_text
+   use femcod_process, only: process_id, host_name
    use test_results, only: self_command
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -25,7 +26,8 @@ contains
 
    subroutine test_corpus(error)
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: manifest, line, name, setup, args, fragment, dir, out, message, listing
+      character(len=:), allocatable :: manifest, line, name, setup, args, fragment, dir, out, message, listing, &
+         limit
       integer :: a, b, code, expected, ncases, ios
       manifest = read_text(corpus//"/MANIFEST")
       call check(error, len(manifest) > 0, "reading "//corpus//"/MANIFEST")
@@ -50,11 +52,11 @@ contains
          dir = scratch_path("hostile/"//name)
          call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
          out = dir//"/out"
-         if (setup(1:min(5, len(setup))) == "ckpt:") then
-            call execute_command_line("cp "//corpus//"/"//setup(6:)//" "//out//".ckpt.h5")
-         end if
-         args = replace(replace(args, "@C", corpus), "@OUT", out)
-         call execute_command_line(self_command()//" "//args//" > "//dir//".stdout 2> "//dir//".stderr", &
+         call set_up(setup, dir, out, limit)
+         call check(error, .not. file_exists(dir//"/SET-UP-FAILED"), name//": the set-up run failed")
+         if (allocated(error)) return
+         args = expand(args, dir, out)
+         call execute_command_line(limit//self_command()//" "//args//" > "//dir//".stdout 2> "//dir//".stderr", &
             exitstat=code)
          message = read_text(dir//".stderr")
          call check(error, code, expected, name//": exit code (message: "//trim(message)//")")
@@ -62,14 +64,10 @@ contains
          call check(error, contains_text(message, fragment), name//": the message '"//trim(message)// &
             "' should contain '"//fragment//"'")
          if (allocated(error)) return
-         ! Nothing under the prefix but what the set-up put there.
-         call execute_command_line("ls -A "//dir//" > "//dir//".listing")
-         listing = read_text(dir//".listing")
-         if (setup(1:min(5, len(setup))) == "ckpt:") then
-            call check(error, listing == "out.ckpt.h5"//new_line("a"), name//": files left: "//listing)
-         else
-            call check(error, len(listing) == 0, name//": files left: "//listing)
-         end if
+         ! Under the case's directory: what the set-up put there, byte for byte, and nothing else.
+         listing = file_listing(dir)
+         call check(error, listing == read_text(dir//".before"), name//": files changed or left: "//listing// &
+            " (before: "//read_text(dir//".before")//")")
          if (allocated(error)) return
          ncases = ncases + 1
       end do
@@ -91,6 +89,68 @@ contains
       call check(error, file_exists(dir//"/my results.h5") .and. file_exists(dir//"/my results.history.csv"), &
          "results written beside the deck")
    end subroutine test_spaces
+
+   !> The set-up of a case (see MANIFEST), then the listing it leaves in DIR.before.
+   !> `limit` is a shell prefix for the run (a file-size limit) or "".
+   subroutine set_up(setup, dir, out, limit)
+      character(len=*), intent(in) :: setup, dir, out
+      character(len=:), allocatable, intent(out) :: limit
+      character(len=:), allocatable :: kind, value
+      integer :: colon, arrow, code
+      limit = ""
+      colon = index(setup, ":")
+      kind = setup
+      value = ""
+      if (colon > 0) then
+         kind = setup(1:colon - 1)
+         value = setup(colon + 1:)
+      end if
+      select case (kind)
+      case ("ckpt")
+         call execute_command_line("cp "//corpus//"/"//value//" "//out//".ckpt.h5")
+      case ("file")
+         ! file:SOURCE>NAME copies the corpus file SOURCE to DIR/NAME.
+         arrow = index(value, ">")
+         call execute_command_line("cp "//corpus//"/"//value(1:arrow - 1)//" "//dir//"/"//value(arrow + 1:))
+      case ("lock")
+         ! lock:live names this test process (alive), lock:empty names none.
+         if (value == "live") then
+            call write_text(out//".lock", to_string(process_id())//" "//host_name()//new_line("a"))
+         else
+            call write_text(out//".lock", "")
+         end if
+      case ("run")
+         ! run:ARGS runs femcod first; it must succeed.
+         call execute_command_line(self_command()//" "//expand(value, dir, out)//" > /dev/null 2>&1", exitstat=code)
+         if (code /= 0) call write_text(dir//"/SET-UP-FAILED", "")
+      case ("ulimit")
+         ! ulimit:N limits every file written to N blocks (512 bytes under dash, 1 KiB under bash).
+         limit = "ulimit -f "//value//" && "
+      end select
+      call write_text(dir//".before", file_listing(dir))
+   end subroutine set_up
+
+   !> Every file under `dir` with its CRC and size (cksum), sorted.
+   function file_listing(dir) result(listing)
+      character(len=*), intent(in) :: dir
+      character(len=:), allocatable :: listing
+      call execute_command_line("cd "//dir//" && find . -type f | LC_ALL=C sort | xargs -r cksum > ../"// &
+         basename(dir)//".listing")
+      listing = read_text(dir//".listing")
+   end function file_listing
+
+   function basename(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      name = path(index(path, "/", back=.true.) + 1:)
+   end function basename
+
+   !> @C is the corpus directory, @DIR the case's own directory, @OUT its output prefix.
+   function expand(args, dir, out) result(r)
+      character(len=*), intent(in) :: args, dir, out
+      character(len=:), allocatable :: r
+      r = replace(replace(replace(args, "@C", corpus), "@OUT", out), "@DIR", dir)
+   end function expand
 
    !> Field k of a " | "-separated line, trimmed.
    function field(line, k) result(f)

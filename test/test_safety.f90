@@ -28,7 +28,8 @@ contains
          new_unittest("a checkpoint is not overwritten without --restart or --force", test_checkpoint_kept), &
          new_unittest("--restart on finished results: nothing to do only for the same inputs", test_restart_finished), &
          new_unittest("--restart works for height-file runs", test_restart_heights), &
-         new_unittest("batch: --outdir; decks that would write the same files are refused", test_batch_outputs) &
+         new_unittest("batch: --outdir; decks that would write the same files are refused", test_batch_outputs), &
+         new_unittest("a full disk (the job's file-size limit): exit 5, the cause, no file left", test_full_disk) &
          ]
    end subroutine collect_safety
 
@@ -253,4 +254,29 @@ contains
       call check(error, code == 0 .and. file_exists(dir//"/results/x/scene.h5") .and. &
          file_exists(dir//"/results/x/other.h5"), "--outdir made and filled")
    end subroutine test_batch_outputs
+
+   !> A write that fails for want of space. A real full disk needs a small file system
+   !> (root); the file-size limit of `ulimit -f` fails writes with EFBIG the same way
+   !> (femcod turns SIGXFSZ off). 32 blocks of 512 bytes (dash, /bin/sh on Debian) or
+   !> 1 KiB (bash): 16 or 32 KiB, below the HDF5 file of this run (about 70 KiB).
+   !> Before femcod wrote through C's stdio, gfortran's WRITE reported success on a
+   !> full disk and the files were cut short with exit 0; HDF5 1.10 crashed at exit.
+   subroutine test_full_disk(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, listing
+      integer :: code
+      dir = scratch_path("full_disk")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir//"/out")
+      call make_deck(dir//"/scene.deck", 40)
+      call execute_command_line("ulimit -f 32 && "//self_command()//" run "//dir//"/scene.deck -o "//dir// &
+         "/out/r --loads 100,200 --quiet 2> "//scratch_path("safety.stderr"), exitstat=code)
+      call check(error, code, 5, "exit 5 (stderr: "//read_text(scratch_path("safety.stderr"))//")")
+      if (allocated(error)) return
+      call check(error, contains_text(read_text(scratch_path("safety.stderr")), "(File too large)"), &
+         "the cause is said: "//read_text(scratch_path("safety.stderr")))
+      if (allocated(error)) return
+      call execute_command_line("ls -A "//dir//"/out > "//dir//"/listing")
+      listing = read_text(dir//"/listing")
+      call check(error, len(listing) == 0, "no file left: "//listing)
+   end subroutine test_full_disk
 end module test_safety

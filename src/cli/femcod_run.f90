@@ -250,8 +250,8 @@ contains
          call set_error(status, STATUS_USAGE, "give -o PREFIX or --outdir DIR, not both")
       else if (settings%prefix /= "") then
          if (settings%prefix(len(settings%prefix):) == "/" .or. path_is_directory(settings%prefix)) &
-            call set_error(status, STATUS_USAGE, "-o takes a prefix such as "//settings%prefix//"/name, not a "// &
-            "directory (or use --outdir DIR)")
+            call set_error(status, STATUS_USAGE, "-o takes a prefix such as "//without_slash(settings%prefix)// &
+            "/name, not a directory (or use --outdir DIR)")
       end if
       if (status%code /= 0) return
       ! Each deck's prefix; two decks may not write the same files.
@@ -730,4 +730,16 @@ contains
       name = path
       if (path == "") name = "the height files"
    end function deck_label
+   !> A directory's name without its trailing slashes ("/" stays "").
+   pure function without_slash(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      integer :: n
+      n = len(path)
+      do while (n > 0)
+         if (path(n:n) /= "/") exit
+         n = n - 1
+      end do
+      name = path(1:n)
+   end function without_slash
 end module femcod_run

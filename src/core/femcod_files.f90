@@ -1,17 +1,44 @@
 !> Small file-system helpers used by the I/O modules (never by the numerical core):
 !> atomic replacement of a file by a temporary one, removal, existence and kind.
 module femcod_files
-   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_ptr, c_associated
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_ptr, c_associated, c_f_pointer, c_size_t, &
+      c_loc
    use femcod_kinds, only: i8
    use femcod_status, only: status_type, set_error, STATUS_IO, STATUS_BAD_INPUT
    use femcod_process, only: process_id, host_name, process_alive
    use femcod_strings, only: int_str
    implicit none
    private
-   public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, commit_file
+   public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, write_bytes, write_file
    public :: default_prefix, file_part, read_file, canonical_path, acquire_lock, release_lock, make_directories
+   public :: clear_write_error, write_error_cause
 
    interface
+      function c_fopen(path, mode) bind(c, name="fopen") result(stream)
+         import :: c_char, c_ptr
+         character(kind=c_char), intent(in) :: path(*), mode(*)
+         type(c_ptr) :: stream
+      end function c_fopen
+      function c_fwrite(buffer, size, count, stream) bind(c, name="fwrite") result(written)
+         import :: c_ptr, c_size_t
+         type(c_ptr), value :: buffer, stream
+         integer(c_size_t), value :: size, count
+         integer(c_size_t) :: written
+      end function c_fwrite
+      function c_fclose(stream) bind(c, name="fclose") result(rc)
+         import :: c_ptr, c_int
+         type(c_ptr), value :: stream
+         integer(c_int) :: rc
+      end function c_fclose
+      function c_errno_location() bind(c, name="__errno_location") result(p)
+         import :: c_ptr
+         type(c_ptr) :: p
+      end function c_errno_location
+      function c_strerror(code) bind(c, name="strerror") result(p)
+         import :: c_int, c_ptr
+         integer(c_int), value :: code
+         type(c_ptr) :: p
+      end function c_strerror
       function c_rename(from, to) bind(c, name="rename") result(rc)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: from(*), to(*)
@@ -48,22 +75,49 @@ contains
       end if
    end subroutine atomic_rename
 
-   !> Close `unit` (open on the temporary file `tmp`) and move it onto `path`; on any
-   !> failure the temporary file is removed and `path` is left as it was.
-   subroutine commit_file(unit, tmp, path, status)
-      integer, intent(in) :: unit
-      character(len=*), intent(in) :: tmp, path
+   !> Write `text` as the whole of the file `path` (created or truncated). Through C's
+   !> stdio, whose fwrite and fclose report a full disk, a quota or a file-size limit:
+   !> gfortran 12's WRITE and CLOSE return iostat = 0 when the disk is full and the data
+   !> is lost. On failure the partial file is removed.
+   subroutine write_bytes(path, text, status)
+      character(len=*), intent(in) :: path
+      character(len=*), target, intent(in) :: text
       type(status_type), intent(inout) :: status
-      integer :: ios
-      close(unit, iostat=ios)
-      if (ios /= 0) then
-         call remove_file(tmp)
-         call set_error(status, STATUS_IO, path//": writing failed")
+      type(c_ptr) :: stream
+      integer(c_size_t) :: written
+      character(len=:), allocatable :: cause
+      if (status%code /= 0) return
+      call clear_write_error()
+      stream = c_fopen(path//c_null_char, "wb"//c_null_char)
+      if (.not. c_associated(stream)) then
+         cause = write_error_cause()
+         if (len(cause) == 0) cause = " (directory missing or not writable)"
+         call set_error(status, STATUS_IO, path//": cannot write"//cause)
          return
       end if
+      written = 0
+      if (len(text) > 0) written = c_fwrite(c_loc(text), 1_c_size_t, int(len(text), c_size_t), stream)
+      ! fclose flushes what stdio still holds: its failure loses data as much as fwrite's.
+      if (c_fclose(stream) /= 0 .or. written /= int(len(text), c_size_t)) then
+         cause = write_error_cause()
+         call remove_file(path)
+         call set_error(status, STATUS_IO, path//": writing failed"//cause)
+      end if
+   end subroutine write_bytes
+
+   !> Write `text` as the file `path` all at once: into the temporary `path.part`, then
+   !> renamed onto `path`, so that `path` is either untouched or complete.
+   subroutine write_file(path, text, status)
+      character(len=*), intent(in) :: path, text
+      type(status_type), intent(inout) :: status
+      character(len=:), allocatable :: tmp
+      if (status%code /= 0) return
+      tmp = temporary_name(path)
+      call write_bytes(tmp, text, status)
+      if (status%code /= 0) return
       call atomic_rename(tmp, path, status)
       if (status%code /= 0) call remove_file(tmp)
-   end subroutine commit_file
+   end subroutine write_file
 
    !> Remove a file if it exists; errors are ignored (used to clean up temporaries).
    subroutine remove_file(path)
@@ -203,10 +257,16 @@ contains
       notice = ""
       if (status%code /= 0) return
       do attempt = 1, 2
+         ! Created exclusively (status="new"), then its line written through write_bytes,
+         ! which, unlike Fortran's WRITE, reports a full disk.
          open(newunit=unit, file=path, status="new", action="write", iostat=ios)
          if (ios == 0) then
-            write(unit, '(i0,1x,a)', iostat=ios) process_id(), host_name()
             close(unit)
+            call write_bytes(path, int_str(process_id())//" "//host_name()//new_line("a"), status)
+            if (status%code /= 0) then
+               call remove_file(path)
+               status%message = status%message//"; nothing was run"
+            end if
             return
          end if
          if (.not. path_exists(path)) exit
@@ -217,6 +277,11 @@ contains
          if (ios == 0) then
             read(unit, *, iostat=ios) pid, holder_host
             close(unit)
+         end if
+         if (ios /= 0) then
+            call set_error(status, STATUS_IO, path//": a lock file that names no process (""PID HOST"" expected); "// &
+               "remove it if no run writes these results")
+            return
          end if
          if (trim(holder_host) == host_name() .and. .not. process_alive(pid)) then
             call remove_file(path)
@@ -257,4 +322,35 @@ contains
       end do
       if (.not. path_is_directory(path)) call set_error(status, STATUS_IO, path//": cannot make the directory")
    end subroutine make_directories
+
+   !> Forget the C library's last error (errno = 0) before a write whose cause
+   !> write_error_cause may have to tell.
+   subroutine clear_write_error()
+      integer(c_int), pointer :: errno
+      call c_f_pointer(c_errno_location(), errno)
+      errno = 0
+   end subroutine clear_write_error
+
+   !> Why a write failed, when the C library says it is the device's fault:
+   !> " (No space left on device)" for ENOSPC, EDQUOT (quota), EFBIG (the job's
+   !> file-size limit), EIO and EROFS; "" otherwise (a library's failure of its own).
+   function write_error_cause() result(cause)
+      character(len=:), allocatable :: cause
+      integer(c_int), parameter :: EIO = 5, EFBIG = 27, ENOSPC = 28, EROFS = 30, EDQUOT = 122
+      integer(c_int), pointer :: errno
+      character(kind=c_char), pointer :: text(:)
+      character(len=:), allocatable :: message
+      integer :: k
+      cause = ""
+      call c_f_pointer(c_errno_location(), errno)
+      if (all(errno /= [EIO, EFBIG, ENOSPC, EROFS, EDQUOT])) return
+      ! Read up to the terminating NUL only: the text is short and static.
+      call c_f_pointer(c_strerror(errno), text, [256])
+      message = ""
+      do k = 1, size(text)
+         if (text(k) == c_null_char) exit
+         message = message//text(k)
+      end do
+      cause = " ("//message//")"
+   end function write_error_cause
 end module femcod_files

@@ -12,7 +12,7 @@ module femcod_process
    public :: SIGINT, SIGTERM, SIGUSR1
 
    !> Linux signal numbers.
-   integer, parameter :: SIGINT = 2, SIGUSR1 = 10, SIGTERM = 15
+   integer, parameter :: SIGINT = 2, SIGUSR1 = 10, SIGTERM = 15, SIGXFSZ = 25
 
    !> The last stop signal caught (0: none).
    integer(c_int), volatile :: caught = 0
@@ -79,13 +79,21 @@ contains
    end function process_alive
 
    !> From now on SIGTERM, SIGINT and SIGUSR1 set the flag stop_signal() reads instead
-   !> of ending the process.
+   !> of ending the process. SIGXFSZ (a file grew past the job's file-size limit,
+   !> `ulimit -f`) no longer kills the process: the write fails with EFBIG instead and is
+   !> reported as the I/O error it is, like a full disk.
    subroutine catch_stop_signals()
       type(c_funptr) :: old
       old = c_signal(int(SIGTERM, c_int), c_funloc(on_signal))
       old = c_signal(int(SIGINT, c_int), c_funloc(on_signal))
       old = c_signal(int(SIGUSR1, c_int), c_funloc(on_signal))
+      old = c_signal(int(SIGXFSZ, c_int), c_funloc(on_file_size_limit))
    end subroutine catch_stop_signals
+
+   !> SIGXFSZ: nothing to do; the failed write reports it.
+   subroutine on_file_size_limit(sig) bind(c)
+      integer(c_int), value :: sig
+   end subroutine on_file_size_limit
 
    !> The handler: remember the signal, nothing else (async-signal-safe).
    subroutine on_signal(sig) bind(c)

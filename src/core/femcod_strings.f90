@@ -6,7 +6,8 @@ module femcod_strings
    use femcod_kinds, only: dp, i8
    implicit none
    private
-   public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, built_text, without_trailing_zeros
+   public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, add_lines, built_text
+   public :: without_trailing_zeros
    public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, is_digit, append_string
 
    !> A string of any length, for lists of arguments.
@@ -52,6 +53,29 @@ contains
       builder%buffer(builder%length + 1:need) = line//new_line("a")
       builder%length = need
    end subroutine add_line
+
+   !> Append up to sixteen lines (the items of a `write(unit, '(a)') a, b, ...`).
+   pure subroutine add_lines(builder, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15, l16)
+      type(text_builder), intent(inout) :: builder
+      character(len=*), intent(in) :: l1
+      character(len=*), intent(in), optional :: l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15, l16
+      call add_line(builder, l1)
+      if (present(l2)) call add_line(builder, l2)
+      if (present(l3)) call add_line(builder, l3)
+      if (present(l4)) call add_line(builder, l4)
+      if (present(l5)) call add_line(builder, l5)
+      if (present(l6)) call add_line(builder, l6)
+      if (present(l7)) call add_line(builder, l7)
+      if (present(l8)) call add_line(builder, l8)
+      if (present(l9)) call add_line(builder, l9)
+      if (present(l10)) call add_line(builder, l10)
+      if (present(l11)) call add_line(builder, l11)
+      if (present(l12)) call add_line(builder, l12)
+      if (present(l13)) call add_line(builder, l13)
+      if (present(l14)) call add_line(builder, l14)
+      if (present(l15)) call add_line(builder, l15)
+      if (present(l16)) call add_line(builder, l16)
+   end subroutine add_lines
 
    !> The text built so far.
    pure function built_text(builder) result(text)

@@ -16,8 +16,8 @@ module femcod_deck
    use femcod_problem, only: contact_problem, validate_problem, MAX_NP, MIN_PIXEL, MAX_PIXEL, MAX_HEIGHT, &
       MIN_YOUNG, MAX_YOUNG
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
-   use femcod_files, only: commit_file, temporary_name, read_file
-   use femcod_strings, only: int_str, parse_real, parse_integer, format_real, is_digit
+   use femcod_files, only: write_file, read_file
+   use femcod_strings, only: int_str, parse_real, parse_integer, format_real, is_digit, text_builder, add_line, built_text
    implicit none
    private
    public :: read_deck, write_deck
@@ -200,30 +200,24 @@ contains
       character(len=*), intent(in) :: path
       type(contact_problem), intent(in) :: deck
       type(status_type), intent(inout) :: status
-      character(len=:), allocatable :: tmp
-      integer :: unit, ios, i
+      type(text_builder) :: b
+      integer :: i
       call validate_problem(deck, status)
       if (status%code /= 0) return
-      tmp = temporary_name(path)
-      open(newunit=unit, file=tmp, status="replace", action="write", form="formatted", iostat=ios)
-      if (ios /= 0) then
-         call set_error(status, STATUS_IO, path//": cannot write (directory missing or not writable)")
-         return
-      end if
-      write(unit, '(a)', iostat=ios) deck%label
-      write(unit, '(a)', iostat=ios) int_str(deck%np)//" "//format_real(deck%pixel)//" "//int_str(deck%maxcont)
+      call add_line(b, deck%label)
+      call add_line(b, int_str(deck%np)//" "//format_real(deck%pixel)//" "//int_str(deck%maxcont))
       do i = 1, 3
-         write(unit, '(a)', iostat=ios) format_real(deck%young(i))//" "//format_real(deck%poisson(i))
+         call add_line(b, format_real(deck%young(i))//" "//format_real(deck%poisson(i)))
       end do
       do i = 1, deck%np
-         call write_row(deck%lower(i, :))
+         call add_line(b, row_text(deck%lower(i, :)))
       end do
       do i = 1, deck%np
-         call write_row(deck%upper(i, :))
+         call add_line(b, row_text(deck%upper(i, :)))
       end do
-      call commit_file(unit, tmp, path, status)
+      call write_file(path, built_text(b), status)
    contains
-      subroutine write_row(row)
+      function row_text(row) result(line)
          real(dp), intent(in) :: row(:)
          character(len=:), allocatable :: line
          integer :: j
@@ -231,8 +225,7 @@ contains
          do j = 2, size(row)
             line = line//" "//format_real(row(j))
          end do
-         if (ios == 0) write(unit, '(a)', iostat=ios) line
-      end subroutine write_row
+      end function row_text
    end subroutine write_deck
 
 

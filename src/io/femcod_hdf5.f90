@@ -9,7 +9,7 @@
 !> `data[i, j]` with i the row and j the column, as in the deck: the Fortran array
 !> `map(i, j)` is written transposed.
 module femcod_hdf5
-   use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, h5fcreate_f, h5fopen_f, h5fclose_f, &
+   use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5dont_atexit_f, h5eset_auto_f, h5fcreate_f, h5fopen_f, h5fclose_f, &
       h5gcreate_f, h5gclose_f, h5screate_simple_f, h5screate_f, h5sclose_f, h5dcreate_f, h5dopen_f, h5dclose_f, &
       h5dwrite_f, h5dread_f, h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
       h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, h5oopen_f, h5oclose_f, h5tcopy_f, h5tset_size_f, &
@@ -18,6 +18,7 @@ module femcod_hdf5
       H5T_COMPOUND_F, H5T_ENUM_F
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
+   use femcod_files, only: clear_write_error, write_error_cause
    implicit none
    private
    public :: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, h5_read, h5_exists
@@ -46,8 +47,13 @@ module femcod_hdf5
 
 contains
 
+   !> Open the library. h5dont_atexit_f first (it fails harmlessly once the library is
+   !> open): HDF5 1.10 crashes in its exit handler when a file's close failed (a full
+   !> disk leaves the file in its table, HDFGroup/hdf5 #2291, fixed in 1.14.1). Every
+   !> file here is closed explicitly, so the exit handler has nothing left to do.
    subroutine initialise()
       integer :: error
+      call h5dont_atexit_f(error)
       call h5open_f(error)
       call h5eset_auto_f(0, error)
    end subroutine initialise
@@ -58,12 +64,16 @@ contains
       type(h5_file), intent(out) :: file
       type(status_type), intent(inout) :: status
       integer :: error
+      character(len=:), allocatable :: cause
       if (status%code /= 0) return
       call initialise()
       file%path = path
+      call clear_write_error()
       call h5fcreate_f(path, H5F_ACC_TRUNC_F, file%id, error)
       if (error /= 0) then
-         call set_error(status, STATUS_IO, path//": cannot create the HDF5 file (directory missing or not writable)")
+         cause = write_error_cause()
+         if (len(cause) == 0) cause = " (directory missing or not writable)"
+         call set_error(status, STATUS_IO, path//": cannot create the HDF5 file"//cause)
          file%id = -1
       end if
    end subroutine h5_create
@@ -94,7 +104,8 @@ contains
       if (file%id < 0) return
       call h5fclose_f(file%id, error)
       file%id = -1
-      if (error /= 0 .and. status%code == 0) call set_error(status, STATUS_IO, file%path//": error closing the file")
+      if (error /= 0 .and. status%code == 0) call set_error(status, STATUS_IO, &
+         file%path//": error closing the file"//write_error_cause())
    end subroutine h5_close
 
    !> Create a group (its parent must exist).
@@ -107,7 +118,7 @@ contains
       if (status%code /= 0) return
       call h5gcreate_f(file%id, name, group, error)
       if (error /= 0) then
-         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the group")
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the group"//write_error_cause())
          return
       end if
       call h5gclose_f(group, error)
@@ -144,13 +155,13 @@ contains
          call h5screate_simple_f(size(dims), dims, space, error)
       end if
       if (error /= 0) then
-         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataspace")
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataspace"//write_error_cause())
          return
       end if
       call h5dcreate_f(file%id, name, dtype, space, dset, error)
       call h5sclose_f(space, error)
       if (dset < 0) then
-         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataset")
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataset"//write_error_cause())
       end if
    end subroutine create_dataset
 
@@ -164,7 +175,7 @@ contains
       integer :: e
       call h5dclose_f(dset, e)
       if (error /= 0) then
-         call set_error(status, STATUS_IO, file%path//":"//name//": cannot write the dataset")
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot write the dataset"//write_error_cause())
          return
       end if
       call h5_attribute(file, name, "units", units, status)
@@ -291,7 +302,7 @@ contains
       call h5sclose_f(space, error)
       if (error /= 0) then
          call h5oclose_f(object, error)
-         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create attribute "//key)
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create attribute "//key//write_error_cause())
       end if
    end subroutine create_attribute
 
@@ -304,7 +315,8 @@ contains
       integer :: e
       call h5aclose_f(attr, e)
       call h5oclose_f(object, e)
-      if (error /= 0) call set_error(status, STATUS_IO, file%path//":"//name//": cannot write attribute "//key)
+      if (error /= 0) call set_error(status, STATUS_IO, &
+         file%path//":"//name//": cannot write attribute "//key//write_error_cause())
    end subroutine close_attribute
 
    subroutine attribute_string(file, name, key, value, status)

@@ -11,7 +11,7 @@ module femcod_results
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real
-   use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists
+   use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, write_bytes
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
       h5_read_string_attribute
@@ -144,16 +144,6 @@ contains
       call commit_set(names, temps, status)
    end subroutine write_file_set
 
-   subroutine close_written(unit, tmp, ios, status)
-      integer, intent(in) :: unit, ios
-      character(len=*), intent(in) :: tmp
-      type(status_type), intent(inout) :: status
-      integer :: ios2
-      close(unit, iostat=ios2)
-      if ((ios /= 0 .or. ios2 /= 0) .and. status%code == 0) &
-         call set_error(status, STATUS_IO, result_name(tmp)//": writing failed (disk full?)")
-   end subroutine close_written
-
    !> The result file a temporary name stands for (temporary_name appends ".part").
    function result_name(tmp) result(name)
       character(len=*), intent(in) :: tmp
@@ -167,16 +157,11 @@ contains
    subroutine write_text(tmp, text, status)
       character(len=*), intent(in) :: tmp, text
       type(status_type), intent(inout) :: status
-      integer :: unit, ios
-      if (status%code /= 0) return
-      ! Unformatted stream: the bytes of `text`, no record marks or added line end.
-      open(newunit=unit, file=tmp, access="stream", form="unformatted", status="replace", action="write", iostat=ios)
-      if (ios /= 0) then
-         call set_error(status, STATUS_IO, result_name(tmp)//": cannot write (directory missing or not writable)")
-         return
-      end if
-      write(unit, iostat=ios) text
-      call close_written(unit, tmp, ios, status)
+      type(status_type) :: st
+      call write_bytes(tmp, text, st)
+      ! Name the result file, not its temporary.
+      if (st%code /= 0 .and. status%code == 0) &
+         call set_error(status, st%code, result_name(tmp)//st%message(len(tmp) + 1:))
    end subroutine write_text
 
    !> PREFIX.history.csv: one row per step.
