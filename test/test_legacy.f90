@@ -245,9 +245,8 @@ contains
       p = c_getcwd(home, int(len(home), c_size_t))
       home = home(1:index(home, c_null_char) - 1)
       dir = scratch_path("batch")
-      call execute_command_line("mkdir -p "//dir//" && cp input/square_punch_n3.deck input/circle_punch_d1.deck "// &
-         dir//"/ && printf 'bad\n' > "//dir//"/bad.deck && rm -f "//dir//"/*.csv "//dir//"/*.h5 "// &
-         dir//"/*.xdmf "//dir//"/*.svg", exitstat=ios)
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir//" && cp input/square_punch_n3.deck "// &
+         "input/circle_punch_d1.deck "//dir//"/ && printf 'bad\n' > "//dir//"/bad.deck", exitstat=ios)
       call check(error, c_chdir(dir//c_null_char) == 0, "cd into the scratch directory")
       if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("square_punch_n3.deck"), string_type("bad.deck"), &

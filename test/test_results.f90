@@ -23,7 +23,7 @@ contains
       testsuite = [ &
          new_unittest("HDF5: schema, units, maps balance the load", test_hdf5), &
          new_unittest("HDF5: maps in C order (h5dump reads row i, column j)", test_c_order), &
-         new_unittest("XDMF: every referenced dataset exists", test_xdmf), &
+         new_unittest("XDMF: one grid of quadrilaterals in the XY plane, rows as in the figures", test_xdmf), &
          new_unittest("SVG: complete documents, fitted exponent and pressure scale", test_svg), &
          new_unittest("existing results are kept without --force", test_force), &
          new_unittest("a result that cannot be put in place leaves no partial set", test_partial), &
@@ -86,13 +86,15 @@ contains
    subroutine test_hdf5(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix, units
-      character(len=*), parameter :: datasets(*) = [character(len=28) :: "/surfaces/lower", "/surfaces/upper", &
+      character(len=*), parameter :: datasets(*) = [character(len=36) :: "/surfaces/lower", "/surfaces/upper", &
          "/history/step", "/history/contacts", "/history/load", "/history/approach", "/history/area", &
          "/history/area_fraction", "/contacts/i", "/contacts/j", "/contacts/step", "/contacts/force", &
-         "/loads/1/pressure", "/loads/1/gap", "/loads/2/pressure", "/loads/2/gap", "/run/max_penetration"]
+         "/contacts/pressure", "/loads/001/pressure", "/loads/001/gap", "/loads/002/pressure", "/loads/002/gap", &
+         "/mesh/nodes_xy", "/mesh/quadrilaterals", "/mesh/cells/lower_nm", "/mesh/cells/pressure_GPa_load002", &
+         "/run/max_penetration"]
       type(h5_file) :: file
       type(status_type) :: st
-      real(dp), allocatable :: p(:, :), g(:, :), load(:), force(:), ci(:), cj(:)
+      real(dp), allocatable :: p(:, :), g(:, :), load(:), force(:), ci(:), cj(:), cp(:)
       real(dp) :: pixel
       integer :: code, k, np
       call sphere_run("h5-sphere", prefix, code)
@@ -109,13 +111,14 @@ contains
          if (allocated(error)) exit
       end do
       if (allocated(error)) return
-      call h5_read_string_attribute(file, "/loads/2/pressure", "units", 16, units, st, STATUS_BAD_INPUT)
+      call h5_read_string_attribute(file, "/loads/002/pressure", "units", 16, units, st, STATUS_BAD_INPUT)
       call check(error, units, "GPa")
       if (allocated(error)) return
-      call h5_read(file, "/loads/2/pressure", p, st, STATUS_BAD_INPUT)
-      call h5_read(file, "/loads/2/gap", g, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/loads/002/pressure", p, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/loads/002/gap", g, st, STATUS_BAD_INPUT)
       call h5_read(file, "/history/load", load, st, STATUS_BAD_INPUT)
       call h5_read(file, "/contacts/force", force, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/contacts/pressure", cp, st, STATUS_BAD_INPUT)
       call h5_close(file, st)
       call check(error, st%code, 0, "reading the maps")
       if (allocated(error)) return
@@ -142,6 +145,10 @@ contains
       do k = 1, size(ci)
          call check(error, abs(p(nint(ci(k)), nint(cj(k))) - force(k)/pixel**2) <= 1.0e-12_dp*maxval(p), &
             "pressure map at contact "//to_string(k))
+         if (allocated(error)) return
+         ! /contacts/pressure is the contact's force over its pixel, nN/nm^2 = GPa.
+         call check(error, abs(cp(k) - force(k)/pixel**2) <= 1.0e-12_dp*maxval(p), &
+            "/contacts/pressure at contact "//to_string(k))
          if (allocated(error)) return
       end do
    end subroutine test_hdf5
@@ -175,21 +182,32 @@ contains
       call check(error, v, deck%upper(2, 5), "upper(2, 5) as h5dump sees it")
    end subroutine test_c_order
 
-   !> Every `file.h5:/path` in the XDMF names a dataset of the HDF5 file beside it, with
-   !> the dimensions the XDMF states.
+   !> The XDMF is one uniform grid of NP^2 quadrilaterals (the form meshio reads) whose
+   !> every `file.h5:/path` is a dataset of the HDF5 file beside it with the stated size;
+   !> the mesh is rebuilt here from its definition (doc/results.md): cell (i, j), number
+   !> (i-1)*NP + j-1, is the d x d square centred at x = (j - 1/2) d, y = (NP - i + 1/2) d
+   !> (row 1 on top, as in the figures), counter-clockwise seen from +z; the cell arrays
+   !> are the NP x NP maps row after row.
    subroutine test_xdmf(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix, text, name, path
       type(h5_file) :: file
       type(status_type) :: st
-      real(dp), allocatable :: map(:, :)
-      integer :: code, a, b, found
+      real(dp), allocatable :: nodes(:, :), quads(:, :), cells(:), map(:, :)
+      real(dp) :: corners(2, 4), centre(2), area
+      integer, parameter :: np = 30
+      real(dp), parameter :: d = 1
+      integer :: code, a, b, found, i, j, c, m
       call sphere_run("xdmf-sphere", prefix, code)
       call check(error, code, 0, "femcod run")
       if (allocated(error)) return
       text = read_text(prefix//".xdmf")
       call check(error, contains_text(text, '<Xdmf Version="3.0">') .and. contains_text(text, "</Xdmf>"), &
          "an XDMF 3 document")
+      if (allocated(error)) return
+      call check(error, count_text(text, "<Grid ") == 1 .and. contains_text(text, 'GridType="Uniform"') .and. &
+         contains_text(text, 'TopologyType="Quadrilateral"') .and. contains_text(text, 'GeometryType="XY"'), &
+         "one uniform grid of quadrilaterals in the XY plane")
       if (allocated(error)) return
       name = "xdmf-sphere.h5:"
       call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
@@ -200,15 +218,55 @@ contains
          if (b == 0) exit
          a = a + b - 1 + len(name)
          path = text(a:a + index(text(a:), "<") - 2)
-         call h5_read(file, path, map, st, STATUS_BAD_INPUT)
-         call check(error, st%code == 0 .and. size(map, 1) == 30 .and. size(map, 2) == 30, "XDMF item "//path)
+         call check(error, h5_exists(file, path), "XDMF item "//path//" in the HDF5 file")
          if (allocated(error)) exit
          found = found + 1
       end do
+      if (.not. allocated(error)) then
+         call h5_read(file, "/mesh/nodes_xy", nodes, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/mesh/quadrilaterals", quads, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/mesh/cells/pressure_GPa_load002", cells, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/loads/002/pressure", map, st, STATUS_BAD_INPUT)
+      end if
       call h5_close(file, st)
       if (allocated(error)) return
-      ! Two surfaces, and pressure and gap at two loads.
-      call check(error, found, 6, "datasets referenced")
+      ! The mesh, two surfaces, pressure and gap at two loads.
+      call check(error, found, 8, "datasets referenced")
+      if (allocated(error)) return
+      call check(error, st%code == 0 .and. size(nodes, 1) == (np + 1)**2 .and. size(nodes, 2) == 2 .and. &
+         size(quads, 1) == np*np .and. size(quads, 2) == 4 .and. size(cells) == np*np, "mesh and cell array sizes")
+      if (allocated(error)) return
+      do i = 1, np
+         do j = 1, np
+            c = (i - 1)*np + j
+            do m = 1, 4
+               corners(:, m) = nodes(nint(quads(c, m)) + 1, :)
+            end do
+            centre = sum(corners, dim=2)/4
+            ! Shoelace formula: positive for counter-clockwise.
+            area = 0
+            do m = 1, 4
+               area = area + (corners(1, m)*corners(2, modulo(m, 4) + 1) - corners(1, modulo(m, 4) + 1)*corners(2, m))/2
+            end do
+            call check(error, abs(centre(1) - (j - 0.5_dp)*d) < 1e-12_dp .and. &
+               abs(centre(2) - (np - i + 0.5_dp)*d) < 1e-12_dp .and. abs(area - d*d) < 1e-12_dp .and. &
+               cells(c) == map(i, j), "cell ("//to_string(i)//", "//to_string(j)//")")
+            if (allocated(error)) return
+         end do
+      end do
+   contains
+      integer function count_text(t, what)
+         character(len=*), intent(in) :: t, what
+         integer :: p, q
+         count_text = 0
+         p = 1
+         do
+            q = index(t(p:), what)
+            if (q == 0) exit
+            count_text = count_text + 1
+            p = p + q
+         end do
+      end function count_text
    end subroutine test_xdmf
 
    !> The figures are complete SVG documents; the area-load figure states the exponent

@@ -101,7 +101,8 @@ contains
       call check(error, code, 143, "exit 128 + SIGTERM (stderr: "//read_text(scratch_path("safety.stderr"))//")")
       if (allocated(error)) return
       call check(error, contains_text(read_text(scratch_path("safety.stderr")), "SIGTERM: stopped at step") .and. &
-         contains_text(read_text(scratch_path("safety.stderr")), "continue with --restart"), "what was saved is said")
+         contains_text(read_text(scratch_path("safety.stderr")), "continue with --restart"), &
+         "what was saved is said: "//read_text(scratch_path("safety.stderr")))
       if (allocated(error)) return
       call check(error, file_exists(dir//"/ck.ckpt.h5") .and. .not. file_exists(dir//"/ck.h5") .and. &
          .not. file_exists(dir//"/ck.history.csv") .and. .not. file_exists(dir//"/ck.lock") .and. &

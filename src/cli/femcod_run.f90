@@ -11,10 +11,10 @@ module femcod_run
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
-   use femcod_strings, only: string_type, int_str, real_str, format_real, append_string
+   use femcod_strings, only: sig_str, string_type, int_str, format_real, append_string
    use femcod_files, only: remove_file, path_exists, path_is_directory, default_prefix, file_part, canonical_path, &
       acquire_lock, release_lock, read_file, make_directories
-   use femcod_process, only: catch_stop_signals, stop_signal, signal_name
+   use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
    use femcod_sha256, only: sha256_hex
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
@@ -91,8 +91,9 @@ contains
             "the run stops once the largest is reached", lower=0.0_dp), &
          real_option("--hardness", "H", "GPa, for n_above_hardness (default 11, polysilicon)", lower=0.0_dp, closed="()"), &
          flag_option("--quiet", "no summary on standard output, no progress lines on standard error", alias="-q"), &
-         flag_option("--force", "overwrite existing result files (otherwise a deck whose results exist fails with "// &
-            "exit code 5 before it is solved)"), &
+         flag_option("--force", "replace existing results as a whole set, and a checkpoint of an interrupted run "// &
+            "(otherwise both are kept and the deck fails with exit code 5 before it is solved); an input file is "// &
+            "never an output"), &
          integer_option("--max-contacts", "N", "stop after N contacts (default: the deck's MAXCONT)", lower=1, &
             mode="event"), &
          flag_option("--no-final-check", "skip the final check of every pixel for missed contacts", mode="event"), &
@@ -103,7 +104,8 @@ contains
          real_option("--checkpoint-interval", "S", "write PREFIX.ckpt.h5 (atomically) every S seconds of wall time "// &
             "(default 300; 0: after every step); removed at the end", lower=0.0_dp, mode="incremental"), &
          flag_option("--restart", "continue from PREFIX.ckpt.h5 if it exists (refused if it belongs to another deck "// &
-            "or other options); the run ends exactly as an uninterrupted one", mode="incremental"), &
+            "or other options); the run ends exactly as an uninterrupted one. Complete results of the same inputs "// &
+            "and options: nothing to do; of others: refused", mode="incremental"), &
          real_option("--tol", "T", "stop when the gap violations over the height range are below T (default 1e-8)", &
             lower=0.0_dp, closed="()", mode="cg"), &
          integer_option("--max-iterations", "N", "iterations on the finest grid (default 2000)", lower=1, mode="cg"), &
@@ -145,9 +147,15 @@ contains
          "         PREFIX.contacts.csv (i,j,step,force_nN,pressure_GPa) at the largest requested load", &
          "         or the last step, PREFIX.loads.csv (load_nN,approach_nm,contacts,area_nm2,area_fraction,", &
          "         max_pressure_GPa,n_above_hardness), PREFIX.h5 (everything, with the pressure and gap", &
-         "         maps at each requested load; doc/results.md), PREFIX.xdmf (the maps for ParaView),", &
-         "         PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg", &
-         "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
+         "         maps at each requested load; doc/results.md), PREFIX.xdmf (the maps on a mesh for", &
+         "         ParaView and meshio), PREFIX.summary.json (the summary as numbers with units),", &
+         "         PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg.", &
+         "         PREFIX.lock exists while a run writes the prefix; another run is refused.", &
+         "signals: SIGTERM, SIGINT and SIGUSR1 stop the run at the next step; the incremental solver", &
+         "         writes its checkpoint (continue with --restart), no result file is left half written.", &
+         "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure or memory, 5 I/O (results or a", &
+         "         checkpoint exist, a lock is held, disk full), 128 + N stopped by signal N (143 SIGTERM,", &
+         "         130 SIGINT, 138 SIGUSR1)"
    end subroutine run_help
 
    !> The arguments of `femcod run` as settings: parsed against run_table, the options
@@ -350,9 +358,11 @@ contains
             call append_string(failed, settings%decks(d)%s)
             if (code == 0) code = rc
          end if
-         if (stop_signal() /= 0) then
+         ! A signal stops the batch. One that arrives after the last deck's results are
+         ! written leaves nothing undone: the exit code stays that of the work.
+         if (stop_signal() /= 0 .and. d < size(settings%decks)) then
             code = 128 + stop_signal()
-            if (d < size(settings%decks)) write(error_unit, '(a)') "femcod: "//signal_name(stop_signal())// &
+            write(error_unit, '(a)') "femcod: "//signal_name(stop_signal())// &
                ": the batch stops; "//int_str(size(settings%decks) - d)//" decks not run"
             exit
          end if
@@ -447,7 +457,7 @@ contains
       type(incremental_state) :: resume
       type(state_maps), allocatable :: maps(:)
       type(run_info) :: info
-      character(len=:), allocatable :: fingerprint, stored
+      character(len=:), allocatable :: fingerprint, stored, started
       logical :: resuming, ok, have_checkpoint
       integer :: k
       associate(options => settings%solve)
@@ -508,6 +518,7 @@ contains
             call remove_file(prefix//".ckpt.h5")
          end if
          if (options%solver == "cg" .and. len(settings%wisdom) > 0) call load_wisdom(settings%wisdom, ok)
+         started = local_time_iso()
          if (resuming) then
             call solve_contact(problem, options, res, st, observer, resume)
          else
@@ -527,6 +538,10 @@ contains
          info%version = FEMCOD_VERSION
          info%solver = trim(options%solver)
          info%options = settings%command_line
+         info%command_line = "femcod run "//settings%command_line
+         info%host = host_name()
+         info%started = started
+         info%finished = local_time_iso()
          info%scene = model_notes(problem, options)
          info%inputs = inputs
          info%fingerprint = fingerprint
@@ -650,31 +665,41 @@ contains
       write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//trim(options%solver)//")"
       write(output_unit, '(a)') "  scene     : "//problem%label
       write(output_unit, '(a)') "              NP = "//int_str(problem%np)//", d = "//format_real(problem%pixel)// &
-         " nm, E = "//real_str(problem%young(1), 4)//" / "//real_str(problem%young(2), 4)//" / "// &
-         real_str(problem%young(3), 4)//" GPa (lower / upper / contact)"
-      write(output_unit, '(a)') "  steps     : "//int_str(last)//", stopped: "//stop_reason_text(res%stop_reason)
-      if (last > 0) then
-         write(output_unit, '(a)') "  last step : "//int_str(res%step_contacts(last))//" contacts up to load "// &
-            real_str(res%step_load(last), 6)//" nN (where the next contact closes), approach "// &
-            real_str(res%step_approach(last), 6)//" nm"
+         " nm, E = "//sig_str(problem%young(1), 4)//" / "//sig_str(problem%young(2), 4)//" / "// &
+         sig_str(problem%young(3), 4)//" GPa (lower / upper / contact)"
+      if (options%solver == "cg") then
+         write(output_unit, '(a)') "  loads     : "//int_str(count(res%states%reached))//" of "// &
+            int_str(size(res%states))//" solved"
+      else
+         write(output_unit, '(a)') "  steps     : "//int_str(last)//", stopped: "//stop_reason_text(res%stop_reason)
+         if (last > 0) then
+            write(output_unit, '(a)') "  last step : "//int_str(res%step_contacts(last))//" contacts up to load "// &
+               sig_str(res%step_load(last), 6)//" nN (where the next contact closes), approach "// &
+               sig_str(res%step_approach(last), 6)//" nm"
+         end if
       end if
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
-         write(output_unit, '(a)') "  at load   : "//real_str(res%states(k)%load, 6)//" nN: approach "// &
-            real_str(res%states(k)%approach, 6)//" nm, "//int_str(res%states(k)%contacts)//" contacts ("// &
-            real_str(res%states(k)%contacts*problem%pixel**2, 4)//" nm^2), max pressure "// &
-            real_str(res%states(k)%max_pressure, 4)//" GPa"
+         write(output_unit, '(a)') "  at load   : "//sig_str(res%states(k)%load, 6)//" nN: approach "// &
+            sig_str(res%states(k)%approach, 6)//" nm, "//int_str(res%states(k)%contacts)//" contacts ("// &
+            sig_str(res%states(k)%contacts*problem%pixel**2, 4)//" nm^2), max pressure "// &
+            sig_str(res%states(k)%max_pressure, 4)//" GPa"
       end do
-      write(output_unit, '(a)') "  wall time : "//real_str(res%wall_seconds, 3)//" s in total, "// &
-         real_str(res%wall_seconds/max(last, 1), 3)//" s per step"
+      if (options%solver == "cg") then
+         write(output_unit, '(a)') "  wall time : "//sig_str(res%wall_seconds, 3)//" s"
+      else
+         write(output_unit, '(a)') "  wall time : "//sig_str(res%wall_seconds, 3)//" s in total, "// &
+            sig_str(res%wall_seconds/max(last, 1), 3)//" s per step"
+      end if
+      write(output_unit, '(a)') "  written   : "//prefix//".h5, .xdmf, .summary.json, .history.csv, .contacts.csv, "// &
+         ".load_approach.svg, .area_load.svg"//trim(merge(", .loads.csv, .pressure_<k>.svg", &
+         repeat(" ", 31), size(res%states) > 0))
+      ! The solver's own account last.
       lines = report_lines(problem, options, res)
       do k = 1, size(lines)
          write(output_unit, '(a)') "  "//lines(k)%label//repeat(" ", max(0, 10 - len(lines(k)%label)))//": "// &
             lines(k)%text
       end do
-      write(output_unit, '(a)') "  written   : "//prefix//".h5, .xdmf, .history.csv, .contacts.csv, "// &
-         ".load_approach.svg, .area_load.svg"//trim(merge(", .loads.csv, .pressure_<k>.svg", &
-         repeat(" ", 31), size(res%states) > 0))
    end subroutine print_summary
 
    !> A progress line on standard error at most every 5 s, with an estimate of the time
@@ -693,10 +718,10 @@ contains
       estimate = ""
       if (fraction > 0 .and. fraction < 1) then
          left = elapsed*(fraction**(-self%growth) - 1)
-         estimate = ", about "//real_str(left, 2)//" s left (cost ~ contacts^"//int_str(nint(self%growth))//")"
+         estimate = ", about "//sig_str(left, 2)//" s left (cost ~ contacts^"//int_str(nint(self%growth))//")"
       end if
       write(error_unit, '(a)') "femcod: event "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
-         real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s elapsed"//estimate
+         sig_str(load, 5)//" nN, "//sig_str(elapsed, 3)//" s elapsed"//estimate
       flush(error_unit)
    end subroutine report_progress
 
@@ -730,6 +755,7 @@ contains
       name = path
       if (path == "") name = "the height files"
    end function deck_label
+
    !> A directory's name without its trailing slashes ("/" stays "").
    pure function without_slash(path) result(name)
       character(len=*), intent(in) :: path

@@ -8,7 +8,7 @@ module femcod_studies
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
-   use femcod_strings, only: string_type, int_str, real_str, split_list, text_builder, add_line, built_text, &
+   use femcod_strings, only: string_type, int_str, sig_str, split_list, text_builder, add_line, built_text, &
       parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, read_height_map, height_map, is_height_file
@@ -427,7 +427,7 @@ contains
       if (self%quiet .or. elapsed - self%last_report < 10) return
       self%last_report = elapsed
       write(error_unit, '(a)') "femcod resolution: event "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
-         real_str(load, 5)//" nN, "//real_str(elapsed, 3)//" s"
+         sig_str(load, 5)//" nN, "//sig_str(elapsed, 3)//" s"
       flush(error_unit)
    end subroutine level_progress
 

@@ -8,7 +8,7 @@ module femcod_process
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_size_t, c_null_char, c_funptr, c_funloc
    implicit none
    private
-   public :: process_id, host_name, process_alive, catch_stop_signals, stop_signal, signal_name
+   public :: process_id, host_name, process_alive, catch_stop_signals, stop_signal, signal_name, local_time_iso
    public :: SIGINT, SIGTERM, SIGUSR1
 
    !> Linux signal numbers.
@@ -121,4 +121,15 @@ contains
          name = "signal"
       end select
    end function signal_name
+   !> Now, as ISO 8601 local time with its offset from UTC: 2026-11-23T21:45:07+01:00.
+   function local_time_iso() result(stamp)
+      character(len=:), allocatable :: stamp
+      integer :: v(8), offset
+      character(len=32) :: buf
+      call date_and_time(values=v)
+      offset = abs(v(4))
+      write(buf, '(i4.4,"-",i2.2,"-",i2.2,"T",i2.2,":",i2.2,":",i2.2,a1,i2.2,":",i2.2)') v(1), v(2), v(3), &
+         v(5), v(6), v(7), merge("+", "-", v(4) >= 0), offset/60, mod(offset, 60)
+      stamp = trim(buf)
+   end function local_time_iso
 end module femcod_process

@@ -7,10 +7,15 @@ module femcod_strings
    implicit none
    private
    public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, add_lines, built_text
-   public :: without_trailing_zeros
+   public :: without_trailing_zeros, xml_escape, json_string, json_number, sig_str
    public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, is_digit, append_string
 
    !> A string of any length, for lists of arguments.
+   !> An integer (default or 64-bit) without blanks.
+   interface int_str
+      module procedure int_str_default, int_str_i8
+   end interface int_str
+
    type :: string_type
       character(len=:), allocatable :: s
    end type string_type
@@ -89,13 +94,22 @@ contains
    end function built_text
 
    !> An integer without blanks.
-   pure function int_str(i) result(s)
+   pure function int_str_default(i) result(s)
       integer, intent(in) :: i
       character(len=:), allocatable :: s
       character(len=12) :: buf
       write(buf, '(i0)') i
       s = trim(buf)
-   end function int_str
+   end function int_str_default
+
+   !> A 64-bit integer without blanks.
+   pure function int_str_i8(i) result(s)
+      integer(i8), intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=21) :: buf
+      write(buf, '(i0)') i
+      s = trim(buf)
+   end function int_str_i8
 
    !> A real in `es` form with `digits` significant digits.
    function real_str(x, digits) result(s)
@@ -315,4 +329,102 @@ contains
       longer(size(list) + 1)%s = text
       call move_alloc(longer, list)
    end subroutine append_string
+   !> Text for XML content and attribute values: & < > " ' as entities.
+   pure function xml_escape(s) result(e)
+      character(len=*), intent(in) :: s
+      character(len=:), allocatable :: e
+      integer :: k
+      e = ""
+      do k = 1, len(s)
+         select case (s(k:k))
+         case ("&")
+            e = e//"&amp;"
+         case ("<")
+            e = e//"&lt;"
+         case (">")
+            e = e//"&gt;"
+         case ('"')
+            e = e//"&quot;"
+         case ("'")
+            e = e//"&apos;"
+         case default
+            e = e//s(k:k)
+         end select
+      end do
+   end function xml_escape
+
+   !> A JSON string literal (RFC 8259): quotes, backslashes and control characters
+   !> escaped; other bytes (UTF-8) as they are.
+   pure function json_string(s) result(j)
+      character(len=*), intent(in) :: s
+      character(len=:), allocatable :: j
+      character(len=*), parameter :: hex = "0123456789abcdef"
+      integer :: k, c
+      j = '"'
+      do k = 1, len(s)
+         c = iachar(s(k:k))
+         select case (c)
+         case (34)
+            j = j//'\"'
+         case (92)
+            j = j//'\\'
+         case (10)
+            j = j//'\n'
+         case (9)
+            j = j//'\t'
+         case (13)
+            j = j//'\r'
+         case (0:8, 11:12, 14:31)
+            j = j//'\u00'//hex(c/16 + 1:c/16 + 1)//hex(mod(c, 16) + 1:mod(c, 16) + 1)
+         case default
+            j = j//s(k:k)
+         end select
+      end do
+      j = j//'"'
+   end function json_string
+
+   !> A JSON number: the shortest decimal that reads back to `x` (format_real); null
+   !> for NaN and infinities, which JSON cannot hold.
+   function json_number(x) result(j)
+      real(dp), intent(in) :: x
+      character(len=:), allocatable :: j
+      if (.not. ieee_is_finite(x) .or. x /= x) then
+         j = "null"
+      else
+         j = format_real(x)
+      end if
+   end function json_number
+
+   !> `v` with `digits` significant digits for people to read: plain decimals from 1e-3
+   !> to below 1e6 ("100", "0.0526049"), else "2.5e-7" and "1.2e+9"; no trailing zeros.
+   function sig_str(v, digits) result(s)
+      real(dp), intent(in) :: v
+      integer, intent(in) :: digits
+      character(len=:), allocatable :: s
+      character(len=40) :: buf
+      integer :: e, mark
+      if (v == 0) then
+         s = "0"
+         return
+      end if
+      write(buf, '(es40.'//int_str(digits - 1)//'e3)') v
+      ! The exponent after rounding to `digits` (9.9996 becomes 1.000E+001).
+      mark = index(buf, "E")
+      read(buf(mark + 1:), *) e
+      if (e >= -3 .and. e < 6) then
+         write(buf, '(f0.'//int_str(max(0, digits - 1 - e))//')') v
+         s = without_trailing_zeros(trim(adjustl(buf)))
+         if (s(1:1) == ".") s = "0"//s
+         if (len(s) > 1) then
+            if (s(1:2) == "-.") s = "-0"//s(2:)
+         end if
+      else
+         s = without_trailing_zeros(trim(adjustl(buf(1:mark - 1))))
+         if (e < 0) then
+            s = s//"e-"//int_str(-e)
+         else
+            s = s//"e+"//int_str(e)
+         end if
+      end if
+   end function sig_str
 end module femcod_strings

@@ -15,14 +15,18 @@ module femcod_hdf5
       h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, h5oopen_f, h5oclose_f, h5tcopy_f, h5tset_size_f, &
       h5tclose_f, h5lexists_f, h5aexists_f, h5dget_type_f, h5tget_class_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
       H5S_SCALAR_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_INTEGER_F, H5T_FLOAT_F, H5T_STRING_F, &
-      H5T_COMPOUND_F, H5T_ENUM_F
+      H5T_COMPOUND_F, H5T_ENUM_F, H5T_C_S1, h5tset_cset_f, H5T_CSET_UTF8_F, h5tis_variable_str_f, h5aget_type_f, &
+      h5pcreate_f, h5pclose_f, h5pset_chunk_f, h5pset_deflate_f, h5pset_shuffle_f, h5pset_virtual_f, &
+      h5sselect_all_f, H5P_DATASET_CREATE_F, H5P_DEFAULT_F
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char, c_size_t, c_int, c_f_pointer, &
+      c_associated, c_null_ptr, c_int64_t
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_files, only: clear_write_error, write_error_cause
    implicit none
    private
    public :: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, h5_read, h5_exists
-   public :: h5_read_string_attribute, h5_rank_and_dims
+   public :: h5_read_string_attribute, h5_rank_and_dims, h5_flat_view
 
    !> An open HDF5 file and the name it was opened under (for messages).
    type :: h5_file
@@ -44,6 +48,23 @@ module femcod_hdf5
    interface h5_read
       module procedure read_real0, read_real1, read_real2, read_int0, read_int1
    end interface h5_read
+
+   interface
+      !> H5Tset_size with H5T_VARIABLE ((size_t) -1), which the Fortran API of 1.10 does
+      !> not name.
+      function c_h5tset_size(type_id, size) bind(c, name="H5Tset_size") result(rc)
+         import :: c_int64_t, c_size_t, c_int
+         !> hid_t, int64_t since HDF5 1.10
+         integer(c_int64_t), value :: type_id
+         integer(c_size_t), value :: size
+         integer(c_int) :: rc
+      end function c_h5tset_size
+      function c_h5free_memory(mem) bind(c, name="H5free_memory") result(rc)
+         import :: c_ptr, c_int
+         type(c_ptr), value :: mem
+         integer(c_int) :: rc
+      end function c_h5free_memory
+   end interface
 
 contains
 
@@ -139,16 +160,32 @@ contains
 
    !> Create the dataset `name` of the given type and shape (`dims` in Fortran order;
    !> empty: scalar) and return it open.
-   subroutine create_dataset(file, name, dtype, dims, dset, status)
+   subroutine create_dataset(file, name, dtype, dims, dset, status, compress)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name
       integer(hid_t), intent(in) :: dtype
       integer(hsize_t), intent(in) :: dims(:)
       integer(hid_t), intent(out) :: dset
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: space
+      !> Chunked, byte-shuffled and deflated (level 1): for regular data such as a mesh.
+      logical, intent(in), optional :: compress
+      integer(hid_t) :: space, dcpl
+      integer(hsize_t) :: chunk(size(dims))
       integer :: error
       dset = -1
+      dcpl = H5P_DEFAULT_F
+      if (present(compress)) then
+         if (compress .and. size(dims) > 0 .and. product(dims) > 0) then
+            ! Chunks of about 1 MiB: whole fastest-varying rows, 2**17 of the others.
+            chunk = dims
+            chunk(size(dims)) = min(dims(size(dims)), max(1_hsize_t, 131072_hsize_t/max(1_hsize_t, &
+               product(dims(1:size(dims) - 1)))))
+            call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, error)
+            call h5pset_chunk_f(dcpl, size(dims), chunk, error)
+            call h5pset_shuffle_f(dcpl, error)
+            call h5pset_deflate_f(dcpl, 1, error)
+         end if
+      end if
       if (size(dims) == 0) then
          call h5screate_f(H5S_SCALAR_F, space, error)
       else
@@ -158,8 +195,9 @@ contains
          call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataspace"//write_error_cause())
          return
       end if
-      call h5dcreate_f(file%id, name, dtype, space, dset, error)
+      call h5dcreate_f(file%id, name, dtype, space, dset, error, dcpl_id=dcpl)
       call h5sclose_f(space, error)
+      if (dcpl /= H5P_DEFAULT_F) call h5pclose_f(dcpl, error)
       if (dset < 0) then
          call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataset"//write_error_cause())
       end if
@@ -213,11 +251,13 @@ contains
    end subroutine write_real1
 
    !> A map(i, j) (row i, column j), stored so that C-order readers see [i, j].
-   subroutine write_real2(file, name, map, units, status)
+   subroutine write_real2(file, name, map, units, status, compress)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, units
       real(dp), intent(in) :: map(:, :)
       type(status_type), intent(inout) :: status
+      !> Chunked and deflated (create_dataset).
+      logical, intent(in), optional :: compress
       integer(hid_t) :: dset
       integer(hsize_t) :: dims(2)
       real(dp), allocatable :: stored(:, :)
@@ -225,7 +265,7 @@ contains
       if (status%code /= 0) return
       dims = [size(map, 2, kind=hsize_t), size(map, 1, kind=hsize_t)]
       stored = transpose(map)
-      call create_dataset(file, name, H5T_NATIVE_DOUBLE, dims, dset, status)
+      call create_dataset(file, name, H5T_NATIVE_DOUBLE, dims, dset, status, compress)
       if (status%code /= 0) return
       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored, dims, error)
       call finish_dataset(file, name, dset, error, units, status)
@@ -262,11 +302,13 @@ contains
       call finish_dataset(file, name, dset, error, units, status)
    end subroutine write_int1
 
-   subroutine write_int2(file, name, map, units, status)
+   subroutine write_int2(file, name, map, units, status, compress)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, units
       integer, intent(in) :: map(:, :)
       type(status_type), intent(inout) :: status
+      !> Chunked and deflated (create_dataset).
+      logical, intent(in), optional :: compress
       integer(hid_t) :: dset
       integer(hsize_t) :: dims(2)
       integer, allocatable :: stored(:, :)
@@ -274,13 +316,57 @@ contains
       if (status%code /= 0) return
       dims = [size(map, 2, kind=hsize_t), size(map, 1, kind=hsize_t)]
       stored = transpose(map)
-      call create_dataset(file, name, H5T_NATIVE_INTEGER, dims, dset, status)
+      call create_dataset(file, name, H5T_NATIVE_INTEGER, dims, dset, status, compress)
       if (status%code /= 0) return
       call h5dwrite_f(dset, H5T_NATIVE_INTEGER, stored, dims, error)
       call finish_dataset(file, name, dset, error, units, status)
    end subroutine write_int2
 
    ! ---- attributes ---------------------------------------------------------------
+
+   !> A one-dimensional virtual dataset `name` that shows the two-dimensional dataset
+   !> `source` of the same file row after row (C order: data[i, j] at i*ncols + j), for
+   !> readers that want cell data as a list (XDMF through meshio). No data is copied.
+   subroutine h5_flat_view(file, name, source, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, source, units
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset, vspace, sspace, dcpl
+      integer(hsize_t) :: dims(2), maxdims(2), flat(1)
+      integer :: error, rank
+      if (status%code /= 0) return
+      call h5dopen_f(file%id, source, dset, error)
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, file%path//":"//source//": no such dataset for "//name)
+         return
+      end if
+      call h5dget_space_f(dset, sspace, error)
+      call h5dclose_f(dset, error)
+      call h5sget_simple_extent_ndims_f(sspace, rank, error)
+      call h5sget_simple_extent_dims_f(sspace, dims, maxdims, error)
+      flat = product(dims(1:rank))
+      call h5sselect_all_f(sspace, error)
+      call h5screate_simple_f(1, flat, vspace, error)
+      call h5sselect_all_f(vspace, error)
+      call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, error)
+      ! "." is this file.
+      call h5pset_virtual_f(dcpl, vspace, ".", source, sspace, error)
+      call h5sclose_f(sspace, error)
+      if (error /= 0) then
+         call h5sclose_f(vspace, error)
+         call h5pclose_f(dcpl, error)
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot map the view onto "//source)
+         return
+      end if
+      call h5dcreate_f(file%id, name, H5T_NATIVE_DOUBLE, vspace, dset, error, dcpl_id=dcpl)
+      call h5sclose_f(vspace, error)
+      call h5pclose_f(dcpl, error)
+      if (dset < 0) then
+         call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the view"//write_error_cause())
+         return
+      end if
+      call finish_dataset(file, name, dset, 0, units, status)
+   end subroutine h5_flat_view
 
    !> Open object `name` and create attribute `key` of type `dtype` (scalar).
    subroutine create_attribute(file, name, key, dtype, object, attr, status)
@@ -319,29 +405,38 @@ contains
          file%path//":"//name//": cannot write attribute "//key//write_error_cause())
    end subroutine close_attribute
 
+   !> A variable-length UTF-8 string attribute: h5py returns it as str, h5dump shows it
+   !> without padding.
    subroutine attribute_string(file, name, key, value, status)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, key, value
       type(status_type), intent(inout) :: status
       integer(hid_t) :: object, attr, stype
-      integer(hsize_t) :: none(0)
+      character(kind=c_char, len=:), allocatable, target :: text
+      type(c_ptr), target :: pointer
       integer :: error
       if (status%code /= 0) return
-      call h5tcopy_f(H5T_FORTRAN_S1, stype, error)
-      call h5tset_size_f(stype, int(max(len(value), 1), size_t), error)
+      call variable_string_type(stype)
       call create_attribute(file, name, key, stype, object, attr, status)
       if (status%code /= 0) then
          call h5tclose_f(stype, error)
          return
       end if
-      if (len(value) == 0) then
-         call h5awrite_f(attr, stype, " ", none, error)
-      else
-         call h5awrite_f(attr, stype, value, none, error)
-      end if
+      text = value//c_null_char
+      pointer = c_loc(text)
+      call h5awrite_f(attr, stype, c_loc(pointer), error)
       call h5tclose_f(stype, error)
       call close_attribute(file, name, key, object, attr, error, status)
    end subroutine attribute_string
+
+   !> A new variable-length UTF-8 C string type (close it with h5tclose_f).
+   subroutine variable_string_type(stype)
+      integer(hid_t), intent(out) :: stype
+      integer :: error
+      call h5tcopy_f(H5T_C_S1, stype, error)
+      error = c_h5tset_size(stype, -1_c_size_t)
+      call h5tset_cset_f(stype, H5T_CSET_UTF8_F, error)
+   end subroutine variable_string_type
 
    subroutine attribute_real(file, name, key, value, status)
       type(h5_file), intent(in) :: file
@@ -373,17 +468,19 @@ contains
       call close_attribute(file, name, key, object, attr, error, status)
    end subroutine attribute_int
 
-   !> Read a string attribute of at most `length` characters.
+   !> Read a string attribute of at most `length` characters (variable or fixed length).
    subroutine h5_read_string_attribute(file, name, key, length, value, status, code)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, key
       integer, intent(in) :: length, code
       character(len=:), allocatable, intent(out) :: value
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: object, attr, stype
+      integer(hid_t) :: object, attr, stype, ftype
       integer(hsize_t) :: none(0)
-      integer :: error
-      logical :: exists
+      integer :: error, error2
+      logical :: exists, variable
+      type(c_ptr), target :: pointer
+      type(c_ptr) :: buffer
       value = ""
       if (status%code /= 0) return
       call h5oopen_f(file%id, name, object, error)
@@ -398,19 +495,37 @@ contains
          return
       end if
       call h5aopen_f(object, key, attr, error)
-      call h5tcopy_f(H5T_FORTRAN_S1, stype, error)
-      call h5tset_size_f(stype, int(length, size_t), error)
-      deallocate(value)
-      allocate(character(len=length) :: value)
-      call h5aread_f(attr, stype, value, none, error)
-      call h5tclose_f(stype, error)
-      call h5aclose_f(attr, error)
-      call h5oclose_f(object, error)
+      call h5aget_type_f(attr, ftype, error)
+      variable = .false.
+      if (error == 0) call h5tis_variable_str_f(ftype, variable, error)
+      call h5tclose_f(ftype, error)
+      if (variable) then
+         ! Variable length (femcod from 2026-11): the library allocates the text.
+         call variable_string_type(stype)
+         pointer = c_null_ptr
+         buffer = c_loc(pointer)
+         call h5aread_f(attr, stype, buffer, error)
+         if (error == 0 .and. c_associated(pointer)) then
+            value = c_text(pointer, length)
+            error = c_h5free_memory(pointer)
+            error = 0
+         end if
+      else
+         ! Fixed length, blank-padded (earlier files and checkpoints).
+         call h5tcopy_f(H5T_FORTRAN_S1, stype, error)
+         call h5tset_size_f(stype, int(length, size_t), error)
+         deallocate(value)
+         allocate(character(len=length) :: value)
+         call h5aread_f(attr, stype, value, none, error)
+         value = trim(value)
+      end if
+      call h5tclose_f(stype, error2)
+      call h5aclose_f(attr, error2)
+      call h5oclose_f(object, error2)
       if (error /= 0) then
          call set_error(status, code, file%path//":"//name//": cannot read attribute "//key)
          return
       end if
-      value = trim(value)
    end subroutine h5_read_string_attribute
 
    ! ---- reading ------------------------------------------------------------------
@@ -628,4 +743,18 @@ contains
       if (status%code /= 0) return
       map = transpose(stored)
    end subroutine read_real2
+   !> The C string at `pointer`, at most `length` characters.
+   function c_text(pointer, length) result(text)
+      type(c_ptr), intent(in) :: pointer
+      integer, intent(in) :: length
+      character(len=:), allocatable :: text
+      character(kind=c_char), pointer :: chars(:)
+      integer :: k
+      call c_f_pointer(pointer, chars, [length + 1])
+      do k = 1, length + 1
+         if (chars(k) == c_null_char) exit
+      end do
+      allocate(character(len=k - 1) :: text)
+      text = transfer(chars(1:k - 1), text)
+   end function c_text
 end module femcod_hdf5

@@ -3,18 +3,20 @@
 !>   PREFIX.history.csv   step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness
 !>   PREFIX.loads.csv     load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness
 !>   PREFIX.contacts.csv  i,j,step,force_nN,pressure_GPa
-!>   PREFIX.h5            /deck /surfaces /history /contacts /loads/<k> /run
-!>   PREFIX.xdmf          the maps of PREFIX.h5 for ParaView
+!>   PREFIX.h5            /deck /surfaces /history /contacts /loads/<kkk> /mesh /run
+!>   PREFIX.xdmf          the maps of PREFIX.h5 on a quadrilateral mesh (ParaView, meshio)
+!>   PREFIX.summary.json  what the summary prints, as numbers with units
 !>   PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg
 module femcod_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_problem, only: contact_problem
-   use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real
+   use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real, xml_escape, &
+      json_string, json_number
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, write_bytes
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
-      h5_read_string_attribute
+      h5_read_string_attribute, h5_flat_view
    use femcod_maps, only: state_maps
    use femcod_svg, only: svg_plot, svg_pressure_map, fmt_sig
    use femcod_richardson, only: power_law_fit
@@ -32,6 +34,9 @@ module femcod_results
       !> the fingerprint of the problem and options (a restart's check).
       type(string_type), allocatable :: inputs(:), digests(:)
       character(len=:), allocatable :: fingerprint
+      !> The command as typed (femcod run ...), the machine, and when the run started
+      !> and its results were written (ISO 8601 with the UTC offset).
+      character(len=:), allocatable :: command_line, host, started, finished
    end type run_info
 
 contains
@@ -45,7 +50,7 @@ contains
       allocate(names(0))
       names = [string_type(prefix//".history.csv"), string_type(prefix//".contacts.csv"), &
          string_type(prefix//".h5"), string_type(prefix//".xdmf"), string_type(prefix//".load_approach.svg"), &
-         string_type(prefix//".area_load.svg")]
+         string_type(prefix//".area_load.svg"), string_type(prefix//".summary.json")]
       if (nloads > 0) names = [names, string_type(prefix//".loads.csv")]
       do k = 1, nloads
          names = [names, string_type(prefix//".pressure_"//int_str(k)//".svg")]
@@ -77,6 +82,8 @@ contains
       end if
       call add(".xdmf")
       call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res), status)
+      call add(".summary.json")
+      call write_text(temps(size(temps))%s, summary_json(prefix, deck, res, info), status)
       call add(".load_approach.svg")
       call write_text(temps(size(temps))%s, svg_plot("femcod: "//deck%label, "approach (nm)", "total load (nN)", &
          res%step_approach(1:res%nsteps), res%step_load(1:res%nsteps), .false., .false.), status)
@@ -270,12 +277,14 @@ contains
       call h5_write(file, "/contacts/j", res%contact_j, "1", local)
       call h5_write(file, "/contacts/step", res%contact_step, "1", local)
       call h5_write(file, "/contacts/force", res%contact_force, "nN", local)
+      call h5_write(file, "/contacts/pressure", res%contact_force/area_pixel, "GPa", local)
       call h5_group(file, "/loads", local)
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
-         g = "/loads/"//int_str(k)
+         g = load_group(k, size(res%states))
          associate(s => res%states(k))
             call h5_group(file, g, local)
+            call h5_attribute(file, g, "index", k, local)
             call h5_attribute(file, g, "load_nN", s%load, local)
             call h5_attribute(file, g, "approach_nm", s%approach, local)
             call h5_attribute(file, g, "contacts", s%contacts, local)
@@ -293,8 +302,13 @@ contains
             call h5_write(file, g//"/gap", maps(k)%gap, "nm", local)
          end associate
       end do
+      call write_mesh(file, deck, res, local)
       call h5_group(file, "/run", local)
       call h5_attribute(file, "/run", "femcod_version", info%version, local)
+      if (allocated(info%command_line)) call h5_attribute(file, "/run", "command_line", info%command_line, local)
+      if (allocated(info%host)) call h5_attribute(file, "/run", "host", info%host, local)
+      if (allocated(info%started)) call h5_attribute(file, "/run", "started", info%started, local)
+      if (allocated(info%finished)) call h5_attribute(file, "/run", "finished", info%finished, local)
       call h5_attribute(file, "/run", "solver", info%solver, local)
       call h5_attribute(file, "/run", "options", info%options, local)
       call h5_attribute(file, "/run", "wall_time_s", res%wall_seconds, local)
@@ -357,47 +371,204 @@ contains
       end if
    end function area_load_svg
 
-   !> XDMF 3 description of the maps: the surfaces, then one grid per reached load in
-   !> a temporal collection (time = load in nN), cell-centred on a 2DCoRectMesh.
+   !> The group of requested load k of n: /loads/001 ... (at least three digits, so
+   !> that the names sort as numbers).
+   function load_group(k, n) result(g)
+      integer, intent(in) :: k, n
+      character(len=:), allocatable :: g
+      integer :: width
+      width = max(3, len(int_str(n)))
+      g = int_str(k)
+      g = "/loads/"//repeat("0", width - len(g))//g
+   end function load_group
+
+   !> /mesh: the pixels as quadrilaterals for XDMF readers that want an explicit mesh
+   !> (meshio reads no structured grid). Node (a, b), a = 0..NP across the rows and
+   !> b = 0..NP across the columns, is number a*(NP+1) + b at x = b d, y = (NP - a) d:
+   !> row 1 on top, as in the figures, in the XY plane. Cell (i, j) is number
+   !> (i-1)*NP + (j-1), the C order of the NP x NP maps, which /mesh/cells/* show as
+   !> lists (virtual datasets, no copy). Both arrays are deflated (regular: small).
+   subroutine write_mesh(file, deck, res, status)
+      type(h5_file), intent(in) :: file
+      type(contact_problem), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      type(status_type), intent(inout) :: status
+      real(dp), allocatable :: nodes(:, :)
+      integer, allocatable :: quads(:, :)
+      integer :: n, a, b, i, j, c, k
+      if (status%code /= 0) return
+      n = deck%np
+      allocate(nodes((n + 1)**2, 2), quads(n*n, 4))
+      do a = 0, n
+         do b = 0, n
+            nodes(a*(n + 1) + b + 1, :) = [b*deck%pixel, (n - a)*deck%pixel]
+         end do
+      end do
+      do i = 1, n
+         do j = 1, n
+            c = (i - 1)*n + j
+            ! Counter-clockwise seen from +z: top-left, bottom-left, bottom-right, top-right.
+            quads(c, :) = [(i - 1)*(n + 1) + (j - 1), i*(n + 1) + (j - 1), i*(n + 1) + j, (i - 1)*(n + 1) + j]
+         end do
+      end do
+      call h5_group(file, "/mesh", status)
+      call h5_write(file, "/mesh/nodes_xy", nodes, "nm", status, compress=.true.)
+      call h5_write(file, "/mesh/quadrilaterals", quads, "node number from 0", status, compress=.true.)
+      call h5_group(file, "/mesh/cells", status)
+      call h5_flat_view(file, "/mesh/cells/lower_nm", "/surfaces/lower", "nm", status)
+      call h5_flat_view(file, "/mesh/cells/upper_nm", "/surfaces/upper", "nm", status)
+      do k = 1, size(res%states)
+         if (.not. res%states(k)%reached) cycle
+         call h5_flat_view(file, "/mesh/cells/"//xdmf_name("pressure_GPa", k, size(res%states)), &
+            load_group(k, size(res%states))//"/pressure", "GPa", status)
+         call h5_flat_view(file, "/mesh/cells/"//xdmf_name("gap_nm", k, size(res%states)), &
+            load_group(k, size(res%states))//"/gap", "nm", status)
+      end do
+   end subroutine write_mesh
+
+   !> The name of load k's map among the cell arrays: pressure_GPa_load001.
+   function xdmf_name(what, k, n) result(name)
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: k, n
+      character(len=:), allocatable :: name, group
+      group = load_group(k, n)
+      name = what//"_load"//group(len("/loads/") + 1:)
+   end function xdmf_name
+
+   !> XDMF 3: one uniform grid (the form meshio reads; ParaView too) of NP^2
+   !> quadrilaterals in the XY plane (/mesh), with the surfaces and, for every reached
+   !> load, its pressure and gap as cell arrays (the load in nN is in the array's name
+   !> and in the HDF5 group).
    function xdmf_text(h5name, deck, res) result(x)
       character(len=*), intent(in) :: h5name
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       character(len=:), allocatable :: x
       character(len=1), parameter :: nl = new_line("a")
-      character(len=:), allocatable :: dims, nodes, geometry
-      integer :: k
-      dims = int_str(deck%np)//" "//int_str(deck%np)
-      nodes = int_str(deck%np + 1)//" "//int_str(deck%np + 1)
-      geometry = '    <Topology TopologyType="2DCoRectMesh" Dimensions="'//nodes//'"/>'//nl// &
-         '    <Geometry GeometryType="ORIGIN_DXDY">'//nl// &
-         '     <DataItem Format="XML" Dimensions="2">0 0</DataItem>'//nl// &
-         '     <DataItem Format="XML" Dimensions="2">'//format_real(deck%pixel)//" "//format_real(deck%pixel)// &
-         '</DataItem>'//nl//'    </Geometry>'//nl
+      character(len=:), allocatable :: file
+      integer :: k, n
+      n = deck%np
+      file = xml_escape(h5name)
       x = '<?xml version="1.0" ?>'//nl//'<Xdmf Version="3.0">'//nl//' <Domain>'//nl// &
-         '  <Grid Name="surfaces" GridType="Uniform">'//nl//geometry// &
-         attribute("lower_nm", "/surfaces/lower")//attribute("upper_nm", "/surfaces/upper")//'  </Grid>'//nl
-      if (any(res%states%reached)) then
-         x = x//'  <Grid Name="loads" GridType="Collection" CollectionType="Temporal">'//nl
-         do k = 1, size(res%states)
-            if (.not. res%states(k)%reached) cycle
-            x = x//'   <Grid Name="load_'//int_str(k)//'" GridType="Uniform">'//nl// &
-               '    <Time Value="'//format_real(res%states(k)%load)//'"/>'//nl//geometry// &
-               attribute("pressure_GPa", "/loads/"//int_str(k)//"/pressure")// &
-               attribute("gap_nm", "/loads/"//int_str(k)//"/gap")//'   </Grid>'//nl
-         end do
-         x = x//'  </Grid>'//nl
-      end if
-      x = x//' </Domain>'//nl//'</Xdmf>'//nl
+         '  <Grid Name="'//xml_escape(shortened(deck%label))//'" GridType="Uniform">'//nl// &
+         '   <Topology TopologyType="Quadrilateral" NumberOfElements="'//int_str(n*n)//'">'//nl// &
+         '    <DataItem Format="HDF" NumberType="Int" Precision="4" Dimensions="'//int_str(n*n)//' 4">'// &
+         file//':/mesh/quadrilaterals</DataItem>'//nl//'   </Topology>'//nl// &
+         '   <Geometry GeometryType="XY">'//nl// &
+         '    <DataItem Format="HDF" NumberType="Float" Precision="8" Dimensions="'//int_str((n + 1)**2)//' 2">'// &
+         file//':/mesh/nodes_xy</DataItem>'//nl//'   </Geometry>'//nl// &
+         attribute("lower_nm")//attribute("upper_nm")
+      do k = 1, size(res%states)
+         if (.not. res%states(k)%reached) cycle
+         x = x//attribute(xdmf_name("pressure_GPa", k, size(res%states)))// &
+            attribute(xdmf_name("gap_nm", k, size(res%states)))
+      end do
+      x = x//'  </Grid>'//nl//' </Domain>'//nl//'</Xdmf>'//nl
    contains
-      function attribute(name, path) result(a)
-         character(len=*), intent(in) :: name, path
+      function attribute(name) result(a)
+         character(len=*), intent(in) :: name
          character(len=:), allocatable :: a
-         a = '    <Attribute Name="'//name//'" AttributeType="Scalar" Center="Cell">'//nl// &
-            '     <DataItem Format="HDF" NumberType="Float" Precision="8" Dimensions="'//dims//'">'// &
-            h5name//':'//path//'</DataItem>'//nl//'    </Attribute>'//nl
+         a = '   <Attribute Name="'//name//'" AttributeType="Scalar" Center="Cell">'//nl// &
+            '    <DataItem Format="HDF" NumberType="Float" Precision="8" Dimensions="'//int_str(n*n)//'">'// &
+            file//':/mesh/cells/'//name//'</DataItem>'//nl//'   </Attribute>'//nl
       end function attribute
+      function shortened(label) result(t)
+         character(len=*), intent(in) :: label
+         character(len=:), allocatable :: t
+         t = label(1:min(len(label), 60))
+      end function shortened
    end function xdmf_text
+
+   !> PREFIX.summary.json: what the summary prints, as numbers whose names carry their
+   !> units, for scripts; the solver's own counters last.
+   function summary_json(prefix, deck, res, info) result(j)
+      character(len=*), intent(in) :: prefix
+      type(contact_problem), intent(in) :: deck
+      type(contact_result), intent(in) :: res
+      type(run_info), intent(in) :: info
+      character(len=:), allocatable :: j
+      character(len=1), parameter :: nl = new_line("a")
+      character(len=:), allocatable :: loads
+      real(dp) :: area_pixel, exponent, prefactor
+      integer :: k, last
+      area_pixel = deck%pixel**2
+      last = res%nsteps
+      loads = ""
+      do k = 1, size(res%states)
+         associate(s => res%states(k))
+            loads = loads//'    {"load_nN": '//json_number(s%load)//', "reached": '// &
+               trim(merge("true ", "false", s%reached))
+            if (s%reached) loads = loads//', "approach_nm": '//json_number(s%approach)//', "contacts": '// &
+               int_str(s%contacts)//', "area_nm2": '//json_number(s%contacts*area_pixel)//', "area_fraction": '// &
+               json_number(s%contacts/real(deck%np, dp)**2)//', "max_pressure_GPa": '//json_number(s%max_pressure)// &
+               ', "n_above_hardness": '//int_str(s%n_above_hardness)//', "hdf5_group": '// &
+               json_string(load_group(k, size(res%states)))
+            loads = loads//'}'//trim(merge(",", " ", k < size(res%states)))//nl
+         end associate
+      end do
+      call area_fit(deck, res, exponent, prefactor)
+      j = '{'//nl// &
+         '  "femcod_version": '//json_string(info%version)//','//nl// &
+         '  "command_line": '//json_string(text_or_empty(info%command_line))//','//nl// &
+         '  "host": '//json_string(text_or_empty(info%host))//','//nl// &
+         '  "started": '//json_string(text_or_empty(info%started))//','//nl// &
+         '  "finished": '//json_string(text_or_empty(info%finished))//','//nl// &
+         '  "results": '//json_string(prefix)//','//nl// &
+         '  "scene": {"label": '//json_string(deck%label)//', "NP": '//int_str(deck%np)//', "pixel_nm": '// &
+         json_number(deck%pixel)//', "MAXCONT": '//int_str(deck%maxcont)//','//nl// &
+         '    "young_GPa": {"lower": '//json_number(deck%young(1))//', "upper": '//json_number(deck%young(2))// &
+         ', "contact": '//json_number(deck%young(3))//'},'//nl// &
+         '    "poisson": {"lower": '//json_number(deck%poisson(1))//', "upper": '//json_number(deck%poisson(2))// &
+         ', "contact": '//json_number(deck%poisson(3))//'}},'//nl// &
+         '  "solver": '//json_string(info%solver)//','//nl// &
+         '  "steps": '//int_str(last)//','//nl// &
+         '  "stopped": '//json_string(stop_reason_text(res%stop_reason))//','//nl
+      if (last > 0) then
+         j = j//'  "last_step": {"contacts": '//int_str(res%step_contacts(last))//', "load_nN": '// &
+            json_number(res%step_load(last))//', "approach_nm": '//json_number(res%step_approach(last))//'},'//nl
+      end if
+      j = j//'  "loads": ['//nl//loads//'  ],'//nl// &
+         '  "area_load_fit": {"exponent": '//json_number(exponent)//', "prefactor_nm2": '// &
+         json_number(prefactor)//'},'//nl// &
+         '  "wall_time_s": '//json_number(res%wall_seconds)//','//nl// &
+         '  "checks": {"penetrating_pixels_at_end": '//int_str(res%missed_final_check)// &
+         ', "deepest_penetration_nm": '//json_number(res%max_penetration)//', "found_late": '// &
+         int_str(res%missed_during_run)//', "releases": '//int_str(res%releases)// &
+         ', "exact_resolve_difference": '//json_number(res%final_check_difference)//'},'//nl// &
+         '  "solver_details": '//solver_details()//nl//'}'//nl
+   contains
+      !> What each solver counts of its own work.
+      function solver_details() result(d)
+         character(len=:), allocatable :: d
+         integer :: m
+         select case (info%solver)
+         case ("incremental")
+            d = '{"exact_pixel_evaluations": '//int_str(res%evaluations)//', "fft_search_steps": '// &
+               int_str(res%fft_steps)//', "cache_hits": '//int_str(res%cache_hits)//', "cache_misses": '// &
+               int_str(res%cache_misses)//', "cache_refills": '//int_str(res%cache_refills)//'}'
+         case ("legacy")
+            d = '{"trfact_condition": '//json_number(res%condition)//', "trfact_pivot_loss": '// &
+               json_number(res%pivot_loss)//'}'
+         case default
+            d = '{"cg": ['
+            do m = 1, size(res%states)
+               d = d//'{"load_nN": '//json_number(res%states(m)%load)//', "iterations": '// &
+                  int_str(res%states(m)%iterations)//', "residual": '//json_number(res%states(m)%residual)// &
+                  ', "penetration_nm": '//json_number(res%states(m)%penetration)//', "contact_gap_nm": '// &
+                  json_number(res%states(m)%contact_gap)//', "load_error": '//json_number(res%states(m)%load_error)// &
+                  '}'//trim(merge(", ", "  ", m < size(res%states)))
+            end do
+            d = d//']}'
+         end select
+      end function solver_details
+
+      function text_or_empty(t) result(r)
+         character(len=:), allocatable, intent(in) :: t
+         character(len=:), allocatable :: r
+         r = ""
+         if (allocated(t)) r = t
+      end function text_or_empty
+   end function summary_json
 
    !> The file name without its directory.
    function base_name(path) result(name)

@@ -56,7 +56,7 @@ module femcod_cg
    use femcod_contact_result, only: contact_result, append_step, STOP_LOADS
    use femcod_solver_options, only: contact_options, cg_settings
    use femcod_observer, only: solver_observer
-   use femcod_strings, only: int_str, real_str, format_real
+   use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
    implicit none
    private
@@ -192,8 +192,8 @@ contains
       do k = 1, m
          if (report(k)%residual > tol) then
             call set_error(status, STATUS_NUMERICAL, "cg: load "//format_real(options%loads(k))//" nN: residual "// &
-               real_str(report(k)%residual, 2)//" after "//int_str(report(k)%iterations)// &
-               " iterations, above --tol "//real_str(tol, 2)//" (raise --max-iterations)")
+               sig_str(report(k)%residual, 2)//" after "//int_str(report(k)%iterations)// &
+               " iterations, above --tol "//sig_str(tol, 2)//" (raise --max-iterations)")
             return
          end if
       end do

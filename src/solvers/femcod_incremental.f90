@@ -12,7 +12,7 @@
 module femcod_incremental
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_INTERRUPTED
-   use femcod_strings, only: int_str, real_str
+   use femcod_strings, only: int_str, sig_str
    use femcod_problem, only: contact_problem
    use femcod_lapack, only: dtrsv
    use femcod_heap, only: heap_pop, heap_push, heap_top_key
@@ -76,7 +76,7 @@ contains
             ! Stop between two steps: the state is complete, so a checkpoint continues it.
             if (options%checkpoint_interval >= 0) call observer%checkpoint(problem, options, state)
             call set_error(status, STATUS_INTERRUPTED, "stopped at step "//int_str(state%step)//" ("// &
-               int_str(state%n)//" contacts, load "//real_str(state%path%total, 6)//" nN)")
+               int_str(state%n)//" contacts, load "//sig_str(state%path%total, 6)//" nN)")
             return
          end if
          if (options%checkpoint_interval >= 0 .and. state%step > 0) then

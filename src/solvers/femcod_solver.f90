@@ -6,7 +6,7 @@
 module femcod_solver
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE
-   use femcod_strings, only: string_type, int_str, real_str
+   use femcod_strings, only: string_type, int_str, sig_str
    use femcod_problem, only: contact_problem
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
@@ -110,9 +110,7 @@ contains
       function es(x) result(text)
          real(dp), intent(in) :: x
          character(len=:), allocatable :: text
-         character(len=16) :: buf
-         write(buf, '(es9.2)') x
-         text = trim(adjustl(buf))
+         text = sig_str(x, 3)
       end function es
    end function model_notes
 
@@ -129,10 +127,10 @@ contains
       select case (options%solver)
       case ("cg")
          do k = 1, size(res%states)
-            call add("cg", "load "//real_str(res%states(k)%load, 6)//" nN: "// &
-               int_str(res%states(k)%iterations)//" iterations, residual "//real_str(res%states(k)%residual, 2)// &
-               ", penetration "//real_str(res%states(k)%penetration, 2)//" nm, |gap| on contact "// &
-               real_str(res%states(k)%contact_gap, 2)//" nm, load error "//real_str(res%states(k)%load_error, 2))
+            call add("cg", "load "//sig_str(res%states(k)%load, 6)//" nN: "// &
+               int_str(res%states(k)%iterations)//" iterations, residual "//sig_str(res%states(k)%residual, 2)// &
+               ", penetration "//sig_str(res%states(k)%penetration, 2)//" nm, |gap| on contact "// &
+               sig_str(res%states(k)%contact_gap, 2)//" nm, load error "//sig_str(res%states(k)%load_error, 2))
          end do
       case ("incremental")
          model = model_notes(problem, options)
@@ -140,9 +138,9 @@ contains
             call add("model", model(k)%s)
          end do
          call add("checked", "every pixel by FFT convolution at the end: "// &
-            int_str(res%missed_final_check)//" penetrating (deepest "//real_str(res%max_penetration, 2)// &
-            " nm); "//int_str(res%releases)//" releases; "//real_str(real(res%evaluations, dp), 3)// &
-            " exact pixel evaluations; exact re-solve differs by "//real_str(res%final_check_difference, 2))
+            int_str(res%missed_final_check)//" penetrating (deepest "//sig_str(res%max_penetration, 2)// &
+            " nm); "//int_str(res%releases)//" releases; "//int_str(res%evaluations)// &
+            " exact pixel evaluations; exact re-solve differs by "//sig_str(res%final_check_difference, 2))
          call add("search", int_str(res%fft_steps)//" of "//int_str(res%nsteps)// &
             " steps by full-field FFT, the others by the gap bound (--event-search "//trim(options%event_search)//")")
          call add("cache", int_str(res%cache_hits)//" contacts bordered from the candidate "// &
@@ -151,9 +149,9 @@ contains
       case default
          call add("checked", int_str(res%missed_during_run)//" contacts found late by the candidate search, "// &
             int_str(res%missed_final_check)//" found by the final check of all pixels; exact re-solve differs by "// &
-            real_str(res%final_check_difference, 2))
-         call add("TRFACT", "condition estimate "//real_str(res%condition, 2)// &
-            " (LAPACK dlacn2): relative errors up to about "//real_str(epsilon(1.0_dp)*res%condition, 1))
+            sig_str(res%final_check_difference, 2))
+         call add("TRFACT", "condition estimate "//sig_str(res%condition, 2)// &
+            " (LAPACK dlacn2): relative errors up to about "//sig_str(epsilon(1.0_dp)*res%condition, 1))
          if (epsilon(1.0_dp)*res%condition > 1.0e-8_dp) call add("warning", "the stiff springs and rigid body cost "// &
             "the legacy solver digits; the incremental solver is immune (doc/stability.md)")
       end select
