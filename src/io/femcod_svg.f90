@@ -4,7 +4,7 @@
 !> the whole document as a string; writing it is the caller's business.
 module femcod_svg
    use femcod_kinds, only: dp
-   use femcod_strings, only: int_str, without_trailing_zeros
+   use femcod_strings, only: int_str, without_trailing_zeros, xml_escape
    implicit none
    private
    public :: svg_plot, svg_pressure_map, nice_ticks, fmt_sig, svg_series, svg_multi_plot, add_series
@@ -175,7 +175,7 @@ contains
          end if
          py = mt + 18 + 18*(s - 1)
          svg = svg//'<line x1="'//fmt(ml + 12)//'" y1="'//fmt(py)//'" x2="'//fmt(ml + 42)//'" y2="'//fmt(py)// &
-            '" stroke="'//c//'" stroke-width="1.5"'//dash//'/>'//text(ml + 48, py + 4, escape(series(s)%label), "start", 12)
+            '" stroke="'//c//'" stroke-width="1.5"'//dash//'/>'//text(ml + 48, py + 4, xml_escape(series(s)%label), "start", 12)
       end do
       svg = svg//"</svg>"//nl
    end function svg_multi_plot
@@ -264,7 +264,7 @@ contains
       svg = '<?xml version="1.0" encoding="UTF-8"?>'//nl// &
          '<svg xmlns="http://www.w3.org/2000/svg" width="'//fmt(w)//'" height="'//fmt(h)//'" viewBox="0 0 '// &
          fmt(w)//' '//fmt(h)//'">'//nl//'<rect width="100%" height="100%" fill="white"/>'//nl// &
-         text(w/2, 28.0_dp, escape(shortened(title, 80)), "middle", 14)
+         text(w/2, 28.0_dp, xml_escape(shortened(title, 80)), "middle", 14)
    end function header
 
    !> Frame, ticks, grid and labels.
@@ -287,9 +287,9 @@ contains
          svg = svg//'<line x1="'//fmt(ml)//'" y1="'//fmt(p)//'" x2="'//fmt(w - mr)//'" y2="'//fmt(p)// &
             '" stroke="#dddddd"/>'//nl//text(ml - 6, p + 4, tick_label(yt(k), logy), "end", 11)
       end do
-      svg = svg//text((ml + w - mr)/2, h - mb + 45, escape(xlabel), "middle", 13)
+      svg = svg//text((ml + w - mr)/2, h - mb + 45, xml_escape(xlabel), "middle", 13)
       svg = svg//'<text x="22" y="'//fmt((mt + h - mb)/2)//'" font-family="sans-serif" font-size="13" '// &
-         'text-anchor="middle" transform="rotate(-90 22 '//fmt((mt + h - mb)/2)//')">'//escape(ylabel)//'</text>'//nl
+         'text-anchor="middle" transform="rotate(-90 22 '//fmt((mt + h - mb)/2)//')">'//xml_escape(ylabel)//'</text>'//nl
    end function axes
 
    function tick_label(v, logscale) result(s)
@@ -390,25 +390,6 @@ contains
       if (len(s) > n) t = s(1:n - 3)//"..."
    end function shortened
 
-   !> XML-escape &, < and >.
-   function escape(s) result(e)
-      character(len=*), intent(in) :: s
-      character(len=:), allocatable :: e
-      integer :: k
-      e = ""
-      do k = 1, len(s)
-         select case (s(k:k))
-         case ("&")
-            e = e//"&amp;"
-         case ("<")
-            e = e//"&lt;"
-         case (">")
-            e = e//"&gt;"
-         case default
-            e = e//s(k:k)
-         end select
-      end do
-   end function escape
 
    !> A coordinate with two decimals.
    function fmt(v) result(s)
