@@ -10,6 +10,7 @@ module test_results
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_exists, h5_read_string_attribute, h5_create, &
       h5_write
    use femcod_generate, only: scene_spec, build_problem
+   use femcod_svg, only: svg_pressure_map, svg_plot
    use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -25,6 +26,9 @@ contains
          new_unittest("HDF5: maps in C order (h5dump reads row i, column j)", test_c_order), &
          new_unittest("XDMF: one grid of quadrilaterals in the XY plane, rows as in the figures", test_xdmf), &
          new_unittest("SVG: complete documents, fitted exponent and pressure scale", test_svg), &
+         new_unittest("pressure figure: its PNG holds the map's 64 levels (decoded by Python)", test_png_levels), &
+         new_unittest("pressure figure of a 2100^2 map: 3 x 3 blocks keep a one-pixel contact", test_png_blocks), &
+         new_unittest("a plot of 200000 steps stays small and keeps its ends", test_long_plot), &
          new_unittest("existing results are kept without --force", test_force), &
          new_unittest("a result that cannot be put in place leaves no partial set", test_partial), &
          new_unittest("--lower/--upper: ASCII and HDF5 heights equal the deck", test_height_files), &
@@ -268,6 +272,107 @@ contains
          end do
       end function count_text
    end subroutine test_xdmf
+
+   !> The pressure map of the figure, decoded by test/tools/png_levels.py (Python's own
+   !> base64, zlib and CRC-32; skipped without python3), against the map of the HDF5
+   !> file binned here: 0 off contact, else 1 + min(63, floor(64 p / p_max)); palette
+   !> entry 0 white.
+   subroutine test_png_levels(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix
+      type(h5_file) :: file
+      type(status_type) :: st
+      real(dp), allocatable :: p(:, :)
+      integer, allocatable :: levels(:, :)
+      integer :: code, i, j, expected
+      call sphere_run("png-sphere", prefix, code)
+      call check(error, code, 0, "femcod run")
+      if (allocated(error)) return
+      call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/loads/002/pressure", p, st, STATUS_BAD_INPUT)
+      call h5_close(file, st)
+      call decode_png(prefix//".pressure_2.svg", levels, error)
+      if (allocated(error) .or. .not. allocated(levels)) return
+      call check(error, size(levels, 1) == 30 .and. size(levels, 2) == 30, "a 30 x 30 image for NP = 30")
+      if (allocated(error)) return
+      do i = 1, 30
+         do j = 1, 30
+            expected = 0
+            if (p(i, j) > 0) expected = 1 + min(63, int(64*p(i, j)/maxval(p)))
+            call check(error, levels(i, j), expected, "level of pixel ("//to_string(i)//", "//to_string(j)//")")
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_png_levels
+
+   !> A 2100 x 2100 map is shown by 3 x 3 blocks (ceiling(2100/1024) = 3): a 700 x 700
+   !> image whose block holding the one loaded pixel, at row 2100, column 1, is at the
+   !> top of the scale and every other block white; the file stays small.
+   subroutine test_png_blocks(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: map(:, :)
+      integer, allocatable :: levels(:, :)
+      character(len=:), allocatable :: path
+      allocate(map(2100, 2100))
+      map = 0
+      map(2100, 1) = 2.5_dp
+      path = scratch_path("blocks.svg")
+      call write_text(path, svg_pressure_map("blocks", map, 2100.0_dp))
+      call check(error, len(read_text(path)) < 100000, "a small file")
+      if (allocated(error)) return
+      call decode_png(path, levels, error)
+      if (allocated(error) .or. .not. allocated(levels)) return
+      call check(error, size(levels, 1) == 700 .and. size(levels, 2) == 700, "700 x 700")
+      if (allocated(error)) return
+      call check(error, levels(700, 1) == 64 .and. count(levels /= 0) == 1, "the one block, at the top level")
+   end subroutine test_png_blocks
+
+   !> 200001 points on a line (a 4096^2 run to 1 % has about 170000 steps): the
+   !> polyline keeps a point only where it moves by half a pixel, so the figure stays
+   !> far below 1 MB; the first and the last point (the frame's corners, at 90,410 and
+   !> 610,50 for this line's range, 0 to 200000 by 0 to 200, which the ticks do not widen) are drawn.
+   subroutine test_long_plot(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: x(:), y(:)
+      character(len=:), allocatable :: svg
+      integer :: k
+      x = [(real(k, dp), k = 0, 200000)]
+      y = x/1000
+      svg = svg_plot("long", "x", "y", x, y, .false., .false.)
+      call check(error, len(svg) < 200000, "size "//to_string(len(svg))//" bytes")
+      if (allocated(error)) return
+      call check(error, contains_text(svg, 'points="90.00,410.00 ') .and. contains_text(svg, '610.00,50.00 "'), &
+         "the first and last points")
+   end subroutine test_long_plot
+
+   !> The palette indices of the PNG in an SVG figure, by test/tools/png_levels.py;
+   !> unallocated (and no error) when python3 is missing.
+   subroutine decode_png(svg_path, levels, error)
+      character(len=*), intent(in) :: svg_path
+      integer, allocatable, intent(out) :: levels(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: out
+      integer :: code, unit, ios, width, height, colours, white(3), i
+      call execute_command_line("command -v python3 > /dev/null", exitstat=code)
+      if (code /= 0) return
+      out = scratch_path("png_levels.txt")
+      call execute_command_line("python3 test/tools/png_levels.py '"//svg_path//"' > "//out//" 2>&1", exitstat=code)
+      call check(error, code, 0, "png_levels.py: "//read_text(out))
+      if (allocated(error)) return
+      open(newunit=unit, file=out, action="read", status="old")
+      read(unit, *, iostat=ios) width, height, colours, white
+      call check(error, ios == 0 .and. colours == 65 .and. all(white == 255), "65 colours, the first white")
+      if (allocated(error)) then
+         close(unit)
+         return
+      end if
+      allocate(levels(height, width))
+      do i = 1, height
+         read(unit, *, iostat=ios) levels(i, :)
+      end do
+      close(unit)
+      call check(error, ios, 0, "reading the decoded rows")
+   end subroutine decode_png
 
    !> The figures are complete SVG documents; the area-load figure states the exponent
    !> of a least-squares fit of log(area) on log(load) over the history, computed here

@@ -4,7 +4,8 @@
 !> the whole document as a string; writing it is the caller's business.
 module femcod_svg
    use femcod_kinds, only: dp
-   use femcod_strings, only: int_str, without_trailing_zeros, xml_escape
+   use femcod_strings, only: int_str, without_trailing_zeros, xml_escape, text_builder, add_text, built_text
+   use femcod_png, only: png_indexed, base64
    implicit none
    private
    public :: svg_plot, svg_pressure_map, nice_ticks, fmt_sig, svg_series, svg_multi_plot, add_series
@@ -36,6 +37,8 @@ contains
       real(dp) :: x0, x1, y0, y1, px, py, xf, yf
       integer :: k, m
       character(len=:), allocatable :: path
+      type(text_builder) :: points
+      real(dp) :: last(2)
       allocate(keep(size(x)))
       keep = .true.
       if (logx) keep = keep .and. x > 0
@@ -52,13 +55,20 @@ contains
       call axis_range(minval(tx), maxval(tx), logx, x0, x1, xt)
       call axis_range(minval(ty), maxval(ty), logy, y0, y1, yt)
       svg = svg//axes(x0, x1, y0, y1, xt, yt, logx, logy, xlabel, ylabel)
-      ! Data: a polyline and markers.
-      path = ""
+      ! Data: a polyline and markers. Beyond 2000 points a point that moves the line by
+      ! less than half a pixel from the last one drawn is left out (the first and the
+      ! last are kept): the line looks the same and the file stays small at any number
+      ! of steps.
+      last = [-huge(1.0_dp), -huge(1.0_dp)]
       do k = 1, size(tx)
          call to_pixels([x0, x1, y0, y1], tx(k), ty(k), px, py)
-         path = path//fmt(px)//","//fmt(py)//" "
+         if (size(tx) > 2000 .and. k > 1 .and. k < size(tx)) then
+            if (abs(px - last(1)) < 0.5_dp .and. abs(py - last(2)) < 0.5_dp) cycle
+         end if
+         last = [px, py]
+         call add_text(points, fmt(px)//","//fmt(py)//" ")
       end do
-      svg = svg//'<polyline fill="none" stroke="#1f4e9c" stroke-width="1.5" points="'//path//'"/>'//nl
+      svg = svg//'<polyline fill="none" stroke="#1f4e9c" stroke-width="1.5" points="'//built_text(points)//'"/>'//nl
       m = max(1, size(tx)/200)
       do k = 1, size(tx), m
          call to_pixels([x0, x1, y0, y1], tx(k), ty(k), px, py)
@@ -180,50 +190,54 @@ contains
       svg = svg//"</svg>"//nl
    end function svg_multi_plot
 
-   !> A map (GPa) of `values(i, j)` (row i drawn downwards, column j to the right) over
-   !> a square of side `side` nm: zero pixels are white, the others coloured on a
-   !> perceptual scale from 0 to the maximum, with a colour bar. Runs of equal colour
-   !> along a row become one rectangle, so the file grows with the contact area.
+   !> The pressure map: a raster image (PNG, embedded as base64) on the 64-level
+   !> perceptual scale from 0 to the maximum, white off contact, with the axes, labels and
+   !> colour bar as vectors. Maps larger than 1024 x 1024 are shown by blocks of f x f
+   !> pixels (f = ceiling(NP/1024)), each with the largest pressure of its block, so no
+   !> contact spot disappears; the file stays near 1 MB or below at any NP (the full map
+   !> is in PREFIX.h5).
    function svg_pressure_map(title, values, side) result(svg)
       character(len=*), intent(in) :: title
       real(dp), intent(in) :: values(:, :)
       real(dp), intent(in) :: side
       character(len=:), allocatable :: svg
-      integer, parameter :: levels = 64
-      integer :: np, i, j, j0, lev, k
-      real(dp) :: vmax, cell, size_px, x0, y0
-      real(dp), allocatable :: ticks(:)
+      integer, parameter :: levels = 64, max_image = 1024
+      integer :: np, i, j, k, f, m, palette(3, 0:levels)
+      real(dp) :: vmax, size_px, x0, y0
+      real(dp), allocatable :: ticks(:), block(:, :)
       integer, allocatable :: bin(:, :)
+      character(len=:), allocatable :: png
+      logical :: ok
       np = size(values, 1)
       vmax = maxval(values)
       size_px = h - mt - mb
-      cell = size_px/np
       x0 = ml
       y0 = mt
-      allocate(bin(np, np))
-      bin = 0
-      if (vmax > 0) then
-         where (values > 0) bin = 1 + min(levels - 1, int(values/vmax*levels))
-      end if
-      svg = header(title)
-      svg = svg//'<rect x="'//fmt(x0)//'" y="'//fmt(y0)//'" width="'//fmt(size_px)//'" height="'//fmt(size_px)// &
-         '" fill="white" stroke="black"/>'//nl
-      do i = 1, np
-         j = 1
-         do while (j <= np)
-            lev = bin(i, j)
-            j0 = j
-            do while (j < np)
-               if (bin(i, j + 1) /= lev) exit
-               j = j + 1
-            end do
-            if (lev > 0) then
-               svg = svg//'<rect x="'//fmt(x0 + (j0 - 1)*cell)//'" y="'//fmt(y0 + (i - 1)*cell)//'" width="'// &
-                  fmt((j - j0 + 1)*cell)//'" height="'//fmt(cell)//'" fill="'//colour((lev - 0.5_dp)/levels)//'"/>'//nl
-            end if
-            j = j + 1
+      f = (np + max_image - 1)/max_image
+      m = (np + f - 1)/f
+      allocate(block(m, m), bin(m, m))
+      do j = 1, m
+         do i = 1, m
+            block(i, j) = maxval(values((i - 1)*f + 1:min(np, i*f), (j - 1)*f + 1:min(np, j*f)))
          end do
       end do
+      bin = 0
+      if (vmax > 0) then
+         where (block > 0) bin = 1 + min(levels - 1, int(block/vmax*levels))
+      end if
+      palette(:, 0) = 255
+      do k = 1, levels
+         palette(:, k) = colour_rgb((k - 0.5_dp)/levels)
+      end do
+      svg = header(title, xlink=.true.)
+      svg = svg//'<rect x="'//fmt(x0)//'" y="'//fmt(y0)//'" width="'//fmt(size_px)//'" height="'//fmt(size_px)// &
+         '" fill="white" stroke="black"/>'//nl
+      png = png_indexed(bin, palette, ok)
+      if (ok) svg = svg//'<image x="'//fmt(x0)//'" y="'//fmt(y0)//'" width="'//fmt(size_px)//'" height="'// &
+         fmt(size_px)//'" preserveAspectRatio="none" style="image-rendering:pixelated" '// &
+         'xlink:href="data:image/png;base64,'//base64(png)//'"/>'//nl
+      if (f > 1) svg = svg//text(x0 + size_px/2, y0 - 8, "shown by "//int_str(f)//" x "//int_str(f)// &
+         " blocks (largest pressure of each); the full map is in the .h5 file", "middle", 10)
       ! Axes in nm and a colour bar in GPa.
       svg = svg//text(x0 + size_px/2, h - mb + 40, "x (nm), column j", "middle", 13)
       svg = svg//'<text x="'//fmt(x0 - 55)//'" y="'//fmt(y0 + size_px/2)//'" font-family="sans-serif" '// &
@@ -258,11 +272,17 @@ contains
       pyv = h - mb - (yv - frame(3))/(frame(4) - frame(3))*(h - mt - mb)
    end subroutine to_pixels
 
-   function header(title) result(svg)
+   !> The document's start; `xlink` declares the namespace an embedded image needs.
+   function header(title, xlink) result(svg)
       character(len=*), intent(in) :: title
-      character(len=:), allocatable :: svg
+      logical, intent(in), optional :: xlink
+      character(len=:), allocatable :: svg, namespaces
+      namespaces = 'xmlns="http://www.w3.org/2000/svg"'
+      if (present(xlink)) then
+         if (xlink) namespaces = namespaces//' xmlns:xlink="http://www.w3.org/1999/xlink"'
+      end if
       svg = '<?xml version="1.0" encoding="UTF-8"?>'//nl// &
-         '<svg xmlns="http://www.w3.org/2000/svg" width="'//fmt(w)//'" height="'//fmt(h)//'" viewBox="0 0 '// &
+         '<svg '//namespaces//' width="'//fmt(w)//'" height="'//fmt(h)//'" viewBox="0 0 '// &
          fmt(w)//' '//fmt(h)//'">'//nl//'<rect width="100%" height="100%" fill="white"/>'//nl// &
          text(w/2, 28.0_dp, xml_escape(shortened(title, 80)), "middle", 14)
    end function header
@@ -361,16 +381,22 @@ contains
    function colour(t) result(hex)
       real(dp), intent(in) :: t
       character(len=7) :: hex
+      write(hex, '("#", 3z2.2)') colour_rgb(t)
+   end function colour
+
+   !> The perceptual scale (viridis through five anchors) at t in [0, 1], as 0-255 RGB.
+   pure function colour_rgb(t) result(rgb)
+      real(dp), intent(in) :: t
+      integer :: rgb(3)
       real(dp), parameter :: anchors(3, 5) = reshape([ &
          68, 1, 84, 59, 82, 139, 33, 145, 140, 94, 201, 98, 253, 231, 37], [3, 5])
       real(dp) :: s, f
-      integer :: k, rgb(3)
+      integer :: k
       s = max(0.0_dp, min(1.0_dp, t))*4
       k = min(3, int(s))
       f = s - k
       rgb = nint(anchors(:, k + 1)*(1 - f) + anchors(:, k + 2)*f)
-      write(hex, '("#", 3z2.2)') rgb
-   end function colour
+   end function colour_rgb
 
    function text(x, y, s, anchor, size) result(svg)
       real(dp), intent(in) :: x, y

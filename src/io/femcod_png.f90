@@ -1,0 +1,129 @@
+!> PNG images for the figures: an indexed-colour (palette) PNG of a small integer image,
+!> compressed by zlib (Debian's zlib1g, the library HDF5 already uses), and its base64
+!> text for embedding in an SVG `<image>`. The format is the W3C PNG specification
+!> (second edition): signature, IHDR, PLTE, IDAT (zlib stream of the scanlines, each
+!> with filter byte 0), IEND; each chunk with its length and CRC-32 (zlib's crc32).
+module femcod_png
+   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long
+   use, intrinsic :: iso_fortran_env, only: int64
+   implicit none
+   private
+   public :: png_indexed, base64
+
+   interface
+      !> int compress2(Bytef *dest, uLongf *destLen, const Bytef *source, uLong sourceLen, int level)
+      function c_compress2(dest, dest_len, source, source_len, level) bind(c, name="compress2") result(rc)
+         import :: c_char, c_long, c_int
+         character(kind=c_char), intent(out) :: dest(*)
+         integer(c_long), intent(inout) :: dest_len
+         character(kind=c_char), intent(in) :: source(*)
+         integer(c_long), value :: source_len
+         integer(c_int), value :: level
+         integer(c_int) :: rc
+      end function c_compress2
+      !> uLong compressBound(uLong sourceLen)
+      function c_compress_bound(source_len) bind(c, name="compressBound") result(bound)
+         import :: c_long
+         integer(c_long), value :: source_len
+         integer(c_long) :: bound
+      end function c_compress_bound
+      !> uLong crc32(uLong crc, const Bytef *buf, uInt len)
+      function c_crc32(crc, buf, length) bind(c, name="crc32") result(next)
+         import :: c_long, c_char, c_int
+         integer(c_long), value :: crc
+         character(kind=c_char), intent(in) :: buf(*)
+         integer(c_int), value :: length
+         integer(c_long) :: next
+      end function c_crc32
+   end interface
+
+contains
+
+   !> The PNG file (its bytes) of `image(row, column)`, entries 0 .. size(palette, 2) - 1
+   !> indexing `palette(1:3, :)` (red, green, blue, 0-255). Row 1 is the top row.
+   !> `ok` is false if zlib fails (then `png` is empty).
+   function png_indexed(image, palette, ok) result(png)
+      integer, intent(in) :: image(:, :)
+      integer, intent(in) :: palette(:, :)
+      logical, intent(out) :: ok
+      character(len=:), allocatable :: png
+      character(len=:), allocatable :: raw, packed, plte
+      integer(c_long) :: packed_len
+      integer :: rows, cols, i, j, k
+      rows = size(image, 1)
+      cols = size(image, 2)
+      ! The scanlines: a filter byte (0, none), then one palette index per pixel.
+      allocate(character(len=rows*(cols + 1)) :: raw)
+      k = 0
+      do i = 1, rows
+         k = k + 1
+         raw(k:k) = achar(0)
+         do j = 1, cols
+            k = k + 1
+            raw(k:k) = achar(image(i, j))
+         end do
+      end do
+      packed_len = c_compress_bound(int(len(raw), c_long))
+      allocate(character(len=packed_len) :: packed)
+      ok = c_compress2(packed, packed_len, raw, int(len(raw), c_long), 6_c_int) == 0
+      png = ""
+      if (.not. ok) return
+      allocate(character(len=3*size(palette, 2)) :: plte)
+      do k = 1, size(palette, 2)
+         plte(3*k - 2:3*k) = achar(palette(1, k))//achar(palette(2, k))//achar(palette(3, k))
+      end do
+      ! Signature; IHDR: width, height, bit depth 8, colour type 3 (palette), deflate,
+      ! filter method 0, no interlace.
+      png = achar(137)//"PNG"//achar(13)//achar(10)//achar(26)//achar(10)// &
+         chunk("IHDR", be32(int(cols, int64))//be32(int(rows, int64))//achar(8)//achar(3)//achar(0)//achar(0)// &
+         achar(0))//chunk("PLTE", plte)//chunk("IDAT", packed(1:packed_len))//chunk("IEND", "")
+   end function png_indexed
+
+   !> A PNG chunk: length, type, data, CRC-32 of type and data.
+   function chunk(kind, data) result(c)
+      character(len=4), intent(in) :: kind
+      character(len=*), intent(in) :: data
+      character(len=:), allocatable :: c
+      character(len=:), allocatable :: body
+      integer(c_long) :: crc
+      body = kind//data
+      crc = c_crc32(0_c_long, body, int(len(body), c_int))
+      c = be32(int(len(data), int64))//body//be32(int(crc, int64))
+   end function chunk
+
+   !> Four bytes, most significant first (of the low 32 bits of v).
+   pure function be32(v) result(b)
+      integer(int64), intent(in) :: v
+      character(len=4) :: b
+      integer :: k
+      do k = 1, 4
+         b(k:k) = achar(int(iand(shiftr(v, 8*(4 - k)), 255_int64)))
+      end do
+   end function be32
+
+   !> RFC 4648 base64 of `bytes`, with padding, in one line.
+   pure function base64(bytes) result(text)
+      character(len=*), intent(in) :: bytes
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/"
+      integer :: n, k, m, v, b1, b2, b3
+      n = len(bytes)
+      allocate(character(len=4*((n + 2)/3)) :: text)
+      m = 0
+      do k = 1, n, 3
+         b1 = iachar(bytes(k:k))
+         b2 = 0
+         b3 = 0
+         if (k + 1 <= n) b2 = iachar(bytes(k + 1:k + 1))
+         if (k + 2 <= n) b3 = iachar(bytes(k + 2:k + 2))
+         v = ior(ior(shiftl(b1, 16), shiftl(b2, 8)), b3)
+         text(m + 1:m + 1) = table(iand(shiftr(v, 18), 63) + 1:iand(shiftr(v, 18), 63) + 1)
+         text(m + 2:m + 2) = table(iand(shiftr(v, 12), 63) + 1:iand(shiftr(v, 12), 63) + 1)
+         text(m + 3:m + 3) = table(iand(shiftr(v, 6), 63) + 1:iand(shiftr(v, 6), 63) + 1)
+         text(m + 4:m + 4) = table(iand(v, 63) + 1:iand(v, 63) + 1)
+         if (k + 1 > n) text(m + 3:m + 3) = "="
+         if (k + 2 > n) text(m + 4:m + 4) = "="
+         m = m + 4
+      end do
+   end function base64
+end module femcod_png
