@@ -8,7 +8,7 @@ module test_deck
    use femcod_strings, only: string_type, format_real
    use femcod_cli, only: run_femcod
    use test_support, only: write_text, scratch_path, contains_text, file_exists
-   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
    public :: collect_deck
@@ -28,6 +28,7 @@ contains
          new_unittest("CRLF, tabs, commas, D exponents, wrapped values", test_formats), &
          new_unittest("write then read is exact", test_roundtrip), &
          new_unittest("shortest round-trip number format", test_format_real), &
+         new_unittest("format_real equals a brute-force search on 40000 values", test_format_real_search), &
          new_unittest("bad deck: "//"missing value line 2", bad_01), &
          new_unittest("bad deck: "//"extra value line 3", bad_02), &
          new_unittest("bad deck: "//"non-numeric height", bad_03), &
@@ -153,6 +154,93 @@ contains
       if (allocated(error)) return
       call check(error, format_real(0.0_dp), "0")
    end subroutine test_format_real
+
+   !> format_real against the definition, searched by brute force with Fortran's own
+   !> formatted I/O (independent of the C conversions format_real uses): the fewest
+   !> significant digits (es, p = 0..16) whose decimal reads back to x; the positional
+   !> form (f0.q, q = 0..20) with the fewest decimals that reads back, when 1e-4 <= |x|
+   !> < 1e15 and not longer. Values: random mantissas at every decade from 1e-310 to
+   !> 1e308, random bit patterns, and the edges (powers of 2 and 10, 1 - ulp, the bounds
+   !> of the positional range, the largest and smallest doubles).
+   subroutine test_format_real_search(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: values(:)
+      real(dp) :: u
+      integer(8) :: bits
+      integer :: k, e, nseed
+      integer, allocatable :: seed(:)
+      allocate(values(0))
+      values = [values, 1.0_dp, 0.1_dp, 1.0e-4_dp, nearest(1.0e-4_dp, -1.0_dp), 1.0e15_dp, nearest(1.0e15_dp, -1.0_dp), &
+         nearest(1.0_dp, -1.0_dp), nearest(1.0_dp, 2.0_dp), huge(1.0_dp), tiny(1.0_dp), tiny(1.0_dp)/2**20, &
+         9007199254740993.0_dp, tiny(1.0_dp)*epsilon(1.0_dp), 123456789012345678.0_dp, 0.3_dp, 2.0_dp/3, &
+         1200.0_dp, 9.5_dp, 999.9999999_dp]
+      do e = -300, 300, 7
+         values = [values, 10.0_dp**e, 2.0_dp**(e*3)]
+      end do
+      call random_seed(size=nseed)
+      allocate(seed(nseed))
+      seed = 20261123
+      call random_seed(put=seed)
+      do k = 1, 30000
+         call random_number(u)
+         e = -310 + mod(k*37, 618)
+         values = [values, (u + 0.1_dp)*10.0_dp**e*merge(1, -1, mod(k, 3) /= 0)]
+      end do
+      do k = 1, 10000
+         call random_number(u)
+         bits = int(u*huge(1_8), 8)
+         values = [values, transfer(bits, 1.0_dp)]
+      end do
+      do k = 1, size(values)
+         if (values(k) /= values(k) .or. abs(values(k)) > huge(1.0_dp)) cycle
+         call check(error, format_real(values(k)), shortest_by_search(values(k)), "format_real of value "// &
+            to_string(k))
+         if (allocated(error)) return
+      end do
+   contains
+      function shortest_by_search(x) result(s)
+         real(dp), intent(in) :: x
+         character(len=:), allocatable :: s
+         character(len=48) :: buf, fmt
+         real(dp) :: back
+         integer :: p, ios, ex, last
+         if (x == 0) then
+            s = "0"
+            return
+         end if
+         do p = 0, 16
+            write(fmt, '("(es40.",i0,"e3)")') p
+            write(buf, fmt) x
+            read(buf, *, iostat=ios) back
+            if (ios == 0 .and. back == x) exit
+         end do
+         buf = adjustl(buf)
+         ex = index(buf, "E")
+         s = buf(1:ex - 1)
+         if (index(s, ".") > 0) then
+            do while (s(len(s):len(s)) == "0")
+               s = s(1:len(s) - 1)
+            end do
+            if (s(len(s):len(s)) == ".") s = s(1:len(s) - 1)
+         end if
+         read(buf(ex + 1:), *) p
+         if (p /= 0) s = s//"e"//to_string(p)
+         if (abs(x) >= 1.0e-4_dp .and. abs(x) < 1.0e15_dp) then
+            do p = 0, 20
+               write(fmt, '("(f0.",i0,")")') p
+               write(buf, fmt) x
+               read(buf, *, iostat=ios) back
+               if (ios == 0 .and. back == x) exit
+            end do
+            buf = adjustl(buf)
+            if (buf(1:1) == ".") buf = "0"//buf
+            if (buf(1:2) == "-.") buf = "-0"//buf(2:)
+            last = len_trim(buf)
+            if (buf(last:last) == ".") last = last - 1
+            if (last <= len(s)) s = buf(1:last)
+         end if
+      end function shortest_by_search
+   end subroutine test_format_real_search
 
    !> The bad-deck cases, one test each: deck text, the line the error must name, and a
    !> word of what was expected.

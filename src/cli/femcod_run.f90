@@ -136,7 +136,7 @@ contains
       call print_lines(option_help(run_table(), "event"))
       write(output_unit, '(a)') "", "incremental solver:"
       call print_lines(option_help(run_table(), "incremental"))
-      write(output_unit, '(a)') "", "cg solver (needs --loads):"
+      write(output_unit, '(a)') "", "cg solver (needs --loads; MAXCONT and --max-contacts do not apply):"
       call print_lines(option_help(run_table(), "cg"))
       write(output_unit, '(a)') "", "scene options, with --lower/--upper only (one scene; -o defaults to the first", &
          "file's name; the elastic body carries the heights, the other is rigid):"
@@ -458,10 +458,13 @@ contains
       type(state_maps), allocatable :: maps(:)
       type(run_info) :: info
       character(len=:), allocatable :: fingerprint, stored, started
+      type(string_type), allocatable :: digests(:)
       logical :: resuming, ok, have_checkpoint
       integer :: k
       associate(options => settings%solve)
-         fingerprint = run_fingerprint(problem, options)
+         ! Every input file's SHA-256, once: for /run and for the fingerprint.
+         call input_digests(files, digests)
+         fingerprint = run_fingerprint(problem, options, digests)
          have_checkpoint = path_exists(prefix//".ckpt.h5")
          ! With --restart, result files are leftovers of the interrupted run while its
          ! checkpoint exists, or while PREFIX.h5 (renamed last) does not. A complete set
@@ -545,7 +548,7 @@ contains
          info%scene = model_notes(problem, options)
          info%inputs = inputs
          info%fingerprint = fingerprint
-         call input_digests(files, info%digests)
+         info%digests = digests
          call load_maps(problem, res%states, maps)
          call write_results(prefix, problem, res, maps, info, st)
          if (st%code /= 0) return
@@ -576,20 +579,33 @@ contains
       call remove_file(prefix//".ckpt.h5.part")
    end subroutine remove_stale_results
 
-   !> SHA-256 of what decides a run's results: the problem (label, grid, materials,
-   !> heights) and the options that shape them.
-   function run_fingerprint(problem, options) result(hex)
+   !> SHA-256 of what decides a run's results: the problem's label, grid and materials,
+   !> the options that shape the results, and the SHA-256 of every input file (which
+   !> fix the heights; hashing those digests instead of the 2 NP^2 heights again saves
+   !> a pass over them).
+   function run_fingerprint(problem, options, digests) result(hex)
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
+      !> "FILE sha256 HEX" per input file (input_digests).
+      type(string_type), intent(in) :: digests(:)
       character(len=64) :: hex
       character(len=:), allocatable :: text
+      integer :: k, at
       text = problem%label//"|"//int_str(problem%np)//"|"//format_real(problem%pixel)//"|"// &
          int_str(problem%maxcont)//"|"//reals(problem%young)//reals(problem%poisson)//trim(options%solver)//"|"// &
          reals(options%loads)//int_str(options%max_contacts)//"|"//format_real(options%hardness)//"|"// &
          format_real(options%tie_tolerance)//"|"//merge("T", "F", options%final_check)//"|"// &
          trim(options%event_search)//"|"//format_real(options%cg%tol)//"|"//int_str(options%cg%max_iterations)//"|"
-      hex = sha256_hex(text//transfer(problem%lower, repeat(" ", 8*size(problem%lower)))// &
-         transfer(problem%upper, repeat(" ", 8*size(problem%upper))))
+      do k = 1, size(digests)
+         ! The digest without the file's path: a moved input is the same input.
+         at = index(digests(k)%s, " sha256 ", back=.true.)
+         if (at > 0) then
+            text = text//digests(k)%s(at + 8:)//"|"
+         else
+            text = text//"unreadable|"
+         end if
+      end do
+      hex = sha256_hex(text)
    contains
       function reals(v) result(t)
          real(dp), intent(in) :: v(:)

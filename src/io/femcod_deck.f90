@@ -17,7 +17,7 @@ module femcod_deck
       MIN_YOUNG, MAX_YOUNG
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_files, only: write_file, read_file
-   use femcod_strings, only: int_str, parse_real, parse_integer, format_real, is_digit, text_builder, add_line, built_text
+   use femcod_strings, only: int_str, parse_real, parse_integer, format_real, is_digit, text_builder, add_line, add_text, built_text
    implicit none
    private
    public :: read_deck, write_deck
@@ -119,31 +119,12 @@ contains
          return
       end if
       allocate(deck%lower(deck%np, deck%np), deck%upper(deck%np, deck%np))
+      ! The message of a bad height is built only when there is one: a string per value
+      ! made reading a 1024 x 1024 deck allocation-bound.
       k = first_line6
-      do i = 1, deck%np
-         do j = 1, deck%np
-            call get_real(k, "a lower-surface height in nm (row "//int_str(i)//", column "//int_str(j)//")", &
-               deck%lower(i, j))
-            if (status%code /= 0) return
-            if (abs(deck%lower(i, j)) > MAX_HEIGHT) then
-               call bad(tok_line(k), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", tok(k))
-               return
-            end if
-            k = k + 1
-         end do
-      end do
-      do i = 1, deck%np
-         do j = 1, deck%np
-            call get_real(k, "an upper-surface height in nm (row "//int_str(i)//", column "//int_str(j)//")", &
-               deck%upper(i, j))
-            if (status%code /= 0) return
-            if (abs(deck%upper(i, j)) > MAX_HEIGHT) then
-               call bad(tok_line(k), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", tok(k))
-               return
-            end if
-            k = k + 1
-         end do
-      end do
+      call get_heights(deck%lower, "a lower-surface height")
+      if (status%code /= 0) return
+      call get_heights(deck%upper, "an upper-surface height")
 
    contains
 
@@ -183,6 +164,29 @@ contains
          if (.not. ok) call bad(tok_line(k), what, tok(k))
       end subroutine get_int
 
+      !> The NP x NP heights from token k on, row by row; k ends past them.
+      subroutine get_heights(z, what)
+         real(dp), intent(out) :: z(:, :)
+         character(len=*), intent(in) :: what
+         integer :: i, j
+         logical :: ok
+         do i = 1, size(z, 1)
+            do j = 1, size(z, 2)
+               call parse_real(text(tok_first(k):tok_last(k)), z(i, j), ok)
+               if (.not. ok) then
+                  call bad(tok_line(k), what//" in nm (row "//int_str(i)//", column "//int_str(j)//") (a finite "// &
+                     "number)", tok(k))
+                  return
+               end if
+               if (abs(z(i, j)) > MAX_HEIGHT) then
+                  call bad(tok_line(k), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", tok(k))
+                  return
+               end if
+               k = k + 1
+            end do
+         end do
+      end subroutine get_heights
+
       subroutine get_real(k, what, value)
          integer, intent(in) :: k
          character(len=*), intent(in) :: what
@@ -210,22 +214,23 @@ contains
          call add_line(b, format_real(deck%young(i))//" "//format_real(deck%poisson(i)))
       end do
       do i = 1, deck%np
-         call add_line(b, row_text(deck%lower(i, :)))
+         call add_row(deck%lower(i, :))
       end do
       do i = 1, deck%np
-         call add_line(b, row_text(deck%upper(i, :)))
+         call add_row(deck%upper(i, :))
       end do
       call write_file(path, built_text(b), status)
    contains
-      function row_text(row) result(line)
+      !> One image row on one line, the values separated by blanks.
+      subroutine add_row(row)
          real(dp), intent(in) :: row(:)
-         character(len=:), allocatable :: line
          integer :: j
-         line = format_real(row(1))
+         call add_text(b, format_real(row(1)))
          do j = 2, size(row)
-            line = line//" "//format_real(row(j))
+            call add_text(b, " "//format_real(row(j)))
          end do
-      end function row_text
+         call add_text(b, new_line("a"))
+      end subroutine add_row
    end subroutine write_deck
 
 
@@ -288,41 +293,42 @@ contains
       character(len=*), intent(in) :: text
       integer, intent(out) :: ntok, last_line
       integer, allocatable, intent(out) :: first(:), last(:), line(:)
-      integer :: pass, i, ln, start
-      logical :: in_tok
+      character(len=*), parameter :: separators = " "//achar(9)//achar(10)//achar(13)//achar(12)//","
+      integer :: pass, i, ln, start, skip, k, n
+      n = len(text)
       do pass = 1, 2
          ntok = 0
-         ln = 1
-         in_tok = .false.
          start = index(text, new_line("a"))
-         if (start == 0) start = len(text)
+         if (start == 0) start = n
          ln = 2
-         do i = start + 1, len(text) + 1
-            if (i <= len(text)) then
-               if (.not. is_separator(text(i:i))) then
-                  if (.not. in_tok) then
-                     in_tok = .true.
-                     ntok = ntok + 1
-                     if (pass == 2) then
-                        first(ntok) = i
-                        line(ntok) = ln
-                     end if
-                  end if
-                  cycle
-               end if
+         i = start + 1
+         do while (i <= n)
+            ! The run of separators (counting its line ends), then the token.
+            skip = verify(text(i:), separators)
+            if (skip == 0) then
+               skip = n - i + 2
             end if
-            if (in_tok .and. pass == 2) last(ntok) = i - 1
-            in_tok = .false.
-            if (i <= len(text)) then
-               if (text(i:i) == new_line("a")) ln = ln + 1
+            do k = i, i + skip - 2
+               if (text(k:k) == new_line("a")) ln = ln + 1
+            end do
+            i = i + skip - 1
+            if (i > n) exit
+            ntok = ntok + 1
+            skip = scan(text(i:), separators)
+            if (skip == 0) skip = n - i + 2
+            if (pass == 2) then
+               first(ntok) = i
+               last(ntok) = i + skip - 2
+               line(ntok) = ln
             end if
+            i = i + skip - 1
          end do
          if (pass == 1) allocate(first(ntok), last(ntok), line(ntok))
       end do
       ! The number of the last line that holds anything.
       last_line = ln
-      if (len(text) > 0) then
-         if (text(len(text):len(text)) == new_line("a")) last_line = ln - 1
+      if (n > 0) then
+         if (text(n:n) == new_line("a")) last_line = ln - 1
       end if
       if (index(text, new_line("a")) == 0) last_line = 1
    end subroutine tokenize
