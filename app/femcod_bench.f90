@@ -5,7 +5,7 @@ module femcod_bench
    use femcod_status, only: status_type
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
-   use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR
+   use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR, verification_spec
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options, cg_settings
    use femcod_solver, only: solve_contact
@@ -22,9 +22,16 @@ module femcod_bench
    use femcod_love, only: offset_table
    use femcod_random, only: random_stream, seed_stream, uniform
    use femcod_clock, only: wall_clock
+   use femcod_deck, only: write_deck
+   use femcod_files, only: write_file
+   use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
+   use femcod_svg, only: svg_pressure_map
    implicit none
    private
    public :: bench_command
+
+   !> The benchmark surface's side: 5 um.
+   real(dp), parameter :: BENCH_LENGTH = 5000
 
 
 contains
@@ -52,6 +59,10 @@ contains
             call bench_convolution(args(2:), code)
             return
          end if
+         if (args(1)%s == "io") then
+            call bench_io(args(2:), code)
+            return
+         end if
       end if
       legacy_contacts = 300
       full = .false.
@@ -59,6 +70,7 @@ contains
          write(output_unit, '(a)') "usage: femcod bench [--full] [--legacy-contacts N]", &
             "       femcod bench cg [--np LIST] [--contact LIST] [--tol T] [--peers PYTHON]  (--help for more)", &
             "       femcod bench convolution [--np LIST] [--repeat N]  (--help for more)", &
+            "       femcod bench io [--np LIST] [--dir DIR]  (--help for more)", &
             "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
             "event, peak memory (resident, per case), error against the reference. The rough surface:", &
             "self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa, nu = 0.25, against a", &
@@ -165,9 +177,12 @@ contains
       subroutine verification_row(name, load, reference, what)
          character(len=*), intent(in) :: name, what
          real(dp), intent(in) :: load, reference
-         call read_deck("input/"//name//".deck", deck, status)
+         type(scene_spec) :: verification
+         ! The deck of input/, built in memory: the bench runs from any directory.
+         call verification_spec(name, verification, status)
+         call build_problem(verification, deck, status)
          if (status%code /= 0) then
-            write(error_unit, '(a)') "femcod bench: "//status%message//" (run from the package root)"
+            write(error_unit, '(a)') "femcod bench: "//status%message
             return
          end if
          options%loads = [load]
@@ -209,7 +224,8 @@ contains
          real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,5,10)", lower=0.0_dp, &
             upper=100.0_dp, closed="(]"), &
          real_option("--tol", "T", "the cg tolerance (default 1e-8)", lower=0.0_dp, closed="()"), &
-         text_option("--peers", "PYTHON", "also run the peers installed in that Python (app/femcod_peers.py)"), &
+         text_option("--peers", "PYTHON", "also run the peers installed in that Python (app/femcod_peers.py of "// &
+            "the source tree: run from its root)"), &
          text_option("--fftw-wisdom", "FILE", "measured FFTW plans kept in FILE"), &
          choice_option("--nested", "on|off", "nested coarse-grid start (default on)"), &
          integer_option("--coarsest", "N", "coarsest grid (default 64)", lower=2), &
@@ -245,6 +261,191 @@ contains
    end function bad_arguments
 
 
+
+   !> The benchmark surface of every table: self-affine, Hurst 0.8, rms 3 nm, 5 um square,
+   !> NP x NP, E = 200 GPa, nu = 0.25, on the lower body against a rigid flat (seed 1).
+   subroutine benchmark_surface(np, label, deck, status)
+      integer, intent(in) :: np
+      character(len=*), intent(in) :: label
+      type(contact_problem), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      type(scene_spec) :: spec
+      spec%kind = "self-affine"
+      spec%np = np
+      spec%pixel = BENCH_LENGTH/np
+      spec%hurst = 0.8_dp
+      spec%rms = 3
+      spec%seed = 1
+      spec%shape_on = "lower"
+      spec%rigid = "upper"
+      spec%label = label
+      spec%matrix_file = ""
+      spec%maxcont = 1
+      call build_problem(spec, deck, status)
+   end subroutine benchmark_surface
+
+   !> What the linear law of contact area needs: the composite modulus E* of the
+   !> solver's model (elastic body on a rigid one) and the rms slope of the gaps; the
+   !> mean pressure for a contact fraction f is f E* slope / 2 (kappa = 2).
+   subroutine linear_law(deck, estar, slope, g0)
+      type(contact_problem), intent(in) :: deck
+      real(dp), intent(out) :: estar, slope
+      real(dp), allocatable, intent(out) :: g0(:, :)
+      integer :: np
+      np = deck%np
+      estar = 1/(1/(deck%young(1)/(1 - deck%poisson(1)**2)) + 1/(deck%young(2)/(1 - deck%poisson(2)**2)))
+      g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
+      slope = sqrt((sum((g0(2:, :) - g0(:np - 1, :))**2) + sum((g0(:, 2:) - g0(:, :np - 1))**2)) &
+         /(np*(np - 1.0_dp)))/deck%pixel
+   end subroutine linear_law
+
+   !> `femcod bench io`: the whole `femcod run` command, as a user runs it, against the
+   !> solve inside it. For each NP: the deck written and read back (values per second),
+   !> then `femcod run DECK --solver cg --loads L1,L5 -o PREFIX --force --quiet` (the
+   !> loads of about 1 and 5 % contact) in a process of its own, its wall time against
+   !> the solver's own (`wall_time_s` of PREFIX.summary.json): what is left is reading,
+   !> set-up and every output. Then the pressure figure of the larger load made and
+   !> written again here (time) and the largest figure on disk (bytes).
+   subroutine bench_io(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      integer, allocatable :: sizes(:)
+      character(len=:), allocatable :: dir, deck_path, prefix, command, text, svg
+      type(contact_problem) :: deck, back
+      type(status_type) :: status
+      type(parsed_options) :: parsed
+      type(h5_file) :: file
+      real(dp), allocatable :: g0(:, :), map(:, :)
+      real(dp) :: estar, slope, loads(2), t0, t1, t_write, t_read, t_run, t_solve, t_figure, outside, mpix
+      integer :: n, np, ios, a
+      integer(8) :: biggest
+      sizes = [512, 1024, 2048]
+      dir = "femcod-bench-io"
+      if (help_requested(args)) then
+         write(output_unit, '(a)') "usage: femcod bench io [--np 512,1024,2048] [--dir DIR]", &
+            "The whole command against the solve inside it, on the benchmark surface (self-affine, Hurst 0.8,", &
+            "rms 3 nm, 5 um square, rigid flat, seed 1): deck written and read back, then femcod run --solver cg", &
+            "at the loads of about 1 and 5 % contact in a process of its own, timed as a whole; its solver time", &
+            "comes from PREFIX.summary.json. Then the pressure figure of the larger load, made and written again", &
+            "here, and the largest figure's size. The files stay in DIR (default femcod-bench-io).", ""
+         call print_lines(option_help(bench_io_table(), ""))
+         write(output_unit, '(a)') "Columns: NP, deck write s (values/s), deck read s (values/s), run s, solver s,", &
+            "outside the solver s (% of the solve, s per million pixels), figure s, largest figure KB."
+         return
+      end if
+      call parse_options(bench_io_table(), args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench io: "//bad_arguments(status, parsed)//" (--help)"
+         code = 2
+         return
+      end if
+      call get_option(parsed, "--np", sizes)
+      call get_option(parsed, "--dir", dir)
+      call execute_command_line("mkdir -p '"//dir//"'", exitstat=ios)
+      write(output_unit, '(a)') "| NP | deck write s (values/s) | deck read s (values/s) | femcod run s | solver s "// &
+         "| outside the solver s (% of solve, s/Mpixel) | figure s | largest figure KB |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|"
+      do n = 1, size(sizes)
+         np = sizes(n)
+         mpix = real(np, dp)**2/1.0e6_dp
+         call benchmark_surface(np, "bench io", deck, status)
+         call linear_law(deck, estar, slope, g0)
+         loads = [1.0_dp, 5.0_dp]/100*estar*slope/2*BENCH_LENGTH**2
+         deck_path = dir//"/io_"//int_str(np)//".deck"
+         prefix = dir//"/io_"//int_str(np)
+         call wall_clock(t0)
+         call write_deck(deck_path, deck, status)
+         call wall_clock(t1)
+         t_write = t1 - t0
+         call wall_clock(t0)
+         call read_deck(deck_path, back, status)
+         call wall_clock(t1)
+         t_read = t1 - t0
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod bench io: "//status%message
+            code = status%code
+            return
+         end if
+         command = self_path()//" run '"//deck_path//"' --solver cg --loads "//real_str(loads(1), 17)//","// &
+            real_str(loads(2), 17)//" -o '"//prefix//"' --force --quiet"
+         call wall_clock(t0)
+         call execute_command_line(command, exitstat=ios)
+         call wall_clock(t1)
+         t_run = t1 - t0
+         if (ios /= 0) then
+            write(error_unit, '(a)') "femcod bench io: "//command//" ended with exit code "//int_str(ios)
+            code = 4
+            return
+         end if
+         ! The solver's own time, from the summary file.
+         text = read_text_file(prefix//".summary.json")
+         a = index(text, '"wall_time_s": ')
+         t_solve = 0
+         if (a > 0) read(text(a + 15:a + 15 + scan(text(a + 15:), ","//new_line("a")) - 2), *, iostat=ios) t_solve
+         outside = t_run - t_solve
+         ! The figure of the larger load, again, timed.
+         call h5_open(prefix//".h5", file, status, 5)
+         call h5_read(file, "/loads/002/pressure", map, status, 5)
+         call h5_close(file, status)
+         call wall_clock(t0)
+         svg = svg_pressure_map("bench io", map, np*deck%pixel)
+         call write_file(dir//"/figure.svg", svg, status)
+         call wall_clock(t1)
+         t_figure = t1 - t0
+         biggest = largest_figure(prefix)
+         write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(t_write, 2)//" ("//real_str(2*np**2/t_write, 2)// &
+            ") | "//fixed_str(t_read, 2)//" ("//real_str(2*np**2/t_read, 2)//") | "//fixed_str(t_run, 2)//" | "// &
+            fixed_str(t_solve, 2)//" | "//fixed_str(outside, 2)//" ("//fixed_str(100*outside/max(t_solve, 1.0e-9_dp), 0)// &
+            " %, "//fixed_str(outside/mpix, 2)//") | "//fixed_str(t_figure, 3)//" | "//fixed_str(biggest/1024.0_dp, 0)//" |"
+         flush(output_unit)
+      end do
+   contains
+      !> This program's path (argument 0).
+      function self_path() result(path)
+         character(len=:), allocatable :: path
+         integer :: length
+         call get_command_argument(0, length=length)
+         allocate(character(len=length) :: path)
+         call get_command_argument(0, path)
+      end function self_path
+
+      function read_text_file(path) result(t)
+         character(len=*), intent(in) :: path
+         character(len=:), allocatable :: t
+         integer :: unit, size_bytes, ios2
+         open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios2)
+         if (ios2 /= 0) then
+            t = ""
+            return
+         end if
+         inquire(unit=unit, size=size_bytes)
+         allocate(character(len=size_bytes) :: t)
+         read(unit, iostat=ios2) t
+         close(unit)
+      end function read_text_file
+
+      !> The largest of PREFIX's SVG figures, in bytes.
+      integer(8) function largest_figure(prefix)
+         character(len=*), intent(in) :: prefix
+         character(len=*), parameter :: names(*) = [character(len=20) :: ".load_approach.svg", ".area_load.svg", &
+            ".pressure_1.svg", ".pressure_2.svg"]
+         integer(8) :: bytes
+         integer :: k
+         largest_figure = 0
+         do k = 1, size(names)
+            inquire(file=prefix//trim(names(k)), size=bytes)
+            largest_figure = max(largest_figure, bytes)
+         end do
+      end function largest_figure
+   end subroutine bench_io
+
+   !> The options of `femcod bench io`.
+   function bench_io_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [integer_list_option("--np", "N1,...", "grid sizes (default 512,1024,2048)", lower=2), &
+         text_option("--dir", "DIR", "where the decks and results go (default femcod-bench-io)")]
+   end function bench_io_table
 
    !> `femcod bench cg`: the fixed-load solver on self-affine surfaces of growing size at
    !> the mean pressures that give about the requested contact fractions, side by side with
@@ -298,6 +499,15 @@ contains
       call get_option(parsed, "--tol", tol)
       call get_option(parsed, "--peers", python)
       call get_option(parsed, "--fftw-wisdom", wisdom)
+      if (len(python) > 0) then
+         inquire(file="app/femcod_peers.py", exist=loaded)
+         if (.not. loaded) then
+            write(error_unit, '(a)') "femcod bench cg: --peers runs app/femcod_peers.py of the femcod source tree; "// &
+               "run it from the tree's root"
+            code = 2
+            return
+         end if
+      end if
       associate(method => options%cg)
          if (option_given(parsed, "--nested")) method%nested = switch("--nested")
          if (option_given(parsed, "--restart")) method%restart_on_entry = switch("--restart")
@@ -321,30 +531,14 @@ contains
       write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|"
       do n = 1, size(sizes)
          np = sizes(n)
-         length = 5000
-         spec%kind = "self-affine"
-         spec%np = np
-         spec%pixel = length/np
-         spec%hurst = 0.8_dp
-         spec%rms = 3
-         spec%seed = 1
-         spec%shape_on = "lower"
-         spec%rigid = "upper"
-         spec%label = "bench cg"
-         spec%matrix_file = ""
-         spec%maxcont = 1
-         call build_problem(spec, deck, status)
+         length = BENCH_LENGTH
+         call benchmark_surface(np, "bench cg", deck, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod bench cg: "//status%message
             code = status%code
             return
          end if
-         ! The composite modulus of the solver's model: pi/(c pixel) with c the summed
-         ! single-pixel compliances' Love factor (E* for an elastic body on a rigid one).
-         estar = 1/(1/(deck%young(1)/(1 - deck%poisson(1)**2)) + 1/(deck%young(2)/(1 - deck%poisson(2)**2)))
-         g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
-         slope = sqrt((sum((g0(2:, :) - g0(:np - 1, :))**2) + sum((g0(:, 2:) - g0(:, :np - 1))**2)) &
-            /(np*(np - 1.0_dp)))/deck%pixel
+         call linear_law(deck, estar, slope, g0)
          if (len(python) > 0) then
             path = "femcod-bench-gaps.f64"
             open(newunit=unit, file=path, access="stream", form="unformatted", status="replace", action="write")

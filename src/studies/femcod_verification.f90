@@ -1,10 +1,10 @@
 !> `femcod verify`: recompute every thesis check of chapter 4 with the legacy solver
 !> and write doc/verification.md (Markdown), so that the document is produced by the
-!> program, never typed by hand. Run from the package root (it reads input/).
+!> program, never typed by hand. The decks of input/ are built in memory (femcod_generate).
 module femcod_verification
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
-   use femcod_deck, only: read_deck
+   use femcod_generate, only: scene_spec, verification_spec, build_problem
    use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, format_real, text_builder, add_lines, built_text
    use femcod_contact_result, only: contact_result
@@ -176,7 +176,11 @@ contains
          type(contact_problem) :: deck
          type(contact_options) :: options
          integer :: m, cc
-         call read_deck("input/"//name//".deck", deck, status)
+         type(scene_spec) :: spec
+         ! The deck of input/ built in memory (the same bytes, a test checks): verify runs
+         ! from any directory.
+         call verification_spec(name, spec, status)
+         call build_problem(spec, deck, status)
          if (status%code /= 0) return
          options%loads = loads
          options%solver = "legacy"
