@@ -124,12 +124,13 @@ contains
       type(string_type), allocatable :: files(:)
       character(len=:), allocatable :: text, line
       integer :: f, start, k
-      logical :: in_procedure
+      logical :: in_procedure, in_type
       files = sources()
       do f = 1, size(files)
          text = read_text(files(f)%s)
          start = 1
          in_procedure = .false.
+         in_type = .false.
          do k = 1, len(text)
             if (text(k:k) /= new_line("a")) cycle
             line = lower(adjustl(text(start:k - 1)))
@@ -140,9 +141,20 @@ contains
                files(f)%s//": a stop statement")
             if (allocated(error)) return
             if (in_procedure) cycle
+            ! Derived-type components may have default values; module variables may not.
+            if (index(line, "type ::") == 1 .or. index(line, "type, ") == 1) in_type = .true.
+            if (index(line, "end type") == 1) in_type = .false.
             call check(error, index(line, ", save ::") == 0 .and. index(line, ", save,") == 0 .and. &
                index(line, "save ::") /= 1 .and. line /= "save", files(f)%s//": a module-level save variable: "//line)
             if (allocated(error)) return
+            ! An initialised module variable is saved too. The one exception is volatile:
+            ! the flag a signal handler sets (core/femcod_process), which has no other way
+            ! to speak.
+            if (.not. in_type .and. index(line, "::") > 0 .and. index(line, "=") > index(line, "::") .and. &
+               index(line, "parameter") == 0 .and. index(line, "volatile") == 0 .and. index(line, "=>") == 0) then
+               call check(error, .false., files(f)%s//": an initialised (saved) module variable: "//line)
+               return
+            end if
          end do
       end do
    end subroutine test_no_state
