@@ -223,7 +223,10 @@ contains
       args = "run --lower "//dir//"/scan.txt --pixel 5 --maxcont 1500 --quiet -o "//dir//"/out "
       code = femcod_terminated(args, 0.2_dp)
       if (code /= 0) then
-         call check(error, code == 143 .and. file_exists(dir//"/out.ckpt.h5"), "stopped with a checkpoint")
+         ! Stopped: with a checkpoint, or before the first step with nothing to keep.
+         call check(error, code == 143 .and. (file_exists(dir//"/out.ckpt.h5") .or. &
+            contains_text(read_text(scratch_path("safety.stderr")), "nothing was written")), &
+            "stopped with a checkpoint, or before anything was solved: "//read_text(scratch_path("safety.stderr")))
          if (allocated(error)) return
       end if
       code = femcod(args//"--restart")

@@ -272,12 +272,23 @@ contains
       character(len=40), intent(out) :: buf
       character(kind=c_char, len=40) :: cbuf
       integer(c_int) :: length
+      logical :: halting
       buf = ""
       length = c_decimal_e(x, int(digits, c_int), cbuf, int(len(cbuf), c_int))
       reads_back = .false.
       if (length <= 0 .or. length >= len(cbuf)) return
       buf = cbuf(1:length)
-      reads_back = c_decimal_read(cbuf) == x
+      if (abs(x) > 1.0e307_dp) then
+         ! Rounded up past the largest double, the decimal reads as infinity: strtod
+         ! raises overflow, which must not trap under -ffpe-trap=overflow.
+         call ieee_get_halting_mode(ieee_overflow, halting)
+         if (halting) call ieee_set_halting_mode(ieee_overflow, .false.)
+         reads_back = c_decimal_read(cbuf) == x
+         call ieee_set_flag(ieee_overflow, .false.)
+         if (halting) call ieee_set_halting_mode(ieee_overflow, .true.)
+      else
+         reads_back = c_decimal_read(cbuf) == x
+      end if
    end function reads_back
 
    !> Parse a real token: [sign] digits [. digits] [(e|E|d|D) [sign] digits], at least

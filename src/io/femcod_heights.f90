@@ -208,9 +208,10 @@ contains
             return
          end if
          used%pixel = first%pixel_x
-      else if (first%pixel_x > 0 .and. abs(used%pixel/max(first%pixel_x, tiny(1.0_dp)) - 1) > 1.0e-6_dp) then
-         call append_string(warned, "--pixel "//format_real(used%pixel)//" nm replaces the "//format_real(first%pixel_x)// &
-            " nm of "//spec%matrix_file)
+      else if (first%pixel_x > 0) then
+         ! Nested: .and. may evaluate the ratio for a file without a pixel size.
+         if (abs(used%pixel/first%pixel_x - 1) > 1.0e-6_dp) call append_string(warned, "--pixel "// &
+            format_real(used%pixel)//" nm replaces the "//format_real(first%pixel_x)//" nm of "//spec%matrix_file)
       end if
       if (used%pixel < 1.0e-3_dp) call append_string(warned, "a pixel of "//format_real(used%pixel)// &
          " nm: if that is metres, give the size in nm")
@@ -240,9 +241,10 @@ contains
       if (size(map%z, 1) /= size(map%z, 2)) then
          call set_error(status, STATUS_BAD_INPUT, path//": expected a square matrix of heights, found "// &
             int_str(size(map%z, 1))//" rows of "//int_str(size(map%z, 2))//" values")
-      else if (map%pixel_x > 0 .and. map%pixel_y > 0 .and. abs(map%pixel_x/map%pixel_y - 1) > 1.0e-6_dp) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected square pixels, found "// &
-            format_real(map%pixel_x)//" x "//format_real(map%pixel_y)//" nm")
+      else if (map%pixel_x > 0 .and. map%pixel_y > 0) then
+         ! Nested: Fortran's .and. may evaluate the ratio even when a size is 0.
+         if (abs(map%pixel_x/map%pixel_y - 1) > 1.0e-6_dp) call set_error(status, STATUS_BAD_INPUT, path// &
+            ": expected square pixels, found "//format_real(map%pixel_x)//" x "//format_real(map%pixel_y)//" nm")
       end if
    end subroutine square_grid
 
