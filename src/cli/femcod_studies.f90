@@ -15,7 +15,7 @@ module femcod_studies
    use femcod_files, only: default_prefix, file_part
    use femcod_files, only: path_exists
    use femcod_results, only: write_file_set
-   use femcod_svg, only: svg_series, svg_multi_plot, fmt_sig, add_series
+   use femcod_svg, only: svg_series, svg_multi_plot, add_series
    use femcod_clock, only: wall_clock
    use femcod_resolution_study, only: resolution_level, solve_level, extrapolate_levels
    use femcod_summits, only: summit_statistics, summit_search, summits_of_size, default_sizes, profile_psd, summit_power_laws, &
@@ -189,9 +189,9 @@ contains
          if (.not. quiet) then
             associate(r => levels(k)%res)
                write(output_unit, '(a)') "femcod resolution: NP = "//int_str(levels(k)%np)//" ("//method//", pixel "// &
-                  fmt_sig(levels(k)%pixel, 6)//" nm): "//int_str(r%nsteps)//" steps, "// &
-                  int_str(r%step_contacts(r%nsteps))//" contacts, load "//fmt_sig(r%step_load(r%nsteps), 6)// &
-                  " nN, area ~ load^"//fmt_sig(levels(k)%exponent, 4)//", "//fmt_sig(t1 - t0, 3)//" s"
+                  sig_str(levels(k)%pixel, 6)//" nm): "//int_str(r%nsteps)//" steps, "// &
+                  int_str(r%step_contacts(r%nsteps))//" contacts, load "//sig_str(r%step_load(r%nsteps), 6)// &
+                  " nN, area ~ load^"//sig_str(levels(k)%exponent, 4)//", "//sig_str(t1 - t0, 3)//" s"
             end associate
          end if
       end do
@@ -205,12 +205,12 @@ contains
       if (.not. quiet) then
          do k = 1, size(levels)
             if (levels(k)%coarser_np > 0) write(output_unit, '(a)') "  Richardson "//int_str(levels(k)%coarser_np)// &
-               " & "//int_str(levels(k)%np)//": area ~ load^"//fmt_sig(fitted_exponent(levels(k)%richardson_load, &
+               " & "//int_str(levels(k)%np)//": area ~ load^"//sig_str(fitted_exponent(levels(k)%richardson_load, &
                levels(k)%richardson_area), 4)
             write(output_unit, '(a)') "  McCool NP = "//int_str(levels(k)%np)//": area ~ load^"// &
-               fmt_sig(fitted_exponent(levels(k)%res%step_load(1:levels(k)%res%nsteps), levels(k)%mccool_area), 4)// &
-               " (eta "//fmt_sig(levels(k)%mccool%density, 4)//" /nm^2, R "//fmt_sig(levels(k)%mccool%radius, 4)// &
-               " nm, sigma_s "//fmt_sig(levels(k)%mccool%sigma, 4)//" nm)"
+               sig_str(fitted_exponent(levels(k)%res%step_load(1:levels(k)%res%nsteps), levels(k)%mccool_area), 4)// &
+               " (eta "//sig_str(levels(k)%mccool%density, 4)//" /nm^2, R "//sig_str(levels(k)%mccool%radius, 4)// &
+               " nm, sigma_s "//sig_str(levels(k)%mccool%sigma, 4)//" nm)"
          end do
          write(output_unit, '(a)') "  wrote "//prefix//".resolution.csv, .powerlaw.csv, .estimates.csv, .hardness.csv "// &
             "and 5 SVG figures"
@@ -328,7 +328,7 @@ contains
       character(len=:), allocatable :: svg
       type(svg_series), allocatable :: series(:)
       call add_series(series, "summits", box, values)
-      call add_series(series, "fit: d^"//fmt_sig(exponent, 3), box, fit_line(prefactor, exponent, box), dashed=.true., &
+      call add_series(series, "fit: d^"//sig_str(exponent, 3), box, fit_line(prefactor, exponent, box), dashed=.true., &
          markers=.false.)
       svg = svg_multi_plot(title, "box size d (nm)", ylabel, series, .true., .true.)
    end function summit_plot
@@ -656,12 +656,12 @@ contains
       if (allocated(series)) deallocate(series)
       allocate(series(0))
       call add_series(series, "profile PSD", freq, power, markers=.false.)
-      texts(9)%s = svg_multi_plot("power spectral density: D = "//fmt_sig(dpsd, 3)//" (eq. 3.1, slope "// &
-         fmt_sig(slope, 3)//")", "frequency (1/nm)", "power (nm^3)", series, .true., .true.)
+      texts(9)%s = svg_multi_plot("power spectral density: D = "//sig_str(dpsd, 3)//" (eq. 3.1, slope "// &
+         sig_str(slope, 3)//")", "frequency (1/nm)", "power (nm^3)", series, .true., .true.)
       if (allocated(series)) deallocate(series)
       allocate(series(0))
       call add_series(series, "structure function", tau, sf, markers=.false.)
-      texts(10)%s = svg_multi_plot("structure function: D = "//fmt_sig(dsf, 3)//" (eq. 2.15)", "tau (nm)", &
+      texts(10)%s = svg_multi_plot("structure function: D = "//sig_str(dsf, 3)//" (eq. 2.15)", "tau (nm)", &
          "S (nm^2)", series, .true., .true.)
       call write_file_set(names, texts, status)
       if (status%code /= 0) then
@@ -670,11 +670,11 @@ contains
       end if
       if (.not. opts%quiet) then
          write(output_unit, '(a)') "femcod summits: "//int_str(size(z, 1))//" x "//int_str(size(z, 2))//" heights, pixel "// &
-            fmt_sig(d, 6)//" nm, "//int_str(size(stats))//" box sizes from "//fmt_sig(stats(1)%box, 4)//" to "// &
-            fmt_sig(stats(size(stats))%box, 4)//" nm"
-         write(output_unit, '(a)') "  density ~ d^"//fmt_sig(e(1), 4)//", height ~ d^"//fmt_sig(e(2), 4)// &
-            ", radius ~ d^"//fmt_sig(e(3), 4)
-         write(output_unit, '(a)') "  fractal dimension of a profile: "//fmt_sig(dpsd, 4)//" (PSD), "//fmt_sig(dsf, 4)// &
+            sig_str(d, 6)//" nm, "//int_str(size(stats))//" box sizes from "//sig_str(stats(1)%box, 4)//" to "// &
+            sig_str(stats(size(stats))%box, 4)//" nm"
+         write(output_unit, '(a)') "  density ~ d^"//sig_str(e(1), 4)//", height ~ d^"//sig_str(e(2), 4)// &
+            ", radius ~ d^"//sig_str(e(3), 4)
+         write(output_unit, '(a)') "  fractal dimension of a profile: "//sig_str(dpsd, 4)//" (PSD), "//sig_str(dsf, 4)// &
             " (structure function); surface: +1"
          write(output_unit, '(a)') "  wrote "//opts%prefix//".summits.csv, .summit_exponents.csv, .psd.csv, .structure.csv, "// &
             ".fractal.csv and 5 SVG figures"
@@ -794,7 +794,7 @@ contains
                   format_real(result%length(k))//","//format_real(load)//","//format_real(result%area(k))//","// &
                   int_str(result%contacts(k)))
             end do
-            call add_series(series, "s = "//fmt_sig(svals(ks), 3)//", "//trim(constraints(kc)), result%length, &
+            call add_series(series, "s = "//sig_str(svals(ks), 3)//", "//trim(constraints(kc)), result%length, &
                result%area, dashed=kc == 2)
          end do
       end do
@@ -809,9 +809,9 @@ contains
       end if
       if (.not. opts%quiet) then
          write(output_unit, '(a)') "femcod multiscale: template of "//int_str(size(template%heights))//" summits (n = "// &
-            int_str(tsize)//", box "//fmt_sig(template%box, 4)//" nm, density "//fmt_sig(template%density*1.0e6_dp, 4)// &
-            " per um^2); heights ~ d^"//fmt_sig(ex(1), 3)//", radii ~ d^"//fmt_sig(ex(2), 3)//", density ~ d^"// &
-            fmt_sig(ex(3), 3)
+            int_str(tsize)//", box "//sig_str(template%box, 4)//" nm, density "//sig_str(template%density*1.0e6_dp, 4)// &
+            " per um^2); heights ~ d^"//sig_str(ex(1), 3)//", radii ~ d^"//sig_str(ex(2), 3)//", density ~ d^"// &
+            sig_str(ex(3), 3)
          write(output_unit, '(a)') "  wrote "//opts%prefix//".multiscale.csv and .multiscale.svg"
       end if
    end subroutine multiscale_command

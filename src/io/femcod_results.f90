@@ -11,14 +11,14 @@ module femcod_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_problem, only: contact_problem
-   use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real, xml_escape, &
+   use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real, xml_escape, sig_str, &
       json_string, json_number
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, write_bytes
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
       h5_read_string_attribute, h5_flat_view
    use femcod_maps, only: state_maps
-   use femcod_svg, only: svg_plot, svg_pressure_map, fmt_sig
+   use femcod_svg, only: svg_plot, svg_pressure_map
    use femcod_richardson, only: power_law_fit
    implicit none
    private
@@ -93,7 +93,7 @@ contains
          if (.not. res%states(k)%reached) cycle
          call add(".pressure_"//int_str(k)//".svg")
          call write_text(temps(size(temps))%s, svg_pressure_map("contact pressure at "// &
-            fmt_sig(res%states(k)%load, 6)//" nN (approach "//fmt_sig(res%states(k)%approach, 4)//" nm, "// &
+            sig_str(res%states(k)%load, 6)//" nN (approach "//sig_str(res%states(k)%approach, 4)//" nm, "// &
             int_str(res%states(k)%contacts)//" contacts)", &
             maps(k)%pressure, deck%np*deck%pixel), status)
       end do

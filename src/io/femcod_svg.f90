@@ -4,11 +4,11 @@
 !> the whole document as a string; writing it is the caller's business.
 module femcod_svg
    use femcod_kinds, only: dp
-   use femcod_strings, only: int_str, without_trailing_zeros, xml_escape, text_builder, add_text, built_text
+   use femcod_strings, only: int_str, sig_str, xml_escape, text_builder, add_text, built_text
    use femcod_png, only: png_indexed, base64
    implicit none
    private
-   public :: svg_plot, svg_pressure_map, nice_ticks, fmt_sig, svg_series, svg_multi_plot, add_series
+   public :: svg_plot, svg_pressure_map, nice_ticks, svg_series, svg_multi_plot, add_series
 
    !> One curve of a multi-series plot: legend label, points, dashed line, markers.
    type :: svg_series
@@ -93,7 +93,7 @@ contains
             path//'"/>'//nl
          svg = svg//'<line x1="'//fmt(w - mr - 190)//'" y1="'//fmt(mt + 38)//'" x2="'//fmt(w - mr - 160)//'" y2="'// &
             fmt(mt + 38)//'" stroke="#c0392b" stroke-width="1.5" stroke-dasharray="6,4"/>'// &
-            text(w - mr - 154, mt + 42, "fit: exponent "//fmt_sig(exponent, 4), "start", 12)
+            text(w - mr - 154, mt + 42, "fit: exponent "//sig_str(exponent, 4), "start", 12)
       end if
       svg = svg//"</svg>"//nl
    end function svg_plot
@@ -243,8 +243,8 @@ contains
       svg = svg//'<text x="'//fmt(x0 - 55)//'" y="'//fmt(y0 + size_px/2)//'" font-family="sans-serif" '// &
          'font-size="13" text-anchor="middle" transform="rotate(-90 '//fmt(x0 - 55)//' '//fmt(y0 + size_px/2)// &
          ')">y (nm), row i</text>'//nl
-      svg = svg//text(x0, h - mb + 18, "0", "middle", 11)//text(x0 + size_px, h - mb + 18, fmt_sig(side, 4), "middle", 11)
-      svg = svg//text(x0 - 6, y0 + 4, "0", "end", 11)//text(x0 - 6, y0 + size_px + 4, fmt_sig(side, 4), "end", 11)
+      svg = svg//text(x0, h - mb + 18, "0", "middle", 11)//text(x0 + size_px, h - mb + 18, sig_str(side, 4), "middle", 11)
+      svg = svg//text(x0 - 6, y0 + 4, "0", "end", 11)//text(x0 - 6, y0 + size_px + 4, sig_str(side, 4), "end", 11)
       do k = 0, levels - 1
          svg = svg//'<rect x="'//fmt(x0 + size_px + 40)//'" y="'//fmt(y0 + size_px*(1 - real(k + 1, dp)/levels))// &
             '" width="20" height="'//fmt(size_px/levels + 0.5_dp)//'" fill="'//colour((k + 0.5_dp)/levels)//'"/>'//nl
@@ -255,11 +255,11 @@ contains
          ticks = nice_ticks(0.0_dp, vmax)
          do k = 1, size(ticks)
             if (ticks(k) < 0 .or. ticks(k) > vmax) cycle
-            svg = svg//text(x0 + size_px + 66, y0 + size_px*(1 - ticks(k)/vmax) + 4, fmt_sig(ticks(k), 4), "start", 11)
+            svg = svg//text(x0 + size_px + 66, y0 + size_px*(1 - ticks(k)/vmax) + 4, sig_str(ticks(k), 4), "start", 11)
          end do
       end if
       svg = svg//text(x0 + size_px + 50, y0 - 10, "GPa", "middle", 12)
-      svg = svg//text(x0 + size_px + 50, h - mb + 18, "max "//fmt_sig(vmax, 4), "middle", 11)
+      svg = svg//text(x0 + size_px + 50, h - mb + 18, "max "//sig_str(vmax, 4), "middle", 11)
       svg = svg//"</svg>"//nl
    end function svg_pressure_map
 
@@ -319,7 +319,7 @@ contains
       if (logscale) then
          s = "1e"//int_str(nint(v))
       else
-         s = fmt_sig(v, 4)
+         s = sig_str(v, 4)
       end if
    end function tick_label
 
@@ -430,29 +430,4 @@ contains
       end if
    end function fmt
 
-   !> A value with `digits` significant digits, without trailing zeros.
-   function fmt_sig(v, digits) result(s)
-      real(dp), intent(in) :: v
-      integer, intent(in) :: digits
-      character(len=:), allocatable :: s
-      character(len=40) :: buf
-      integer :: e
-      if (v == 0) then
-         s = "0"
-         return
-      end if
-      e = floor(log10(abs(v)))
-      if (e >= -3 .and. e < 6) then
-         write(buf, '(f0.'//int_str(max(0, digits - 1 - e))//')') v
-         s = trim(adjustl(buf))
-         s = without_trailing_zeros(s)
-         if (s(1:1) == ".") s = "0"//s
-         if (len(s) > 1) then
-            if (s(1:2) == "-.") s = "-0"//s(2:)
-         end if
-      else
-         write(buf, '(es16.'//int_str(digits - 1)//')') v
-         s = trim(adjustl(buf))
-      end if
-   end function fmt_sig
 end module femcod_svg
