@@ -9,7 +9,8 @@ module femcod_strings
    private
    public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, add_lines, add_text, built_text
    public :: without_trailing_zeros, xml_escape, json_string, json_number, sig_str
-   public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, is_digit, append_string
+   public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, format_reals, is_digit, &
+      append_string, integer_text
 
    !> A string of any length, for lists of arguments.
    !> An integer (default or 64-bit) without blanks.
@@ -123,19 +124,54 @@ contains
    pure function int_str_default(i) result(s)
       integer, intent(in) :: i
       character(len=:), allocatable :: s
-      character(len=12) :: buf
-      write(buf, '(i0)') i
-      s = trim(buf)
+      character(len=20) :: text
+      integer :: length
+      call integer_text(int(i, i8), text, length)
+      s = text(1:length)
    end function int_str_default
 
    !> A 64-bit integer without blanks.
    pure function int_str_i8(i) result(s)
       integer(i8), intent(in) :: i
       character(len=:), allocatable :: s
-      character(len=21) :: buf
-      write(buf, '(i0)') i
-      s = trim(buf)
+      character(len=20) :: text
+      integer :: length
+      call integer_text(i, text, length)
+      s = text(1:length)
    end function int_str_i8
+
+   !> The decimal digits of `i` in text(1:length), with a sign when negative: what
+   !> write '(i0)' gives, without formatted I/O and safe in a parallel region.
+   pure subroutine integer_text(i, text, length)
+      integer(i8), intent(in) :: i
+      character(len=20), intent(out) :: text
+      integer, intent(out) :: length
+      character(len=20) :: reversed
+      integer(i8) :: m
+      integer :: n, d
+      text = ""
+      n = 0
+      m = i
+      ! Digits from the least significant, taken from a negative number so that
+      ! -huge - 1 has no overflow.
+      if (m > 0) m = -m
+      do
+         d = int(-mod(m, 10_i8))
+         n = n + 1
+         reversed(n:n) = achar(iachar("0") + d)
+         m = m/10
+         if (m == 0) exit
+      end do
+      length = 0
+      if (i < 0) then
+         text(1:1) = "-"
+         length = 1
+      end if
+      do d = n, 1, -1
+         length = length + 1
+         text(length:length) = reversed(d:d)
+      end do
+   end subroutine integer_text
 
    !> A real in `es` form with `digits` significant digits.
    function real_str(x, digits) result(s)
@@ -199,13 +235,30 @@ contains
    function format_real(x) result(s)
       real(dp), intent(in) :: x
       character(len=:), allocatable :: s
-      character(len=:), allocatable :: mantissa, digits, fixed
-      character(len=40) :: buf, good
+      character(len=24) :: text
+      integer :: length
+      call shortest_decimal(x, text, length)
+      s = text(1:length)
+   end function format_real
+
+   !> format_real's answer in text(1:length), with fixed-length buffers only: gfortran 12
+   !> keeps the length of a deferred-length function result in a static variable of the
+   !> caller, so a routine that calls one (int_str, without_trailing_zeros) is not safe
+   !> in an OpenMP parallel region, and format_reals runs this one there.
+   subroutine shortest_decimal(x, text, length)
+      real(dp), intent(in) :: x
+      !> The longest answer is "-d.dddddddddddddddde-ddd", 24 characters.
+      character(len=24), intent(out) :: text
+      integer, intent(out) :: length
+      character(len=40) :: buf, good, digits, fixed
       character(kind=c_char, len=40) :: cbuf
-      integer(c_int) :: length
-      integer :: n, lo, hi, mid, e, mark, k, ios
+      integer(c_int) :: clength
+      integer :: n, lo, hi, mid, e, mark, k, m, nm, nd, nf, i
+      logical :: negative_exponent
+      text = ""
       if (x == 0) then
-         s = "0"
+         text = "0"
+         length = 1
          return
       end if
       ! Seventeen digits always read back: that case needs no check.
@@ -231,38 +284,97 @@ contains
          buf = good
       else
          n = 17
-         length = c_decimal_e(x, 17_c_int, cbuf, int(len(cbuf), c_int))
-         buf = cbuf(1:max(0, min(length, len(cbuf) - 1)))
+         clength = c_decimal_e(x, 17_c_int, cbuf, int(len(cbuf), c_int))
+         buf = cbuf(1:max(0, min(clength, len(cbuf) - 1)))
       end if
-      ! buf holds "-d.ddde+XX" for n digits.
+      ! buf holds "-d.ddde+XX" for n digits: the exponent e, the mantissa buf(1:nm)
+      ! without trailing zeros (and without a trailing point).
       mark = index(buf, "e")
-      read(buf(mark + 1:), *, iostat=ios) e
-      mantissa = without_trailing_zeros(trim(buf(1:mark - 1)))
-      s = mantissa
-      if (e /= 0) s = s//"e"//int_str(e)
-      if (abs(x) >= 1.0e-4_dp .and. abs(x) < 1.0e15_dp) then
-         ! The same digits in positional form.
-         ! The digits of "-d.ddd": without the sign and the point.
+      e = 0
+      negative_exponent = buf(mark + 1:mark + 1) == "-"
+      do i = mark + 2, len_trim(buf)
+         e = 10*e + (iachar(buf(i:i)) - iachar("0"))
+      end do
+      if (negative_exponent) e = -e
+      nm = mark - 1
+      if (index(buf(1:nm), ".") > 0) then
+         do while (buf(nm:nm) == "0")
+            nm = nm - 1
+         end do
+         if (buf(nm:nm) == ".") nm = nm - 1
+      end if
+      text = buf(1:nm)
+      length = nm
+      if (e /= 0) then
+         text(length + 1:length + 1) = "e"
+         length = length + 1
+         if (e < 0) then
+            text(length + 1:length + 1) = "-"
+            length = length + 1
+         end if
+         m = abs(e)
          k = 1
-         if (mantissa(1:1) == "-") k = 2
-         if (len(mantissa) > k) then
-            digits = mantissa(k:k)//mantissa(k + 2:)
+         do while (k*10 <= m)
+            k = 10*k
+         end do
+         do while (k >= 1)
+            text(length + 1:length + 1) = achar(iachar("0") + m/k)
+            length = length + 1
+            m = mod(m, k)
+            k = k/10
+         end do
+      end if
+      if (abs(x) >= 1.0e-4_dp .and. abs(x) < 1.0e15_dp) then
+         ! The same digits in positional form. The digits of "-d.ddd": without the sign
+         ! and the point.
+         k = 1
+         if (buf(1:1) == "-") k = 2
+         if (nm > k) then
+            digits = buf(k:k)//buf(k + 2:nm)
+            nd = nm - k
          else
-            digits = mantissa(k:k)
+            digits = buf(k:k)
+            nd = 1
          end if
          if (e >= 0) then
-            if (len(digits) <= e + 1) then
-               fixed = digits//repeat("0", e + 1 - len(digits))
+            if (nd <= e + 1) then
+               fixed = digits(1:nd)//repeat("0", e + 1 - nd)
+               nf = e + 1
             else
-               fixed = digits(1:e + 1)//"."//digits(e + 2:)
+               fixed = digits(1:e + 1)//"."//digits(e + 2:nd)
+               nf = nd + 1
             end if
          else
-            fixed = "0."//repeat("0", -e - 1)//digits
+            fixed = "0."//repeat("0", -e - 1)//digits(1:nd)
+            nf = 1 - e + nd
          end if
-         if (x < 0) fixed = "-"//fixed
-         if (len(fixed) <= len(s)) s = fixed
+         if (x < 0) then
+            fixed = "-"//fixed
+            nf = nf + 1
+         end if
+         if (nf <= length) then
+            text = fixed(1:nf)
+            length = nf
+         end if
       end if
-   end function format_real
+   end subroutine shortest_decimal
+
+   !> format_real of every element of `x`, converted in parallel (OpenMP): element k
+   !> is texts(k)(1:lengths(k)). For the large tables (a deck's heights, every contact),
+   !> where the conversions are most of the writing.
+   subroutine format_reals(x, texts, lengths)
+      real(dp), intent(in) :: x(:)
+      !> format_real's longest answer is "-d.dddddddddddddddde-ddd", 24 characters.
+      character(len=24), allocatable, intent(out) :: texts(:)
+      integer, allocatable, intent(out) :: lengths(:)
+      integer :: k
+      allocate(texts(size(x)), lengths(size(x)))
+      !$omp parallel do private(k) schedule(static)
+      do k = 1, size(x)
+         call shortest_decimal(x(k), texts(k), lengths(k))
+      end do
+      !$omp end parallel do
+   end subroutine format_reals
 
    !> Whether `x` with `digits` significant digits reads back to `x`; `buf` holds that
    !> decimal.

@@ -17,7 +17,8 @@ module femcod_deck
       MIN_YOUNG, MAX_YOUNG
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_files, only: write_file, read_file
-   use femcod_strings, only: int_str, parse_real, parse_integer, format_real, is_digit, text_builder, add_line, add_text, built_text
+   use femcod_strings, only: int_str, parse_real, parse_integer, format_real, format_reals, is_digit, text_builder, &
+      add_line, add_text, built_text
    implicit none
    private
    public :: read_deck, write_deck
@@ -224,10 +225,13 @@ contains
       !> One image row on one line, the values separated by blanks.
       subroutine add_row(row)
          real(dp), intent(in) :: row(:)
+         character(len=24), allocatable :: texts(:)
+         integer, allocatable :: lengths(:)
          integer :: j
-         call add_text(b, format_real(row(1)))
+         call format_reals(row, texts, lengths)
+         call add_text(b, texts(1)(1:lengths(1)))
          do j = 2, size(row)
-            call add_text(b, " "//format_real(row(j)))
+            call add_text(b, " "//texts(j)(1:lengths(j)))
          end do
          call add_text(b, new_line("a"))
       end subroutine add_row

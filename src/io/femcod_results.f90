@@ -8,11 +8,11 @@
 !>   PREFIX.summary.json  what the summary prints, as numbers with units
 !>   PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg
 module femcod_results
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real, xml_escape, sig_str, &
-      json_string, json_number
+      json_string, json_number, format_reals, integer_text
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, write_bytes
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
@@ -196,16 +196,53 @@ contains
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       character(len=:), allocatable :: text
-      type(text_builder) :: b
-      integer :: k
-      call add_line(b, "i,j,step,force_nN,pressure_GPa")
+      character(len=*), parameter :: header = "i,j,step,force_nN,pressure_GPa"
+      character(len=24), allocatable :: force(:), pressure(:)
+      character(len=112), allocatable :: rows(:)
+      integer, allocatable :: nf(:), np(:), lengths(:)
+      character(len=20) :: number
+      integer :: k, at, n, length
+      call format_reals(res%contact_force, force, nf)
+      call format_reals(res%contact_force/deck%pixel**2, pressure, np)
+      ! The rows in parallel (fixed-length buffers only: see shortest_decimal), then
+      ! joined.
+      allocate(rows(size(res%contact_i)), lengths(size(res%contact_i)))
+      !$omp parallel do private(k, number, n, length) schedule(static)
       do k = 1, size(res%contact_i)
-         call add_line(b, int_str(res%contact_i(k))//","//int_str(res%contact_j(k))//","// &
-            int_str(res%contact_step(k))//","//format_real(res%contact_force(k))//","// &
-            format_real(res%contact_force(k)/deck%pixel**2))
+         length = 0
+         call integer_text(int(res%contact_i(k), i8), number, n)
+         call append_piece(rows(k), length, number(1:n))
+         call append_piece(rows(k), length, ",")
+         call integer_text(int(res%contact_j(k), i8), number, n)
+         call append_piece(rows(k), length, number(1:n))
+         call append_piece(rows(k), length, ",")
+         call integer_text(int(res%contact_step(k), i8), number, n)
+         call append_piece(rows(k), length, number(1:n))
+         call append_piece(rows(k), length, ",")
+         call append_piece(rows(k), length, force(k)(1:nf(k)))
+         call append_piece(rows(k), length, ",")
+         call append_piece(rows(k), length, pressure(k)(1:np(k)))
+         call append_piece(rows(k), length, new_line("a"))
+         lengths(k) = length
       end do
-      text = built_text(b)
+      !$omp end parallel do
+      allocate(character(len=len(header) + 1 + sum(lengths)) :: text)
+      text(1:len(header) + 1) = header//new_line("a")
+      at = len(header) + 1
+      do k = 1, size(rows)
+         text(at + 1:at + lengths(k)) = rows(k)(1:lengths(k))
+         at = at + lengths(k)
+      end do
    end function contacts_csv
+
+   !> Put `piece` at row(length + 1:) and advance `length`.
+   pure subroutine append_piece(row, length, piece)
+      character(len=*), intent(inout) :: row
+      integer, intent(inout) :: length
+      character(len=*), intent(in) :: piece
+      row(length + 1:length + len(piece)) = piece
+      length = length + len(piece)
+   end subroutine append_piece
 
    !> PREFIX.loads.csv: the states at the requested loads that were reached.
    function loads_csv(deck, res) result(text)
