@@ -30,6 +30,7 @@ contains
          new_unittest("shortest round-trip number format", test_format_real), &
          new_unittest("format_real equals a brute-force search on 40000 values", test_format_real_search), &
          new_unittest("int_str equals Fortran's i0 edit descriptor", test_int_str), &
+         new_unittest("the first bad height in file order is reported", test_first_bad_height), &
          new_unittest("bad deck: "//"missing value line 2", bad_01), &
          new_unittest("bad deck: "//"extra value line 3", bad_02), &
          new_unittest("bad deck: "//"non-numeric height", bad_03), &
@@ -284,6 +285,39 @@ contains
          end if
       end do
    end subroutine test_int_str
+
+   !> The heights are converted in parallel: with two bad values far apart (a name in
+   !> the lower surface's last row, a NaN in its second) the error names the earlier
+   !> one, as a reader going through the file would.
+   subroutine test_first_bad_height(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      character(len=:), allocatable :: path, text
+      integer :: i, j, n
+      n = 64
+      text = "first bad"//nl//int_str(n)//" 1 10"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl
+      do i = 1, 2*n
+         do j = 1, n
+            if (i == 2 .and. j == 7) then
+               text = text//"NaN "
+            else if (i == n .and. j == 3) then
+               text = text//"x "
+            else
+               text = text//"0.5 "
+            end if
+         end do
+         text = text//nl
+      end do
+      path = scratch_path("first_bad.deck")
+      call write_text(path, text)
+      call read_deck(path, deck, status)
+      call check(error, status%code, 3, "a bad height is status 3")
+      if (allocated(error)) return
+      ! Line 7 of the file holds row 2 (line 6 holds row 1).
+      call check(error, contains_text(status%message, path//":7:") .and. contains_text(status%message, &
+         "row 2, column 7") .and. contains_text(status%message, "'NaN'"), "the NaN of row 2 is named: "//status%message)
+   end subroutine test_first_bad_height
 
    !> The bad-deck cases, one test each: deck text, the line the error must name, and a
    !> word of what was expected.

@@ -165,27 +165,39 @@ contains
          if (.not. ok) call bad(tok_line(k), what, tok(k))
       end subroutine get_int
 
-      !> The NP x NP heights from token k on, row by row; k ends past them.
+      !> The NP x NP heights from token k on, row by row; k ends past them. The values
+      !> are converted in parallel; the first bad one (in file order) is reported.
       subroutine get_heights(z, what)
          real(dp), intent(out) :: z(:, :)
          character(len=*), intent(in) :: what
-         integer :: i, j
+         integer :: i, j, m, ncol, first_bad
          logical :: ok
+         ncol = size(z, 2)
+         first_bad = huge(first_bad)
+         !$omp parallel do private(i, j, m, ok) reduction(min: first_bad) schedule(static)
          do i = 1, size(z, 1)
-            do j = 1, size(z, 2)
-               call parse_real(text(tok_first(k):tok_last(k)), z(i, j), ok)
-               if (.not. ok) then
-                  call bad(tok_line(k), what//" in nm (row "//int_str(i)//", column "//int_str(j)//") (a finite "// &
-                     "number)", tok(k))
-                  return
-               end if
-               if (abs(z(i, j)) > MAX_HEIGHT) then
-                  call bad(tok_line(k), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", tok(k))
-                  return
-               end if
-               k = k + 1
+            do j = 1, ncol
+               m = k + (i - 1)*ncol + j - 1
+               call parse_real(text(tok_first(m):tok_last(m)), z(i, j), ok)
+               if (ok) ok = abs(z(i, j)) <= MAX_HEIGHT
+               if (.not. ok) first_bad = min(first_bad, m)
             end do
          end do
+         !$omp end parallel do
+         if (first_bad < huge(first_bad)) then
+            m = first_bad
+            i = (m - k)/ncol + 1
+            j = m - k - (i - 1)*ncol + 1
+            call parse_real(text(tok_first(m):tok_last(m)), z(i, j), ok)
+            if (.not. ok) then
+               call bad(tok_line(m), what//" in nm (row "//int_str(i)//", column "//int_str(j)//") (a finite "// &
+                  "number)", tok(m))
+            else
+               call bad(tok_line(m), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", tok(m))
+            end if
+            return
+         end if
+         k = k + size(z)
       end subroutine get_heights
 
       subroutine get_real(k, what, value)
@@ -292,41 +304,40 @@ contains
    end function label_of
 
    !> Split everything after line 1 into tokens separated by blanks, tabs, CR, FF or
-   !> commas, recording the line of each token and the number of the last line.
+   !> commas, recording the line of each token and the number of the last line. One
+   !> pass over the bytes counts the tokens, a second records them (a byte table rather
+   !> than SCAN and VERIFY, which made this a tenth of reading a large deck).
    subroutine tokenize(text, ntok, first, last, line, last_line)
       character(len=*), intent(in) :: text
       integer, intent(out) :: ntok, last_line
       integer, allocatable, intent(out) :: first(:), last(:), line(:)
-      character(len=*), parameter :: separators = " "//achar(9)//achar(10)//achar(13)//achar(12)//","
-      integer :: pass, i, ln, start, skip, k, n
+      logical :: separator(0:255), inside
+      integer :: pass, i, ln, start, n, c
+      separator = .false.
+      separator([9, 10, 12, 13, 32, 44]) = .true.
       n = len(text)
+      start = index(text, new_line("a"))
+      if (start == 0) start = n
       do pass = 1, 2
          ntok = 0
-         start = index(text, new_line("a"))
-         if (start == 0) start = n
          ln = 2
-         i = start + 1
-         do while (i <= n)
-            ! The run of separators (counting its line ends), then the token.
-            skip = verify(text(i:), separators)
-            if (skip == 0) then
-               skip = n - i + 2
+         inside = .false.
+         do i = start + 1, n
+            c = iachar(text(i:i))
+            if (separator(c)) then
+               if (inside .and. pass == 2) last(ntok) = i - 1
+               inside = .false.
+               if (c == 10) ln = ln + 1
+            else if (.not. inside) then
+               inside = .true.
+               ntok = ntok + 1
+               if (pass == 2) then
+                  first(ntok) = i
+                  line(ntok) = ln
+               end if
             end if
-            do k = i, i + skip - 2
-               if (text(k:k) == new_line("a")) ln = ln + 1
-            end do
-            i = i + skip - 1
-            if (i > n) exit
-            ntok = ntok + 1
-            skip = scan(text(i:), separators)
-            if (skip == 0) skip = n - i + 2
-            if (pass == 2) then
-               first(ntok) = i
-               last(ntok) = i + skip - 2
-               line(ntok) = ln
-            end if
-            i = i + skip - 1
          end do
+         if (inside .and. pass == 2) last(ntok) = n
          if (pass == 1) allocate(first(ntok), last(ntok), line(ntok))
       end do
       ! The number of the last line that holds anything.
@@ -337,9 +348,4 @@ contains
       if (index(text, new_line("a")) == 0) last_line = 1
    end subroutine tokenize
 
-   pure logical function is_separator(c)
-      character(len=1), intent(in) :: c
-      is_separator = c == " " .or. c == achar(9) .or. c == achar(10) .or. c == achar(13) .or. c == achar(12) &
-         .or. c == ","
-   end function is_separator
 end module femcod_deck
