@@ -27,7 +27,7 @@ prefix=$(cd "$prefix" && pwd)
 
 sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 
-debian_packages=(gfortran liblapack-dev libopenblas-dev libhdf5-dev libfftw3-dev pkg-config hdf5-tools zlib1g-dev
+debian_packages=(gfortran liblapack-dev libopenblas-dev libhdf5-dev libfftw3-dev pkg-config hdf5-tools zlib1g-dev libssl-dev
   python3-venv)
 missing=()
 for p in "${debian_packages[@]}"; do
