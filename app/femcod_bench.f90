@@ -316,8 +316,8 @@ contains
       type(parsed_options) :: parsed
       type(h5_file) :: file
       real(dp), allocatable :: g0(:, :), map(:, :)
-      real(dp) :: estar, slope, loads(2), t0, t1, t_write, t_read, t_run, t_solve, t_figure, outside, mpix
-      integer :: n, np, ios, a
+      real(dp) :: estar, slope, loads(2), t0, t1, t_write, t_read, t_run, t_solve, t_figure, outside, mpix, parts(5)
+      integer :: n, np, ios
       integer(8) :: biggest
       sizes = [512, 1024, 2048]
       dir = "femcod-bench-io"
@@ -330,7 +330,9 @@ contains
             "here, and the largest figure's size. The files stay in DIR (default femcod-bench-io).", ""
          call print_lines(option_help(bench_io_table(), ""))
          write(output_unit, '(a)') "Columns: NP, deck write s (values/s), deck read s (values/s), run s, solver s,", &
-            "outside the solver s (% of the solve, s per million pixels), figure s, largest figure KB."
+            "outside the solver s (% of the solve, s per million pixels), and its parts from the run's own", &
+            "timings_s in PREFIX.summary.json: reading the deck, the input digests, the maps, PREFIX.h5, the", &
+            "text files and figures (the rest is starting the process and checks); figure s, largest figure KB."
          return
       end if
       call parse_options(bench_io_table(), args, parsed, status)
@@ -344,8 +346,9 @@ contains
       call get_option(parsed, "--dir", dir)
       call execute_command_line("mkdir -p '"//dir//"'", exitstat=ios)
       write(output_unit, '(a)') "| NP | deck write s (values/s) | deck read s (values/s) | femcod run s | solver s "// &
-         "| outside the solver s (% of solve, s/Mpixel) | figure s | largest figure KB |"
-      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|"
+         "| outside the solver s (% of solve, s/Mpixel) | read / digests / maps / h5 / text s | figure s "// &
+         "| largest figure KB |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|"
       do n = 1, size(sizes)
          np = sizes(n)
          mpix = real(np, dp)**2/1.0e6_dp
@@ -378,12 +381,12 @@ contains
             code = 4
             return
          end if
-         ! The solver's own time, from the summary file.
+         ! The solver's own time and the parts outside it, from the summary file.
          text = read_text_file(prefix//".summary.json")
-         a = index(text, '"wall_time_s": ')
-         t_solve = 0
-         if (a > 0) read(text(a + 15:a + 15 + scan(text(a + 15:), ","//new_line("a")) - 2), *, iostat=ios) t_solve
+         t_solve = json_seconds(text, '"wall_time_s"')
          outside = t_run - t_solve
+         parts = [json_seconds(text, '"read_inputs"'), json_seconds(text, '"input_digests"'), &
+            json_seconds(text, '"maps"'), json_seconds(text, '"write_hdf5"'), json_seconds(text, '"write_text_and_figures"')]
          ! The figure of the larger load, again, timed.
          call h5_open(prefix//".h5", file, status, 5)
          call h5_read(file, "/loads/002/pressure", map, status, 5)
@@ -397,7 +400,9 @@ contains
          write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(t_write, 2)//" ("//real_str(2*np**2/t_write, 2)// &
             ") | "//fixed_str(t_read, 2)//" ("//real_str(2*np**2/t_read, 2)//") | "//fixed_str(t_run, 2)//" | "// &
             fixed_str(t_solve, 2)//" | "//fixed_str(outside, 2)//" ("//fixed_str(100*outside/max(t_solve, 1.0e-9_dp), 0)// &
-            " %, "//fixed_str(outside/mpix, 2)//") | "//fixed_str(t_figure, 3)//" | "//fixed_str(biggest/1024.0_dp, 0)//" |"
+            " %, "//fixed_str(outside/mpix, 2)//") | "//fixed_str(parts(1), 2)//" / "//fixed_str(parts(2), 2)//" / "// &
+            fixed_str(parts(3), 2)//" / "//fixed_str(parts(4), 2)//" / "//fixed_str(parts(5), 2)//" | "// &
+            fixed_str(t_figure, 3)//" | "//fixed_str(biggest/1024.0_dp, 0)//" |"
          flush(output_unit)
       end do
    contains
@@ -409,6 +414,20 @@ contains
          allocate(character(len=length) :: path)
          call get_command_argument(0, path)
       end function self_path
+
+      !> The number after `"key": ` in the JSON text (0 when absent).
+      real(dp) function json_seconds(t, key)
+         character(len=*), intent(in) :: t, key
+         integer :: at, ends, ios2
+         json_seconds = 0
+         at = index(t, key//": ")
+         if (at == 0) return
+         at = at + len(key) + 2
+         ends = scan(t(at:), ",}"//new_line("a"))
+         if (ends == 0) return
+         read(t(at:at + ends - 2), *, iostat=ios2) json_seconds
+         if (ios2 /= 0) json_seconds = 0
+      end function json_seconds
 
       function read_text_file(path) result(t)
          character(len=*), intent(in) :: path

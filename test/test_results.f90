@@ -29,6 +29,7 @@ contains
          new_unittest("pressure figure: its PNG holds the map's 64 levels (decoded by Python)", test_png_levels), &
          new_unittest("pressure figure of a 2100^2 map: 3 x 3 blocks keep a one-pixel contact", test_png_blocks), &
          new_unittest("a plot of 200000 steps stays small and keeps its ends", test_long_plot), &
+         new_unittest("summary.json: valid JSON, the CSV's numbers, timings within the command", test_summary_json), &
          new_unittest("existing results are kept without --force", test_force), &
          new_unittest("a result that cannot be put in place leaves no partial set", test_partial), &
          new_unittest("--lower/--upper: ASCII and HDF5 heights equal the deck", test_height_files), &
@@ -83,6 +84,66 @@ contains
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
          string_type(prefix), string_type("--loads"), string_type("100,1000"), string_type("--quiet")], code)
    end subroutine sphere_run
+
+   !> PREFIX.summary.json read by Python's json module (test/tools/summary_fields.py;
+   !> skipped without python3): every load's approach and contacts equal PREFIX.loads.csv,
+   !> its timings_s are non-negative, their solve is wall_time_s, and together they fit in
+   !> the whole command as timed here around it.
+   subroutine test_summary_json(error)
+      use femcod_clock, only: wall_clock
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, out, text
+      character(len=*), parameter :: parts(*) = [character(len=22) :: "read_inputs", "input_digests", "solve", "maps", &
+         "write_hdf5", "write_text_and_figures"]
+      real(dp), allocatable :: approach(:), contacts(:)
+      real(dp) :: t0, t1, total, v
+      integer :: code, k
+      call execute_command_line("command -v python3 > /dev/null", exitstat=code)
+      if (code /= 0) return
+      call wall_clock(t0)
+      call sphere_run("json-sphere", prefix, code)
+      call wall_clock(t1)
+      call check(error, code, 0, "femcod run")
+      if (allocated(error)) return
+      out = prefix//".fields.txt"
+      call execute_command_line("python3 test/tools/summary_fields.py '"//prefix//".summary.json' > '"//out// &
+         "' 2>&1", exitstat=code)
+      text = read_text(out)
+      call check(error, code, 0, "Python's json module reads the summary: "//text)
+      if (allocated(error)) return
+      approach = csv_column(prefix//".loads.csv", 2)
+      contacts = csv_column(prefix//".loads.csv", 3)
+      do k = 1, 2
+         call check(error, field("approach_"//to_string(k)), approach(k), "approach of load "//to_string(k))
+         if (allocated(error)) return
+         call check(error, field("contacts_"//to_string(k)), contacts(k), "contacts of load "//to_string(k))
+         if (allocated(error)) return
+      end do
+      total = 0
+      do k = 1, size(parts)
+         v = field("timing_"//trim(parts(k)))
+         call check(error, v >= 0, "timings_s."//trim(parts(k))//" >= 0: "//to_string(v))
+         if (allocated(error)) return
+         total = total + v
+      end do
+      call check(error, field("timing_solve"), field("wall_time_s"), "timings_s.solve is wall_time_s")
+      if (allocated(error)) return
+      call check(error, total <= t1 - t0, "the parts ("//to_string(total)//" s) within the command ("// &
+         to_string(t1 - t0)//" s)")
+   contains
+      !> The value printed for `name` (-1 when absent).
+      real(dp) function field(name)
+         character(len=*), intent(in) :: name
+         integer :: at, ends, ios
+         field = -1
+         at = index(new_line("a")//text, new_line("a")//name//" ")
+         if (at == 0) return
+         at = at + len(name) + 1
+         ends = index(text(at:), new_line("a"))
+         if (ends == 0) ends = len(text) - at + 2
+         read(text(at:at + ends - 2), *, iostat=ios) field
+      end function field
+   end subroutine test_summary_json
 
    !> Every dataset of the schema (doc/results.md) with its units; the pressure map
    !> integrates to the requested load (force balance, an independent physical check);

@@ -16,6 +16,7 @@ module femcod_run
       acquire_lock, release_lock, read_file, make_directories
    use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
    use femcod_sha256, only: sha256_hex
+   use femcod_clock, only: wall_clock
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec
@@ -386,8 +387,10 @@ contains
       type(status_type) :: st
       type(string_type), allocatable :: inputs(:), warnings(:), files(:)
       character(len=:), allocatable :: notice
+      real(dp) :: t0, read_seconds
       integer :: k
       rc = 0
+      call wall_clock(t0)
       if (deck_path == "") then
          call load_scene(settings%scene, problem, st, inputs, warnings)
          do k = 1, size(warnings)
@@ -403,13 +406,15 @@ contains
          inputs = [string_type(deck_path//": femcod deck")]
          files = [string_type(deck_path)]
       end if
+      call wall_clock(read_seconds)
+      read_seconds = read_seconds - t0
       ! No output may ever replace an input.
       if (st%code == 0) call refuse_input_as_output(prefix, size(settings%solve%loads), files, st)
       if (st%code == 0) then
          call acquire_lock(prefix//".lock", st, notice)
          if (notice /= "" .and. .not. settings%quiet) write(error_unit, '(a)') "femcod: "//notice
          if (st%code == 0) then
-            call run_locked(deck_path, prefix, settings, problem, inputs, files, st)
+            call run_locked(deck_path, prefix, settings, problem, inputs, files, read_seconds, st)
             call release_lock(prefix//".lock")
          end if
       end if
@@ -446,11 +451,13 @@ contains
    end subroutine refuse_input_as_output
 
    !> A deck with its prefix locked: the checks of existing files, the solve, the results.
-   subroutine run_locked(deck_path, prefix, settings, problem, inputs, files, st)
+   subroutine run_locked(deck_path, prefix, settings, problem, inputs, files, read_seconds, st)
       character(len=*), intent(in) :: deck_path, prefix
       type(run_settings), intent(in) :: settings
       type(contact_problem), intent(in) :: problem
       type(string_type), intent(in) :: inputs(:), files(:)
+      !> Wall seconds of reading the inputs.
+      real(dp), intent(in) :: read_seconds
       type(status_type), intent(inout) :: st
       type(contact_result) :: res
       type(run_observer) :: observer
@@ -460,10 +467,14 @@ contains
       character(len=:), allocatable :: fingerprint, stored, started
       type(string_type), allocatable :: digests(:)
       logical :: resuming, ok, have_checkpoint
+      real(dp) :: t0, t1, digest_seconds
       integer :: k
       associate(options => settings%solve)
          ! Every input file's SHA-256, once: for /run and for the fingerprint.
+         call wall_clock(t0)
          call input_digests(files, digests)
+         call wall_clock(t1)
+         digest_seconds = t1 - t0
          fingerprint = run_fingerprint(problem, options, digests)
          have_checkpoint = path_exists(prefix//".ckpt.h5")
          ! With --restart, result files are leftovers of the interrupted run while its
@@ -549,7 +560,12 @@ contains
          info%inputs = inputs
          info%fingerprint = fingerprint
          info%digests = digests
+         info%read_seconds = read_seconds
+         info%digest_seconds = digest_seconds
+         call wall_clock(t0)
          call load_maps(problem, res%states, maps)
+         call wall_clock(t1)
+         info%maps_seconds = t1 - t0
          call write_results(prefix, problem, res, maps, info, st)
          if (st%code /= 0) return
          ! The set is replaced as a whole: what an earlier run left beside it goes, and the

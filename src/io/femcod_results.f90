@@ -9,6 +9,7 @@
 !>   PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg
 module femcod_results
    use femcod_kinds, only: dp, i8
+   use femcod_clock, only: wall_clock
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real, xml_escape, sig_str, &
@@ -37,6 +38,9 @@ module femcod_results
       !> The command as typed (femcod run ...), the machine, and when the run started
       !> and its results were written (ISO 8601 with the UTC offset).
       character(len=:), allocatable :: command_line, host, started, finished
+      !> Wall seconds of the parts of the run before the writing: reading the inputs,
+      !> their digests, the maps of the reached loads (the solve is the result's own).
+      real(dp) :: read_seconds = 0, digest_seconds = 0, maps_seconds = 0
    end type run_info
 
 contains
@@ -69,9 +73,16 @@ contains
       type(run_info), intent(in) :: info
       type(status_type), intent(inout) :: status
       type(string_type), allocatable :: names(:), temps(:)
+      real(dp) :: t0, t1, t2, hdf5_seconds
       integer :: k
       if (status%code /= 0) return
       allocate(names(0), temps(0))
+      ! PREFIX.h5 is written first and renamed last (when it exists, the whole set is
+      ! complete); the summary is written last, so that it holds the writing's times.
+      call wall_clock(t0)
+      call write_hdf5(temporary_name(prefix//".h5"), deck, res, info, maps, status)
+      call wall_clock(t1)
+      hdf5_seconds = t1 - t0
       call add(".history.csv")
       call write_text(temps(size(temps))%s, history_csv(deck, res), status)
       call add(".contacts.csv")
@@ -82,8 +93,6 @@ contains
       end if
       call add(".xdmf")
       call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res), status)
-      call add(".summary.json")
-      call write_text(temps(size(temps))%s, summary_json(prefix, deck, res, info), status)
       call add(".load_approach.svg")
       call write_text(temps(size(temps))%s, svg_plot("femcod: "//deck%label, "approach (nm)", "total load (nN)", &
          res%step_approach(1:res%nsteps), res%step_load(1:res%nsteps), .false., .false.), status)
@@ -97,9 +106,10 @@ contains
             int_str(res%states(k)%contacts)//" contacts)", &
             maps(k)%pressure, deck%np*deck%pixel), status)
       end do
-      ! PREFIX.h5 is renamed last: when it exists, the whole set is complete.
+      call wall_clock(t2)
+      call add(".summary.json")
+      call write_text(temps(size(temps))%s, summary_json(prefix, deck, res, info, [hdf5_seconds, t2 - t1]), status)
       call add(".h5")
-      call write_hdf5(temps(size(temps))%s, deck, res, info, maps, status)
       call commit_set(names, temps, status)
    contains
       subroutine add(suffix)
@@ -518,11 +528,13 @@ contains
 
    !> PREFIX.summary.json: what the summary prints, as numbers whose names carry their
    !> units, for scripts; the solver's own counters last.
-   function summary_json(prefix, deck, res, info) result(j)
+   function summary_json(prefix, deck, res, info, write_seconds) result(j)
       character(len=*), intent(in) :: prefix
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       type(run_info), intent(in) :: info
+      !> Seconds of writing PREFIX.h5 and of the text files and figures before this one.
+      real(dp), intent(in) :: write_seconds(2)
       character(len=:), allocatable :: j
       character(len=1), parameter :: nl = new_line("a")
       character(len=:), allocatable :: loads
@@ -568,6 +580,10 @@ contains
          '  "area_load_fit": {"exponent": '//json_number(exponent)//', "prefactor_nm2": '// &
          json_number(prefactor)//'},'//nl// &
          '  "wall_time_s": '//json_number(res%wall_seconds)//','//nl// &
+         '  "timings_s": {"read_inputs": '//json_number(info%read_seconds)//', "input_digests": '// &
+         json_number(info%digest_seconds)//', "solve": '//json_number(res%wall_seconds)//', "maps": '// &
+         json_number(info%maps_seconds)//', "write_hdf5": '//json_number(write_seconds(1))// &
+         ', "write_text_and_figures": '//json_number(write_seconds(2))//'},'//nl// &
          '  "checks": {"penetrating_pixels_at_end": '//int_str(res%missed_final_check)// &
          ', "deepest_penetration_nm": '//json_number(res%max_penetration)//', "found_late": '// &
          int_str(res%missed_during_run)//', "releases": '//int_str(res%releases)// &
