@@ -28,6 +28,10 @@ module femcod_contact_result
       !> The contact pixels (row, column) and their forces (nN) at this load.
       integer, allocatable :: i(:), j(:)
       real(dp), allocatable :: force(:)
+      !> The gap map (nm, NP x NP, 0 at the contacts) when the solver has it from its last
+      !> double-precision convolution (cg); otherwise unallocated and the maps are
+      !> computed afterwards (solvers/femcod_maps). Not kept in checkpoints.
+      real(dp), allocatable :: gap(:, :)
    end type load_state
 
    !> Results of a run. Units: nN, nm, GPa. What continues a run (the history, the

@@ -143,7 +143,8 @@ contains
                end if
                if (status%code /= 0) exit
             end if
-            call constrained_cg(fine, load, tol, max_iterations, how, p, approach, report(k), status, observer)
+            call constrained_cg(fine, load, tol, max_iterations, how, p, approach, report(k), status, observer, &
+               res%states(k)%gap)
             if (status%code /= 0) exit
          end if
          call wall_clock(t1)
@@ -276,7 +277,7 @@ contains
    !> Polonsky-Keer constrained CG on `grid` at total load P from the forces p (nN, any
    !> positive start; returned: the solution). `approach` (nm) is the mean gap of the
    !> contact pixels before the rigid shift, i.e. the approach from first touch.
-   subroutine constrained_cg(grid, total_load, tol, max_iterations, how, p, approach, rep, status, observer)
+   subroutine constrained_cg(grid, total_load, tol, max_iterations, how, p, approach, rep, status, observer, final_gap)
       type(cg_grid), intent(inout) :: grid
       real(dp), intent(in) :: total_load, tol
       integer, intent(in) :: max_iterations
@@ -287,6 +288,10 @@ contains
       type(status_type), intent(inout) :: status
       !> Asked every iteration whether to stop (a stop signal).
       class(solver_observer), intent(inout) :: observer
+      !> The gap (nm) of the solution, from the last fresh double-precision convolution,
+      !> 0 at the contacts: the gap map of this load (solvers/femcod_maps), without a
+      !> convolution of its own.
+      real(dp), allocatable, intent(out), optional :: final_gap(:, :)
       real(dp), allocatable :: w(:, :), g(:, :), t(:, :), r(:, :), gm(:, :), z(:, :), g_old(:, :)
       integer, allocatable :: changed(:, :)
       real(dp), allocatable :: delta(:)
@@ -500,6 +505,7 @@ contains
       rep%contact_gap = contact_gap
       rep%penetration = penetration
       rep%load_error = abs(sum(p) - total_load)/total_load
+      if (present(final_gap)) final_gap = merge(0.0_dp, g, p > 0)
    contains
       !> z = the stencil applied to the contacts' gaps gm (zero off the contacts), on the
       !> contacts; zbar its mean there (the direction is z - zbar); big_g = g . (z - zbar),
