@@ -14,6 +14,7 @@ module test_cg
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
    use femcod_love, only: offset_table, surface_compliance
+   use femcod_spring, only: spring_stiffness
    use femcod_scene, only: initial_gaps
    use femcod_random, only: random_stream, seed_stream, uniform
    use test_support, only: scratch_path, file_exists, remove_scratch
@@ -30,8 +31,14 @@ contains
       testsuite = [ &
          new_unittest("equals the event-exact solver inside steps on every input/ deck", test_against_incremental), &
          new_unittest("sphere, 0.5 nm mesh: Hertz at 1000 nN, Segedin at 18000 nN", test_sphere), &
-         new_unittest("--solver cg without --loads is a usage error", test_usage), &
+         new_unittest("usage errors: no --loads; --plastic without cg or at full capacity", test_usage), &
          new_unittest("the gap maps it hands over equal a direct sum over the Love table", test_gap_maps), &
+         new_unittest("--plastic: a hardness no pixel reaches gives the elastic answer bit for bit", test_plastic_inert), &
+         new_unittest("--plastic: equals a dense bounded QP solution (8 x 8 rough surface) to 1e-8", &
+            test_plastic_dense), &
+         new_unittest("--plastic: contact area tends to load / H as H -> 0 (bearing area)", test_plastic_bearing), &
+         new_unittest("--plastic: 90 % plastic area converges, no pressure above H", test_plastic_90), &
+         new_unittest("--plastic: a square punch past full plasticity carries A H", test_plastic_punch), &
          new_unittest("pruned padded FFT convolution equals the direct sum (NP 7, 8, 33)", test_convolution), &
          new_unittest("preconditioner taps equal the inverse of a direct DFT (NP 4, 5, 9)", test_inverse_taps), &
          new_unittest("every acceleration, alone and together, keeps the event-exact answer", test_accelerations), &
@@ -174,12 +181,323 @@ contains
       end do
    end subroutine test_gap_maps
 
+   !> A rough surface for the plastic checks: self-affine (Hurst 0.8, rms 3 nm), pixel
+   !> 10 nm, against a rigid flat.
+   subroutine rough_scene(np, seed, deck)
+      integer, intent(in) :: np, seed
+      type(contact_problem), intent(out) :: deck
+      type(scene_spec) :: spec
+      type(status_type) :: status
+      spec%kind = "self-affine"
+      spec%np = np
+      spec%pixel = 10
+      spec%hurst = 0.8_dp
+      spec%rms = 3
+      spec%seed = seed
+      spec%shape_on = "lower"
+      spec%rigid = "upper"
+      spec%label = "plastic test"
+      spec%matrix_file = ""
+      spec%maxcont = np*np
+      call build_problem(spec, deck, status)
+   end subroutine rough_scene
+
+   !> cg options for the plastic checks.
+   function plastic_options(loads, hardness, tol) result(options)
+      real(dp), intent(in) :: loads(:), hardness, tol
+      type(contact_options) :: options
+      options%solver = "cg"
+      options%loads = loads
+      options%cg = cg_settings()
+      options%cg%tol = tol
+      options%cg%max_iterations = 5000
+      options%hardness = hardness
+      options%plastic = .true.
+   end function plastic_options
+
+   !> With a hardness far above every elastic pressure no pixel is capped: the forces
+   !> and approach equal the elastic solve's exactly (the same operations).
+   subroutine test_plastic_inert(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: elastic, capped
+      type(status_type) :: status
+      integer :: k
+      call rough_scene(64, 3, deck)
+      options = plastic_options([2.0e3_dp, 2.0e4_dp], 1.0e9_dp, 1.0e-8_dp)
+      call solve_contact(deck, options, capped, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      options%plastic = .false.
+      call solve_contact(deck, options, elastic, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      do k = 1, 2
+         call check(error, capped%states(k)%n_plastic, 0, "no pixel capped")
+         if (allocated(error)) return
+         call check(error, capped%states(k)%approach == elastic%states(k)%approach .and. &
+            all(capped%states(k)%force == elastic%states(k)%force) .and. &
+            all(capped%states(k)%gap == elastic%states(k)%gap), "load "//to_string(k)//": bit for bit")
+         if (allocated(error)) return
+      end do
+   end subroutine test_plastic_inert
+
+   !> The bounded problem on an 8 x 8 rough surface solved independently of the cg code:
+   !> the quadratic programme  min 1/2 F.C F + g0.F  subject to 0 <= F <= H d^2 and
+   !> sum F = P, with the dense compliance C = c L + s I (L the Love table by offsets), by
+   !> projected gradients (the projection a shift found by bisection), then the active
+   !> sets it found solved exactly (the KKT system of the free forces and the approach,
+   !> Gaussian elimination) and checked. Forces agree to 1e-8 of H d^2, the approach to
+   !> 1e-8 of the height range, with cg at tol 1e-12.
+   subroutine test_plastic_dense(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status
+      integer, parameter :: np = 8, n = np*np
+      real(dp) :: cmat(n, n), g0(n), f(n), y(n), kkt(n + 1, n + 1), rhs(n + 1), gap(n), table(0:np - 1, 0:np - 1)
+      real(dp) :: c, s, fmax, load, eta, hardness, approach, range, lo, hi, lam, piv
+      integer :: a, b, it, k, m, nf, row
+      integer :: free(n)
+      logical :: capped(n), zero(n)
+      real(dp), allocatable :: cg_force(:)
+      call rough_scene(np, 7, deck)
+      table = offset_table(np)
+      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
+         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
+      s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
+      ! Pixel a = (i - 1) np + j, as the cg solver's g0 = transpose(reshape(...)).
+      y = initial_gaps(deck%lower, deck%upper)
+      do a = 1, n
+         g0(a) = y(a)
+      end do
+      range = maxval(g0) - minval(g0)
+      do a = 1, n
+         do b = 1, n
+            cmat(a, b) = c*table(abs((a - 1)/np - (b - 1)/np), abs(mod(a - 1, np) - mod(b - 1, np)))
+         end do
+         cmat(a, a) = cmat(a, a) + s
+      end do
+      ! A load and hardness that leave plastic, elastic and open pixels (5, 17 and 42
+      ! here): a fifth of the region's plastic capacity at 50 GPa.
+      hardness = 50
+      fmax = hardness*deck%pixel**2
+      load = 0.2_dp*n*fmax
+      f = load/n
+      eta = 1/maxval(sum(abs(cmat), dim=2))
+      do it = 1, 200000
+         y = f - eta*(matmul(cmat, f) + g0)
+         lo = minval(y) - fmax
+         hi = maxval(y) + fmax
+         do k = 1, 200
+            lam = (lo + hi)/2
+            if (sum(min(max(y - lam, 0.0_dp), fmax)) > load) then
+               lo = lam
+            else
+               hi = lam
+            end if
+         end do
+         f = min(max(y - lam, 0.0_dp), fmax)
+      end do
+      ! The active sets, then the exact solution on them.
+      capped = f > fmax*(1 - 1.0e-9_dp)
+      zero = f < fmax*1.0e-9_dp
+      nf = 0
+      do a = 1, n
+         if (.not. (capped(a) .or. zero(a))) then
+            nf = nf + 1
+            free(nf) = a
+         end if
+      end do
+      call check(error, count(capped) > 0 .and. nf > 0 .and. count(zero) > 0, "the case has plastic ("// &
+         to_string(count(capped))//"), elastic ("//to_string(nf)//") and open ("//to_string(count(zero))//") pixels")
+      if (allocated(error)) return
+      ! KKT: C_FF F_F - A = -g0_F - C_FU fmax;  sum F_F = P - n_U fmax.
+      kkt = 0
+      rhs = 0
+      do k = 1, nf
+         do m = 1, nf
+            kkt(k, m) = cmat(free(k), free(m))
+         end do
+         kkt(k, nf + 1) = -1
+         kkt(nf + 1, k) = 1
+         rhs(k) = -g0(free(k)) - fmax*sum(cmat(free(k), :), mask=capped)
+      end do
+      rhs(nf + 1) = load - count(capped)*fmax
+      ! Gaussian elimination with partial pivoting on the (nf + 1) system.
+      m = nf + 1
+      do k = 1, m
+         row = k - 1 + maxloc(abs(kkt(k:m, k)), dim=1)
+         if (row /= k) then
+            kkt([k, row], 1:m) = kkt([row, k], 1:m)
+            rhs([k, row]) = rhs([row, k])
+         end if
+         piv = kkt(k, k)
+         do row = k + 1, m
+            lam = kkt(row, k)/piv
+            kkt(row, k:m) = kkt(row, k:m) - lam*kkt(k, k:m)
+            rhs(row) = rhs(row) - lam*rhs(k)
+         end do
+      end do
+      do k = m, 1, -1
+         rhs(k) = (rhs(k) - dot_product(kkt(k, k + 1:m), rhs(k + 1:m)))/kkt(k, k)
+      end do
+      f = merge(fmax, 0.0_dp, capped)
+      f(free(1:nf)) = rhs(1:nf)
+      approach = rhs(nf + 1)
+      gap = g0 - approach + matmul(cmat, f)
+      call check(error, all(f >= 0) .and. all(f <= fmax), "the reference forces within their bounds")
+      if (allocated(error)) return
+      call check(error, all(pack(gap, zero) >= -1.0e-12_dp*range) .and. all(pack(gap, capped) <= 1.0e-12_dp*range), &
+         "the reference satisfies the complementarity on the sets it found")
+      if (allocated(error)) return
+      options = plastic_options([load], hardness, 1.0e-12_dp)
+      call solve_contact(deck, options, res, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      allocate(cg_force(n))
+      cg_force = 0
+      do k = 1, size(res%states(1)%force)
+         cg_force((res%states(1)%i(k) - 1)*np + res%states(1)%j(k)) = res%states(1)%force(k)
+      end do
+      call check(error, maxval(abs(cg_force - f)) <= 1.0e-8_dp*fmax, "forces: largest difference "// &
+         to_string(maxval(abs(cg_force - f))/fmax)//" of H d^2")
+      if (allocated(error)) return
+      call check(error, res%states(1)%n_plastic, count(capped), "plastic pixels")
+      if (allocated(error)) return
+      ! The approach in femcod's sense is the contacts' mean gap before the shift; the
+      ! multiplier A here is the same quantity.
+      call check(error, abs(res%states(1)%approach - approach) <= 1.0e-8_dp*range, "approach "// &
+         to_string(res%states(1)%approach)//" against "//to_string(approach))
+   end subroutine test_plastic_dense
+
+   !> As H -> 0 every contact is plastic and the area tends to the bearing area P / H
+   !> (from above: the elastic pixels carry less than H d^2 each). Checked on a 64 x 64
+   !> rough surface at a load of 2 % of the region's plastic capacity, for H = 1, 0.1 and
+   !> 0.01 GPa: area H / P within 5 %, 1 % and 0.2 % of 1, and never below 1.
+   subroutine test_plastic_bearing(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status
+      real(dp), parameter :: hardness(3) = [1.0_dp, 0.1_dp, 0.01_dp], bound(3) = [0.05_dp, 0.01_dp, 0.002_dp]
+      real(dp) :: load, ratio
+      integer :: k
+      call rough_scene(64, 3, deck)
+      do k = 1, 3
+         load = 0.02_dp*64**2*hardness(k)*deck%pixel**2
+         options = plastic_options([load], hardness(k), 1.0e-8_dp)
+         call solve_contact(deck, options, res, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         ratio = res%states(1)%contacts*deck%pixel**2*hardness(k)/load
+         call check(error, ratio >= 1 - 1.0e-12_dp .and. ratio - 1 <= bound(k), "H = "//to_string(hardness(k))// &
+            " GPa: area H / P = "//to_string(ratio))
+         if (allocated(error)) return
+      end do
+   end subroutine test_plastic_bearing
+
+   !> A hardness that leaves about 90 % of the contact plastic (128 x 128 rough surface;
+   !> peers report non-convergence there): the solve converges to tol 1e-8, no pressure
+   !> exceeds H, every plastic pixel's gap is closed or overlapping and every elastic
+   !> contact's is zero to the tolerance (the gap map).
+   subroutine test_plastic_90(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status
+      real(dp) :: hardness, load, range, fraction
+      integer :: k
+      call rough_scene(128, 4, deck)
+      hardness = 1.5_dp
+      load = 0.05_dp*128**2*hardness*deck%pixel**2
+      options = plastic_options([load], hardness, 1.0e-8_dp)
+      call solve_contact(deck, options, res, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      associate(st => res%states(1))
+         fraction = real(st%n_plastic, dp)/st%contacts
+         call check(error, fraction >= 0.85_dp .and. fraction <= 0.95_dp, "plastic fraction "//to_string(fraction))
+         if (allocated(error)) return
+         call check(error, st%max_pressure <= hardness, "max pressure "//to_string(st%max_pressure))
+         if (allocated(error)) return
+         call check(error, abs(sum(st%force) - load) <= 1.0e-12_dp*load, "the load is carried")
+         if (allocated(error)) return
+         range = maxval(deck%lower) - minval(deck%lower)
+         call check(error, minval(st%gap) >= -maxval(st%plastic) - 1.0e-9_dp*range .and. &
+            all(st%plastic >= 0), "plastic displacements are the overlaps")
+         if (allocated(error)) return
+         k = count(st%plastic > 0)
+         call check(error, k <= st%n_plastic, "only capped pixels overlap")
+      end associate
+   end subroutine test_plastic_90
+
+   !> The square punch of Table 4.2 (81 pixels of 1.11 nm, 10 nm high, rigid, NP = 27)
+   !> on the half-space with H = 5 GPa, at 0.99 and 1.01 times its face's plastic
+   !> capacity A H: below it the face alone carries the load; above it every face pixel
+   !> is plastic and the face carries exactly A H, the rest going to the surface around.
+   !> The face: the 81 pixels of the smallest initial gap.
+   subroutine test_plastic_punch(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status
+      real(dp), allocatable :: g0(:, :)
+      real(dp) :: hardness, capacity, face
+      integer :: k, nface
+      call read_deck("input/square_punch_n9.deck", deck, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [deck%np, deck%np]))
+      nface = count(g0 == minval(g0))
+      call check(error, nface, 81, "the punch face")
+      if (allocated(error)) return
+      hardness = 5
+      capacity = nface*hardness*deck%pixel**2
+      options = plastic_options([0.99_dp*capacity, 1.01_dp*capacity], hardness, 1.0e-10_dp)
+      call solve_contact(deck, options, res, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, res%states(1)%contacts, nface, "below A H: the face's pixels only")
+      if (allocated(error)) return
+      call check(error, res%states(2)%contacts > nface .and. res%states(2)%n_plastic == nface, &
+         "above A H: the face plastic ("//to_string(res%states(2)%n_plastic)//") and more contacts ("// &
+         to_string(res%states(2)%contacts)//")")
+      if (allocated(error)) return
+      face = 0
+      do k = 1, size(res%states(2)%force)
+         if (g0(res%states(2)%i(k), res%states(2)%j(k)) == minval(g0)) face = face + res%states(2)%force(k)
+      end do
+      call check(error, face, capacity, rel=.true., thr=1.0e-12_dp, message="the face carries A H")
+   end subroutine test_plastic_punch
+
    subroutine test_usage(error)
       type(error_type), allocatable, intent(out) :: error
       integer :: code
+      character(len=:), allocatable :: prefix
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--solver"), &
          string_type("cg"), string_type("--quiet")], code)
       call check(error, code, 2)
+      if (allocated(error)) return
+      ! --plastic with an event solver, and a load above the fully plastic capacity
+      ! (30^2 pixels of 1 nm^2 at 1 GPa carry at most 900 nN): exit 2, no result file.
+      prefix = scratch_path("plastic-refused")
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--plastic"), &
+         string_type("--loads"), string_type("100"), string_type("-o"), string_type(prefix), string_type("--quiet")], code)
+      call check(error, code, 2, "--plastic with the incremental solver")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--solver"), &
+         string_type("cg"), string_type("--plastic"), string_type("--hardness"), string_type("1"), &
+         string_type("--loads"), string_type("900"), string_type("-o"), string_type(prefix), string_type("--quiet")], code)
+      call check(error, code, 2, "a load at the fully plastic capacity")
+      if (allocated(error)) return
+      call check(error, .not. file_exists(prefix//".h5") .and. .not. file_exists(prefix//".loads.csv"), &
+         "no result file")
    end subroutine test_usage
    !> The convolution by pruned 1-D passes, the real kernel spectrum and the wrapped
    !> kernel, against the O(NP^4) direct sum over the same Love table (independent of any

@@ -90,7 +90,10 @@ contains
          choice_option("--solver", "incremental|legacy|cg", "the solver (default incremental; doc/solver.md)"), &
          real_list_option("--loads", "F1,...", "total loads in nN at which to report the state (PREFIX.loads.csv); "// &
             "the run stops once the largest is reached", lower=0.0_dp), &
-         real_option("--hardness", "H", "GPa, for n_above_hardness (default 11, polysilicon)", lower=0.0_dp, closed="()"), &
+         real_option("--hardness", "H", "GPa, for n_above_hardness (default 11, polysilicon), and the cap of "// &
+            "--plastic", lower=0.0_dp, closed="()"), &
+         flag_option("--plastic", "elastic-perfectly-plastic interface: no pixel's pressure exceeds the hardness; "// &
+            "a capped pixel carries H d^2 and interpenetrates (its plastic displacement, in PREFIX.h5)", mode="cg"), &
          flag_option("--quiet", "no summary on standard output, no progress lines on standard error", alias="-q"), &
          flag_option("--force", "replace existing results as a whole set, and a checkpoint of an interrupted run "// &
             "(otherwise both are kept and the deck fails with exit code 5 before it is solved); an input file is "// &
@@ -191,6 +194,7 @@ contains
          call get_option(parsed, "--loads", o%loads)
          call get_option(parsed, "--max-contacts", o%max_contacts)
          call get_option(parsed, "--hardness", o%hardness)
+         call get_option(parsed, "--plastic", o%plastic)
          if (option_given(parsed, "--no-final-check")) o%final_check = .false.
          if (option_given(parsed, "--event-search")) o%event_search = option_value(parsed, "--event-search")
          call get_option(parsed, "--checkpoint-interval", o%checkpoint_interval)
@@ -610,6 +614,7 @@ contains
       text = problem%label//"|"//int_str(problem%np)//"|"//format_real(problem%pixel)//"|"// &
          int_str(problem%maxcont)//"|"//reals(problem%young)//reals(problem%poisson)//trim(options%solver)//"|"// &
          reals(options%loads)//int_str(options%max_contacts)//"|"//format_real(options%hardness)//"|"// &
+         trim(merge("plastic|", "        ", options%plastic))// &
          format_real(options%tie_tolerance)//"|"//merge("T", "F", options%final_check)//"|"// &
          trim(options%event_search)//"|"//format_real(options%cg%tol)//"|"//int_str(options%cg%max_iterations)//"|"
       do k = 1, size(digests)
@@ -716,6 +721,9 @@ contains
             sig_str(res%states(k)%approach, 6)//" nm, "//int_str(res%states(k)%contacts)//" contacts ("// &
             sig_str(res%states(k)%contacts*problem%pixel**2, 4)//" nm^2), max pressure "// &
             sig_str(res%states(k)%max_pressure, 4)//" GPa"
+         if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
+            " of them plastic (at the hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "// &
+            sig_str(res%states(k)%plastic_volume, 4)//" nm^3"
       end do
       if (options%solver == "cg") then
          write(output_unit, '(a)') "  wall time : "//sig_str(res%wall_seconds, 3)//" s"

@@ -191,15 +191,25 @@ contains
       real(dp) :: area_pixel, region
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      call add_line(b, "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness")
+      call add_line(b, "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness,n_plastic")
       do k = 1, res%nsteps
          call add_line(b, int_str(k)//","//int_str(res%step_contacts(k))//","// &
             format_real(res%step_load(k))//","//format_real(res%step_approach(k))//","// &
             format_real(res%step_contacts(k)*area_pixel)//","//format_real(res%step_contacts(k)*area_pixel/region)// &
-            ","//int_str(res%step_above_hardness(k)))
+            ","//int_str(res%step_above_hardness(k))//","//int_str(step_plastic(res, k)))
       end do
       text = built_text(b)
    end function history_csv
+
+   !> The pixels at the hardness after step k (0 without the plastic cap).
+   pure integer function step_plastic(res, k)
+      type(contact_result), intent(in) :: res
+      integer, intent(in) :: k
+      step_plastic = 0
+      if (allocated(res%step_plastic)) then
+         if (k <= size(res%step_plastic)) step_plastic = res%step_plastic(k)
+      end if
+   end function step_plastic
 
    !> PREFIX.contacts.csv: the contact pixels and their forces at the reported load.
    function contacts_csv(deck, res) result(text)
@@ -264,14 +274,15 @@ contains
       real(dp) :: area_pixel, region
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      call add_line(b, "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness")
+      call add_line(b, "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,"// &
+         "n_plastic,plastic_volume_nm3")
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          associate(s => res%states(k))
             call add_line(b, format_real(s%load)//","//format_real(s%approach)//","// &
                int_str(s%contacts)//","//format_real(s%contacts*area_pixel)//","// &
                format_real(s%contacts*area_pixel/region)//","//format_real(s%max_pressure)//","// &
-               int_str(s%n_above_hardness))
+               int_str(s%n_above_hardness)//","//int_str(s%n_plastic)//","//format_real(s%plastic_volume))
          end associate
       end do
       text = built_text(b)
@@ -318,6 +329,7 @@ contains
       call h5_write(file, "/history/area", res%step_contacts(1:n)*area_pixel, "nm^2", local)
       call h5_write(file, "/history/area_fraction", res%step_contacts(1:n)*area_pixel/region, "1", local)
       call h5_write(file, "/history/n_above_hardness", res%step_above_hardness(1:n), "1", local)
+      call h5_write(file, "/history/n_plastic", [(step_plastic(res, k), k = 1, n)], "1", local)
       call h5_group(file, "/contacts", local)
       call h5_attribute(file, "/contacts", "load_nN", res%reported_load, local)
       call h5_write(file, "/contacts/i", res%contact_i, "1", local)
@@ -338,6 +350,8 @@ contains
             call h5_attribute(file, g, "area_nm2", s%contacts*area_pixel, local)
             call h5_attribute(file, g, "max_pressure_GPa", s%max_pressure, local)
             call h5_attribute(file, g, "n_above_hardness", s%n_above_hardness, local)
+            call h5_attribute(file, g, "n_plastic", s%n_plastic, local)
+            call h5_attribute(file, g, "plastic_volume_nm3", s%plastic_volume, local)
             if (info%solver == "cg") then
                call h5_attribute(file, g, "cg_iterations", s%iterations, local)
                call h5_attribute(file, g, "cg_residual", s%residual, local)
@@ -347,6 +361,7 @@ contains
             end if
             call h5_write(file, g//"/pressure", maps(k)%pressure, "GPa", local)
             call h5_write(file, g//"/gap", maps(k)%gap, "nm", local)
+            if (allocated(s%plastic)) call h5_write(file, g//"/plastic_displacement", s%plastic, "nm", local)
          end associate
       end do
       call write_mesh(file, deck, res, local)
@@ -550,7 +565,8 @@ contains
             if (s%reached) loads = loads//', "approach_nm": '//json_number(s%approach)//', "contacts": '// &
                int_str(s%contacts)//', "area_nm2": '//json_number(s%contacts*area_pixel)//', "area_fraction": '// &
                json_number(s%contacts/real(deck%np, dp)**2)//', "max_pressure_GPa": '//json_number(s%max_pressure)// &
-               ', "n_above_hardness": '//int_str(s%n_above_hardness)//', "hdf5_group": '// &
+               ', "n_above_hardness": '//int_str(s%n_above_hardness)//', "n_plastic": '// &
+               int_str(s%n_plastic)//', "plastic_volume_nm3": '//json_number(s%plastic_volume)//', "hdf5_group": '// &
                json_string(load_group(k, size(res%states)))
             loads = loads//'}'//trim(merge(",", " ", k < size(res%states)))//nl
          end associate

@@ -17,6 +17,11 @@ module femcod_contact_result
       integer :: contacts = 0
       real(dp) :: max_pressure = 0
       integer :: n_above_hardness = 0
+      !> With the plastic cap (--plastic): the pixels at the hardness, the rounds of the
+      !> plastic set the cg solver took, and the plastic volume (nm^3): the sum of the
+      !> capped pixels' interpenetrations times d^2.
+      integer :: n_plastic = 0, plastic_rounds = 0
+      real(dp) :: plastic_volume = 0
       logical :: reached = .false.
       !> Fixed-load solver only: iterations, relative complementarity residual, deepest
       !> penetration (nm), largest |gap| on contact (nm), relative load error.
@@ -32,6 +37,9 @@ module femcod_contact_result
       !> double-precision convolution (cg); otherwise unallocated and the maps are
       !> computed afterwards (solvers/femcod_maps). Not kept in checkpoints.
       real(dp), allocatable :: gap(:, :)
+      !> With the plastic cap: the plastic displacement map (nm, NP x NP; the
+      !> interpenetration of the capped pixels, 0 elsewhere).
+      real(dp), allocatable :: plastic(:, :)
    end type load_state
 
    !> Results of a run. Units: nN, nm, GPa. What continues a run (the history, the
@@ -41,6 +49,9 @@ module femcod_contact_result
       !> Per step: contacts carrying load, total load and approach at the end of the step,
       !> and the contacts whose pressure exceeds the hardness there (thesis Fig. 4.21).
       integer, allocatable :: step_contacts(:), step_above_hardness(:)
+      !> Per step, the pixels at the hardness (--plastic): set only by a solver with the
+      !> plastic cap (cg); absent, no pixel is capped. Not in checkpoints.
+      integer, allocatable :: step_plastic(:)
       real(dp), allocatable :: step_load(:), step_approach(:), step_seconds(:)
       !> Requested loads, in the order given.
       type(load_state), allocatable :: states(:)

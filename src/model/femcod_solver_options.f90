@@ -60,6 +60,10 @@ module femcod_solver_options
       real(dp), allocatable :: loads(:)
       !> Hardness (GPa) for the count of pixels above it (thesis polysilicon: 11 GPa).
       real(dp) :: hardness = 11
+      !> Elastic-perfectly-plastic interface: each pixel's pressure is capped at
+      !> `hardness`; a capped pixel keeps the force H d^2 and interpenetrates (its
+      !> plastic displacement). The cg solver only.
+      logical :: plastic = .false.
       !> Candidates whose closing load is within this fraction of the total load of the
       !> smallest one join in the same step (ties).
       real(dp) :: tie_tolerance = 1.0e-9_dp

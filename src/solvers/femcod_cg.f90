@@ -46,14 +46,14 @@
 !> are returned: max penetration (nm), largest |gap| on contact (nm), load error, r.
 module femcod_cg
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED
+   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
    use femcod_love, only: offset_table, surface_compliance
    use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
-   use femcod_contact_result, only: contact_result, append_step, STOP_LOADS
+   use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS
    use femcod_solver_options, only: contact_options, cg_settings
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
@@ -99,7 +99,8 @@ contains
       class(solver_observer), intent(inout) :: observer
       type(cg_residuals), allocatable :: report(:)
       type(cg_grid) :: fine
-      real(dp), allocatable :: p(:, :)
+      real(dp), allocatable :: p(:, :), g0(:, :)
+      logical, allocatable :: capped(:, :)
       integer, allocatable :: order(:)
       real(dp) :: load, tstart, t0, t1, approach
       integer :: np, k, kk, m, i, j, nc
@@ -115,6 +116,17 @@ contains
       end if
       call make_grid(fine, transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np])), problem, problem%pixel, how)
       allocate(p(np, np))
+      if (options%plastic) then
+         g0 = fine%g0
+         allocate(res%step_plastic(0), capped(np, np))
+         capped = .false.
+         if (maxval(options%loads) >= real(np, dp)**2*options%hardness*problem%pixel**2) then
+            call set_error(status, STATUS_USAGE, "--plastic: load "//format_real(maxval(options%loads))// &
+               " nN is at or above the fully plastic capacity NP^2 H d^2 = "// &
+               format_real(real(np, dp)**2*options%hardness*problem%pixel**2)//" nN")
+            return
+         end if
+      end if
       ! Ascending loads, each warm-started from the last.
       allocate(order(m))
       order = [(k, k = 1, m)]
@@ -134,6 +146,10 @@ contains
          if (load <= 0) then
             p = 0
             approach = -minval(fine%g0)
+         else if (options%plastic) then
+            call capped_solve(fine, problem, g0, load, options%hardness*problem%pixel**2, how, p, capped, approach, &
+               report(k), res%states(k), status, observer)
+            if (status%code /= 0) exit
          else
             if (.not. sum(p) > 0) then
                if (how%nested) then
@@ -162,6 +178,10 @@ contains
             st%contacts = count(p > 0)
             st%max_pressure = maxval(p)/problem%pixel**2
             st%n_above_hardness = count(p/problem%pixel**2 > options%hardness)
+            if (options%plastic) then
+               st%n_plastic = count(capped)
+               st%plastic_volume = sum(st%plastic)*problem%pixel**2
+            end if
             allocate(st%i(st%contacts), st%j(st%contacts), st%force(st%contacts))
             nc = 0
             do i = 1, np
@@ -175,6 +195,7 @@ contains
                end do
             end do
             call append_step(res, st%contacts, st%n_above_hardness, load, st%approach, t1 - t0)
+            if (options%plastic) res%step_plastic = [res%step_plastic, st%n_plastic]
             call observer%progress(kk, st%contacts, load, t1 - tstart)
             if (load == maxval(options%loads)) then
                res%contact_i = st%i
@@ -200,6 +221,92 @@ contains
       end do
       end associate
    end subroutine solve_cg
+
+   !> The elastic-perfectly-plastic interface at one load: 0 <= F <= fmax = H d^2 per
+   !> pixel, with
+   !>     F = 0: g >= 0,   0 < F < fmax: g = 0,   F = fmax: g <= 0 (plastic, -g its
+   !>     plastic displacement),   sum F = P.
+   !> By rounds on the plastic set: the capped pixels carry fmax and are taken out of the
+   !> elastic problem (their displacements c I * fmax become part of the others' gaps),
+   !> which constrained_cg solves for the rest at the load left, P - n_capped fmax; then
+   !> the pixels above fmax join the set and the capped pixels whose gap opened (beyond
+   !> tol of the height range) leave it, until neither happens. A set only grows by
+   !> pixels that carried more than fmax in a solution of the whole load, so the load left
+   !> stays positive. Without a capped pixel this is the elastic solve, bit for bit.
+   !> Returned: the forces (fmax on the capped pixels), the approach, the plastic set,
+   !> and in `state` the gap map (0 on the elastic contacts, minus the plastic
+   !> displacement on the capped ones) and the plastic displacement map.
+   subroutine capped_solve(grid, problem, g0, load, fmax, how, p, capped, approach, rep, state, status, observer)
+      type(cg_grid), intent(inout) :: grid
+      type(contact_problem), intent(in) :: problem
+      !> The deck's gaps (nm); grid%g0 is restored to them on return.
+      real(dp), intent(in) :: g0(:, :)
+      real(dp), intent(in) :: load, fmax
+      type(cg_settings), intent(in) :: how
+      real(dp), intent(inout) :: p(:, :)
+      logical, intent(inout) :: capped(:, :)
+      real(dp), intent(out) :: approach
+      type(cg_residuals), intent(inout) :: rep
+      type(load_state), intent(inout) :: state
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      !> The gap that takes a capped pixel out of the elastic problem (it never touches).
+      real(dp), parameter :: EXCLUDED = 1.0e30_dp
+      integer, parameter :: MAX_ROUNDS = 200
+      real(dp), allocatable :: force(:, :), w(:, :), gap(:, :)
+      logical, allocatable :: grow(:, :), release(:, :)
+      real(dp) :: left
+      integer :: round, ncap
+      allocate(force(size(p, 1), size(p, 2)), w(size(p, 1), size(p, 2)))
+      do round = 1, MAX_ROUNDS
+         ncap = count(capped)
+         if (ncap > 0) then
+            force = merge(fmax, 0.0_dp, capped)
+            call convolution_apply(grid%conv, force, w, grid%c)
+            grid%g0 = merge(EXCLUDED, g0 + w + grid%s*force, capped)
+            where (capped) p = 0
+         else
+            grid%g0 = g0
+         end if
+         left = load - ncap*fmax
+         if (.not. sum(p) > 0) then
+            if (how%nested .and. ncap == 0) then
+               call nested_start(grid, problem, left, how, p, rep, status, observer)
+            else
+               call first_guess(grid, left, p)
+            end if
+            if (status%code /= 0) exit
+         end if
+         call constrained_cg(grid, left, how%tol, how%max_iterations, how, p, approach, rep, status, observer, &
+            state%gap)
+         if (status%code /= 0) exit
+         ! The gaps of all forces together, from one fresh double-precision convolution.
+         force = merge(fmax, p, capped)
+         call convolution_apply(grid%conv, force, w, grid%c)
+         gap = g0 - approach + w + grid%s*force
+         grow = .not. capped .and. p > fmax
+         release = capped .and. gap > how%tol*grid%scale
+         if (.not. (any(grow) .or. any(release))) exit
+         ! A released pixel starts from the force it had.
+         where (release) p = fmax
+         capped = (capped .or. grow) .and. .not. release
+      end do
+      grid%g0 = g0
+      state%plastic_rounds = min(round, MAX_ROUNDS)
+      if (status%code /= 0) return
+      if (round > MAX_ROUNDS) then
+         call set_error(status, STATUS_NUMERICAL, "cg --plastic: the plastic set did not settle in "// &
+            int_str(MAX_ROUNDS)//" rounds at load "//format_real(load)//" nN")
+         return
+      end if
+      p = merge(fmax, p, capped)
+      allocate(state%plastic(size(p, 1), size(p, 2)))
+      state%plastic = 0
+      if (any(capped)) then
+         state%gap = merge(0.0_dp, gap, p > 0 .and. .not. capped)
+         where (capped) state%plastic = max(-gap, 0.0_dp)
+      end if
+   end subroutine capped_solve
 
    !> A grid for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's materials.
    subroutine make_grid(grid, g0, problem, pixel, how)

@@ -82,6 +82,8 @@ contains
       case ("cg")
          lines = [string_type("handles and springs condensed: one composite compliance c1 + c2 with the springs' "// &
             "3/k on the diagonal, one composite gap")]
+         if (.not. options%plastic) lines = [lines, string_type("no plastic cap: pressures are elastic, "// &
+            "n_above_hardness counts the pixels above the hardness (--plastic caps them)")]
          return
       end select
       c1 = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel)
@@ -122,15 +124,18 @@ contains
       type(contact_result), intent(in) :: res
       type(report_line), allocatable :: lines(:)
       type(string_type), allocatable :: model(:)
+      character(len=:), allocatable :: rounds
       integer :: k
       allocate(lines(0))
       select case (options%solver)
       case ("cg")
          do k = 1, size(res%states)
+            rounds = ""
+            if (options%plastic) rounds = ", in "//int_str(res%states(k)%plastic_rounds)//" rounds of the plastic set"
             call add("cg", "load "//sig_str(res%states(k)%load, 6)//" nN: "// &
                int_str(res%states(k)%iterations)//" iterations, residual "//sig_str(res%states(k)%residual, 2)// &
                ", penetration "//sig_str(res%states(k)%penetration, 2)//" nm, |gap| on contact "// &
-               sig_str(res%states(k)%contact_gap, 2)//" nm, load error "//sig_str(res%states(k)%load_error, 2))
+               sig_str(res%states(k)%contact_gap, 2)//" nm, load error "//sig_str(res%states(k)%load_error, 2)//rounds)
          end do
       case ("incremental")
          model = model_notes(problem, options)
