@@ -129,9 +129,18 @@ contains
       allocate(lines(0))
       select case (options%solver)
       case ("cg")
+         model = model_notes(problem, options)
+         do k = 1, size(model)
+            call add("model", model(k)%s)
+         end do
+         if (options%plastic .and. size(res%states) > 0) then
+            if (all(res%states%n_plastic == 0)) call add("model", "no pixel reached the hardness: the cap left "// &
+               "every load one elastic solve, with no plastic bookkeeping")
+         end if
          do k = 1, size(res%states)
             rounds = ""
-            if (options%plastic) rounds = ", in "//int_str(res%states(k)%plastic_rounds)//" rounds of the plastic set"
+            if (options%plastic) rounds = ", in "//int_str(res%states(k)%plastic_rounds)//" round"// &
+               trim(merge("s", " ", res%states(k)%plastic_rounds /= 1))//" of the plastic set"
             call add("cg", "load "//sig_str(res%states(k)%load, 6)//" nN: "// &
                int_str(res%states(k)%iterations)//" iterations, residual "//sig_str(res%states(k)%residual, 2)// &
                ", penetration "//sig_str(res%states(k)%penetration, 2)//" nm, |gap| on contact "// &
