@@ -263,7 +263,7 @@ contains
          if (ncap > 0) then
             force = merge(fmax, 0.0_dp, capped)
             call convolution_apply(grid%conv, force, w, grid%c)
-            grid%g0 = merge(EXCLUDED, g0 + w + grid%s*force, capped)
+            grid%g0 = merge(EXCLUDED, g0 + w, capped)
             where (capped) p = 0
          else
             grid%g0 = g0
