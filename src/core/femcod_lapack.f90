@@ -4,7 +4,7 @@ module femcod_lapack
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv, dlacn2, dtrsm
+   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv, dlacn2, dtrsm, dsyrk
 
    interface
       pure subroutine dpotrf(uplo, n, a, lda, info)
@@ -40,6 +40,14 @@ module femcod_lapack
          integer, intent(in) :: n, incx, incy
          real(dp), intent(in) :: x(*), y(*)
       end function ddot
+      !> C = alpha A A^T + beta C (uplo's triangle of C), A n x k.
+      pure subroutine dsyrk(uplo, trans, n, k, alpha, a, lda, beta, c, ldc)
+         import :: dp
+         character(len=1), intent(in) :: uplo, trans
+         integer, intent(in) :: n, k, lda, ldc
+         real(dp), intent(in) :: alpha, beta, a(lda, *)
+         real(dp), intent(inout) :: c(ldc, *)
+      end subroutine dsyrk
       pure subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
          import :: dp
          character(len=1), intent(in) :: trans

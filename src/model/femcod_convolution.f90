@@ -2,6 +2,11 @@
 !> (FFTW, plans made once): (I * F)(p) = sum_k I(p - k) F(k), exact for the non-periodic
 !> half-space because the padding keeps every image out of the grid.
 !>
+!> For a periodic surface (`periodic` at set-up, `--boundary periodic`) the same passes
+!> run on the unpadded NP^2 grid with a periodic table (femcod_love_periodic): the
+!> cyclic convolution sum_k K((p - k) mod NP) F(k), with transforms of half the length
+!> per dimension, a quarter of the data, and no padding to fill or crop.
+!>
 !> The 2-D transform is done in three passes of 1-D transforms so that the padding costs
 !> nothing it need not, and each pass works through the grid in blocks of a few lines
 !> that stay in cache (one block per OpenMP thread at a time, FFTW's single-threaded
@@ -56,10 +61,12 @@ module femcod_convolution
    !> Plans, the transformed kernel, the half spectrum and the threads' buffers for one
    !> grid size.
    type :: love_convolution
-      !> Grid size NP, padded size M = 2 NP, rows of the half spectrum MH = M/2 + 1, lines
-      !> per block, threads (buffers) the passes run on.
+      !> Grid size NP, transform length M (2 NP padded, NP periodic), rows of the half
+      !> spectrum MH = M/2 + 1, lines per block, threads (buffers) the passes run on.
       integer :: np = 0, m = 0, mh = 0, block = 0, threads = 0
       logical :: has_single = .false.
+      !> Cyclic convolution of a periodic table on the unpadded grid.
+      logical :: periodic = .false.
       type(plan_set) :: double, single
       !> The half spectrum of the NP data columns (MH x NP), in double or in float32.
       type(c_ptr) :: spectrum_mem
@@ -67,7 +74,7 @@ module femcod_convolution
       complex(c_float_complex), pointer :: spectrum32(:, :) => null()
       !> Per thread: a real block (M x block) and a complex block (M x block).
       type(c_ptr), allocatable :: real_mem(:), complex_mem(:)
-      !> Real kernel spectrum divided by M^2, transposed: kernel(k2, k1), k2 = 0..NP,
+      !> Real kernel spectrum divided by M^2, transposed: kernel(k2, k1), k2 = 0..M/2,
       !> k1 = 1..MH; and its float32 copy.
       real(dp), allocatable :: kernel(:, :)
       real(sp), allocatable :: kernel32(:, :)
@@ -79,18 +86,23 @@ contains
    !> `single` true the float32 plans are made as well. With `measure` true FFTW times
    !> candidate plans (FFTW_MEASURE: about a second at NP = 4096, faster transforms;
    !> plans in FFTW's wisdom, which the caller may import beforehand, are reused at once);
-   !> otherwise it picks them by estimate.
-   subroutine convolution_setup(conv, table, single, measure)
+   !> otherwise it picks them by estimate. With `periodic` true the table is a periodic
+   !> one (table(p, q) = table(NP - p, q), femcod_love_periodic) and the convolution
+   !> cyclic, without padding.
+   subroutine convolution_setup(conv, table, single, measure, periodic)
       type(love_convolution), intent(inout) :: conv
       real(dp), intent(in) :: table(0:, 0:)
-      logical, intent(in), optional :: single, measure
-      integer :: np, m, mh, b, t, p, q, j, jb, j0, nb, thread
+      logical, intent(in), optional :: single, measure, periodic
+      integer :: np, m, mh, b, t, p, q, j, jb, j0, nb, thread, kh
       integer(c_int) :: flags
       real(c_double), pointer :: lines(:, :)
       complex(c_double_complex), pointer :: half(:, :)
       np = size(table, 1)
-      m = 2*np
+      conv%periodic = .false.
+      if (present(periodic)) conv%periodic = periodic
+      m = merge(np, 2*np, conv%periodic)
       mh = m/2 + 1
+      kh = m/2
       b = min(lines_per_block, np)
       conv%np = np
       conv%m = m
@@ -118,6 +130,7 @@ contains
       ! middle line (offset np) is never reached by a pair of grid pixels. Columns
       ! q = 0..np-1 go through the column pass into the half spectrum; the row pass fills
       ! columns q = np+1..m-1 from their mirror images m-q (the kernel is even in q).
+      ! Periodic: the table is the whole cell, offsets 0..np-1 once, nothing mirrored.
       !$omp parallel num_threads(conv%threads) private(thread, lines, half, jb, j0, nb, j, q, p)
       thread = 0
       !$ thread = omp_get_thread_num()
@@ -130,16 +143,20 @@ contains
          lines = 0
          do j = 1, nb
             q = j0 + j - 1
-            do p = -(np - 1), np - 1
-               lines(modulo(p, m) + 1, j) = table(abs(p), q)
-            end do
+            if (conv%periodic) then
+               lines(1:np, j) = table(:, q)
+            else
+               do p = -(np - 1), np - 1
+                  lines(modulo(p, m) + 1, j) = table(abs(p), q)
+               end do
+            end if
          end do
          call fftw_execute_dft_r2c(conv%double%columns_forward, lines, half)
          conv%spectrum(:, j0 + 1:j0 + nb) = half(:, 1:nb)
       end do
       !$omp end do
       !$omp end parallel
-      allocate(conv%kernel(0:np, mh))
+      allocate(conv%kernel(0:kh, mh))
       !$omp parallel num_threads(conv%threads) private(thread, half, jb, j0, nb, j, q)
       thread = 0
       !$ thread = omp_get_thread_num()
@@ -158,13 +175,15 @@ contains
          call fftw_execute_dft(conv%double%rows_forward, half, half)
          ! Even kernel: the spectrum is real (the imaginary part is round-off).
          do j = 1, nb
-            conv%kernel(:, j0 + j) = real(half(1:np + 1, j), dp)/real(m, dp)**2
+            conv%kernel(:, j0 + j) = real(half(1:kh + 1, j), dp)/real(m, dp)**2
          end do
       end do
       !$omp end do
       !$omp end parallel
+      ! A periodic table has zero mean (round-off aside): no zero-frequency response.
+      if (conv%periodic) conv%kernel(0, 1) = 0
       if (conv%has_single) then
-         allocate(conv%kernel32(0:np, mh))
+         allocate(conv%kernel32(0:kh, mh))
          conv%kernel32(:, :) = real(conv%kernel, sp)
       end if
    end subroutine convolution_setup
@@ -227,12 +246,13 @@ contains
       real(c_double), pointer :: lines(:, :)
       complex(c_double_complex), pointer :: half(:, :)
       real(dp) :: f
-      integer :: np, m, mh, b, thread, jb, j0, nb, j
+      integer :: np, m, mh, kh, b, thread, jb, j0, nb, j
       f = 1
       if (present(factor)) f = factor
       np = conv%np
       m = conv%m
       mh = conv%mh
+      kh = m/2
       b = conv%block
       !$omp parallel num_threads(conv%threads) private(thread, lines, half, jb, j0, nb, j)
       thread = 0
@@ -264,8 +284,8 @@ contains
          half(:, nb + 1:) = 0
          call fftw_execute_dft(conv%double%rows_forward, half, half)
          do j = 1, nb
-            half(1:np + 1, j) = half(1:np + 1, j)*conv%kernel(:, j0 + j)
-            half(np + 2:m, j) = half(np + 2:m, j)*conv%kernel(np - 1:1:-1, j0 + j)
+            half(1:kh + 1, j) = half(1:kh + 1, j)*conv%kernel(:, j0 + j)
+            half(kh + 2:m, j) = half(kh + 2:m, j)*conv%kernel(m - kh - 1:1:-1, j0 + j)
          end do
          call fftw_execute_dft(conv%double%rows_backward, half, half)
          do j = 1, np
@@ -298,12 +318,13 @@ contains
       real(c_float), pointer :: lines(:, :)
       complex(c_float_complex), pointer :: half(:, :)
       real(dp) :: f
-      integer :: np, m, mh, b, thread, jb, j0, nb, j
+      integer :: np, m, mh, kh, b, thread, jb, j0, nb, j
       f = 1
       if (present(factor)) f = factor
       np = conv%np
       m = conv%m
       mh = conv%mh
+      kh = m/2
       b = conv%block
       !$omp parallel num_threads(conv%threads) private(thread, lines, half, jb, j0, nb, j)
       thread = 0
@@ -333,8 +354,8 @@ contains
          half(:, nb + 1:) = 0
          call fftwf_execute_dft(conv%single%rows_forward, half, half)
          do j = 1, nb
-            half(1:np + 1, j) = half(1:np + 1, j)*conv%kernel32(:, j0 + j)
-            half(np + 2:m, j) = half(np + 2:m, j)*conv%kernel32(np - 1:1:-1, j0 + j)
+            half(1:kh + 1, j) = half(1:kh + 1, j)*conv%kernel32(:, j0 + j)
+            half(kh + 2:m, j) = half(kh + 2:m, j)*conv%kernel32(m - kh - 1:1:-1, j0 + j)
          end do
          call fftwf_execute_dft(conv%single%rows_backward, half, half)
          do j = 1, np
@@ -357,28 +378,37 @@ contains
    end subroutine convolution_apply_single
 
    !> The central coefficients of the inverse of the convolution on the padded periodic
-   !> grid: taps(a, b), a, b = 0..2, at offsets (+-a, +-b) (dimensionless, for the table's
-   !> units; a discrete form of the |q| operator, E* |q| / 2 in the continuum). `ok` is
-   !> false when the kernel spectrum is not positive, so that it has no inverse.
+   !> grid (on the cell, periodic): taps(a, b), a, b = 0..2, at offsets (+-a, +-b)
+   !> (dimensionless, for the table's units; a discrete form of the |q| operator, E* |q| / 2
+   !> in the continuum). A periodic kernel has no mean (spectrum 0 at zero frequency):
+   !> its inverse is taken on the other frequencies (a pseudo-inverse, 0 at zero
+   !> frequency). `ok` is false when another coefficient of the kernel spectrum is not
+   !> positive, so that it has no inverse.
    !> The inverse's spectrum is real and even in both frequencies, so each tap is a
-   !> cosine sum over the quarter k1, k2 = 0..NP (weight 2 off the lines 0 and NP).
+   !> cosine sum over the quarter k1, k2 = 0..M/2 (weight 2 off the lines 0 and M/2).
    subroutine inverse_kernel_taps(conv, taps, ok)
       type(love_convolution), intent(in) :: conv
       real(dp), intent(out) :: taps(0:2, 0:2)
       logical, intent(out) :: ok
       real(dp), parameter :: two_pi = 8*atan(1.0_dp)
-      real(dp), allocatable :: inner(:, :), weight(:), cosines(:, :)
-      integer :: np, k, a
+      real(dp), allocatable :: inner(:, :), weight(:), cosines(:, :), inverse(:, :)
+      integer :: kh, k, a
       taps = 0
-      ok = minval(conv%kernel) > 0 .and. conv%np >= 3
+      ok = conv%np >= 3
       if (.not. ok) return
-      np = conv%np
-      allocate(weight(0:np), cosines(0:np, 0:2), inner(0:2, conv%mh))
+      kh = conv%m/2
+      inverse = conv%kernel
+      if (conv%periodic) inverse(0, 1) = 1
+      ok = minval(inverse) > 0
+      if (.not. ok) return
+      inverse = 1/inverse
+      if (conv%periodic) inverse(0, 1) = 0
+      allocate(weight(0:kh), cosines(0:kh, 0:2), inner(0:2, conv%mh))
       weight = 2
       weight(0) = 1
-      weight(np) = 1
+      if (mod(conv%m, 2) == 0) weight(kh) = 1
       do a = 0, 2
-         do k = 0, np
+         do k = 0, kh
             cosines(k, a) = weight(k)*cos(two_pi*real(a*k, dp)/real(conv%m, dp))
          end do
       end do
@@ -386,7 +416,7 @@ contains
       !$omp parallel do num_threads(conv%threads) private(a)
       do k = 1, conv%mh
          do a = 0, 2
-            inner(a, k) = sum(cosines(:, a)/conv%kernel(:, k))
+            inner(a, k) = sum(cosines(:, a)*inverse(:, k))
          end do
       end do
       do a = 0, 2

@@ -1,0 +1,143 @@
+!> The Love kernel of a periodic half-space (`--boundary periodic`): the square-pixel
+!> influence of femcod_love summed over all periodic images of an NP x NP cell.
+!>
+!> The image sum of I diverges (I ~ 1/rho), but only in its mean: a periodic load with a
+!> non-zero mean displaces a half-space without bound. femcod fixes the convention that
+!> the displacement field has zero mean over the cell (the zero-frequency coefficient of
+!> the kernel is 0), as the periodic FFT solvers of the literature do (Stanley and Kato
+!> 1997; tamaas, ContactMechanics). The rigid-body approach then measures how far the
+!> mean planes of the two surfaces came together: mean gap = mean g0 - approach.
+!>
+!> The kernel is computed in Fourier space, exactly. By Poisson's summation the DFT of the
+!> periodised samples of I at the frequency (a, b) = (k1, k2)/NP (cycles per pixel) is
+!> the alias sum of the continuous transform of (pixel box) * 1/r:
+!>     S(a, b) = sum over integers m, n of s(a + m) s(b + n) / |(a + m, b + n)|,
+!>     s(x) = sin(pi x)/(pi x),
+!> which converges slowly. With 1/|v| = 2/sqrt(pi) int_0^inf exp(-t^2 |v|^2) dt the sum
+!> separates:
+!>     S(a, b) = 2/sqrt(pi) int_0^inf A(a, t) A(b, t) dt,
+!>     A(a, t) = sum_m s(a + m) exp(-t^2 (a + m)^2)
+!>             = erf(pi/(2t)) + sum_{k>=1} [erfc(pi(k - 1/2)/t) - erfc(pi(k + 1/2)/t)] cos(2 pi k a),
+!> the second form by Poisson's summation again (used for t < 1, where the first
+!> converges slowly; both need at most 8 terms). With t = exp(u) the integrand is
+!> analytic in the strip |Im u| < pi/4 and decays doubly exponentially at both ends, so
+!> the trapezoidal rule in u with step 1/8 is exact to about exp(-2 pi (pi/4) 8) = 1e-17
+!> of the integral. The integral for all (NP/2 + 1)^2 pairs is then one symmetric
+!> rank-k update (BLAS dsyrk): A (NP/2 + 1 x about 400 nodes) times its transpose.
+!> In the continuum limit S -> 1/|(a, b)|: the displacement over the pressure is
+!> 2/(E* |q|), as for the continuous periodic half-space.
+module femcod_love_periodic
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_double_complex, c_size_t, c_int, c_f_pointer
+   use femcod_kinds, only: dp
+   use femcod_lapack, only: dsyrk
+   use femcod_fftw, only: fftw_plan_dft_c2r_2d, fftw_execute_dft_c2r, fftw_destroy_plan, fftw_alloc_real, &
+      fftw_alloc_complex, fftw_free, FFTW_ESTIMATE
+   implicit none
+   private
+   public :: periodic_love_spectrum, periodic_offset_table
+
+   real(dp), parameter :: pi = 3.141592653589793238462643383279502884_dp
+
+contains
+
+   !> S(k1, k2), k1, k2 = 0 .. NP/2: the DFT of the periodic kernel at the frequencies
+   !> (k1, k2)/NP (dimensionless, pixel units; the table's DFT, so that the periodic
+   !> convolution of forces F is c * IDFT(S * DFT(F))). S is even in both frequencies
+   !> and symmetric; S(0, 0) = 0 (zero-mean displacements).
+   function periodic_love_spectrum(np) result(s)
+      integer, intent(in) :: np
+      real(dp) :: s(0:np/2, 0:np/2)
+      !> Step in u = ln t, and the ends: below t = 1e-17 the integrand is 2/sqrt(pi)
+      !> (A = 1 + O(t^2)), so the part left out is 1e-17; above t = 7 NP every factor
+      !> exp(-t^2 |v|^2) with |v| >= 1/NP is below exp(-49).
+      real(dp), parameter :: step = 0.125_dp
+      real(dp), allocatable :: a(:, :)
+      real(dp) :: u_low, u_high, t, w
+      integer :: kh, nodes, j, k
+      kh = np/2
+      u_low = log(1.0e-17_dp)
+      u_high = log(7.0_dp*max(np, 1))
+      nodes = ceiling((u_high - u_low)/step) + 1
+      allocate(a(0:kh, nodes))
+      !$omp parallel do private(t, w, k)
+      do j = 1, nodes
+         t = exp(u_low + (j - 1)*step)
+         ! Trapezoidal weight (dt = t du), its square root shared by the two factors.
+         w = sqrt(2/sqrt(pi)*step*t)
+         do k = 0, kh
+            a(k, j) = w*sampled_box_gaussian(real(k, dp)/real(np, dp), t)
+         end do
+      end do
+      !$omp end parallel do
+      s = 0
+      call dsyrk("U", "N", kh + 1, nodes, 1.0_dp, a, kh + 1, 0.0_dp, s, kh + 1)
+      do k = 0, kh
+         s(k + 1:kh, k) = s(k, k + 1:kh)
+      end do
+      s(0, 0) = 0
+   end function periodic_love_spectrum
+
+   !> A(a, t) = sum_m s(a + m) exp(-t^2 (a + m)^2), 0 <= a <= 1/2, t > 0: the samples
+   !> at the pixel centres, shifted by a, of the pixel box smoothed by a Gaussian.
+   pure real(dp) function sampled_box_gaussian(a, t) result(total)
+      real(dp), intent(in) :: a, t
+      real(dp) :: x, sa
+      integer :: m, mmax, k
+      if (t >= 1) then
+         ! Direct: the Gaussian ends the sum, exp(-t^2 (|m| - 1/2)^2) < 1e-17 beyond.
+         ! s(a + m) = (-1)^m sin(pi a)/(pi (a + m)), exact 0 for a = 0, m /= 0.
+         sa = sin(pi*a)
+         mmax = ceiling(6.3_dp/t + 0.5_dp)
+         total = 0
+         do m = -mmax, mmax
+            x = a + m
+            if (x == 0) then
+               total = total + 1
+            else
+               total = total + merge(1, -1, mod(m, 2) == 0)*sa/(pi*x)*exp(-(t*x)**2)
+            end if
+         end do
+      else
+         ! Dual: the transform of the smoothed box, a difference of error functions
+         ! that ends the sum, erfc(pi (k - 1/2)/t) < 1e-17 beyond k = 2t + 1/2.
+         total = erf(pi/(2*t))
+         do k = 1, ceiling(2*t + 0.5_dp) + 1
+            total = total + (erfc(pi*(k - 0.5_dp)/t) - erfc(pi*(k + 0.5_dp)/t))*cos(2*pi*k*a)
+         end do
+      end if
+   end function sampled_box_gaussian
+
+   !> The periodic influence table K(p, q), p, q = 0 .. NP-1 (dimensionless, as
+   !> femcod_love's offset_table): the inverse DFT of periodic_love_spectrum, even and
+   !> periodic (K(p, q) = K(NP - p, q)), so that K(|i - k|, |j - l|) is the influence
+   !> between any two pixels of the cell, images included; its mean over the cell is 0.
+   function periodic_offset_table(np) result(table)
+      integer, intent(in) :: np
+      real(dp) :: table(0:np - 1, 0:np - 1)
+      real(dp), allocatable :: s(:, :)
+      type(c_ptr) :: plan, in_mem, out_mem
+      complex(c_double_complex), pointer :: spectrum(:, :)
+      real(c_double), pointer :: field(:, :)
+      integer :: kh, k1, k2
+      kh = np/2
+      allocate(s(0:kh, 0:kh))
+      s(:, :) = periodic_love_spectrum(np)
+      in_mem = fftw_alloc_complex(int(kh + 1, c_size_t)*int(np, c_size_t))
+      out_mem = fftw_alloc_real(int(np, c_size_t)*int(np, c_size_t))
+      call c_f_pointer(in_mem, spectrum, [kh + 1, np])
+      call c_f_pointer(out_mem, field, [np, np])
+      ! Column-major (kh + 1) x np half spectrum of a row-major np x np transform: the
+      ! first index is the halved frequency k2, the second k1 = 0 .. np-1 (mirrored).
+      plan = fftw_plan_dft_c2r_2d(int(np, c_int), int(np, c_int), spectrum, field, FFTW_ESTIMATE)
+      do k1 = 0, np - 1
+         do k2 = 0, kh
+            spectrum(k2 + 1, k1 + 1) = cmplx(s(k2, min(k1, np - k1)), 0, c_double_complex)
+         end do
+      end do
+      call fftw_execute_dft_c2r(plan, spectrum, field)
+      table = field/real(np, dp)**2
+      call fftw_destroy_plan(plan)
+      call fftw_free(in_mem)
+      call fftw_free(out_mem)
+   end function periodic_offset_table
+end module femcod_love_periodic
