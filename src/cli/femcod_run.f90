@@ -92,6 +92,9 @@ contains
             "the run stops once the largest is reached", lower=0.0_dp), &
          real_option("--hardness", "H", "GPa, for n_above_hardness (default 11, polysilicon), and the cap of "// &
             "--plastic", lower=0.0_dp, closed="()"), &
+         choice_option("--boundary", "free|periodic", "free (default): the grid alone on a half-space, as in the "// &
+            "thesis; periodic: the grid is one cell of a surface repeating with period NP d in both directions "// &
+            "(incremental and cg solvers; zero-mean displacements, the approach is the fall of the mean gap)"), &
          flag_option("--plastic", "elastic-perfectly-plastic interface: no pixel's pressure exceeds the hardness; "// &
             "a capped pixel carries H d^2 and interpenetrates (its plastic displacement, in PREFIX.h5)", mode="cg"), &
          flag_option("--quiet", "no summary on standard output, no progress lines on standard error", alias="-q"), &
@@ -195,6 +198,7 @@ contains
          call get_option(parsed, "--max-contacts", o%max_contacts)
          call get_option(parsed, "--hardness", o%hardness)
          call get_option(parsed, "--plastic", o%plastic)
+         if (option_given(parsed, "--boundary")) o%boundary = option_value(parsed, "--boundary")
          if (option_given(parsed, "--no-final-check")) o%final_check = .false.
          if (option_given(parsed, "--event-search")) o%event_search = option_value(parsed, "--event-search")
          call get_option(parsed, "--checkpoint-interval", o%checkpoint_interval)
@@ -555,6 +559,7 @@ contains
          if (st%code /= 0) return
          info%version = FEMCOD_VERSION
          info%solver = trim(options%solver)
+         info%boundary = trim(options%boundary)
          info%options = settings%command_line
          info%command_line = "femcod run "//settings%command_line
          info%host = host_name()
@@ -567,7 +572,7 @@ contains
          info%read_seconds = read_seconds
          info%digest_seconds = digest_seconds
          call wall_clock(t0)
-         call load_maps(problem, res%states, maps)
+         call load_maps(problem, res%states, maps, options%boundary == "periodic")
          call wall_clock(t1)
          info%maps_seconds = t1 - t0
          call write_results(prefix, problem, res, maps, info, st)
@@ -614,7 +619,8 @@ contains
       text = problem%label//"|"//int_str(problem%np)//"|"//format_real(problem%pixel)//"|"// &
          int_str(problem%maxcont)//"|"//reals(problem%young)//reals(problem%poisson)//trim(options%solver)//"|"// &
          reals(options%loads)//int_str(options%max_contacts)//"|"//format_real(options%hardness)//"|"// &
-         trim(merge("plastic|", "        ", options%plastic))// &
+         trim(merge("plastic|", "        ", options%plastic))//trim(merge("periodic|", "         ", &
+         options%boundary == "periodic"))// &
          format_real(options%tie_tolerance)//"|"//merge("T", "F", options%final_check)//"|"// &
          trim(options%event_search)//"|"//format_real(options%cg%tol)//"|"//int_str(options%cg%max_iterations)//"|"
       do k = 1, size(digests)

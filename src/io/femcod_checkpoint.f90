@@ -99,6 +99,7 @@ contains
          call h5_write(file, "/options/final_check", merge(1, 0, options%final_check), "1", status)
          call h5_write(file, "/options/event_search", merge(1, 0, options%event_search == "fft") + &
             2*merge(1, 0, options%event_search == "bound"), "1", status)
+         call h5_write(file, "/options/periodic", merge(1, 0, options%boundary == "periodic"), "1", status)
          if (status%code == 0) then
             call state%visit(writer)
             if (writer%status%code /= 0) call set_error(status, writer%status%code, writer%status%message)
@@ -214,6 +215,14 @@ contains
       if (status%code == 0 .and. i /= merge(1, 0, options%event_search == "fft") + &
          2*merge(1, 0, options%event_search == "bound")) then
          call refuse("written with another --event-search")
+         return
+      end if
+      ! Checkpoints older than --boundary have no entry: they are of the free boundary.
+      i = 0
+      if (status%code == 0 .and. h5_exists(file, "/options/periodic")) call h5_read(file, "/options/periodic", i, &
+         status, bad)
+      if (status%code == 0 .and. (i == 1 .neqv. options%boundary == "periodic")) then
+         call refuse("written with another --boundary")
          return
       end if
       if (status%code /= 0) then

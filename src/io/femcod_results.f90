@@ -28,6 +28,8 @@ module femcod_results
    !> What the run was, for /run in the HDF5 file.
    type :: run_info
       character(len=:), allocatable :: version, solver, options
+      !> The lateral boundary, "free" or "periodic" (--boundary).
+      character(len=:), allocatable :: boundary
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
       !> The input files, one line each: the deck, or what each height file gave
@@ -372,6 +374,7 @@ contains
       if (allocated(info%started)) call h5_attribute(file, "/run", "started", info%started, local)
       if (allocated(info%finished)) call h5_attribute(file, "/run", "finished", info%finished, local)
       call h5_attribute(file, "/run", "solver", info%solver, local)
+      call h5_attribute(file, "/run", "boundary", run_boundary(info), local)
       call h5_attribute(file, "/run", "options", info%options, local)
       call h5_attribute(file, "/run", "wall_time_s", res%wall_seconds, local)
       call h5_attribute(file, "/run", "stop_reason", stop_reason_text(res%stop_reason), local)
@@ -586,6 +589,7 @@ contains
          '    "poisson": {"lower": '//json_number(deck%poisson(1))//', "upper": '//json_number(deck%poisson(2))// &
          ', "contact": '//json_number(deck%poisson(3))//'}},'//nl// &
          '  "solver": '//json_string(info%solver)//','//nl// &
+         '  "boundary": '//json_string(run_boundary(info))//','//nl// &
          '  "steps": '//int_str(last)//','//nl// &
          '  "stopped": '//json_string(stop_reason_text(res%stop_reason))//','//nl
       if (last > 0) then
@@ -671,4 +675,12 @@ contains
       call h5_close(file, local)
       if (local%code /= 0) hex = ""
    end function stored_fingerprint
+
+   !> The run's boundary ("free" unless the caller says otherwise).
+   pure function run_boundary(info) result(text)
+      type(run_info), intent(in) :: info
+      character(len=:), allocatable :: text
+      text = "free"
+      if (allocated(info%boundary)) text = info%boundary
+   end function run_boundary
 end module femcod_results

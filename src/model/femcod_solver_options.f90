@@ -6,11 +6,15 @@ module femcod_solver_options
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: contact_options, cg_settings, SOLVER_NAMES
+   public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES
 
    !> The solvers by name: the event-exact incremental solver, the Appendix B program,
    !> and the fixed-load constrained conjugate gradients.
    character(len=*), parameter :: SOLVER_NAMES(3) = [character(len=11) :: "incremental", "legacy", "cg"]
+
+   !> The lateral boundary: the thesis' half-space with the grid alone on it (free), or
+   !> the grid as one cell of a surface that repeats in both directions (periodic).
+   character(len=*), parameter :: BOUNDARY_NAMES(2) = [character(len=8) :: "free", "periodic"]
 
    !> The cg solver's own options (solvers/femcod_cg). The accelerations default to on;
    !> each can be switched off.
@@ -54,6 +58,8 @@ module femcod_solver_options
    type :: contact_options
       !> One of SOLVER_NAMES.
       character(len=11) :: solver = "incremental"
+      !> One of BOUNDARY_NAMES: "free" (default) or "periodic" (femcod_love_periodic).
+      character(len=8) :: boundary = "free"
       !> Stop after this many contacts (0: the deck's MAXCONT; the event solvers only).
       integer :: max_contacts = 0
       !> Requested total loads (nN); empty: the event solvers run to MAXCONT.

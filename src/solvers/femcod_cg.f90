@@ -50,6 +50,7 @@ module femcod_cg
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
    use femcod_love, only: offset_table, surface_compliance
+   use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
@@ -77,6 +78,8 @@ module femcod_cg
    !> compliance s (nm/nN), the Love table and its convolution.
    type :: cg_grid
       integer :: np = 0
+      !> The grid is one cell of a periodic surface (periodic table, cyclic convolution).
+      logical :: periodic = .false.
       real(dp) :: pixel = 0, c = 0, s = 0, scale = 1
       real(dp), allocatable :: g0(:, :), table(:, :)
       !> Preconditioner taps (inverse_kernel_taps); `preconditioned` false: none.
@@ -114,7 +117,8 @@ contains
          call set_error(status, STATUS_NUMERICAL, "cg: --solver cg needs --loads")
          return
       end if
-      call make_grid(fine, transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np])), problem, problem%pixel, how)
+      call make_grid(fine, transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np])), problem, &
+         problem%pixel, how, options%boundary == "periodic")
       allocate(p(np, np))
       if (options%plastic) then
          g0 = fine%g0
@@ -308,14 +312,17 @@ contains
       end if
    end subroutine capped_solve
 
-   !> A grid for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's materials.
-   subroutine make_grid(grid, g0, problem, pixel, how)
+   !> A grid for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's materials, one
+   !> cell of a periodic surface when `periodic`.
+   subroutine make_grid(grid, g0, problem, pixel, how, periodic)
       type(cg_grid), intent(inout) :: grid
       real(dp), intent(in) :: g0(:, :)
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: pixel
       type(cg_settings), intent(in) :: how
+      logical, intent(in) :: periodic
       grid%np = size(g0, 1)
+      grid%periodic = periodic
       grid%pixel = pixel
       grid%g0 = g0
       grid%c = surface_compliance(problem%young(1), problem%poisson(1), pixel) + &
@@ -323,8 +330,12 @@ contains
       grid%s = 3/spring_stiffness(problem%young(3), problem%poisson(3), pixel, pixel)
       grid%scale = max(maxval(g0) - minval(g0), tiny(1.0_dp))
       allocate(grid%table(0:grid%np - 1, 0:grid%np - 1))
-      grid%table = offset_table(grid%np)
-      call convolution_setup(grid%conv, grid%table, how%single_until > 0, how%measure_plans)
+      if (periodic) then
+         grid%table(:, :) = periodic_offset_table(grid%np)
+      else
+         grid%table(:, :) = offset_table(grid%np)
+      end if
+      call convolution_setup(grid%conv, grid%table, how%single_until > 0, how%measure_plans, periodic)
       if (how%precondition) call inverse_kernel_taps(grid%conv, grid%taps, grid%preconditioned)
    end subroutine make_grid
 
@@ -366,7 +377,7 @@ contains
       end if
       n = n/2
       call make_grid(coarse, (grid%g0(1::2, 1::2) + grid%g0(2::2, 1::2) + grid%g0(1::2, 2::2) + &
-         grid%g0(2::2, 2::2))/4, problem, 2*grid%pixel, how)
+         grid%g0(2::2, 2::2))/4, problem, 2*grid%pixel, how, grid%periodic)
       allocate(pc(n, n))
       call nested_start(coarse, problem, total_load, how, pc, rep, status, observer)
       if (status%code == 0) call constrained_cg(coarse, total_load, how%coarse_tol, 10000, how, pc, approach, &

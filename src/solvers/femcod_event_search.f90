@@ -196,7 +196,7 @@ contains
       integer :: qq, iq, jq, np
       np = state%np
       if (search%conv%m == 0) then
-         call convolution_setup(search%conv, state%table)
+         call convolution_setup(search%conv, state%table, periodic=state%periodic)
          allocate(search%field_f(np, np), search%field_u(np, np), search%disp_f(np, np), search%disp_u(np, np))
       end if
       search%field_f = 0

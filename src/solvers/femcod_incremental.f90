@@ -208,7 +208,7 @@ contains
       do qq = 1, state%n
          field(state%ic(qq), state%jc(qq)) = state%ftot(qq)
       end do
-      call convolution_setup(conv, state%table)
+      call convolution_setup(conv, state%table, periodic=state%periodic)
       call convolution_apply(conv, field, disp)
       call convolution_free(conv)
       worst = 0

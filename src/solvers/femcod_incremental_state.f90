@@ -24,6 +24,7 @@ module femcod_incremental_state
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
    use femcod_love, only: offset_table, surface_compliance
+   use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
    use femcod_lapack, only: dtrsv, dtrsm, dpotrf
    use femcod_condensed, only: gap_and_rate
@@ -51,6 +52,10 @@ module femcod_incremental_state
       integer :: np = 0, npix = 0, maxc = 0, kc = 0
       real(dp) :: c = 0, s = 0, self = 0
       real(dp), allocatable :: table(:, :), g0(:)
+      !> The grid is one cell of a periodic surface (--boundary periodic); the smallest
+      !> entry of the table if negative, else 0 (for the gap bound of unit_load).
+      logical :: periodic = .false.
+      real(dp) :: table_min = 0
       !> Steps done, contacts n; per contact: row, column, pixel, step joined, total force
       !> (nN) and force per unit load increment; slot(p): the contact at pixel p (0: none).
       integer :: step = 0, n = 0
@@ -101,7 +106,14 @@ contains
       self%npix = self%np*self%np
       self%maxc = self%path%max_contacts
       allocate(self%table(0:self%np - 1, 0:self%np - 1))
-      self%table = offset_table(self%np)
+      self%periodic = options%boundary == "periodic"
+      if (self%periodic) then
+         self%table(:, :) = periodic_offset_table(self%np)
+      else
+         self%table(:, :) = offset_table(self%np)
+      end if
+      ! The most negative influence (a periodic table's, whose mean is 0; none free).
+      self%table_min = min(minval(self%table), 0.0_dp)
       self%g0 = initial_gaps(problem%lower, problem%upper)
       self%c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
          surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
@@ -187,7 +199,9 @@ contains
 
    !> The solution under a unit load increment: x = M^-1 1 (kept current by add_contact),
    !> beta = 1'x = y'y, delta = 1/beta, funit = x delta, and the fastest closing rate of
-   !> any gap, delta_max = delta + c I(0,0) sum_k max(-funit_k, 0) (since F >= 0).
+   !> any gap, delta_max = delta + c I(0,0) sum_k max(-funit_k, 0) (since F >= 0)
+   !> + c |min I| sum_k max(funit_k, 0) (0 for the free table, positive everywhere;
+   !> a periodic table has negative entries, through which growing forces lift others).
    pure subroutine unit_load(self)
       class(incremental_state), intent(inout) :: self
       real(dp) :: beta
@@ -196,6 +210,7 @@ contains
          self%delta = 1/beta
          self%funit(1:n) = self%x(1:n)*self%delta
          self%delta_max = self%delta + self%c*self%table(0, 0)*sum(max(-self%funit(1:n), 0.0_dp))
+         if (self%table_min < 0) self%delta_max = self%delta_max - self%c*self%table_min*sum(max(self%funit(1:n), 0.0_dp))
       end associate
    end subroutine unit_load
 

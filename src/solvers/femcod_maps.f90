@@ -4,6 +4,7 @@ module femcod_maps
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
    use femcod_love, only: offset_table, surface_compliance
+   use femcod_love_periodic, only: periodic_offset_table
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: load_state
    implicit none
@@ -19,15 +20,18 @@ contains
 
    !> For every reached state: pressure(i, j) (GPa) = contact force / pixel area;
    !> gap(i, j) (nm) = separation of the deformed surfaces, g0 - approach + c (I * F),
-   !> from one zero-padded FFT convolution, and 0 at the contacts (where the penalty
+   !> from one zero-padded FFT convolution (cyclic on a periodic cell), and 0 at the contacts (where the penalty
    !> springs' compression s F is the only remaining separation). The Love table and the
    !> FFT plans are made once for all states, and only when a state lacks the gap map its
    !> solver already had (the cg solver's, from the same formula and its own last
    !> double-precision convolution).
-   subroutine load_maps(problem, states, maps)
+   subroutine load_maps(problem, states, maps, periodic)
       type(contact_problem), intent(in) :: problem
       type(load_state), intent(in) :: states(:)
       type(state_maps), allocatable, intent(out) :: maps(:)
+      !> The grid is one cell of a periodic surface (default: free).
+      logical, intent(in), optional :: periodic
+      logical :: cyclic
       type(love_convolution) :: conv
       real(dp), allocatable :: force(:, :), disp(:, :), g0(:, :), table(:, :)
       real(dp) :: c
@@ -41,13 +45,19 @@ contains
          if (allocated(states(s)%gap)) maps(s)%gap = states(s)%gap
       end do
       if (all(allocated_gap(states) .or. .not. states%reached)) return
+      cyclic = .false.
+      if (present(periodic)) cyclic = periodic
       allocate(force(np, np), disp(np, np), table(0:np - 1, 0:np - 1))
-      table = offset_table(np)
+      if (cyclic) then
+         table(:, :) = periodic_offset_table(np)
+      else
+         table(:, :) = offset_table(np)
+      end if
       c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
          surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
       ! g0 is numbered pixel by pixel along rows: p = (i - 1) np + j.
       g0 = transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np]))
-      call convolution_setup(conv, table)
+      call convolution_setup(conv, table, periodic=cyclic)
       do s = 1, size(states)
          if (.not. states(s)%reached .or. allocated(states(s)%gap)) cycle
          force = 0

@@ -39,6 +39,15 @@ contains
       type(incremental_state), intent(inout), optional :: resume
       type(solver_observer) :: nobody
       if (status%code /= 0) return
+      if (options%boundary /= "free" .and. options%boundary /= "periodic") then
+         call set_error(status, STATUS_USAGE, "unknown boundary '"//trim(options%boundary)//"' (free or periodic)")
+         return
+      end if
+      if (options%boundary == "periodic" .and. options%solver == "legacy") then
+         call set_error(status, STATUS_USAGE, "--boundary periodic: the legacy solver is the Appendix B program "// &
+            "of the free half-space; use --solver incremental or cg")
+         return
+      end if
       if (present(resume) .and. options%solver /= "incremental") then
          call set_error(status, STATUS_USAGE, "only the incremental solver continues from a stored state")
          return
@@ -84,6 +93,7 @@ contains
             "3/k on the diagonal, one composite gap")]
          if (.not. options%plastic) lines = [lines, string_type("no plastic cap: pressures are elastic, "// &
             "n_above_hardness counts the pixels above the hardness (--plastic caps them)")]
+         if (options%boundary == "periodic") lines = [lines, periodic_note(problem%np, "cg")]
          return
       end select
       c1 = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel)
@@ -105,9 +115,25 @@ contains
       end if
       lines = [lines, string_type("interface and penalty springs: an exact diagonal compliance 3/k = "//es(s/cself)// &
          " of a pixel's self-compliance")]
+      if (options%boundary == "periodic") lines = [lines, periodic_note(problem%np, "incremental")]
       if (all(problem%lower == problem%lower(1, 1))) lines = [lines, string_type("lower surface flat")]
       if (all(problem%upper == problem%upper(1, 1))) lines = [lines, string_type("upper surface flat")]
    contains
+      !> What the periodic boundary changes, for `solver`.
+      function periodic_note(np, solver) result(line)
+         integer, intent(in) :: np
+         character(len=*), intent(in) :: solver
+         type(string_type) :: line
+         line%s = "periodic cell of "//int_str(np)//" x "//int_str(np)//" pixels: the Love kernel summed over "// &
+            "all images (zero-mean displacements; approach = fall of the mean gap)"
+         if (solver == "cg") then
+            line%s = line%s//"; cyclic transforms of "//int_str(np)//"^2, no padding (the free boundary's are "// &
+               int_str(2*np)//"^2)"
+         else
+            line%s = line%s//"; the event path and its checks as for the free boundary, on the periodic table"
+         end if
+      end function periodic_note
+
       !> es9.2 without blanks, as the summary has always printed these ratios.
       function es(x) result(text)
          real(dp), intent(in) :: x
