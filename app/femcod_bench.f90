@@ -5,7 +5,7 @@ module femcod_bench
    use femcod_status, only: status_type
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
-   use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR, verification_spec
+   use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR, RIGID_FACTOR, verification_spec
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options, cg_settings
    use femcod_solver, only: solve_contact
@@ -20,6 +20,7 @@ module femcod_bench
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free
    use femcod_love, only: offset_table
+   use femcod_love_periodic, only: periodic_love_spectrum
    use femcod_random, only: random_stream, seed_stream, uniform
    use femcod_clock, only: wall_clock
    use femcod_deck, only: write_deck
@@ -63,6 +64,10 @@ contains
             call bench_io(args(2:), code)
             return
          end if
+         if (args(1)%s == "periodic") then
+            call bench_periodic(args(2:), code)
+            return
+         end if
       end if
       legacy_contacts = 300
       full = .false.
@@ -71,6 +76,7 @@ contains
             "       femcod bench cg [--np LIST] [--contact LIST] [--tol T] [--peers PYTHON]  (--help for more)", &
             "       femcod bench convolution [--np LIST] [--repeat N]  (--help for more)", &
             "       femcod bench io [--np LIST] [--dir DIR]  (--help for more)", &
+            "       femcod bench periodic [--np LIST] [--contact LIST]  (--help for more)", &
             "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
             "event, peak memory (resident, per case), error against the reference. The rough surface:", &
             "self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa, nu = 0.25, against a", &
@@ -465,6 +471,148 @@ contains
       table = [integer_list_option("--np", "N1,...", "grid sizes (default 512,1024,2048)", lower=2), &
          text_option("--dir", "DIR", "where the decks and results go (default femcod-bench-io)")]
    end function bench_io_table
+
+   !> `femcod bench periodic`: the periodic boundary against Westergaard's sinusoid at 64
+   !> to 1024 pixels per period (the discretisation error and its order), and the cost of
+   !> the periodic cg solver against the free one on the benchmark surface.
+   subroutine bench_periodic(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      real(dp), parameter :: pi = acos(-1.0_dp), widths(3) = [1.0_dp/6, 1.0_dp/4, 1.0_dp/3]
+      character(len=*), parameter :: boundaries(2) = [character(len=8) :: "free", "periodic"]
+      integer, allocatable :: sizes(:), rough_sizes(:)
+      real(dp), allocatable :: fractions(:), z(:, :), g0(:, :), s(:, :), previous(:)
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(parsed_options) :: parsed
+      real(dp) :: estar, pstar, lambda, ratio, closed, slope, load, peak
+      real(dp), allocatable :: approach_error(:)
+      integer :: n, np, j, k, b, width
+      sizes = [64, 128, 256, 512, 1024]
+      rough_sizes = [512, 1024]
+      fractions = [1.0_dp, 10.0_dp]
+      if (help_requested(args)) then
+         write(output_unit, '(a)') &
+            "usage: femcod bench periodic [--np 64,128,256,512,1024] [--rough-np 512,1024] [--contact 1,10]", &
+            "1. Westergaard's sinusoid h = cos(2 pi x / lambda) nm, lambda = NP pixels of 1 nm, E = 200 GPa,", &
+            "   nu = 0.25, on a rigid flat, --boundary periodic, cg to 1e-10: at the mean pressures of the", &
+            "   contact half-widths a/lambda = 1/6, 1/4, 1/3 (p = p* sin^2(pi a/lambda), p* = pi E* h0/lambda),", &
+            "   the contact width on a row against 2a (pixels), the approach against the closed form", &
+            "   A/h0 = (p/p*)(1 - ln(p/p*)) with its observed order, and the discrete full-contact pressure", &
+            "   against p* (from the kernel's spectrum: p_full/p* = NP/S(1/NP, 0)).", &
+            "2. The benchmark surface (self-affine, periodic by construction) at --contact fractions,", &
+            "   cg with each boundary: wall time, iterations, contact %, peak RSS.", ""
+         call print_lines(option_help(bench_periodic_table(), ""))
+         write(output_unit, '(a)') "Run it with the release build."
+         return
+      end if
+      call parse_options(bench_periodic_table(), args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench periodic: "//bad_arguments(status, parsed)//" (--help)"
+         code = 2
+         return
+      end if
+      call get_option(parsed, "--np", sizes)
+      call get_option(parsed, "--rough-np", rough_sizes)
+      call get_option(parsed, "--contact", fractions)
+      options%solver = "cg"
+      options%boundary = "periodic"
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-10_dp
+      options%cg%max_iterations = 5000
+      estar = 200/(1 - 0.25_dp**2)
+      write(output_unit, '(a)') "| pixels per period | a/lambda | width (pixels) | 2a (pixels) | approach (nm) | "// &
+         "closed form (nm) | relative error | order | p_full/p* - 1 | wall (s) |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|---|"
+      allocate(previous(size(widths)), approach_error(size(widths)))
+      previous = 0
+      do n = 1, size(sizes)
+         np = sizes(n)
+         allocate(z(np, np))
+         do j = 1, np
+            z(:, j) = cos(2*pi*(j - 1)/np)
+         end do
+         deck%label = "bench periodic"
+         deck%np = np
+         deck%pixel = 1
+         deck%maxcont = np*np
+         deck%young = [200.0_dp, 200*RIGID_FACTOR, 200*RIGID_FACTOR]
+         deck%poisson = 0.25_dp
+         deck%lower = z
+         deck%upper = 0*z
+         lambda = np*deck%pixel
+         pstar = pi*estar/lambda
+         options%loads = [(pstar*sin(pi*widths(k))**2*lambda**2, k = 1, size(widths))]
+         call solve_contact(deck, options, res, status)
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod bench periodic: "//status%message
+            code = status%code
+            return
+         end if
+         allocate(s(0:np/2, 0:np/2))
+         s(:, :) = periodic_love_spectrum(np)
+         do k = 1, size(widths)
+            width = count(res%states(k)%i == 1)
+            ratio = sin(pi*widths(k))**2
+            closed = ratio*(1 - log(ratio))
+            approach_error(k) = abs(res%states(k)%approach/closed - 1)
+            write(output_unit, '(a)') "| "//int_str(np)//" | 1/"//int_str(nint(1/widths(k)))//" | "//int_str(width)// &
+               " | "//fixed_str(2*widths(k)*np, 2)//" | "//real_str(res%states(k)%approach, 8)//" | "// &
+               real_str(closed, 8)//" | "//real_str(approach_error(k), 2)//" | "// &
+               trim(merge(fixed_str(log(previous(k)/approach_error(k))/log(2.0_dp), 2), "-                 ", &
+               previous(k) > 0 .and. approach_error(k) > 0))//" | "//real_str(np/s(1, 0) - 1, 3)//" | "// &
+               fixed_str(res%wall_seconds, 2)//" |"
+         end do
+         previous = approach_error
+         flush(output_unit)
+         deallocate(z, s)
+      end do
+      write(output_unit, '(a)') "", "| NP | target % | boundary | wall (s) | iterations | contact % | peak RSS (MB) |", &
+         "|---|---|---|---|---|---|---|"
+      do n = 1, size(rough_sizes)
+         np = rough_sizes(n)
+         call benchmark_surface(np, "bench periodic", deck, status)
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod bench periodic: "//status%message
+            code = status%code
+            return
+         end if
+         call linear_law(deck, estar, slope, g0)
+         do k = 1, size(fractions)
+            load = fractions(k)/100*estar*slope/2*BENCH_LENGTH**2
+            do b = 1, size(boundaries)
+               options%boundary = boundaries(b)
+               options%loads = [load]
+               options%cg = cg_settings()
+               call reset_peak()
+               call solve_contact(deck, options, res, status)
+               peak = peak_mb()
+               if (status%code /= 0) then
+                  write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | "// &
+                     trim(boundaries(b))//" | "//status%message//" | | | |"
+                  status = status_type()
+                  cycle
+               end if
+               write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | "// &
+                  trim(boundaries(b))//" | "//fixed_str(res%wall_seconds, 2)//" | "// &
+                  int_str(res%states(1)%iterations)//" (+"//int_str(res%states(1)%coarse_iterations)//" coarse) | "// &
+                  fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)//" | "//fixed_str(peak, 0)//" |"
+               flush(output_unit)
+            end do
+         end do
+      end do
+   end subroutine bench_periodic
+
+   function bench_periodic_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [integer_list_option("--np", "N1,...", "pixels per period of the sinusoid (default "// &
+         "64,128,256,512,1024)", lower=8), &
+         integer_list_option("--rough-np", "N1,...", "sizes of the benchmark surface (default 512,1024)", lower=8), &
+         real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,10)", lower=0.0_dp)]
+   end function bench_periodic_table
 
    !> `femcod bench cg`: the fixed-load solver on self-affine surfaces of growing size at
    !> the mean pressures that give about the requested contact fractions, side by side with
