@@ -19,6 +19,8 @@ module test_cg
    use femcod_random, only: random_stream, seed_stream, uniform
    use test_support, only: scratch_path, file_exists, remove_scratch
    use femcod_analytic, only: hertz_approach, segedin_sphere
+   use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
+   use femcod_status, only: STATUS_BAD_INPUT
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -31,14 +33,19 @@ contains
       testsuite = [ &
          new_unittest("equals the event-exact solver inside steps on every input/ deck", test_against_incremental), &
          new_unittest("sphere, 0.5 nm mesh: Hertz at 1000 nN, Segedin at 18000 nN", test_sphere), &
-         new_unittest("usage errors: no --loads; --plastic without cg or at full capacity", test_usage), &
+         new_unittest("usage errors: no --loads; --plastic with legacy or at full capacity", test_usage), &
          new_unittest("the gap maps it hands over equal a direct sum over the Love table", test_gap_maps), &
-         new_unittest("--plastic: a hardness no pixel reaches gives the elastic answer bit for bit", test_plastic_inert), &
-         new_unittest("--plastic: equals a dense bounded QP solution (8 x 8 rough surface) to 1e-8", &
+         new_unittest("--plastic: a hardness no pixel reaches gives the elastic answer bit for bit (both)", &
+            test_plastic_inert), &
+         new_unittest("--plastic: the event path equals cg inside its steps (contacts, plastic, approach)", &
+            test_plastic_paths), &
+         new_unittest("--plastic, cg and event path: equal a dense bounded QP solution (8 x 8) to 1e-8", &
             test_plastic_dense), &
          new_unittest("--plastic: contact area tends to load / H as H -> 0 (bearing area)", test_plastic_bearing), &
          new_unittest("--plastic: 90 % plastic area converges, no pressure above H", test_plastic_90), &
          new_unittest("--plastic: a square punch past full plasticity carries A H", test_plastic_punch), &
+         new_unittest("--plastic maps, both solvers: gap = -plastic displacement where capped, 0 on contact", &
+            test_plastic_maps), &
          new_unittest("pruned padded FFT convolution equals the direct sum (NP 7, 8, 33)", test_convolution), &
          new_unittest("preconditioner taps equal the inverse of a direct DFT (NP 4, 5, 9)", test_inverse_taps), &
          new_unittest("every acceleration, alone and together, keeps the event-exact answer", test_accelerations), &
@@ -216,7 +223,8 @@ contains
    end function plastic_options
 
    !> With a hardness far above every elastic pressure no pixel is capped: the forces
-   !> and approach equal the elastic solve's exactly (the same operations).
+   !> and approach equal the elastic solve's exactly (the same operations), for cg and
+   !> for the event path (its whole history).
    subroutine test_plastic_inert(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_problem) :: deck
@@ -241,6 +249,22 @@ contains
             all(capped%states(k)%gap == elastic%states(k)%gap), "load "//to_string(k)//": bit for bit")
          if (allocated(error)) return
       end do
+      ! The event path: the same history, step by step, bit for bit.
+      options%solver = "incremental"
+      call solve_contact(deck, options, elastic, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      options%plastic = .true.
+      call solve_contact(deck, options, capped, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, capped%nsteps, elastic%nsteps, "event path: steps")
+      if (allocated(error)) return
+      k = elastic%nsteps
+      call check(error, all(capped%step_load(1:k) == elastic%step_load(1:k)) .and. &
+         all(capped%step_approach(1:k) == elastic%step_approach(1:k)) .and. &
+         all(capped%step_contacts(1:k) == elastic%step_contacts(1:k)) .and. all(capped%step_plastic(1:k) == 0) .and. &
+         all(capped%states(2)%force == elastic%states(2)%force), "event path: the history bit for bit")
    end subroutine test_plastic_inert
 
    !> The bounded problem on an 8 x 8 rough surface solved independently of the cg code:
@@ -249,7 +273,8 @@ contains
    !> projected gradients (the projection a shift found by bisection), then the active
    !> sets it found solved exactly (the KKT system of the free forces and the approach,
    !> Gaussian elimination) and checked. Forces agree to 1e-8 of H d^2, the approach to
-   !> 1e-8 of the height range, with cg at tol 1e-12.
+   !> 1e-8 of the height range, with cg at tol 1e-12 and with the event path (the
+   !> incremental solver's plastic events: contacts reaching H d^2 leave the elastic set).
    subroutine test_plastic_dense(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_problem) :: deck
@@ -259,7 +284,7 @@ contains
       integer, parameter :: np = 8, n = np*np
       real(dp) :: cmat(n, n), g0(n), f(n), y(n), kkt(n + 1, n + 1), rhs(n + 1), gap(n), table(0:np - 1, 0:np - 1)
       real(dp) :: c, s, fmax, load, eta, hardness, approach, range, lo, hi, lam, piv
-      integer :: a, b, it, k, m, nf, row
+      integer :: a, b, it, k, m, nf, row, solver
       integer :: free(n)
       logical :: capped(n), zero(n)
       real(dp), allocatable :: cg_force(:)
@@ -353,25 +378,86 @@ contains
       call check(error, all(pack(gap, zero) >= -1.0e-12_dp*range) .and. all(pack(gap, capped) <= 1.0e-12_dp*range), &
          "the reference satisfies the complementarity on the sets it found")
       if (allocated(error)) return
-      options = plastic_options([load], hardness, 1.0e-12_dp)
-      call solve_contact(deck, options, res, status)
+      ! Both solvers: cg by rounds on the plastic set, the event path by its plastic
+      ! events along the loading.
+      deck%maxcont = n
+      allocate(cg_force(n))
+      do solver = 1, 2
+         options = plastic_options([load], hardness, 1.0e-12_dp)
+         if (solver == 2) options%solver = "incremental"
+         call solve_contact(deck, options, res, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         cg_force = 0
+         do k = 1, size(res%states(1)%force)
+            cg_force((res%states(1)%i(k) - 1)*np + res%states(1)%j(k)) = res%states(1)%force(k)
+         end do
+         call check(error, maxval(abs(cg_force - f)) <= 1.0e-8_dp*fmax, trim(options%solver)// &
+            ": forces: largest difference "//to_string(maxval(abs(cg_force - f))/fmax)//" of H d^2")
+         if (allocated(error)) return
+         call check(error, res%states(1)%n_plastic, count(capped), trim(options%solver)//": plastic pixels")
+         if (allocated(error)) return
+         ! The approach in femcod's sense is the contacts' mean gap before the shift; the
+         ! multiplier A here is the same quantity.
+         call check(error, abs(res%states(1)%approach - approach) <= 1.0e-8_dp*range, trim(options%solver)// &
+            ": approach "//to_string(res%states(1)%approach)//" against "//to_string(approach))
+         if (allocated(error)) return
+      end do
+   end subroutine test_plastic_dense
+
+   !> The event path's plastic events against cg's rounds on the plastic set, two
+   !> independent algorithms for the same bounded problem: on a 32 x 32 rough surface with
+   !> a hardness that caps part of the contact, at the midpoints of five steps of the
+   !> event history (where the sets are unambiguous), the same contacts and plastic
+   !> pixels, the approach to 1e-8, and no pressure above H (measured: 436 to 897 of
+   !> the 758 to 979 contacts plastic, 1876 steps).
+   subroutine test_plastic_paths(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: inc, cg
+      type(status_type) :: status
+      real(dp), allocatable :: loads(:)
+      real(dp) :: hardness
+      integer :: k, n, m
+      call rough_scene(32, 5, deck)
+      deck%maxcont = 400
+      hardness = 20
+      options = plastic_options([real(dp) ::], hardness, 1.0e-12_dp)
+      options%solver = "incremental"
+      call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
-      allocate(cg_force(n))
-      cg_force = 0
-      do k = 1, size(res%states(1)%force)
-         cg_force((res%states(1)%i(k) - 1)*np + res%states(1)%j(k)) = res%states(1)%force(k)
+      n = inc%nsteps
+      call check(error, maxval(inc%step_plastic(1:n)) > 0, "the case caps no pixel")
+      if (allocated(error)) return
+      m = min(5, n - 1)
+      allocate(loads(m))
+      do k = 1, m
+         associate(s => n/2 + (k*(n - 1 - n/2))/(m + 1))
+            loads(k) = (inc%step_load(s) + inc%step_load(s + 1))/2
+         end associate
       end do
-      call check(error, maxval(abs(cg_force - f)) <= 1.0e-8_dp*fmax, "forces: largest difference "// &
-         to_string(maxval(abs(cg_force - f))/fmax)//" of H d^2")
+      options%loads = loads
+      call solve_contact(deck, options, inc, status)
+      call check(error, status%code, 0, status%message)
       if (allocated(error)) return
-      call check(error, res%states(1)%n_plastic, count(capped), "plastic pixels")
+      options%solver = "cg"
+      call solve_contact(deck, options, cg, status)
+      call check(error, status%code, 0, status%message)
       if (allocated(error)) return
-      ! The approach in femcod's sense is the contacts' mean gap before the shift; the
-      ! multiplier A here is the same quantity.
-      call check(error, abs(res%states(1)%approach - approach) <= 1.0e-8_dp*range, "approach "// &
-         to_string(res%states(1)%approach)//" against "//to_string(approach))
-   end subroutine test_plastic_dense
+      do k = 1, m
+         call check(error, inc%states(k)%contacts, cg%states(k)%contacts, "contacts at "//to_string(loads(k)))
+         if (allocated(error)) return
+         call check(error, inc%states(k)%n_plastic, cg%states(k)%n_plastic, "plastic at "//to_string(loads(k)))
+         if (allocated(error)) return
+         call check(error, inc%states(k)%approach, cg%states(k)%approach, rel=.true., thr=1.0e-8_dp, &
+            message="approach at "//to_string(loads(k)))
+         if (allocated(error)) return
+         call check(error, inc%states(k)%max_pressure <= hardness*(1 + 1.0e-12_dp), "a pressure above H")
+         if (allocated(error)) return
+      end do
+   end subroutine test_plastic_paths
 
    !> As H -> 0 every contact is plastic and the area tends to the bearing area P / H
    !> (from above: the elastic pixels carry less than H d^2 each). Checked on a 64 x 64
@@ -450,7 +536,7 @@ contains
       type(status_type) :: status
       real(dp), allocatable :: g0(:, :)
       real(dp) :: hardness, capacity, face
-      integer :: k, nface
+      integer :: k, nface, solver
       call read_deck("input/square_punch_n9.deck", deck, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -460,22 +546,85 @@ contains
       if (allocated(error)) return
       hardness = 5
       capacity = nface*hardness*deck%pixel**2
-      options = plastic_options([0.99_dp*capacity, 1.01_dp*capacity], hardness, 1.0e-10_dp)
-      call solve_contact(deck, options, res, status)
-      call check(error, status%code, 0, status%message)
-      if (allocated(error)) return
-      call check(error, res%states(1)%contacts, nface, "below A H: the face's pixels only")
-      if (allocated(error)) return
-      call check(error, res%states(2)%contacts > nface .and. res%states(2)%n_plastic == nface, &
-         "above A H: the face plastic ("//to_string(res%states(2)%n_plastic)//") and more contacts ("// &
-         to_string(res%states(2)%contacts)//")")
-      if (allocated(error)) return
-      face = 0
-      do k = 1, size(res%states(2)%force)
-         if (g0(res%states(2)%i(k), res%states(2)%j(k)) == minval(g0)) face = face + res%states(2)%force(k)
+      deck%maxcont = deck%np**2
+      do solver = 1, 2
+         options = plastic_options([0.99_dp*capacity, 1.01_dp*capacity], hardness, 1.0e-10_dp)
+         if (solver == 2) options%solver = "incremental"
+         call solve_contact(deck, options, res, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         call check(error, res%states(1)%contacts, nface, trim(options%solver)//": below A H: the face's pixels only")
+         if (allocated(error)) return
+         call check(error, res%states(2)%contacts > nface .and. res%states(2)%n_plastic == nface, &
+            trim(options%solver)//": above A H: the face plastic ("//to_string(res%states(2)%n_plastic)// &
+            ") and more contacts ("//to_string(res%states(2)%contacts)//")")
+         if (allocated(error)) return
+         face = 0
+         do k = 1, size(res%states(2)%force)
+            if (g0(res%states(2)%i(k), res%states(2)%j(k)) == minval(g0)) face = face + res%states(2)%force(k)
+         end do
+         call check(error, face, capacity, rel=.true., thr=1.0e-12_dp, message=trim(options%solver)// &
+            ": the face carries A H")
+         if (allocated(error)) return
       end do
-      call check(error, face, capacity, rel=.true., thr=1.0e-12_dp, message="the face carries A H")
    end subroutine test_plastic_punch
+
+   !> The maps femcod run writes with --plastic (input/sphere_d1.deck at 1000 nN, Hertz
+   !> peak pressure about 34 GPa, capped at H = 20 GPa), from each solver: the pressure is
+   !> H where the plastic displacement is positive and nowhere above it; the gap is minus
+   !> the plastic displacement there, 0 on the other contacts (to 1e-12 nm) and nowhere
+   !> negative elsewhere; the two solvers' maps agree (cg at 1e-12: to 1e-8 of the
+   !> largest plastic displacement).
+   subroutine test_plastic_maps(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(h5_file) :: file
+      type(status_type) :: st
+      character(len=:), allocatable :: prefix
+      real(dp), allocatable :: gap(:, :), pressure(:, :), plastic(:, :), first(:, :)
+      integer :: code, solver
+      do solver = 1, 2
+         prefix = scratch_path("plastic-maps-"//trim(merge("cg         ", "incremental", solver == 1)))
+         if (solver == 1) then
+            call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--solver"), &
+               string_type("cg"), string_type("--tol"), string_type("1e-12"), string_type("--plastic"), &
+               string_type("--hardness"), string_type("20"), string_type("--loads"), string_type("1000"), &
+               string_type("-o"), string_type(prefix), string_type("--quiet"), string_type("--force")], code)
+         else
+            call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--plastic"), &
+               string_type("--hardness"), string_type("20"), string_type("--loads"), string_type("1000"), &
+               string_type("-o"), string_type(prefix), string_type("--quiet"), string_type("--force")], code)
+         end if
+         call check(error, code, 0, "the run")
+         if (allocated(error)) return
+         call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/loads/001/gap", gap, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/loads/001/pressure", pressure, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/loads/001/plastic_displacement", plastic, st, STATUS_BAD_INPUT)
+         call h5_close(file, st)
+         call check(error, st%code, 0, st%message)
+         if (allocated(error)) return
+         call check(error, count(plastic > 0) > 0 .and. maxval(pressure) <= 20*(1 + 1.0e-12_dp), &
+            "capped pixels, no pressure above H")
+         if (allocated(error)) return
+         call check(error, all(abs(pack(pressure, plastic > 0) - 20) <= 1.0e-12_dp*20), "pressure H where capped")
+         if (allocated(error)) return
+         call check(error, maxval(abs(pack(gap + plastic, plastic > 0))) <= 1.0e-12_dp, &
+            "gap = -plastic displacement where capped")
+         if (allocated(error)) return
+         call check(error, maxval(abs(pack(gap, pressure > 0 .and. .not. plastic > 0))) <= 1.0e-12_dp, &
+            "gap 0 on the elastic contacts")
+         if (allocated(error)) return
+         call check(error, minval(pack(gap, .not. pressure > 0)) >= -1.0e-12_dp, "no penetration off contact")
+         if (allocated(error)) return
+         if (solver == 1) then
+            first = plastic
+         else
+            call check(error, maxval(abs(plastic - first)) <= 1.0e-8_dp*maxval(first), &
+               "the two solvers' plastic displacements differ by "//to_string(maxval(abs(plastic - first))))
+            if (allocated(error)) return
+         end if
+      end do
+   end subroutine test_plastic_maps
 
    subroutine test_usage(error)
       type(error_type), allocatable, intent(out) :: error
@@ -485,12 +634,13 @@ contains
          string_type("cg"), string_type("--quiet")], code)
       call check(error, code, 2)
       if (allocated(error)) return
-      ! --plastic with an event solver, and a load above the fully plastic capacity
+      ! --plastic with the legacy solver, and a load above the fully plastic capacity
       ! (30^2 pixels of 1 nm^2 at 1 GPa carry at most 900 nN): exit 2, no result file.
       prefix = scratch_path("plastic-refused")
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--plastic"), &
-         string_type("--loads"), string_type("100"), string_type("-o"), string_type(prefix), string_type("--quiet")], code)
-      call check(error, code, 2, "--plastic with the incremental solver")
+         string_type("--solver"), string_type("legacy"), string_type("--loads"), string_type("100"), string_type("-o"), &
+         string_type(prefix), string_type("--quiet")], code)
+      call check(error, code, 2, "--plastic with the legacy solver")
       if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--solver"), &
          string_type("cg"), string_type("--plastic"), string_type("--hardness"), string_type("1"), &

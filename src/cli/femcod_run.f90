@@ -96,7 +96,8 @@ contains
             "thesis; periodic: the grid is one cell of a surface repeating with period NP d in both directions "// &
             "(incremental and cg solvers; zero-mean displacements, the approach is the fall of the mean gap)"), &
          flag_option("--plastic", "elastic-perfectly-plastic interface: no pixel's pressure exceeds the hardness; "// &
-            "a capped pixel carries H d^2 and interpenetrates (its plastic displacement, in PREFIX.h5)", mode="cg"), &
+            "a capped pixel carries H d^2 and interpenetrates (its plastic displacement, in PREFIX.h5)", &
+            mode="cg|incremental"), &
          flag_option("--quiet", "no summary on standard output, no progress lines on standard error", alias="-q"), &
          flag_option("--force", "replace existing results as a whole set, and a checkpoint of an interrupted run "// &
             "(otherwise both are kept and the deck fails with exit code 5 before it is solved); an input file is "// &

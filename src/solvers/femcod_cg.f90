@@ -124,12 +124,6 @@ contains
          g0 = fine%g0
          allocate(res%step_plastic(0), capped(np, np))
          capped = .false.
-         if (maxval(options%loads) >= real(np, dp)**2*options%hardness*problem%pixel**2) then
-            call set_error(status, STATUS_USAGE, "--plastic: load "//format_real(maxval(options%loads))// &
-               " nN is at or above the fully plastic capacity NP^2 H d^2 = "// &
-               format_real(real(np, dp)**2*options%hardness*problem%pixel**2)//" nN")
-            return
-         end if
       end if
       ! Ascending loads, each warm-started from the last.
       allocate(order(m))

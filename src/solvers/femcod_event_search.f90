@@ -39,6 +39,15 @@ module femcod_event_search
       !> The pixels that close at lam_best (ties within the tie tolerance), in pixel order.
       integer :: njoin = 0
       integer, allocatable :: joiners(:)
+      !> The plastic cap: the smallest load increment at which a contact reaches fmax or a
+      !> capped pixel's gap opens again (huge: none); the contacts' pixels that cap and
+      !> the capped pixels that unload at lam_best (ties within the tie tolerance); the
+      !> capped pixels' gaps (nm, minus their plastic displacement) and closing rates
+      !> (nm/nN) at the step's start, in the order of the state's plastic list.
+      real(dp) :: lam_plastic = 0
+      integer :: ncap = 0, nuncap = 0
+      integer, allocatable :: cap_pix(:), uncap_pix(:)
+      real(dp), allocatable :: plastic_gap(:), plastic_rate(:)
       !> Whether this step searched the full field.
       logical :: used_fft = .false.
       type(love_convolution) :: conv
@@ -77,8 +86,11 @@ contains
             end if
          end do
 
+         ! Plastic events: a contact reaching the cap, a capped pixel unloading.
+         call plastic_events(search, state)
+
          ! Closing events.
-         search%lam_best = search%lam_release
+         search%lam_best = min(search%lam_release, search%lam_plastic)
          search%neval = 0
          search%used_fft = choose_fft(state, options)
          if (search%used_fft) then
@@ -124,8 +136,53 @@ contains
          end if
          state%res%missed_during_run = state%res%missed_during_run + &
             count(search%gap_eval(1:search%neval) < -options%tie_tolerance*state%path%approach)
+         ! The plastic events of this step: every one within the tie tolerance of lam_best.
+         search%ncap = 0
+         search%nuncap = 0
+         if (state%fmax > 0 .and. search%lam_best < huge(1.0_dp)) then
+            do k = 1, n
+               if (state%funit(k) > 0) then
+                  if ((state%fmax - state%ftot(k))/state%funit(k) <= search%lam_best + tie) then
+                     search%ncap = search%ncap + 1
+                     search%cap_pix(search%ncap) = state%pix(k)
+                  end if
+               end if
+            end do
+            do q = 1, state%nplastic
+               if (search%plastic_rate(q) < 0) then
+                  if (search%plastic_gap(q)/search%plastic_rate(q) <= search%lam_best + tie) then
+                     search%nuncap = search%nuncap + 1
+                     search%uncap_pix(search%nuncap) = state%plastic_pix(q)
+                  end if
+               end if
+            end do
+         end if
       end associate
    end subroutine next_event
+
+   !> The plastic events ahead (state%fmax > 0): contact k reaches the cap at the load
+   !> increment (fmax - ftot_k)/funit_k when funit_k > 0; a capped pixel, whose gap g <= 0
+   !> closes at the rate r, opens again at g/r when r < 0 (it would leave the cap with
+   !> its force falling below fmax). lam_plastic is the smallest of both.
+   subroutine plastic_events(search, state)
+      type(event_search), intent(inout) :: search
+      type(incremental_state), intent(inout) :: state
+      integer :: k, q
+      search%lam_plastic = huge(1.0_dp)
+      if (state%fmax <= 0) return
+      if (.not. allocated(search%cap_pix)) allocate(search%cap_pix(state%npix), search%uncap_pix(state%npix))
+      if (allocated(search%plastic_gap)) deallocate(search%plastic_gap, search%plastic_rate)
+      allocate(search%plastic_gap(state%nplastic), search%plastic_rate(state%nplastic))
+      do k = 1, state%n
+         if (state%funit(k) > 0) search%lam_plastic = min(search%lam_plastic, &
+            max(state%fmax - state%ftot(k), 0.0_dp)/state%funit(k))
+      end do
+      do q = 1, state%nplastic
+         call state%evaluate(state%plastic_pix(q), search%plastic_gap(q), search%plastic_rate(q))
+         if (search%plastic_rate(q) < 0) search%lam_plastic = min(search%lam_plastic, &
+            min(search%plastic_gap(q), 0.0_dp)/search%plastic_rate(q))
+      end do
+   end subroutine plastic_events
 
    !> Evaluate a pixel exactly and record it for this step's event: its gap, the load
    !> increment that closes it, the best so far, and its predicted closing load (for the

@@ -9,6 +9,9 @@
 !>   4. the event itself: a release refactors, joining pixels border the factor.
 !> For monotonic loading the history is the exact piecewise-linear solution of the
 !> contact problem; a full-field check by FFT convolution closes the run.
+!> With the plastic cap (--plastic) a step may also end where a contact reaches
+!> fmax = H d^2 (it leaves the elastic set, keeping fmax: femcod_incremental_state's
+!> cap_contact) or where a capped pixel's gap opens again (it rejoins).
 module femcod_incremental
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_INTERRUPTED
@@ -66,8 +69,9 @@ contains
       class(solver_observer), intent(inout) :: observer
       real(dp), intent(in) :: tstart
       type(event_search) :: search
-      real(dp) :: t0, t1, last_checkpoint, lam
-      integer :: q, reason
+      real(dp) :: t0, t1, last_checkpoint, lam, total_before, tie
+      integer :: q, k, reason, release_pixel
+      logical, allocatable :: reached_before(:)
 
       call wall_clock(last_checkpoint)
 
@@ -93,9 +97,19 @@ contains
 
          lam = NO_EVENT
          if (search%lam_best < huge(1.0_dp)) lam = max(search%lam_best, 0.0_dp)
+         total_before = state%path%total
+         reached_before = state%res%states%reached
          associate(n => state%n)
-            reason = state%path%close_step(state%res, lam, state%delta, state%ftot(1:n), state%funit(1:n), &
-               state%ic(1:n), state%jc(1:n), t0)
+            if (state%nplastic == 0) then
+               reason = state%path%close_step(state%res, lam, state%delta, state%ftot(1:n), state%funit(1:n), &
+                  state%ic(1:n), state%jc(1:n), t0)
+            else
+               reason = close_with_plastic()
+            end if
+            if (state%fmax > 0) then
+               state%res%step_plastic = [state%res%step_plastic, state%nplastic]
+               where (state%res%states%reached .and. .not. reached_before) state%res%states%n_plastic = state%nplastic
+            end if
             if (reason /= STOP_NO_CONTACT) then
                state%phi = state%phi + lam*state%delta_max
                call wall_clock(t1)
@@ -107,10 +121,36 @@ contains
             if (reason /= STOP_NO_CONTACT) call return_joiners()
             exit
          end if
-         if (search%njoin == 0 .and. search%krel > 0) then
-            ! A release: drop the contact and refactor (rare).
-            call state%release_contact(search%krel, status)
+         ! Plastic events: contacts reaching the cap leave the elastic set, capped pixels
+         ! whose gaps open rejoin it.
+         release_pixel = 0
+         if (search%krel > 0) release_pixel = state%pix(search%krel)
+         do q = 1, search%ncap
+            k = state%slot(search%cap_pix(q))
+            if (k <= 0) cycle
+            state%ftot(k) = state%fmax
+            call state%cap_contact(k, state%step, status)
             if (status%code /= 0) return
+         end do
+         do q = 1, search%nuncap
+            call state%uncap_pixel(search%uncap_pix(q), state%step + 1, status)
+            if (status%code /= 0) return
+         end do
+         tie = options%tie_tolerance*(total_before + lam)
+         if (search%njoin == 0 .and. release_pixel > 0 .and. search%lam_release <= search%lam_best + tie) then
+            ! A release: drop the contact and refactor (rare).
+            call state%release_contact(state%slot(release_pixel), status)
+            if (status%code /= 0) return
+            cycle
+         end if
+         if (state%n == 0 .and. search%njoin == 0) then
+            ! Every contact capped: the load cannot grow until the next pixel touches.
+            call touch_again(state, options, status)
+            if (status%code /= 0) return
+            if (state%n == 0) then
+               state%res%stop_reason = STOP_NO_CONTACT
+               exit
+            end if
             cycle
          end if
          if (.not. state%path%room_for(state%n, search%njoin)) then
@@ -128,15 +168,38 @@ contains
 
       call search%free()
       if (options%final_check) call final_check(state, options)
-      associate(n => state%n)
-         call finish_contacts(state%res, state%ic(1:n), state%jc(1:n), state%cstep(1:n), state%ftot(1:n), &
-            state%path%total)
+      associate(n => state%n, npl => state%nplastic)
+         if (npl == 0) then
+            call finish_contacts(state%res, state%ic(1:n), state%jc(1:n), state%cstep(1:n), state%ftot(1:n), &
+               state%path%total)
+         else
+            call finish_contacts(state%res, [state%ic(1:n), (state%plastic_pix(1:npl) - 1)/state%np + 1], &
+               [state%jc(1:n), state%plastic_pix(1:npl) - ((state%plastic_pix(1:npl) - 1)/state%np)*state%np], &
+               [state%cstep(1:n), state%plastic_step(1:npl)], [state%ftot(1:n), spread(state%fmax, 1, npl)], &
+               state%path%total)
+         end if
       end associate
+      if (state%fmax > 0) call plastic_displacements(state)
       res = state%res
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
 
    contains
+
+      !> close_step with the capped pixels beside the elastic contacts (forces fmax, no
+      !> rate), so that the history and the load states count and carry them.
+      integer function close_with_plastic() result(why)
+         real(dp), allocatable :: fall(:), uall(:)
+         integer, allocatable :: iall(:), jall(:)
+         associate(n => state%n, npl => state%nplastic, pp => state%plastic_pix)
+            fall = [state%ftot(1:n), spread(state%fmax, 1, npl)]
+            uall = [state%funit(1:n), spread(0.0_dp, 1, npl)]
+            iall = [state%ic(1:n), (pp(1:npl) - 1)/state%np + 1]
+            jall = [state%jc(1:n), pp(1:npl) - ((pp(1:npl) - 1)/state%np)*state%np]
+            why = state%path%close_step(state%res, lam, state%delta, fall, uall, iall, jall, t0)
+            state%ftot(1:n) = fall(1:n)
+         end associate
+      end function close_with_plastic
 
       !> The joiners of a step that ends the run go back into the heap (the bound search
       !> popped them), so that the heap stays the set of pixels not in contact.
@@ -232,10 +295,66 @@ contains
          call dtrsv("U", "N", "N", n, u, ld, w, 1)
          state%x(1:n) = state%y(1:n)
          call dtrsv("U", "N", "N", n, u, ld, state%x, 1)
-         aex = (state%path%total + sum(w))/sum(state%x(1:n))
+         aex = (state%path%total - state%nplastic*state%fmax + sum(w))/sum(state%x(1:n))
          fex = aex*state%x(1:n) - w
          state%res%final_check_difference = max(abs(aex - state%path%approach)/max(abs(aex), tiny(1.0_dp)), &
             maxval(abs(fex - state%ftot(1:n)))/max(maxval(abs(fex)), tiny(1.0_dp)))
       end associate
    end subroutine final_check
+
+   !> Every contact is capped and the load cannot grow until another pixel touches: the
+   !> approach moves on at constant load to the smallest gap of the free pixels (exact:
+   !> with no elastic contact a gap is g0 - approach), and that pixel and every pixel
+   !> tied with it join. The heap's bounds move with the approach.
+   subroutine touch_again(state, options, status)
+      type(incremental_state), intent(inout) :: state
+      type(contact_options), intent(in) :: options
+      type(status_type), intent(inout) :: status
+      real(dp) :: lowest, limit, shift
+      integer :: p
+      lowest = huge(1.0_dp)
+      do p = 1, state%npix
+         if (state%slot(p) == 0) lowest = min(lowest, state%g0(p))
+      end do
+      if (lowest >= huge(1.0_dp)) return
+      shift = max(lowest - state%path%approach, 0.0_dp)
+      state%path%approach = state%path%approach + shift
+      state%phi = state%phi + shift
+      limit = lowest + options%tie_tolerance*max(abs(lowest), maxval(abs(state%g0)))
+      do p = 1, state%npix
+         if (state%slot(p) /= 0 .or. state%g0(p) > limit) cycle
+         if (.not. state%path%room_for(state%n, 1)) exit
+         call state%add_contact(p, state%step + 1, status)
+         if (status%code /= 0) return
+      end do
+   end subroutine touch_again
+
+   !> The plastic displacement of every reached load state: at its capped pixels (force
+   !> fmax), minus the gap g0 - approach + c sum_k I(p - k) F_k + s fmax over all its
+   !> contacts (the deck's gaps; the springs' compression is elastic), summed directly;
+   !> their sum times d^2 is the plastic volume.
+   subroutine plastic_displacements(state)
+      type(incremental_state), intent(inout) :: state
+      integer :: s, k, m, np
+      real(dp) :: gap, d2
+      np = state%np
+      d2 = state%fmax/state%path%hardness
+      do s = 1, size(state%res%states)
+         associate(st => state%res%states(s))
+            if (.not. st%reached) cycle
+            allocate(st%plastic(np, np))
+            st%plastic = 0
+            st%n_plastic = count(st%force >= state%fmax)
+            do k = 1, size(st%force)
+               if (st%force(k) < state%fmax) cycle
+               gap = state%g0_deck((st%i(k) - 1)*np + st%j(k)) - st%approach + state%s*st%force(k)
+               do m = 1, size(st%force)
+                  gap = gap + state%c*state%table(abs(st%i(k) - st%i(m)), abs(st%j(k) - st%j(m)))*st%force(m)
+               end do
+               st%plastic(st%i(k), st%j(k)) = max(-gap, 0.0_dp)
+            end do
+            st%plastic_volume = sum(st%plastic)*d2
+         end associate
+      end do
+   end subroutine plastic_displacements
 end module femcod_incremental

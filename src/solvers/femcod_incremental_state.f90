@@ -56,6 +56,14 @@ module femcod_incremental_state
       !> entry of the table if negative, else 0 (for the gap bound of unit_load).
       logical :: periodic = .false.
       real(dp) :: table_min = 0
+      !> The plastic cap (--plastic): the force H d^2 (nN) a capped pixel carries (0: no
+      !> cap). Capped pixels are out of the elastic set and the heap (slot -1); their
+      !> forces are folded into g0 (c fmax I at every pixel), so the elastic problem is
+      !> the thesis' one with other initial gaps. g0_deck keeps the deck's gaps.
+      real(dp) :: fmax = 0
+      integer :: nplastic = 0
+      integer, allocatable :: plastic_pix(:), plastic_step(:)
+      real(dp), allocatable :: g0_deck(:)
       !> Steps done, contacts n; per contact: row, column, pixel, step joined, total force
       !> (nN) and force per unit load increment; slot(p): the contact at pixel p (0: none).
       integer :: step = 0, n = 0
@@ -88,6 +96,8 @@ module femcod_incremental_state
       procedure :: evaluate
       procedure :: add_contact
       procedure :: release_contact
+      procedure :: cap_contact
+      procedure :: uncap_pixel
       procedure :: refill_cache
    end type incremental_state
 
@@ -115,6 +125,14 @@ contains
       ! The most negative influence (a periodic table's, whose mean is 0; none free).
       self%table_min = min(minval(self%table), 0.0_dp)
       self%g0 = initial_gaps(problem%lower, problem%upper)
+      self%fmax = 0
+      self%nplastic = 0
+      allocate(self%plastic_pix(0), self%plastic_step(0))
+      if (options%plastic) then
+         self%fmax = options%hardness*problem%pixel**2
+         self%g0_deck = self%g0
+         allocate(self%res%step_plastic(0))
+      end if
       self%c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
          surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
       self%s = 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
@@ -169,6 +187,24 @@ contains
       call visitor%real_prefix("heap_key", self%heap%key, self%heap%size)
       call visitor%integer_prefix("heap_item", self%heap%item, self%heap%size)
       call visit_result(self%res, visitor)
+      if (self%fmax > 0) then
+         ! The plastic set (runs without the cap store nothing more, as before it).
+         call visitor%group("plastic")
+         call visitor%integer_value("nplastic", self%nplastic)
+         if (visitor%status%code /= 0) return
+         if (size(self%plastic_pix) /= self%nplastic) then
+            deallocate(self%plastic_pix, self%plastic_step)
+            allocate(self%plastic_pix(max(self%nplastic, 0)), self%plastic_step(max(self%nplastic, 0)))
+         end if
+         call visitor%integer_prefix("pixel", self%plastic_pix, self%nplastic)
+         call visitor%integer_prefix("step", self%plastic_step, self%nplastic)
+         if (.not. allocated(self%res%step_plastic)) allocate(self%res%step_plastic(0))
+         if (size(self%res%step_plastic) /= self%res%nsteps) then
+            deallocate(self%res%step_plastic)
+            allocate(self%res%step_plastic(max(self%res%nsteps, 0)))
+         end if
+         call visitor%integer_prefix("step_plastic", self%res%step_plastic, self%res%nsteps)
+      end if
    end subroutine visit
 
    !> After a reader filled the stored fields: check them against the problem and derive
@@ -195,6 +231,22 @@ contains
       do k = 1, self%kc
          if (self%cpix(k) > 0) self%cslot(self%cpix(k)) = k
       end do
+      ! The capped pixels: out of the elastic set, their forces back in the gaps.
+      if (self%fmax > 0) then
+         if (any(self%plastic_pix(1:self%nplastic) < 1) .or. any(self%plastic_pix(1:self%nplastic) > self%npix)) then
+            call set_error(status, STATUS_BAD_INPUT, "the stored state is inconsistent (corrupted)")
+            return
+         end if
+         self%g0 = self%g0_deck
+         do k = 1, self%nplastic
+            if (self%slot(self%plastic_pix(k)) /= 0) then
+               call set_error(status, STATUS_BAD_INPUT, "the stored state is inconsistent (corrupted)")
+               return
+            end if
+            self%slot(self%plastic_pix(k)) = -1
+            call fold_force(self, self%plastic_pix(k), self%fmax)
+         end do
+      end if
    end subroutine rebuild
 
    !> The solution under a unit load increment: x = M^-1 1 (kept current by add_contact),
@@ -341,11 +393,79 @@ contains
       class(incremental_state), intent(inout) :: self
       integer, intent(in) :: krm
       type(status_type), intent(inout) :: status
+      self%ftot(krm) = 0
+      self%slot(self%pix(krm)) = 0
+      call heap_push(self%heap, self%phi, self%pix(krm))
+      call remove_contact(self, krm, status)
+      self%res%releases = self%res%releases + 1
+   end subroutine release_contact
+
+   !> Contact k has reached the cap fmax = H d^2: it leaves the elastic set (the factor
+   !> shrinks; refactored by LAPACK dpotrf) and keeps fmax, folded into every pixel's
+   !> g0. A periodic table's negative entries lower some gaps by up to c fmax |min K|:
+   !> the heap's bounds move by that much (phi).
+   subroutine cap_contact(self, k, joined, status)
+      class(incremental_state), intent(inout) :: self
+      integer, intent(in) :: k, joined
+      type(status_type), intent(inout) :: status
+      integer :: pixel
+      pixel = self%pix(k)
+      self%slot(pixel) = -1
+      call remove_contact(self, k, status)
+      if (status%code /= 0) return
+      self%nplastic = self%nplastic + 1
+      self%plastic_pix = [self%plastic_pix(1:self%nplastic - 1), pixel]
+      self%plastic_step = [self%plastic_step(1:self%nplastic - 1), joined]
+      call fold_force(self, pixel, self%fmax)
+      self%phi = self%phi - self%c*self%fmax*self%table_min
+   end subroutine cap_contact
+
+   !> Capped pixel `pixel` has unloaded to zero gap: it rejoins the elastic set as a
+   !> contact carrying fmax (its force leaves g0, which lowers gaps by up to c fmax I(0,0):
+   !> the heap's bounds move by that much).
+   subroutine uncap_pixel(self, pixel, joined, status)
+      class(incremental_state), intent(inout) :: self
+      integer, intent(in) :: pixel, joined
+      type(status_type), intent(inout) :: status
+      integer :: q
+      q = findloc(self%plastic_pix(1:self%nplastic), pixel, 1)
+      if (q == 0) return
+      call fold_force(self, pixel, -self%fmax)
+      self%phi = self%phi + self%c*self%fmax*self%table(0, 0)
+      self%plastic_pix = [self%plastic_pix(1:q - 1), self%plastic_pix(q + 1:self%nplastic)]
+      self%plastic_step = [self%plastic_step(1:q - 1), self%plastic_step(q + 1:self%nplastic)]
+      self%nplastic = self%nplastic - 1
+      self%slot(pixel) = 0
+      call self%add_contact(pixel, joined, status)
+      if (status%code /= 0) return
+      self%ftot(self%n) = self%fmax
+   end subroutine uncap_pixel
+
+   !> g0 += c f I(p - pixel) at every pixel p: a fixed force f (nN) at `pixel`.
+   subroutine fold_force(self, pixel, f)
+      type(incremental_state), intent(inout) :: self
+      integer, intent(in) :: pixel
+      real(dp), intent(in) :: f
+      integer :: ip, jp, i, j
+      ip = (pixel - 1)/self%np + 1
+      jp = pixel - (ip - 1)*self%np
+      !$omp parallel do private(j) if (self%npix > 65536)
+      do i = 1, self%np
+         do j = 1, self%np
+            self%g0((i - 1)*self%np + j) = self%g0((i - 1)*self%np + j) + &
+               self%c*f*self%table(abs(i - ip), abs(j - jp))
+         end do
+      end do
+      !$omp end parallel do
+   end subroutine fold_force
+
+   !> Take contact krm out of the elastic set and refactor the rest (LAPACK dpotrf).
+   subroutine remove_contact(self, krm, status)
+      type(incremental_state), intent(inout) :: self
+      integer, intent(in) :: krm
+      type(status_type), intent(inout) :: status
       integer :: a, b, info
       associate(n => self%n, u => self%u)
-         self%ftot(krm) = 0
-         self%slot(self%pix(krm)) = 0
-         call heap_push(self%heap, self%phi, self%pix(krm))
          self%ic(krm:n - 1) = self%ic(krm + 1:n)
          self%jc(krm:n - 1) = self%jc(krm + 1:n)
          self%pix(krm:n - 1) = self%pix(krm + 1:n)
@@ -363,7 +483,7 @@ contains
          end do
          call dpotrf("U", n, u, self%ld, info)
          if (info /= 0) then
-            call set_error(status, STATUS_NUMERICAL, "incremental: refactorisation after a release failed")
+            call set_error(status, STATUS_NUMERICAL, "incremental: refactorisation after a contact left the elastic set failed")
             return
          end if
          self%y(1:n) = 1
@@ -375,9 +495,8 @@ contains
             if (self%cpix(a) > 0) self%cslot(self%cpix(a)) = 0
          end do
          self%cpix = 0
-         self%res%releases = self%res%releases + 1
       end associate
-   end subroutine release_contact
+   end subroutine remove_contact
 
    !> Refill the cache with the candidates predicted to close next (smallest predicted
    !> closing load from their last exact evaluation): the new ones get l = U^-T M_c and

@@ -5,6 +5,7 @@ module femcod_maps
    use femcod_scene, only: initial_gaps
    use femcod_love, only: offset_table, surface_compliance
    use femcod_love_periodic, only: periodic_offset_table
+   use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: load_state
    implicit none
@@ -34,7 +35,7 @@ contains
       logical :: cyclic
       type(love_convolution) :: conv
       real(dp), allocatable :: force(:, :), disp(:, :), g0(:, :), table(:, :)
-      real(dp) :: c
+      real(dp) :: c, spring
       integer :: np, k, s
       allocate(maps(size(states)))
       if (.not. any(states%reached)) return
@@ -55,6 +56,7 @@ contains
       end if
       c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
          surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
+      spring = 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
       ! g0 is numbered pixel by pixel along rows: p = (i - 1) np + j.
       g0 = transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np]))
       call convolution_setup(conv, table, periodic=cyclic)
@@ -67,6 +69,15 @@ contains
          call convolution_apply(conv, force, disp)
          maps(s)%gap = g0 - states(s)%approach + c*disp
          do k = 1, size(states(s)%force)
+            ! A capped pixel (--plastic) keeps its negative gap, the springs' compression
+            ! s F included: minus its plastic displacement.
+            if (allocated(states(s)%plastic)) then
+               if (states(s)%plastic(states(s)%i(k), states(s)%j(k)) > 0) then
+                  maps(s)%gap(states(s)%i(k), states(s)%j(k)) = maps(s)%gap(states(s)%i(k), states(s)%j(k)) + &
+                     spring*states(s)%force(k)
+                  cycle
+               end if
+            end if
             maps(s)%gap(states(s)%i(k), states(s)%j(k)) = 0
          end do
       end do

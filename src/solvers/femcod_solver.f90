@@ -6,7 +6,7 @@
 module femcod_solver
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE
-   use femcod_strings, only: string_type, int_str, sig_str
+   use femcod_strings, only: string_type, int_str, sig_str, format_real
    use femcod_problem, only: contact_problem
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
@@ -42,6 +42,23 @@ contains
       if (options%boundary /= "free" .and. options%boundary /= "periodic") then
          call set_error(status, STATUS_USAGE, "unknown boundary '"//trim(options%boundary)//"' (free or periodic)")
          return
+      end if
+      if (options%plastic .and. options%solver == "legacy") then
+         call set_error(status, STATUS_USAGE, "--plastic: the legacy solver is the Appendix B program of the "// &
+            "elastic interface; use --solver incremental or cg")
+         return
+      end if
+      ! The fixed-load solver cannot carry more than every pixel at H d^2; the event path
+      ! stops where no pixel is left to touch, and says which loads it did not reach.
+      if (options%plastic .and. options%solver == "cg" .and. allocated(options%loads)) then
+         if (size(options%loads) > 0) then
+            if (maxval(options%loads) >= real(problem%np, dp)**2*options%hardness*problem%pixel**2) then
+               call set_error(status, STATUS_USAGE, "--plastic: load "//format_real(maxval(options%loads))// &
+                  " nN is at or above the fully plastic capacity NP^2 H d^2 = "// &
+                  format_real(real(problem%np, dp)**2*options%hardness*problem%pixel**2)//" nN")
+               return
+            end if
+         end if
       end if
       if (options%boundary == "periodic" .and. options%solver == "legacy") then
          call set_error(status, STATUS_USAGE, "--boundary periodic: the legacy solver is the Appendix B program "// &
@@ -116,6 +133,13 @@ contains
       lines = [lines, string_type("interface and penalty springs: an exact diagonal compliance 3/k = "//es(s/cself)// &
          " of a pixel's self-compliance")]
       if (options%boundary == "periodic") lines = [lines, periodic_note(problem%np, "incremental")]
+      if (options%plastic) then
+         lines = [lines, string_type("plastic cap H = "//sig_str(options%hardness, 4)//" GPa: a contact reaching "// &
+            "H d^2 is an event; it leaves the elastic set (the factor shrinks) and its fixed force joins the gaps")]
+      else
+         lines = [lines, string_type("no plastic cap: pressures are elastic, n_above_hardness counts the pixels "// &
+            "above the hardness (--plastic caps them)")]
+      end if
       if (all(problem%lower == problem%lower(1, 1))) lines = [lines, string_type("lower surface flat")]
       if (all(problem%upper == problem%upper(1, 1))) lines = [lines, string_type("upper surface flat")]
    contains
