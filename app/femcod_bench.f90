@@ -489,13 +489,21 @@ contains
       type(parsed_options) :: parsed
       real(dp) :: estar, pstar, lambda, ratio, closed, slope, load, peak
       real(dp), allocatable :: approach_error(:)
-      integer :: n, np, j, k, b, width
+      real(dp) :: tol, pressure, fraction
+      character(len=:), allocatable :: python, path, peer_out
+      character(len=512) :: line
+      character(len=64) :: words(8)
+      character(len=*), parameter :: peers(2) = [character(len=25) :: "tamaas", "contactmechanics-periodic"]
+      integer :: n, np, j, k, b, width, i, unit, ios
       sizes = [64, 128, 256, 512, 1024]
       rough_sizes = [512, 1024]
-      fractions = [1.0_dp, 10.0_dp]
+      fractions = [1.0_dp, 10.0_dp, 30.0_dp]
+      tol = 1.0e-8_dp
+      python = ""
       if (help_requested(args)) then
          write(output_unit, '(a)') &
-            "usage: femcod bench periodic [--np 64,128,256,512,1024] [--rough-np 512,1024] [--contact 1,10]", &
+            "usage: femcod bench periodic [--np 64,128,256,512,1024] [--rough-np 512,1024] [--contact 1,10,30]", &
+            "       [--tol 1e-8] [--peers PYTHON]", &
             "1. Westergaard's sinusoid h = cos(2 pi x / lambda) nm, lambda = NP pixels of 1 nm, E = 200 GPa,", &
             "   nu = 0.25, on a rigid flat, --boundary periodic, cg to 1e-10: at the mean pressures of the", &
             "   contact half-widths a/lambda = 1/6, 1/4, 1/3 (p = p* sin^2(pi a/lambda), p* = pi E* h0/lambda),", &
@@ -503,7 +511,9 @@ contains
             "   A/h0 = (p/p*)(1 - ln(p/p*)) with its observed order, and the discrete full-contact pressure", &
             "   against p* (from the kernel's spectrum: p_full/p* = NP/S(1/NP, 0)).", &
             "2. The benchmark surface (self-affine, periodic by construction) at --contact fractions,", &
-            "   cg with each boundary: wall time, iterations, contact %, peak RSS.", ""
+            "   cg with each boundary: solve time, iterations, contact %, mean gap, peak RSS; with --peers,", &
+            "   tamaas (PolonskyKeerRey) and ContactMechanics (PeriodicFFTElasticHalfSpace) on the same", &
+            "   gaps, pressure and tolerance, from that Python (app/femcod_peers.py; never a dependency).", ""
          call print_lines(option_help(bench_periodic_table(), ""))
          write(output_unit, '(a)') "Run it with the release build."
          return
@@ -518,6 +528,8 @@ contains
       call get_option(parsed, "--np", sizes)
       call get_option(parsed, "--rough-np", rough_sizes)
       call get_option(parsed, "--contact", fractions)
+      call get_option(parsed, "--tol", tol)
+      call get_option(parsed, "--peers", python)
       options%solver = "cg"
       options%boundary = "periodic"
       options%cg = cg_settings()
@@ -570,8 +582,8 @@ contains
          flush(output_unit)
          deallocate(z, s)
       end do
-      write(output_unit, '(a)') "", "| NP | target % | boundary | wall (s) | iterations | contact % | peak RSS (MB) |", &
-         "|---|---|---|---|---|---|---|"
+      write(output_unit, '(a)') "", "| NP | target % | solver | boundary | wall (s) | iterations | contact % | "// &
+         "mean gap (nm) | peak RSS (MB) |", "|---|---|---|---|---|---|---|---|---|"
       do n = 1, size(rough_sizes)
          np = rough_sizes(n)
          call benchmark_surface(np, "bench periodic", deck, status)
@@ -581,28 +593,63 @@ contains
             return
          end if
          call linear_law(deck, estar, slope, g0)
+         if (len(python) > 0) then
+            path = "femcod-bench-gaps.f64"
+            open(newunit=unit, file=path, access="stream", form="unformatted", status="replace", action="write")
+            write(unit) g0
+            close(unit)
+         end if
          do k = 1, size(fractions)
-            load = fractions(k)/100*estar*slope/2*BENCH_LENGTH**2
+            pressure = fractions(k)/100*estar*slope/2
+            load = pressure*BENCH_LENGTH**2
             do b = 1, size(boundaries)
                options%boundary = boundaries(b)
                options%loads = [load]
                options%cg = cg_settings()
+               options%cg%tol = tol
+               options%cg%max_iterations = 5000
                call reset_peak()
                call solve_contact(deck, options, res, status)
                peak = peak_mb()
                if (status%code /= 0) then
-                  write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | "// &
-                     trim(boundaries(b))//" | "//status%message//" | | | |"
+                  write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | "// &
+                     trim(boundaries(b))//" | "//status%message//" | | | | |"
                   status = status_type()
                   cycle
                end if
-               write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | "// &
+               write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | "// &
                   trim(boundaries(b))//" | "//fixed_str(res%wall_seconds, 2)//" | "// &
                   int_str(res%states(1)%iterations)//" (+"//int_str(res%states(1)%coarse_iterations)//" coarse) | "// &
-                  fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)//" | "//fixed_str(peak, 0)//" |"
+                  fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 3)//" | "// &
+                  real_str(sum(res%states(1)%gap)/real(np, dp)**2, 7)//" | "//fixed_str(peak, 0)//" |"
+               flush(output_unit)
+            end do
+            if (len(python) == 0) cycle
+            do i = 1, size(peers)
+               peer_out = "femcod-bench-peer.txt"
+               call execute_command_line(python//" app/femcod_peers.py "//trim(peers(i))//" "//path//" "// &
+                  int_str(np)//" "//real_str(deck%pixel, 16)//" "//real_str(estar, 16)//" "// &
+                  real_str(pressure, 16)//" "//real_str(tol, 3)//" > "//peer_out, exitstat=ios)
+               line = trim(peers(i))//" - - - - - failed -"
+               open(newunit=unit, file=peer_out, action="read", status="old", iostat=ios)
+               if (ios == 0) then
+                  read(unit, '(a)', iostat=ios) line
+                  close(unit, status="delete")
+               end if
+               words = "-"
+               read(line, *, iostat=ios) words
+               read(words(5), *, iostat=ios) fraction
+               if (ios == 0) words(5) = fixed_str(100*fraction, 3)
+               write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | "// &
+                  trim(words(1))//" | periodic | "//trim(words(2))//" | "//trim(words(3))//" | "//trim(words(5))// &
+                  " | "//trim(words(8))//" | "//trim(words(6))//" |"
                flush(output_unit)
             end do
          end do
+         if (len(python) > 0) then
+            open(newunit=unit, file=path, status="old", iostat=ios)
+            if (ios == 0) close(unit, status="delete")
+         end if
       end do
    end subroutine bench_periodic
 
@@ -611,7 +658,10 @@ contains
       table = [integer_list_option("--np", "N1,...", "pixels per period of the sinusoid (default "// &
          "64,128,256,512,1024)", lower=8), &
          integer_list_option("--rough-np", "N1,...", "sizes of the benchmark surface (default 512,1024)", lower=8), &
-         real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,10)", lower=0.0_dp)]
+         real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,10,30)", lower=0.0_dp), &
+         real_option("--tol", "T", "tolerance of the rough-surface solves, femcod's and the peers' (default 1e-8)", &
+            lower=0.0_dp, closed="()"), &
+         text_option("--peers", "PYTHON", "a Python with tamaas and ContactMechanics installed")]
    end function bench_periodic_table
 
    !> `femcod bench cg`: the fixed-load solver on self-affine surfaces of growing size at

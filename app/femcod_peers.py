@@ -1,8 +1,9 @@
 """Run one peer contact solver on a surface written by `femcod bench cg` and print one line.
 
-Called by `femcod bench cg --peers PYTHON` with the Python of a separate virtual
-environment where the peers are installed (never a femcod dependency, see
-doc/performance.md):
+Called by `femcod bench cg --peers PYTHON` (free boundary: aspher, contactmechanics) and
+`femcod bench periodic --peers PYTHON` (periodic: tamaas, contactmechanics-periodic) with
+the Python of a separate virtual environment where the peers are installed (never a femcod
+dependency, see doc/performance.md):
 
     PYTHON app/femcod_peers.py PEER GAPS NP PIXEL ESTAR PRESSURE TOL
 
@@ -13,8 +14,12 @@ TOL the solver tolerance. Output, one line:
     peer seconds iterations residual contact_fraction peak_rss_mb status
 
 `seconds` is the solve alone (set-up of the surface excluded), peak RSS the process
-high-water mark. A peer that is not installed prints `peer - - - - - missing`.
+high-water mark. A peer that is not installed prints `peer - - - - - missing`. The
+periodic peers add an eighth field, the mean gap (nm) of the solution: the mean over the
+cell of the separation of the deformed surfaces (0 in contact).
 """
+import contextlib
+import os
 import resource
 import sys
 import time
@@ -46,7 +51,65 @@ def run_contactmechanics(gap, n, pixel, estar, pressure, tol):
     return t1 - t0, sol.nit, float("nan"), np.count_nonzero(forces > 0) / n ** 2, str(sol.success)
 
 
-PEERS = {"aspher": run_aspher, "contactmechanics": run_contactmechanics}
+@contextlib.contextmanager
+def quiet_stdout():
+    """Silence what a C++ library writes to the process's standard output and error
+    (tamaas prints its iterations), so that the answer is the only line."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    os.dup2(null, 2)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        os.close(null)
+        for fd in saved:
+            os.close(fd)
+
+
+def run_tamaas(gap, n, pixel, estar, pressure, tol):
+    import tamaas as tm
+    height = np.ascontiguousarray(gap.max() - gap)
+    length = n * pixel
+    model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [length, length], [n, n])
+    model.E = estar
+    model.nu = 0.0
+    solver = tm.PolonskyKeerRey(model, height, tol)
+    with quiet_stdout():
+        t0 = time.perf_counter()
+        error = solver.solve(pressure)
+        t1 = time.perf_counter()
+    traction = np.asarray(model.traction)
+    separation = np.asarray(model.displacement) - height
+    return (t1 - t0, "-", float(error), np.count_nonzero(traction > 0) / n ** 2, "converged",
+            float(separation.mean()))
+
+
+def run_contactmechanics_periodic(gap, n, pixel, estar, pressure, tol):
+    from ContactMechanics import PeriodicFFTElasticHalfSpace
+    from ContactMechanics.Systems import NonSmoothContactSystem
+    from SurfaceTopography import Topography
+    height = gap.max() - gap
+    length = n * pixel
+    topography = Topography(height, physical_sizes=(length, length), periodic=True)
+    substrate = PeriodicFFTElasticHalfSpace((n, n), estar, physical_sizes=(length, length))
+    system = NonSmoothContactSystem(substrate, topography)
+    t0 = time.perf_counter()
+    sol = system.minimize_proxy(external_force=pressure * length ** 2, pentol=tol * np.ptp(height))
+    t1 = time.perf_counter()
+    separation = system.compute_gap(sol.x, sol.offset)
+    return (t1 - t0, sol.nit, float("nan"), np.count_nonzero(sol.jac > 0) / n ** 2, str(sol.success),
+            float(separation.mean()))
+
+
+PEERS = {"aspher": run_aspher, "contactmechanics": run_contactmechanics, "tamaas": run_tamaas,
+         "contactmechanics-periodic": run_contactmechanics_periodic}
 
 
 def main():
@@ -54,14 +117,15 @@ def main():
     n = int(n)
     gap = np.fromfile(path, dtype="<f8").reshape((n, n), order="F")
     try:
-        seconds, iterations, residual, fraction, status = PEERS[peer](
-            gap, n, float(pixel), float(estar), float(pressure), float(tol))
+        answer = PEERS[peer](gap, n, float(pixel), float(estar), float(pressure), float(tol))
     except ImportError:
         print(peer, "-", "-", "-", "-", "-", "missing")
         return
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    seconds, iterations, residual, fraction, status = answer[:5]
+    extra = [f"{answer[5]:.10e}"] if len(answer) > 5 else []
     print(peer, f"{seconds:.3f}", iterations, f"{residual:.2e}", f"{fraction:.5f}", f"{peak:.0f}",
-          str(status).replace(" ", "_"))
+          str(status).replace(" ", "_"), *extra)
 
 
 if __name__ == "__main__":
