@@ -621,7 +621,7 @@ contains
       if (allocated(error)) return
       do variant = 1, 2
          ! The elastic interface, and the plastic cap (H = 20 GPa caps 8 pixels by the
-         ! end of the 416 steps: its plastic set and history are part of the checkpoint).
+         ! end of the 408 steps: its plastic set and history are part of the checkpoint).
          tag = trim(merge("       ", "plastic", variant == 1))
          run_args = " run "//dir//"/scene.deck --loads 3e4,1e9 --quiet "
          if (variant == 2) run_args = run_args//"--plastic --hardness 20 "

@@ -39,15 +39,14 @@ module femcod_event_search
       !> The pixels that close at lam_best (ties within the tie tolerance), in pixel order.
       integer :: njoin = 0
       integer, allocatable :: joiners(:)
-      !> The plastic cap: the smallest load increment at which a contact reaches fmax or a
-      !> capped pixel's gap opens again (huge: none); the contacts' pixels that cap and
-      !> the capped pixels that unload at lam_best (ties within the tie tolerance); the
-      !> capped pixels' gaps (nm, minus their plastic displacement) and closing rates
-      !> (nm/nN) at the step's start, in the order of the state's plastic list.
+      !> The plastic cap: the smallest load increment at which a contact reaches fmax (huge:
+      !> none); the contacts' pixels that cap and the capped pixels that unload (their gap
+      !> opens again) at lam_best (ties within the tie tolerance); the load increment at
+      !> which each capped pixel evaluated this step opens (huge: not evaluated, or closing).
       real(dp) :: lam_plastic = 0
       integer :: ncap = 0, nuncap = 0
       integer, allocatable :: cap_pix(:), uncap_pix(:)
-      real(dp), allocatable :: plastic_gap(:), plastic_rate(:)
+      real(dp), allocatable :: lam_open(:)
       !> Whether this step searched the full field.
       logical :: used_fft = .false.
       type(love_convolution) :: conv
@@ -114,6 +113,9 @@ contains
             state%last_neval = search%neval
          end if
 
+         ! Capped pixels whose gap opens before the events found so far.
+         call plastic_unloading(search, state)
+
          ! The pixels that close at the smallest load (within the tie tolerance of the
          ! total load) join; the bound search's others go back into the heap.
          tie = options%tie_tolerance*(total + max(search%lam_best, 0.0_dp))
@@ -149,40 +151,59 @@ contains
                end if
             end do
             do q = 1, state%nplastic
-               if (search%plastic_rate(q) < 0) then
-                  if (search%plastic_gap(q)/search%plastic_rate(q) <= search%lam_best + tie) then
-                     search%nuncap = search%nuncap + 1
-                     search%uncap_pix(search%nuncap) = state%plastic_pix(q)
-                  end if
+               if (search%lam_open(q) <= search%lam_best + tie) then
+                  search%nuncap = search%nuncap + 1
+                  search%uncap_pix(search%nuncap) = state%plastic_pix(q)
                end if
             end do
          end if
       end associate
    end subroutine next_event
 
-   !> The plastic events ahead (state%fmax > 0): contact k reaches the cap at the load
-   !> increment (fmax - ftot_k)/funit_k when funit_k > 0; a capped pixel, whose gap g <= 0
-   !> closes at the rate r, opens again at g/r when r < 0 (it would leave the cap with
-   !> its force falling below fmax). lam_plastic is the smallest of both.
+   !> The caps ahead (state%fmax > 0): contact k reaches fmax at the load increment
+   !> (fmax - ftot_k)/funit_k when funit_k > 0; lam_plastic is the smallest.
    subroutine plastic_events(search, state)
       type(event_search), intent(inout) :: search
       type(incremental_state), intent(inout) :: state
-      integer :: k, q
+      integer :: k
       search%lam_plastic = huge(1.0_dp)
       if (state%fmax <= 0) return
       if (.not. allocated(search%cap_pix)) allocate(search%cap_pix(state%npix), search%uncap_pix(state%npix))
-      if (allocated(search%plastic_gap)) deallocate(search%plastic_gap, search%plastic_rate)
-      allocate(search%plastic_gap(state%nplastic), search%plastic_rate(state%nplastic))
       do k = 1, state%n
          if (state%funit(k) > 0) search%lam_plastic = min(search%lam_plastic, &
             max(state%fmax - state%ftot(k), 0.0_dp)/state%funit(k))
       end do
-      do q = 1, state%nplastic
-         call state%evaluate(state%plastic_pix(q), search%plastic_gap(q), search%plastic_rate(q))
-         if (search%plastic_rate(q) < 0) search%lam_plastic = min(search%lam_plastic, &
-            min(search%plastic_gap(q), 0.0_dp)/search%plastic_rate(q))
-      end do
    end subroutine plastic_events
+
+   !> Capped pixels whose gap opens again (g <= 0 rising at the rate -r > 0) before
+   !> lam_best: such a pixel would leave the cap, its force falling below fmax. Each
+   !> capped pixel keeps an upper bound on its gap, key + psi (psi grows by the fastest
+   !> any gap can open, open_max, per unit load: femcod_incremental_state's unit_load);
+   !> only a pixel whose bound could reach 0 within lam_best is evaluated exactly, and
+   !> opens at g/r when r < 0. lam_best becomes the smallest opening found.
+   subroutine plastic_unloading(search, state)
+      type(event_search), intent(inout) :: search
+      type(incremental_state), intent(inout) :: state
+      real(dp) :: gap, rate, reach
+      integer :: q
+      if (state%fmax <= 0) return
+      if (allocated(search%lam_open)) deallocate(search%lam_open)
+      allocate(search%lam_open(state%nplastic))
+      search%lam_open = huge(1.0_dp)
+      do q = 1, state%nplastic
+         reach = huge(1.0_dp)
+         if (search%lam_best < huge(1.0_dp)) reach = state%plastic_key(q) + state%psi + &
+            max(search%lam_best, 0.0_dp)*state%open_max
+         if (reach < 0) cycle
+         call state%evaluate(state%plastic_pix(q), gap, rate)
+         state%res%evaluations = state%res%evaluations + 1
+         state%plastic_key(q) = min(gap, 0.0_dp) - state%psi
+         if (rate < 0) then
+            search%lam_open(q) = min(gap, 0.0_dp)/rate
+            search%lam_best = min(search%lam_best, search%lam_open(q))
+         end if
+      end do
+   end subroutine plastic_unloading
 
    !> Evaluate a pixel exactly and record it for this step's event: its gap, the load
    !> increment that closes it, the best so far, and its predicted closing load (for the

@@ -112,6 +112,7 @@ contains
             end if
             if (reason /= STOP_NO_CONTACT) then
                state%phi = state%phi + lam*state%delta_max
+               state%psi = state%psi + lam*state%open_max
                call wall_clock(t1)
                call observer%progress(state%step, n, state%path%total, t1 - tstart)
             end if
@@ -153,7 +154,7 @@ contains
             end if
             cycle
          end if
-         if (.not. state%path%room_for(state%n, search%njoin)) then
+         if (.not. state%path%room_for(state%n + state%nplastic, search%njoin)) then
             state%res%stop_reason = STOP_MAXCONT
             call return_joiners()
             exit
@@ -323,7 +324,7 @@ contains
       limit = lowest + options%tie_tolerance*max(abs(lowest), maxval(abs(state%g0)))
       do p = 1, state%npix
          if (state%slot(p) /= 0 .or. state%g0(p) > limit) cycle
-         if (.not. state%path%room_for(state%n, 1)) exit
+         if (.not. state%path%room_for(state%n + state%nplastic, 1)) exit
          call state%add_contact(p, state%step + 1, status)
          if (status%code /= 0) return
       end do

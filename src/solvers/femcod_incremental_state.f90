@@ -26,7 +26,7 @@ module femcod_incremental_state
    use femcod_love, only: offset_table, surface_compliance
    use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
-   use femcod_lapack, only: dtrsv, dtrsm, dpotrf
+   use femcod_lapack, only: dtrsv, dtrsm
    use femcod_condensed, only: gap_and_rate
    use femcod_heap, only: min_heap, heap_build, heap_push
    use femcod_sort, only: merge_sort_index
@@ -64,6 +64,12 @@ module femcod_incremental_state
       integer :: nplastic = 0
       integer, allocatable :: plastic_pix(:), plastic_step(:)
       real(dp), allocatable :: g0_deck(:)
+      !> Upper bounds on the capped pixels' gaps, plastic_key + psi (nm): psi grows by
+      !> open_max (nm/nN), the fastest any gap can open, per unit of load (not stored in
+      !> checkpoints: a bound of 0 is valid for a capped pixel, and exact evaluations
+      !> decide every event, so a restart repeats the same events).
+      real(dp), allocatable :: plastic_key(:)
+      real(dp) :: psi = 0, open_max = 0
       !> Steps done, contacts n; per contact: row, column, pixel, step joined, total force
       !> (nN) and force per unit load increment; slot(p): the contact at pixel p (0: none).
       integer :: step = 0, n = 0
@@ -127,7 +133,7 @@ contains
       self%g0 = initial_gaps(problem%lower, problem%upper)
       self%fmax = 0
       self%nplastic = 0
-      allocate(self%plastic_pix(0), self%plastic_step(0))
+      allocate(self%plastic_pix(0), self%plastic_step(0), self%plastic_key(0))
       if (options%plastic) then
          self%fmax = options%hardness*problem%pixel**2
          self%g0_deck = self%g0
@@ -238,6 +244,8 @@ contains
             return
          end if
          self%g0 = self%g0_deck
+         self%psi = 0
+         self%plastic_key = [(0.0_dp, k = 1, self%nplastic)]
          do k = 1, self%nplastic
             if (self%slot(self%plastic_pix(k)) /= 0) then
                call set_error(status, STATUS_BAD_INPUT, "the stored state is inconsistent (corrupted)")
@@ -263,6 +271,10 @@ contains
          self%funit(1:n) = self%x(1:n)*self%delta
          self%delta_max = self%delta + self%c*self%table(0, 0)*sum(max(-self%funit(1:n), 0.0_dp))
          if (self%table_min < 0) self%delta_max = self%delta_max - self%c*self%table_min*sum(max(self%funit(1:n), 0.0_dp))
+         ! The fastest any gap can open: c I sum f - delta, with I at most I(0, 0) where
+         ! f > 0 and at least min I where f < 0.
+         if (self%fmax > 0) self%open_max = max(0.0_dp, self%c*self%table(0, 0)*sum(max(self%funit(1:n), 0.0_dp)) - &
+            self%c*self%table_min*sum(max(-self%funit(1:n), 0.0_dp)) - self%delta)
       end associate
    end subroutine unit_load
 
@@ -387,8 +399,8 @@ contains
       call move_alloc(bigger, self%wc)
    end subroutine resize_factor
 
-   !> Remove contact k (its force is zero) and refactor the rest (LAPACK dpotrf); the
-   !> pixel goes back into the heap at the current bound offset.
+   !> Remove contact k (its force is zero; remove_contact); the pixel goes back into the
+   !> heap at the current bound offset.
    subroutine release_contact(self, krm, status)
       class(incremental_state), intent(inout) :: self
       integer, intent(in) :: krm
@@ -401,7 +413,7 @@ contains
    end subroutine release_contact
 
    !> Contact k has reached the cap fmax = H d^2: it leaves the elastic set (the factor
-   !> shrinks; refactored by LAPACK dpotrf) and keeps fmax, folded into every pixel's
+   !> shrinks by a column, remove_contact) and keeps fmax, folded into every pixel's
    !> g0. A periodic table's negative entries lower some gaps by up to c fmax |min K|:
    !> the heap's bounds move by that much (phi).
    subroutine cap_contact(self, k, joined, status)
@@ -416,6 +428,8 @@ contains
       self%nplastic = self%nplastic + 1
       self%plastic_pix = [self%plastic_pix(1:self%nplastic - 1), pixel]
       self%plastic_step = [self%plastic_step(1:self%nplastic - 1), joined]
+      ! Its gap is -s fmax <= 0 now.
+      self%plastic_key = [self%plastic_key(1:self%nplastic - 1), -self%psi]
       call fold_force(self, pixel, self%fmax)
       self%phi = self%phi - self%c*self%fmax*self%table_min
    end subroutine cap_contact
@@ -434,6 +448,7 @@ contains
       self%phi = self%phi + self%c*self%fmax*self%table(0, 0)
       self%plastic_pix = [self%plastic_pix(1:q - 1), self%plastic_pix(q + 1:self%nplastic)]
       self%plastic_step = [self%plastic_step(1:q - 1), self%plastic_step(q + 1:self%nplastic)]
+      self%plastic_key = [self%plastic_key(1:q - 1), self%plastic_key(q + 1:self%nplastic)]
       self%nplastic = self%nplastic - 1
       self%slot(pixel) = 0
       call self%add_contact(pixel, joined, status)
@@ -459,33 +474,50 @@ contains
       !$omp end parallel do
    end subroutine fold_force
 
-   !> Take contact krm out of the elastic set and refactor the rest (LAPACK dpotrf).
+   !> Take contact krm out of the elastic set: its column leaves the factor, which is made
+   !> triangular again by Givens rotations (M = U'U stays the Cholesky factorisation of the
+   !> remaining contacts: O(n^2), where a refactorisation would cost n^3/3), then
+   !> y = U^-T 1 and x = U^-1 y afresh (two triangular solves).
    subroutine remove_contact(self, krm, status)
       type(incremental_state), intent(inout) :: self
       integer, intent(in) :: krm
       type(status_type), intent(inout) :: status
-      integer :: a, b, info
+      integer :: a, j
+      real(dp) :: r, t1, t2
+      real(dp), allocatable :: cs(:), sn(:)
       associate(n => self%n, u => self%u)
          self%ic(krm:n - 1) = self%ic(krm + 1:n)
          self%jc(krm:n - 1) = self%jc(krm + 1:n)
          self%pix(krm:n - 1) = self%pix(krm + 1:n)
          self%cstep(krm:n - 1) = self%cstep(krm + 1:n)
          self%ftot(krm:n - 1) = self%ftot(krm + 1:n)
+         ! Columns krm+1..n move left; the trailing block is then upper Hessenberg: the
+         ! rotation of rows (j, j+1) zeroes the entry below the diagonal of column j.
+         ! Column by column (contiguous): the rotations found so far, then its own.
+         allocate(cs(krm:n), sn(krm:n))
+         do j = krm, n - 1
+            u(1:j + 1, j) = u(1:j + 1, j + 1)
+            do a = krm, j - 1
+               t1 = u(a, j)
+               t2 = u(a + 1, j)
+               u(a, j) = cs(a)*t1 + sn(a)*t2
+               u(a + 1, j) = cs(a)*t2 - sn(a)*t1
+            end do
+            r = hypot(u(j, j), u(j + 1, j))
+            if (.not. r > 0) then
+               call set_error(status, STATUS_NUMERICAL, "incremental: the factor lost its diagonal when a "// &
+                  "contact left the elastic set")
+               return
+            end if
+            cs(j) = u(j, j)/r
+            sn(j) = u(j + 1, j)/r
+            u(j, j) = r
+            u(j + 1, j) = 0
+         end do
          n = n - 1
          do a = 1, n
             self%slot(self%pix(a)) = a
          end do
-         do b = 1, n
-            do a = 1, b
-               u(a, b) = self%c*self%table(abs(self%ic(a) - self%ic(b)), abs(self%jc(a) - self%jc(b)))
-            end do
-            u(b, b) = u(b, b) + self%s
-         end do
-         call dpotrf("U", n, u, self%ld, info)
-         if (info /= 0) then
-            call set_error(status, STATUS_NUMERICAL, "incremental: refactorisation after a contact left the elastic set failed")
-            return
-         end if
          self%y(1:n) = 1
          call dtrsv("U", "T", "N", n, u, self%ld, self%y, 1)
          self%x(1:n) = self%y(1:n)
