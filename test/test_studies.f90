@@ -42,6 +42,8 @@ contains
          new_unittest("down-sampling chain, levels and MAXCONT", test_level_deck), &
          new_unittest("pixels above the hardness per step: incremental = legacy", test_hardness_steps), &
          new_unittest("femcod resolution writes the study", test_resolution_command), &
+         new_unittest("Fig. 4.21 capped curve: the elastic history until the first pixel reaches H", &
+            test_capped_curve), &
          new_unittest("summits of the sinusoid eq. 3.3: R = 100 nm, then R ~ d^2", test_sinusoid_summits), &
          new_unittest("paraboloid fit of an exact elliptic paraboloid", test_paraboloid), &
          new_unittest("Weierstrass-Mandelbrot radius exponent near D = 1.4 (eq. 3.8)", test_wm_radius_exponent), &
@@ -248,15 +250,87 @@ contains
       call check(error, a%step_above_hardness(a%nsteps), count(a%contact_force/deck%pixel**2 > 5))
    end subroutine test_hardness_steps
 
+   !> The capped curve of Fig. 4.21 (PREFIX.hardness_capped.csv: the finest level solved
+   !> again with the pressures capped at H = 5 GPa, the event path's plastic events). A row
+   !> is the state where the next event happens, with the plastic pixels before it (as the
+   !> contacts are counted before the next one joins). So until the first pixel reaches H
+   !> the capped path is the elastic one: the loads of PREFIX.resolution.csv row for row,
+   !> to the digit; the row where the first pixel reaches H comes at a load no larger than
+   !> the elastic row's (the cap came first); from the next row on pixels are plastic, never
+   !> more than there are contacts.
+   subroutine test_capped_curve(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, capped, elastic
+      character(len=64), allocatable :: crow(:, :), erow(:, :)
+      real(dp) :: cload, eload
+      integer :: code, k, first, plastic, contacts
+      prefix = scratch_path("capped-curve")
+      call run_femcod([string_type("resolution"), string_type("input/rough_selfaffine_32.deck"), &
+         string_type("--levels"), string_type("32"), string_type("--hardness"), string_type("5"), &
+         string_type("-o"), string_type(prefix), string_type("--quiet"), string_type("--force")], code)
+      call check(error, code, 0)
+      if (allocated(error)) return
+      capped = read_text(prefix//".hardness_capped.csv")
+      elastic = read_text(prefix//".resolution.csv")
+      call check(error, capped(1:index(capped, new_line("a")) - 1), &
+         "np,step,load_nN,area_fraction,contacts,n_plastic,fraction_plastic")
+      if (allocated(error)) return
+      crow = csv_rows(capped, 7)
+      erow = csv_rows(elastic, 5)
+      first = 0
+      do k = 1, size(crow, 2)
+         read(crow(6, k), *) plastic
+         read(crow(5, k), *) contacts
+         call check(error, plastic >= 0 .and. plastic <= contacts, "row "//to_string(k))
+         if (allocated(error)) return
+         if (plastic > 0 .and. first == 0) first = k
+      end do
+      call check(error, first > 2, "plastic rows in the capped curve (first "//to_string(first)//")")
+      if (allocated(error)) return
+      do k = 1, first - 2
+         call check(error, trim(crow(3, k)), trim(erow(3, k)), "row "//to_string(k)//": the load before H")
+         if (allocated(error)) return
+      end do
+      read(crow(3, first - 1), *) cload
+      read(erow(3, first - 1), *) eload
+      call check(error, cload <= eload, "the first pixel reaches H at "//to_string(cload)//" nN, after the elastic "// &
+         "event at "//to_string(eload)//" nN")
+   contains
+      !> The rows after the header of a CSV text, `nf` fields each (64 characters).
+      function csv_rows(text, nf) result(rows)
+         character(len=*), intent(in) :: text
+         integer, intent(in) :: nf
+         character(len=64), allocatable :: rows(:, :)
+         character(len=:), allocatable :: rest, line
+         integer :: m, at, start, f
+         rest = text(index(text, new_line("a")) + 1:)
+         allocate(rows(nf, count([(rest(m:m) == new_line("a"), m = 1, len(rest))])))
+         rows = ""
+         do m = 1, size(rows, 2)
+            line = rest(1:index(rest, new_line("a")) - 1)
+            rest = rest(index(rest, new_line("a")) + 1:)
+            start = 1
+            f = 0
+            do at = 1, len(line) + 1
+               if (at > len(line) .or. line(min(at, len(line)):min(at, len(line))) == ",") then
+                  f = f + 1
+                  if (f <= nf) rows(f, m) = line(start:at - 1)
+                  start = at + 1
+               end if
+            end do
+         end do
+      end function csv_rows
+   end subroutine test_capped_curve
+
    !> The command on a 32 x 32 deck, levels 32 and 16: every file, the headers of its
    !> help (femcod resolution --help), and the fitted exponent equal to an independent fit
    !> of the coupled rows.
    subroutine test_resolution_command(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix, text
-      character(len=*), parameter :: suffixes(9) = [character(len=22) :: ".resolution.csv", ".powerlaw.csv", &
+      character(len=*), parameter :: suffixes(10) = [character(len=22) :: ".resolution.csv", ".powerlaw.csv", &
          ".estimates.csv", ".hardness.csv", ".load_displacement.svg", ".area_displacement.svg", ".area_pressure.svg", &
-         ".richardson.svg", ".hardness.svg"]
+         ".richardson.svg", ".hardness.svg", ".hardness_capped.csv"]
       integer :: code, k
       prefix = scratch_path("resolution")
       do k = 1, size(suffixes)

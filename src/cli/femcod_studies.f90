@@ -91,6 +91,8 @@ contains
          "                                richardson (rate-1 extrapolation from the next coarser level; np is", &
          "                                the finer one)", &
          "         PREFIX.hardness.csv    np,step,area_fraction,contacts,n_above_hardness,fraction_above_hardness", &
+         "         PREFIX.hardness_capped.csv  np,step,load_nN,area_fraction,contacts,n_plastic,fraction_plastic:", &
+         "                                the finest level again with pressures capped at H (--plastic)", &
          "         PREFIX.load_displacement.svg, .area_displacement.svg (Fig. 4.17), .area_pressure.svg,", &
          "         .richardson.svg (Fig. 4.18), .hardness.svg (Fig. 4.21)", &
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
@@ -168,7 +170,7 @@ contains
          string_type(prefix//".estimates.csv"), string_type(prefix//".hardness.csv"), &
          string_type(prefix//".load_displacement.svg"), string_type(prefix//".area_displacement.svg"), &
          string_type(prefix//".area_pressure.svg"), string_type(prefix//".richardson.svg"), &
-         string_type(prefix//".hardness.svg")]
+         string_type(prefix//".hardness.svg"), string_type(prefix//".hardness_capped.csv")]
       call check_outputs(names, force, status)
       if (status%code /= 0) then
          call fail(status)
@@ -179,7 +181,9 @@ contains
       do k = 1, size(nps)
          call wall_clock(t0)
          observer%last_report = 0
-         call solve_level(deck, nps(k), method, hardness, levels(k), status, observer)
+         ! The finest level also with the pressures capped at H (Fig. 4.21's capped curve).
+         call solve_level(deck, nps(k), method, hardness, levels(k), status, observer, &
+            capped=nps(k) == maxval(nps))
          if (status%code /= 0) then
             status%message = "level NP = "//int_str(nps(k))//": "//status%message
             call fail(status)
@@ -212,8 +216,8 @@ contains
                " (eta "//sig_str(levels(k)%mccool%density, 4)//" /nm^2, R "//sig_str(levels(k)%mccool%radius, 4)// &
                " nm, sigma_s "//sig_str(levels(k)%mccool%sigma, 4)//" nm)"
          end do
-         write(output_unit, '(a)') "  wrote "//prefix//".resolution.csv, .powerlaw.csv, .estimates.csv, .hardness.csv "// &
-            "and 5 SVG figures"
+         write(output_unit, '(a)') "  wrote "//prefix//".resolution.csv, .powerlaw.csv, .estimates.csv, .hardness.csv, "// &
+            ".hardness_capped.csv and 5 SVG figures"
       end if
    contains
       subroutine usage(message)
@@ -233,8 +237,8 @@ contains
       type(resolution_level), intent(in) :: levels(:)
       character(len=*), intent(in) :: method
       real(dp), intent(in) :: side
-      type(string_type) :: texts(9)
-      type(text_builder) :: b(4)
+      type(string_type) :: texts(10)
+      type(text_builder) :: b(5)
       type(svg_series), allocatable :: s1(:), s2(:), s3(:), s4(:), s5(:)
       integer :: k, i, n
       real(dp) :: a0, px2
@@ -244,6 +248,7 @@ contains
       call add_line(b(2), "np,exponent,prefactor")
       call add_line(b(3), "np,model,load_nN,area_nm2")
       call add_line(b(4), "np,step,area_fraction,contacts,n_above_hardness,fraction_above_hardness")
+      call add_line(b(5), "np,step,load_nN,area_fraction,contacts,n_plastic,fraction_plastic")
       allocate(s1(0), s2(0), s3(0), s4(0), s5(0))
       do k = 1, size(levels)
          associate(r => levels(k)%res)
@@ -290,6 +295,18 @@ contains
                levels(k)%richardson_area/a0, markers=.false.)
             call add_series(s5, npk//" x "//npk, r%step_contacts(1:n)*px2/a0*100, &
                100*real(r%step_above_hardness(1:n), dp)/max(r%step_contacts(1:n), 1))
+            if (levels(k)%has_capped) then
+               associate(c => levels(k)%capped, nc => levels(k)%capped%nsteps)
+                  do i = 1, nc
+                     call add_line(b(5), npk//","//int_str(i)//","//format_real(c%step_load(i))//","// &
+                        format_real(c%step_contacts(i)*px2/a0)//","//int_str(c%step_contacts(i))//","// &
+                        int_str(c%step_plastic(i))//","// &
+                        format_real(real(c%step_plastic(i), dp)/max(c%step_contacts(i), 1)))
+                  end do
+                  call add_series(s5, npk//" x "//npk//", capped at H", c%step_contacts(1:nc)*px2/a0*100, &
+                     100*real(c%step_plastic(1:nc), dp)/max(c%step_contacts(1:nc), 1), dashed=.true.)
+               end associate
+            end if
          end associate
       end do
       ! The uncoupled model of the finest level (dashed, as in Fig. 4.17).
@@ -316,8 +333,9 @@ contains
          "apparent pressure (MPa)", "fraction of the area in contact", s3, .false., .false.)
       texts(8)%s = svg_multi_plot("Richardson extrapolation, rate 1 (thesis Fig. 4.18b)", "apparent pressure (MPa)", &
          "fraction of the area in contact", s4, .false., .false.)
-      texts(9)%s = svg_multi_plot("contacts above the hardness (thesis Fig. 4.21)", &
-         "contact area / total surface area (%)", "contacts with p > H (%)", s5, .false., .false.)
+      texts(9)%s = svg_multi_plot("contacts above the hardness (thesis Fig. 4.21), and at it when capped", &
+         "contact area / total surface area (%)", "contacts with p > H, or at H when capped (%)", s5, .false., .false.)
+      texts(10)%s = built_text(b(5))
    end function resolution_texts
 
    !> One of the Fig. 3.2 panels: a summit statistic against the box size, log-log,

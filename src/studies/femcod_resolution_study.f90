@@ -43,6 +43,10 @@ module femcod_resolution_study
       !> level's loads within the coarser history (empty for the coarsest level).
       integer :: coarser_np = 0
       real(dp), allocatable :: richardson_load(:), richardson_area(:)
+      !> The same level with the pressures capped at the hardness (the event path with
+      !> --plastic; Fig. 4.21's capped curve), when asked for: `has_capped`.
+      logical :: has_capped = .false.
+      type(contact_result) :: capped
    end type resolution_level
 
 contains
@@ -92,8 +96,10 @@ contains
       call validate_problem(level, status)
    end subroutine level_deck
 
-   !> Solve one level and compute its estimates.
-   subroutine solve_level(deck, np, method, hardness, level, status, observer)
+   !> Solve one level and compute its estimates; with `capped` true solve it a second
+   !> time with the pressures capped at the hardness (the plastic events of the event
+   !> path), for the capped curve of Fig. 4.21.
+   subroutine solve_level(deck, np, method, hardness, level, status, observer, capped)
       type(contact_problem), intent(in) :: deck
       integer, intent(in) :: np
       character(len=*), intent(in) :: method
@@ -102,6 +108,7 @@ contains
       type(status_type), intent(inout) :: status
       !> Told of the solve's progress.
       class(solver_observer), intent(inout), optional :: observer
+      logical, intent(in), optional :: capped
       type(contact_problem) :: d
       type(contact_options) :: options
       real(dp), allocatable :: load(:), area(:), composite(:, :)
@@ -115,6 +122,12 @@ contains
       allocate(options%loads(0))
       call solve_contact(d, options, level%res, status, observer)
       if (status%code /= 0) return
+      if (present(capped)) level%has_capped = capped
+      if (level%has_capped) then
+         options%plastic = .true.
+         call solve_contact(d, options, level%capped, status, observer)
+         if (status%code /= 0) return
+      end if
       n = level%res%nsteps
       load = level%res%step_load(1:n)
       area = level%res%step_contacts(1:n)*d%pixel**2
