@@ -201,6 +201,10 @@ contains
          do k = 1, size(model)
             call add("model", model(k)%s)
          end do
+         if (options%plastic .and. allocated(res%step_plastic)) then
+            if (all(res%step_plastic == 0)) call add("model", "no pixel reached the hardness: no plastic event, "// &
+               "the elastic path with one more comparison per contact and step")
+         end if
          call add("checked", "every pixel by FFT convolution at the end: "// &
             int_str(res%missed_final_check)//" penetrating (deepest "//sig_str(res%max_penetration, 2)// &
             " nm); "//int_str(res%releases)//" releases; "//int_str(res%evaluations)// &
