@@ -17,7 +17,7 @@ module test_cg
    use femcod_spring, only: spring_stiffness
    use femcod_scene, only: initial_gaps
    use femcod_random, only: random_stream, seed_stream, uniform
-   use test_support, only: scratch_path, file_exists, remove_scratch
+   use test_support, only: scratch_path, file_exists, remove_scratch, read_text
    use femcod_analytic, only: hertz_approach, segedin_sphere
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
    use femcod_status, only: STATUS_BAD_INPUT
@@ -34,6 +34,12 @@ contains
          new_unittest("equals the event-exact solver inside steps on every input/ deck", test_against_incremental), &
          new_unittest("sphere, 0.5 nm mesh: Hertz at 1000 nN, Segedin at 18000 nN", test_sphere), &
          new_unittest("usage errors: no --loads; --plastic with legacy or at full capacity", test_usage), &
+         new_unittest("--approach (displacement control): Hertz's load at the sphere's approach, both solvers", &
+            test_approach_hertz), &
+         new_unittest("--approach: event path and cg agree; any order; loads give the approaches back", &
+            test_approach_paths), &
+         new_unittest("--approach from the command line: rows in the order given, below touch, refusals", &
+            test_approach_cli), &
          new_unittest("the gap maps it hands over equal a direct sum over the Love table", test_gap_maps), &
          new_unittest("--plastic: a hardness no pixel reaches gives the elastic answer bit for bit (both)", &
             test_plastic_inert), &
@@ -632,6 +638,138 @@ contains
          end if
       end do
    end subroutine test_plastic_maps
+
+   !> Displacement control on the 0.5 nm sphere (R = 15 nm, E* = 213.3 GPa): at the approach
+   !> that Hertz gives for 1000 nN (eq. 4.14, delta = (9 P^2/(16 E*^2 R))^(1/3) = 0.9375 nm)
+   !> both solvers find a load within 1 % of 1000 nN (the tolerance of the load-controlled
+   !> Hertz check, test_sphere; measured 0.09 %), and at half that approach within 2 % of
+   !> Hertz's P = (4/3) E* R^(1/2) delta^(3/2) (measured 1.2 %: the contact radius is then
+   !> 5.3 pixels instead of 7.5, and the staircase of the pixel area weighs more).
+   subroutine test_approach_hertz(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status
+      real(dp) :: estar, r, d(2), hertz
+      integer :: solver, k
+      call read_deck("input/sphere_d05.deck", deck, status)
+      estar = 200/(1 - 0.25_dp**2)
+      r = 15
+      d(1) = hertz_approach(1000.0_dp, r, estar)
+      d(2) = d(1)/2
+      do solver = 1, 2
+         options = contact_options()
+         options%solver = trim(merge("cg         ", "incremental", solver == 1))
+         options%loads = [real(dp) ::]
+         options%approaches = d
+         options%cg = cg_settings()
+         options%cg%max_iterations = 5000
+         call solve_contact(deck, options, res, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         do k = 1, 2
+            hertz = 4*estar*sqrt(r)*d(k)**1.5_dp/3
+            call check(error, res%states(k)%reached, trim(options%solver)//": reached")
+            if (allocated(error)) return
+            call check(error, res%states(k)%load, hertz, rel=.true., thr=0.01_dp*k, message=trim(options%solver)// &
+               ": load at "//to_string(d(k))//" nm against Hertz "//to_string(hertz))
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_approach_hertz
+
+   !> On a 32 x 32 rough surface, approaches in decreasing order with one below first
+   !> touch: the event path's states do not depend on the order (bit for bit against the
+   !> increasing order); cg's loads agree with the event path's to 1e-7 and its
+   !> contacts are the same; the event path at the loads it found (--loads) gives the
+   !> approaches back to 1e-12 of them (a second, load-driven, route along the same
+   !> piecewise-linear path); below first touch: load 0, no contact.
+   subroutine test_approach_paths(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: down, up, cg, back
+      type(status_type) :: status
+      real(dp), parameter :: d(4) = [2.0_dp, 1.2_dp, 0.7_dp, -0.3_dp]
+      integer :: k
+      call rough_scene(32, 5, deck)
+      deck%maxcont = 1024
+      options%solver = "incremental"
+      options%loads = [real(dp) ::]
+      options%approaches = d
+      call solve_contact(deck, options, down, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      options%approaches = d(size(d):1:-1)
+      call solve_contact(deck, options, up, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      do k = 1, size(d)
+         call check(error, down%states(k)%load == up%states(size(d) + 1 - k)%load .and. &
+            all(down%states(k)%force == up%states(size(d) + 1 - k)%force), "order: approach "//to_string(d(k)))
+         if (allocated(error)) return
+      end do
+      call check(error, down%states(4)%load == 0 .and. down%states(4)%contacts == 0 .and. &
+         down%states(4)%approach == d(4), "below first touch")
+      if (allocated(error)) return
+      options%solver = "cg"
+      options%approaches = d
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-10_dp
+      options%cg%max_iterations = 5000
+      call solve_contact(deck, options, cg, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      do k = 1, 3
+         call check(error, cg%states(k)%load, down%states(k)%load, rel=.true., thr=1.0e-7_dp, &
+            message="cg's load at "//to_string(d(k))//" nm")
+         if (allocated(error)) return
+         call check(error, cg%states(k)%contacts, down%states(k)%contacts, "cg's contacts at "//to_string(d(k)))
+         if (allocated(error)) return
+      end do
+      options%solver = "incremental"
+      options%approaches = [real(dp) ::]
+      options%loads = down%states(1:3)%load
+      call solve_contact(deck, options, back, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      do k = 1, 3
+         call check(error, back%states(k)%approach, d(k), rel=.true., thr=1.0e-12_dp, &
+            message="the approach at the load found for "//to_string(d(k))//" nm")
+         if (allocated(error)) return
+      end do
+   end subroutine test_approach_paths
+
+   !> femcod run --approach 0.8,0.4,-0.1 on input/sphere_d1.deck: PREFIX.loads.csv has one
+   !> row per approach in the order given (approach column equal to the request), the
+   !> negative one with load 0 and no contact; --loads with --approach, and --plastic with
+   !> approaches that decrease, are refused (exit 2).
+   subroutine test_approach_cli(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, text
+      integer :: code
+      prefix = scratch_path("approach-cli")
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--approach"), &
+         string_type("0.8,0.4,-0.1"), string_type("-o"), string_type(prefix), string_type("--quiet"), &
+         string_type("--force")], code)
+      call check(error, code, 0, "the run")
+      if (allocated(error)) return
+      text = read_text(prefix//".loads.csv")
+      text = text(index(text, new_line("a")) + 1:)
+      call check(error, index(text, ",0.8,") > 0 .and. index(text, ",0.8,") < index(text, ",0.4,") .and. &
+         index(text, ",0.4,") < index(text, "0,-0.1,0,"), "rows in the order given: "//text)
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--approach"), &
+         string_type("0.5"), string_type("--loads"), string_type("100"), string_type("-o"), string_type(prefix), &
+         string_type("--quiet"), string_type("--force")], code)
+      call check(error, code, 2, "--loads with --approach")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("--approach"), &
+         string_type("0.5,0.2"), string_type("--plastic"), string_type("-o"), string_type(prefix), &
+         string_type("--quiet"), string_type("--force")], code)
+      call check(error, code, 2, "--plastic with a decreasing approach")
+   end subroutine test_approach_cli
 
    subroutine test_usage(error)
       type(error_type), allocatable, intent(out) :: error

@@ -22,7 +22,7 @@ module femcod_run
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, height_file_path
    use femcod_contact_result, only: contact_result, stop_reason_text
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, requested_states
    use femcod_observer, only: solver_observer
    use femcod_state_visitor, only: visitable
    use femcod_incremental_state, only: incremental_state
@@ -92,6 +92,9 @@ contains
             "the run stops once the largest is reached", lower=0.0_dp), &
          real_option("--hardness", "H", "GPa, for n_above_hardness (default 11, polysilicon), and the cap of "// &
             "--plastic", lower=0.0_dp, closed="()"), &
+         real_list_option("--approach", "D1,...", "displacement control instead of --loads: approaches in nm "// &
+            "(from first touch; any order) at which to report the state, the load being the answer "// &
+            "(PREFIX.loads.csv, one row per approach in the order given)"), &
          choice_option("--boundary", "free|periodic", "free (default): the grid alone on a half-space, as in the "// &
             "thesis; periodic: the grid is one cell of a surface repeating with period NP d in both directions "// &
             "(incremental and cg solvers; zero-mean displacements, the approach is the fall of the mean gap)"), &
@@ -144,7 +147,7 @@ contains
       call print_lines(option_help(run_table(), "event"))
       write(output_unit, '(a)') "", "incremental solver:"
       call print_lines(option_help(run_table(), "incremental"))
-      write(output_unit, '(a)') "", "cg solver (needs --loads; MAXCONT and --max-contacts do not apply):"
+      write(output_unit, '(a)') "", "cg solver (needs --loads or --approach; MAXCONT and --max-contacts do not apply):"
       call print_lines(option_help(run_table(), "cg"))
       write(output_unit, '(a)') "", "scene options, with --lower/--upper only (one scene; -o defaults to the first", &
          "file's name; the elastic body carries the heights, the other is rigid):"
@@ -193,9 +196,10 @@ contains
       call get_option(parsed, "--restart", settings%restart)
       associate(o => settings%solve)
          o%checkpoint_interval = 300
-         allocate(o%loads(0))
+         allocate(o%loads(0), o%approaches(0))
          if (option_given(parsed, "--solver")) o%solver = option_value(parsed, "--solver")
          call get_option(parsed, "--loads", o%loads)
+         call get_option(parsed, "--approach", o%approaches)
          call get_option(parsed, "--max-contacts", o%max_contacts)
          call get_option(parsed, "--hardness", o%hardness)
          call get_option(parsed, "--plastic", o%plastic)
@@ -259,8 +263,16 @@ contains
          call set_error(status, STATUS_USAGE, "run needs a DECK")
       else if (settings%restart .and. settings%solve%solver /= "incremental") then
          call set_error(status, STATUS_USAGE, "--restart: checkpoints are written by the incremental solver only")
-      else if (settings%solve%solver == "cg" .and. size(settings%solve%loads) == 0) then
-         call set_error(status, STATUS_USAGE, "--solver cg solves at given loads: add --loads F1,F2,...")
+      else if (size(settings%solve%loads) > 0 .and. size(settings%solve%approaches) > 0) then
+         call set_error(status, STATUS_USAGE, "give --loads (load control) or --approach (displacement control), "// &
+            "not both")
+      else if (settings%solve%solver == "cg" .and. requested_states(settings%solve) == 0) then
+         call set_error(status, STATUS_USAGE, "--solver cg solves at given loads or approaches: add --loads F1,F2,... "// &
+            "or --approach D1,D2,...")
+      else if (settings%solve%plastic .and. size(settings%solve%approaches) > 1) then
+         if (any(settings%solve%approaches(2:) < settings%solve%approaches(:size(settings%solve%approaches) - 1))) &
+            call set_error(status, STATUS_USAGE, "--approach with --plastic: give the approaches in increasing order "// &
+            "(unloading a plastic interface is not modelled)")
       else if (size(settings%decks) > 1 .and. settings%prefix /= "" .and. .not. settings%from_files) then
          call set_error(status, STATUS_USAGE, "-o PREFIX names the outputs of one deck; with several decks each "// &
             "deck's outputs are named after it (--outdir DIR puts them in DIR)")
@@ -418,7 +430,7 @@ contains
       call wall_clock(read_seconds)
       read_seconds = read_seconds - t0
       ! No output may ever replace an input.
-      if (st%code == 0) call refuse_input_as_output(prefix, size(settings%solve%loads), files, st)
+      if (st%code == 0) call refuse_input_as_output(prefix, requested_states(settings%solve), files, st)
       if (st%code == 0) then
          call acquire_lock(prefix//".lock", st, notice)
          if (notice /= "" .and. .not. settings%quiet) write(error_unit, '(a)') "femcod: "//notice
@@ -510,7 +522,7 @@ contains
          call check_writable(prefix, st)
          if (st%code == 0 .and. .not. settings%force) then
             if (.not. (settings%restart .and. (have_checkpoint .or. .not. path_exists(prefix//".h5")))) &
-               call refuse_overwrite(prefix, size(options%loads), st)
+               call refuse_overwrite(prefix, requested_states(options), st)
          end if
          if (st%code /= 0) return
          observer%quiet = settings%quiet
@@ -580,10 +592,17 @@ contains
          if (st%code /= 0) return
          ! The set is replaced as a whole: what an earlier run left beside it goes, and the
          ! checkpoint has served its purpose.
-         call remove_stale_results(prefix, size(options%loads))
+         call remove_stale_results(prefix, requested_states(options))
          do k = 1, size(res%states)
-            if (.not. res%states(k)%reached) write(error_unit, '(a)') "femcod: warning: load "// &
-               format_real(res%states(k)%load)//" nN not reached ("//stop_reason_text(res%stop_reason)//")"
+            if (.not. res%states(k)%reached) then
+               if (size(options%approaches) > 0) then
+                  write(error_unit, '(a)') "femcod: warning: approach "//format_real(res%states(k)%approach)// &
+                     " nm not reached ("//stop_reason_text(res%stop_reason)//")"
+               else
+                  write(error_unit, '(a)') "femcod: warning: load "//format_real(res%states(k)%load)// &
+                     " nN not reached ("//stop_reason_text(res%stop_reason)//")"
+               end if
+            end if
          end do
          if (.not. settings%quiet) call print_summary(deck_path, prefix, problem, options, res)
       end associate
@@ -619,7 +638,8 @@ contains
       integer :: k, at
       text = problem%label//"|"//int_str(problem%np)//"|"//format_real(problem%pixel)//"|"// &
          int_str(problem%maxcont)//"|"//reals(problem%young)//reals(problem%poisson)//trim(options%solver)//"|"// &
-         reals(options%loads)//int_str(options%max_contacts)//"|"//format_real(options%hardness)//"|"// &
+         reals(options%loads)//trim(merge("approach|", "         ", size(options%approaches) > 0))// &
+         reals(options%approaches)//int_str(options%max_contacts)//"|"//format_real(options%hardness)//"|"// &
          trim(merge("plastic|", "        ", options%plastic))//trim(merge("periodic|", "         ", &
          options%boundary == "periodic"))// &
          format_real(options%tie_tolerance)//"|"//merge("T", "F", options%final_check)//"|"// &

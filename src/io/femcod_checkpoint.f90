@@ -100,6 +100,10 @@ contains
          call h5_write(file, "/options/event_search", merge(1, 0, options%event_search == "fft") + &
             2*merge(1, 0, options%event_search == "bound"), "1", status)
          call h5_write(file, "/options/periodic", merge(1, 0, options%boundary == "periodic"), "1", status)
+         if (allocated(options%approaches)) then
+            if (size(options%approaches) > 0) call h5_write(file, "/options/approaches", options%approaches, "nm", &
+               status)
+         end if
          if (status%code == 0) then
             call state%visit(writer)
             if (writer%status%code /= 0) call set_error(status, writer%status%code, writer%status%message)
@@ -223,6 +227,15 @@ contains
          status, bad)
       if (status%code == 0 .and. (i == 1 .neqv. options%boundary == "periodic")) then
          call refuse("written with another --boundary")
+         return
+      end if
+      ! Displacement control: the same approaches (none stored: load control).
+      if (allocated(r1)) deallocate(r1)
+      allocate(r1(0))
+      if (status%code == 0 .and. h5_exists(file, "/options/approaches")) call h5_read(file, "/options/approaches", &
+         r1, status, bad)
+      if (status%code == 0 .and. .not. same(r1, given_approaches(options))) then
+         call refuse("written with other --approach")
          return
       end if
       if (status%code /= 0) then
@@ -489,4 +502,12 @@ contains
       end if
       fits = .true.
    end function fits
+
+   !> The requested approaches, none when not given.
+   pure function given_approaches(options) result(values)
+      type(contact_options), intent(in) :: options
+      real(dp), allocatable :: values(:)
+      allocate(values(0))
+      if (allocated(options%approaches)) values = options%approaches
+   end function given_approaches
 end module femcod_checkpoint

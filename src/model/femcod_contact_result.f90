@@ -6,7 +6,7 @@ module femcod_contact_result
    use femcod_strings, only: int_str
    implicit none
    private
-   public :: contact_result, load_state, append_step, visit_result
+   public :: contact_result, load_state, append_step, visit_result, record_approach_states
    public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text, record_load_states, finish_contacts
 
    integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3
@@ -212,6 +212,40 @@ contains
          end if
       end do
    end subroutine record_load_states
+
+   !> As record_load_states for requested approaches (displacement control): an unreached
+   !> state's approach is its target D; within the step the approach is approach + l delta,
+   !> so D is reached at l = (D - approach)/delta, where the load is total + l.
+   pure subroutine record_approach_states(res, lam, bounded, total, approach, delta, ftot, funit, pixel, hardness, &
+      ic, jc)
+      type(contact_result), intent(inout) :: res
+      real(dp), intent(in) :: lam, total, approach, delta, ftot(:), funit(:), pixel, hardness
+      integer, intent(in) :: ic(:), jc(:)
+      logical, intent(in) :: bounded
+      integer :: s
+      real(dp) :: dl
+      real(dp), allocatable :: f(:)
+      if (.not. delta > 0) return
+      do s = 1, size(res%states)
+         if (res%states(s)%reached) cycle
+         dl = max(res%states(s)%approach - approach, 0.0_dp)/delta
+         if (bounded .and. dl > lam) cycle
+         f = ftot + dl*funit
+         res%states(s)%load = total + dl
+         res%states(s)%contacts = size(ftot)
+         res%states(s)%max_pressure = 0
+         if (size(f) > 0) res%states(s)%max_pressure = maxval(f)/pixel**2
+         res%states(s)%n_above_hardness = count(f/pixel**2 > hardness)
+         res%states(s)%reached = .true.
+         res%states(s)%i = ic
+         res%states(s)%j = jc
+         res%states(s)%force = f
+         if (res%states(s)%approach == maxval(res%states%approach)) then
+            res%contact_force = f
+            res%reported_load = res%states(s)%load
+         end if
+      end do
+   end subroutine record_approach_states
 
    !> Store the contact pixels; the forces at the end when no requested load set them.
    pure subroutine finish_contacts(res, ic, jc, cstep, ftot, total)

@@ -11,7 +11,8 @@ module femcod_event_path
    use femcod_clock, only: wall_clock
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: contact_options
-   use femcod_contact_result, only: contact_result, append_step, record_load_states, STOP_LOADS, STOP_NO_CONTACT
+   use femcod_contact_result, only: contact_result, append_step, record_load_states, record_approach_states, &
+      STOP_LOADS, STOP_NO_CONTACT
    implicit none
    private
    public :: load_path, first_touch_limit, NO_EVENT
@@ -22,9 +23,10 @@ module femcod_event_path
    !> Where a path is: total load (nN), approach (nm), and what ends it.
    type :: load_path
       real(dp) :: total = 0, approach = 0
-      !> The largest requested load (nN), and whether any was requested.
-      real(dp) :: max_load = -huge(1.0_dp)
-      logical :: has_loads = .false.
+      !> The largest requested load (nN), and whether any was requested; the same for
+      !> requested approaches (nm, displacement control).
+      real(dp) :: max_load = -huge(1.0_dp), max_approach = -huge(1.0_dp)
+      logical :: has_loads = .false., has_approaches = .false.
       !> The contacts the path may hold: MAXCONT, or fewer by --max-contacts.
       integer :: max_contacts = 0
       !> Pixel size (nm) and hardness (GPa), for the pressures of the history and states.
@@ -54,11 +56,36 @@ contains
       end if
       path%has_loads = size(loads) > 0
       if (path%has_loads) path%max_load = maxval(loads)
-      allocate(res%states(size(loads)))
-      res%states%load = loads
       path%pixel = problem%pixel
       path%hardness = options%hardness
+      path%has_approaches = .false.
+      if (allocated(options%approaches)) path%has_approaches = size(options%approaches) > 0
+      if (path%has_approaches) then
+         ! Displacement control: the targets wait in the states' approach; those at or
+         ! below first touch are reached at once, with no load and no contact.
+         path%max_approach = maxval(options%approaches)
+         allocate(res%states(size(options%approaches)))
+         res%states%approach = options%approaches
+         res%states%load = 0
+         where (options%approaches <= 0) res%states%reached = .true.
+         call record_untouched(res)
+         return
+      end if
+      allocate(res%states(size(loads)))
+      res%states%load = loads
    end subroutine start_path
+
+   !> The states reached before any contact: no force, no contact.
+   pure subroutine record_untouched(res)
+      type(contact_result), intent(inout) :: res
+      integer :: s
+      do s = 1, size(res%states)
+         if (.not. res%states(s)%reached) cycle
+         res%states(s)%contacts = 0
+         res%states(s)%max_pressure = 0
+         allocate(res%states(s)%i(0), res%states(s)%j(0), res%states(s)%force(0))
+      end do
+   end subroutine record_untouched
 
    !> The gap below which a pixel touches together with the first one (gap `first`): the
    !> tie tolerance of the gaps' range, since the load scale is still zero.
@@ -90,7 +117,21 @@ contains
       integer, intent(in) :: ic(:), jc(:)
       real(dp) :: t1
       reason = 0
-      if (lam >= NO_EVENT) then
+      if (path%has_approaches) then
+         ! Displacement control: the states where the approach crosses a target.
+         if (lam >= NO_EVENT) then
+            call record_approach_states(res, NO_EVENT, .false., path%total, path%approach, delta, ftot, funit, &
+               path%pixel, path%hardness, ic, jc)
+            reason = STOP_NO_CONTACT
+            if (path%max_approach > path%approach .and. delta > 0) &
+               call path%advance((path%max_approach - path%approach)/delta, delta, ftot, funit)
+         else
+            call record_approach_states(res, lam, .true., path%total, path%approach, delta, ftot, funit, &
+               path%pixel, path%hardness, ic, jc)
+            call path%advance(lam, delta, ftot, funit)
+            if (path%max_approach <= path%approach) reason = STOP_LOADS
+         end if
+      else if (lam >= NO_EVENT) then
          call record_load_states(res, NO_EVENT, .false., path%total, path%approach, delta, ftot, funit, &
             path%pixel, path%hardness, ic, jc)
          reason = STOP_NO_CONTACT

@@ -6,7 +6,7 @@ module femcod_solver_options
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES
+   public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, requested_states
 
    !> The solvers by name: the event-exact incremental solver, the Appendix B program,
    !> and the fixed-load constrained conjugate gradients.
@@ -64,6 +64,9 @@ module femcod_solver_options
       integer :: max_contacts = 0
       !> Requested total loads (nN); empty: the event solvers run to MAXCONT.
       real(dp), allocatable :: loads(:)
+      !> Requested approaches (nm; displacement control, instead of loads): the state at
+      !> each, with the load as the answer, in the order given.
+      real(dp), allocatable :: approaches(:)
       !> Hardness (GPa) for the count of pixels above it (thesis polysilicon: 11 GPa).
       real(dp) :: hardness = 11
       !> Elastic-perfectly-plastic interface: each pixel's pressure is capped at
@@ -84,4 +87,14 @@ module femcod_solver_options
       !> The cg solver's own options.
       type(cg_settings) :: cg
    end type contact_options
+
+contains
+
+   !> The number of requested states: one per load of --loads or approach of --approach.
+   pure integer function requested_states(options)
+      type(contact_options), intent(in) :: options
+      requested_states = 0
+      if (allocated(options%loads)) requested_states = size(options%loads)
+      if (allocated(options%approaches)) requested_states = requested_states + size(options%approaches)
+   end function requested_states
 end module femcod_solver_options

@@ -102,19 +102,33 @@ contains
       class(solver_observer), intent(inout) :: observer
       type(cg_residuals), allocatable :: report(:)
       type(cg_grid) :: fine
-      real(dp), allocatable :: p(:, :), g0(:, :)
+      real(dp), allocatable :: p(:, :), g0(:, :), targets(:)
       logical, allocatable :: capped(:, :)
       integer, allocatable :: order(:)
       real(dp) :: load, tstart, t0, t1, approach
       integer :: np, k, kk, m, i, j, nc
+      logical :: by_approach
       call wall_clock(tstart)
       associate(how => options%cg, tol => options%cg%tol, max_iterations => options%cg%max_iterations)
       np = problem%np
-      m = size(options%loads)
+      ! Displacement control (--approach): the targets are approaches, the loads the answers.
+      by_approach = .false.
+      if (allocated(options%approaches)) by_approach = size(options%approaches) > 0
+      if (by_approach) then
+         targets = options%approaches
+      else
+         targets = options%loads
+      end if
+      m = size(targets)
       allocate(report(m), res%states(m))
-      res%states%load = options%loads
+      if (by_approach) then
+         res%states%approach = targets
+         res%states%load = 0
+      else
+         res%states%load = targets
+      end if
       if (m == 0) then
-         call set_error(status, STATUS_NUMERICAL, "cg: --solver cg needs --loads")
+         call set_error(status, STATUS_NUMERICAL, "cg: --solver cg needs --loads or --approach")
          return
       end if
       call make_grid(fine, transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np])), problem, &
@@ -131,7 +145,7 @@ contains
       do k = 2, m
          kk = k
          do while (kk > 1)
-            if (options%loads(order(kk - 1)) <= options%loads(order(kk))) exit
+            if (targets(order(kk - 1)) <= targets(order(kk))) exit
             order([kk - 1, kk]) = order([kk, kk - 1])
             kk = kk - 1
          end do
@@ -139,28 +153,15 @@ contains
       p = 0
       do kk = 1, m
          k = order(kk)
-         load = options%loads(k)
          call wall_clock(t0)
-         if (load <= 0) then
-            p = 0
-            approach = -minval(fine%g0)
-         else if (options%plastic) then
-            call capped_solve(fine, problem, g0, load, options%hardness*problem%pixel**2, how, p, capped, approach, &
-               report(k), res%states(k), status, observer)
-            if (status%code /= 0) exit
+         if (by_approach) then
+            call find_load(targets(k), k)
+            load = res%states(k)%load
          else
-            if (.not. sum(p) > 0) then
-               if (how%nested) then
-                  call nested_start(fine, problem, load, how, p, report(k), status, observer)
-               else
-                  call first_guess(fine, load, p)
-               end if
-               if (status%code /= 0) exit
-            end if
-            call constrained_cg(fine, load, tol, max_iterations, how, p, approach, report(k), status, observer, &
-               res%states(k)%gap)
-            if (status%code /= 0) exit
+            load = targets(k)
+            call solve_load(load, k)
          end if
+         if (status%code /= 0) exit
          call wall_clock(t1)
          ! The state at this load.
          associate(st => res%states(k))
@@ -195,7 +196,7 @@ contains
             call append_step(res, st%contacts, st%n_above_hardness, load, st%approach, t1 - t0)
             if (options%plastic) res%step_plastic = [res%step_plastic, st%n_plastic]
             call observer%progress(kk, st%contacts, load, t1 - tstart)
-            if (load == maxval(options%loads)) then
+            if (targets(k) == maxval(targets)) then
                res%contact_i = st%i
                res%contact_j = st%j
                res%contact_step = [(kk, i = 1, st%contacts)]
@@ -211,13 +212,105 @@ contains
       if (status%code /= 0) return
       do k = 1, m
          if (report(k)%residual > tol) then
-            call set_error(status, STATUS_NUMERICAL, "cg: load "//format_real(options%loads(k))//" nN: residual "// &
+            call set_error(status, STATUS_NUMERICAL, "cg: "//trim(merge("approach", "load    ", by_approach))//" "// &
+               format_real(targets(k))//trim(merge(" nm", " nN", by_approach))//": residual "// &
                sig_str(report(k)%residual, 2)//" after "//int_str(report(k)%iterations)// &
                " iterations, above --tol "//sig_str(tol, 2)//" (raise --max-iterations)")
             return
          end if
       end do
       end associate
+   contains
+      !> The state at `load` (nN) into res%states(k): the forces p (warm start: the last
+      !> solution's, scaled by the solver to the load) and the approach.
+      subroutine solve_load(load, k)
+         real(dp), intent(in) :: load
+         integer, intent(in) :: k
+         associate(how => options%cg)
+         if (load <= 0) then
+            p = 0
+            approach = -minval(fine%g0)
+            if (options%plastic) capped = .false.
+         else if (options%plastic) then
+            call capped_solve(fine, problem, g0, load, options%hardness*problem%pixel**2, how, p, capped, approach, &
+               report(k), res%states(k), status, observer)
+         else
+            if (.not. sum(p) > 0) then
+               if (how%nested) then
+                  call nested_start(fine, problem, load, how, p, report(k), status, observer)
+               else
+                  call first_guess(fine, load, p)
+               end if
+               if (status%code /= 0) return
+            end if
+            call constrained_cg(fine, load, how%tol, how%max_iterations, how, p, approach, report(k), status, &
+               observer, res%states(k)%gap)
+         end if
+         end associate
+      end subroutine solve_load
+
+      !> Displacement control: the load at which the approach is `target` (nm), by the
+      !> Illinois variant of regula falsi on A(P) - target (A increases with P), each
+      !> A(P) a fixed-load solve warm-started from the last; to |A - target| <= tol times
+      !> the height range, the fixed-load solver's own accuracy. At or below first touch
+      !> (target <= 0) the state has no load and no contact. The load is the answer
+      !> (res%states(k)%load); report(k) counts the iterations of every solve.
+      subroutine find_load(target, k)
+         real(dp), intent(in) :: target
+         integer, intent(in) :: k
+         integer, parameter :: MAX_SOLVES = 100
+         real(dp) :: lo, alo, hi, ahi, trial, accuracy
+         integer :: solve, side
+         accuracy = options%cg%tol*fine%scale
+         if (target <= 0) then
+            res%states(k)%load = 0
+            call solve_load(0.0_dp, k)
+            approach = target
+            return
+         end if
+         lo = 0
+         alo = 0
+         hi = -1
+         ahi = 0
+         side = 0
+         ! First trial: the last solution's load scaled as Hertz (P ~ A^1.5), or one
+         ! pixel's stiffness.
+         if (sum(p) > 0 .and. approach > 0) then
+            trial = sum(p)*(target/approach)**1.5_dp
+         else
+            trial = target/(fine%c*fine%table(0, 0) + fine%s)
+         end if
+         do solve = 1, MAX_SOLVES
+            call solve_load(trial, k)
+            if (status%code /= 0) return
+            if (abs(approach - target) <= accuracy) exit
+            ! Illinois: an end kept twice in a row has its residual halved.
+            if (approach < target) then
+               lo = trial
+               alo = approach
+               if (side == -1) ahi = target + (ahi - target)/2
+               side = -1
+            else
+               hi = trial
+               ahi = approach
+               if (side == 1) alo = target - (target - alo)/2
+               side = 1
+            end if
+            if (hi < 0) then
+               ! No bracket yet: the load grows as Hertz would have it, at least doubled.
+               trial = lo*max(2.0_dp, (target/max(alo, tiny(1.0_dp)))**1.5_dp)
+            else
+               trial = lo + (hi - lo)*(target - alo)/(ahi - alo)
+               if (.not. (trial > lo .and. trial < hi)) trial = (lo + hi)/2
+            end if
+         end do
+         if (solve > MAX_SOLVES) then
+            call set_error(status, STATUS_NUMERICAL, "cg --approach: no load found for the approach "// &
+               format_real(target)//" nm in "//int_str(MAX_SOLVES)//" solves")
+            return
+         end if
+         res%states(k)%load = trial
+      end subroutine find_load
    end subroutine solve_cg
 
    !> The elastic-perfectly-plastic interface at one load: 0 <= F <= fmax = H d^2 per
