@@ -151,6 +151,7 @@ contains
          end do
       end do
       p = 0
+      approach = 0
       do kk = 1, m
          k = order(kk)
          call wall_clock(t0)
