@@ -12,7 +12,7 @@ module test_results
    use femcod_generate, only: scene_spec, build_problem
    use femcod_svg, only: svg_pressure_map, svg_plot
    use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
-   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string, skip_test
    implicit none
    private
    public :: collect_results, self_command, csv_column
@@ -34,7 +34,10 @@ contains
          new_unittest("a result that cannot be put in place leaves no partial set", test_partial), &
          new_unittest("--lower/--upper: ASCII and HDF5 heights equal the deck", test_height_files), &
          new_unittest("checkpoint: killed with SIGKILL and restarted, the same results (elastic, plastic)", &
-            test_sigkill) &
+            test_sigkill), &
+         new_unittest("doc/cluster: array tasks solve their own decks, resubmission is a no-op, collect.py", &
+            test_cluster_array), &
+         new_unittest("doc/cluster: parallel.sbatch runs every deck (needs GNU parallel)", test_cluster_parallel) &
          ]
    end subroutine collect_results
 
@@ -663,4 +666,89 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_sigkill
+
+   !> doc/cluster/array.sbatch with a made-up SLURM_ARRAY_TASK_ID (no Slurm here) on a list
+   !> of two decks with a blank line between: task 1 solves the second deck only, task 0
+   !> the first, task 2 exits 2; task 1 again finds its results complete (--restart) and
+   !> leaves them untouched (the summary's bytes, its finishing time included, unchanged).
+   !> collect.py's table is checked by Python against each run's PREFIX.loads.csv (an
+   !> independent reading: every load, approach and contact count equal).
+   subroutine test_cluster_array(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, env, before
+      integer :: code
+      dir = scratch_path("cluster")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call write_text(dir//"/decks.txt", "input/sphere_d1.deck"//new_line("a")//new_line("a")// &
+         "input/circle_punch_d1.deck"//new_line("a"))
+      env = "DECKS="//dir//"/decks.txt OUTDIR="//dir//"/out FEMCOD='"//self_command()// &
+         "' FEMCOD_ARGS='--loads 0.5,1' "
+      call execute_command_line(env//"SLURM_ARRAY_TASK_ID=1 bash doc/cluster/array.sbatch 2>"//dir//"/err", &
+         exitstat=code)
+      call check(error, code, 0, "task 1: "//read_text(dir//"/err"))
+      if (allocated(error)) return
+      call check(error, file_exists(dir//"/out/circle_punch_d1.summary.json") .and. &
+         .not. file_exists(dir//"/out/sphere_d1.summary.json"), "task 1 solves the second deck only")
+      if (allocated(error)) return
+      call execute_command_line(env//"SLURM_ARRAY_TASK_ID=0 bash doc/cluster/array.sbatch 2>"//dir//"/err", &
+         exitstat=code)
+      call check(error, code == 0 .and. file_exists(dir//"/out/sphere_d1.loads.csv"), "task 0: the first deck")
+      if (allocated(error)) return
+      call execute_command_line(env//"SLURM_ARRAY_TASK_ID=2 bash doc/cluster/array.sbatch 2>"//dir//"/err", &
+         exitstat=code)
+      call check(error, code, 2, "task 2 of two decks")
+      if (allocated(error)) return
+      before = read_text(dir//"/out/circle_punch_d1.summary.json")
+      call execute_command_line(env//"SLURM_ARRAY_TASK_ID=1 bash doc/cluster/array.sbatch 2>"//dir//"/err", &
+         exitstat=code)
+      call check(error, code == 0 .and. read_text(dir//"/out/circle_punch_d1.summary.json") == before, &
+         "the same task again: complete results kept as they are")
+      if (allocated(error)) return
+      call execute_command_line("python3 doc/cluster/collect.py "//dir//"/out > "//dir//"/table.csv 2>"//dir// &
+         "/err", exitstat=code)
+      call check(error, code, 0, "collect.py: "//read_text(dir//"/err"))
+      if (allocated(error)) return
+      call write_text(dir//"/compare.py", &
+         "import csv, sys"//new_line("a")// &
+         "rows = list(csv.DictReader(open(sys.argv[1])))"//new_line("a")// &
+         "assert len(rows) == 4, len(rows)"//new_line("a")// &
+         "for name in ('sphere_d1', 'circle_punch_d1'):"//new_line("a")// &
+         "    mine = [r for r in rows if r['summary'] == name + '.summary.json']"//new_line("a")// &
+         "    runs = list(csv.DictReader(open(sys.argv[2] + '/' + name + '.loads.csv')))"//new_line("a")// &
+         "    assert len(mine) == len(runs) == 2, (name, len(mine), len(runs))"//new_line("a")// &
+         "    for a, b in zip(mine, runs):"//new_line("a")// &
+         "        assert float(a['load_nN']) == float(b['load_nN']), (a, b)"//new_line("a")// &
+         "        assert float(a['approach_nm']) == float(b['approach_nm']), (a, b)"//new_line("a")// &
+         "        assert int(a['contacts']) == int(b['contacts']), (a, b)"//new_line("a"))
+      call execute_command_line("python3 "//dir//"/compare.py "//dir//"/table.csv "//dir//"/out 2>"//dir//"/err", &
+         exitstat=code)
+      call check(error, code, 0, "the table against the runs' loads.csv: "//read_text(dir//"/err"))
+   end subroutine test_cluster_array
+
+   !> doc/cluster/parallel.sbatch outside Slurm (it needs none): both decks of the list
+   !> solved, one job-log line each with exit code 0. Skipped where GNU parallel is missing.
+   subroutine test_cluster_parallel(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir
+      integer :: code, started
+      ! (dash's `command -v` exits 127 for a missing program: cmdstat keeps that from
+      ! being taken for a command that could not run.)
+      call execute_command_line("command -v parallel > /dev/null 2>&1", exitstat=code, cmdstat=started)
+      if (code /= 0 .or. started /= 0) then
+         call skip_test(error, "GNU parallel is not installed on this machine")
+         return
+      end if
+      dir = scratch_path("cluster-parallel")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call write_text(dir//"/decks.txt", "input/sphere_d1.deck"//new_line("a")//"input/circle_punch_d1.deck"// &
+         new_line("a"))
+      call execute_command_line("DECKS="//dir//"/decks.txt OUTDIR="//dir//"/out FEMCOD='"//self_command()// &
+         "' FEMCOD_ARGS='--loads 1' SLURM_CPUS_PER_TASK=2 bash doc/cluster/parallel.sbatch 2>"//dir//"/err", &
+         exitstat=code)
+      call check(error, code, 0, "parallel.sbatch: "//read_text(dir//"/err"))
+      if (allocated(error)) return
+      call check(error, file_exists(dir//"/out/sphere_d1.summary.json") .and. &
+         file_exists(dir//"/out/circle_punch_d1.summary.json") .and. file_exists(dir//"/out.parallel.log"), &
+         "both decks and the job log")
+   end subroutine test_cluster_parallel
 end module test_results
