@@ -46,6 +46,8 @@ contains
             test_event_path), &
          new_unittest("--plastic on a periodic cell, both solvers: capped at H, the load carried, area >= P/H", &
             test_plastic_periodic), &
+         new_unittest("--approach on the periodic cell: Westergaard's load at the closed-form approach, both", &
+            test_approach_westergaard), &
          new_unittest("femcod run --boundary periodic: maps on the periodic kernel, recorded; legacy refused", &
             test_run_periodic) &
          ]
@@ -577,4 +579,53 @@ contains
       if (allocated(error)) return
       call check(error, minval(gap) > -1.0e-10_dp*scale, "a negative gap: "//to_string(minval(gap)))
    end subroutine test_run_periodic
+
+   !> Displacement control on the periodic cell: Westergaard's sinusoid (NP = 128) at the
+   !> approaches the closed form A/h0 = (p/p*)(1 - ln(p/p*)) gives for p/p* = 1/4 and 1/2
+   !> (a/lambda = 1/6 and 1/4). Both solvers find the mean pressure within 1e-3 of p (the
+   !> approach's discretisation error at this resolution is 2e-4 and 1e-5, and
+   !> dp/dA = p/(A ln(p*/p)) magnifies it by at most 1/ln 2, test_westergaard), and the
+   !> two agree to 1e-7.
+   subroutine test_approach_westergaard(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: np = 128
+      real(dp), parameter :: ratios(2) = [0.25_dp, 0.5_dp]
+      type(contact_problem) :: problem
+      type(contact_options) :: options
+      type(contact_result) :: res(2)
+      type(status_type) :: status
+      real(dp), allocatable :: z(:, :)
+      real(dp) :: pstar, lambda
+      integer :: j, k, solver
+      allocate(z(np, np))
+      do j = 1, np
+         z(:, j) = cos(2*pi*(j - 1)/np)
+      end do
+      problem = elastic_on_rigid(z)
+      lambda = np*problem%pixel
+      pstar = pi*200/(1 - 0.25_dp**2)/lambda
+      do solver = 1, 2
+         options = contact_options()
+         options%solver = trim(merge("cg         ", "incremental", solver == 1))
+         options%boundary = "periodic"
+         options%loads = [real(dp) ::]
+         options%approaches = ratios*(1 - log(ratios))
+         options%cg = cg_settings()
+         options%cg%tol = 1.0e-10_dp
+         options%cg%max_iterations = 5000
+         call solve_contact(problem, options, res(solver), status)
+         call check(error, status%code, 0, trim(options%solver)//": "//status%message)
+         if (allocated(error)) return
+         do k = 1, size(ratios)
+            call check(error, res(solver)%states(k)%load/lambda**2, ratios(k)*pstar, rel=.true., thr=1.0e-3_dp, &
+               message=trim(options%solver)//": mean pressure at p/p* = "//to_string(ratios(k)))
+            if (allocated(error)) return
+         end do
+      end do
+      do k = 1, size(ratios)
+         call check(error, res(1)%states(k)%load, res(2)%states(k)%load, rel=.true., thr=1.0e-7_dp, &
+            message="the two solvers' loads at p/p* = "//to_string(ratios(k)))
+         if (allocated(error)) return
+      end do
+   end subroutine test_approach_westergaard
 end module test_periodic
