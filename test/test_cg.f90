@@ -40,6 +40,8 @@ contains
             test_approach_paths), &
          new_unittest("--approach from the command line: rows in the order given, below touch, refusals", &
             test_approach_cli), &
+         new_unittest("--kernel-radius: beyond the grid bit for bit; truncated, the table's own direct sum", &
+            test_kernel_radius), &
          new_unittest("the gap maps it hands over equal a direct sum over the Love table", test_gap_maps), &
          new_unittest("--plastic: a hardness no pixel reaches gives the elastic answer bit for bit (both)", &
             test_plastic_inert), &
@@ -770,6 +772,68 @@ contains
          string_type("--quiet"), string_type("--force")], code)
       call check(error, code, 2, "--plastic with a decreasing approach")
    end subroutine test_approach_cli
+
+   !> The truncated kernel (--kernel-radius): with a radius beyond the grid's diagonal the
+   !> table is whole and the answer bit for bit the untruncated one; with a radius of 5
+   !> pixels on the 30 x 30 sphere (at 3000 nN) the gap map cg hands over is
+   !> g0 - A + c sum L_5(|i-k|, |j-l|) F(k, l), summed directly over the Love table cut at
+   !> 5 pixels (to 1e-10 of the largest gap), 0 on the contacts, and nowhere negative.
+   subroutine test_kernel_radius(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: whole, cut
+      type(status_type) :: status
+      real(dp), allocatable :: table(:, :), g0(:, :), direct(:, :)
+      real(dp) :: c
+      integer :: np, i, j, k
+      call read_deck("input/sphere_d1.deck", deck, status)
+      np = deck%np
+      options%solver = "cg"
+      options%loads = [3000.0_dp]
+      options%cg = cg_settings()
+      call solve_contact(deck, options, whole, status)
+      options%cg%kernel_radius = 2*np
+      call solve_contact(deck, options, cut, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, cut%states(1)%approach == whole%states(1)%approach .and. &
+         all(cut%states(1)%force == whole%states(1)%force), "radius beyond the grid: bit for bit")
+      if (allocated(error)) return
+      options%cg%kernel_radius = 5
+      call solve_contact(deck, options, cut, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      allocate(table(0:np - 1, 0:np - 1), direct(np, np))
+      table = offset_table(np)
+      do j = 0, np - 1
+         do i = 0, np - 1
+            if (i*i + j*j > 25) table(i, j) = 0
+         end do
+      end do
+      c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
+         surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
+      g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
+      do j = 1, np
+         do i = 1, np
+            direct(i, j) = g0(i, j) - cut%states(1)%approach
+            do k = 1, size(cut%states(1)%force)
+               direct(i, j) = direct(i, j) + c*table(abs(i - cut%states(1)%i(k)), abs(j - cut%states(1)%j(k)))* &
+                  cut%states(1)%force(k)
+            end do
+         end do
+      end do
+      do k = 1, size(cut%states(1)%force)
+         direct(cut%states(1)%i(k), cut%states(1)%j(k)) = 0
+      end do
+      call check(error, maxval(abs(cut%states(1)%gap - direct)) <= 1.0e-10_dp*maxval(g0), &
+         "the gap map against the cut table's direct sum: "//to_string(maxval(abs(cut%states(1)%gap - direct))))
+      if (allocated(error)) return
+      call check(error, minval(cut%states(1)%gap) >= -1.0e-8_dp*maxval(g0), "no penetration")
+      if (allocated(error)) return
+      call check(error, abs(cut%states(1)%approach - whole%states(1)%approach) > 1.0e-3_dp*whole%states(1)%approach, &
+         "a 5-pixel kernel changes the approach")
+   end subroutine test_kernel_radius
 
    subroutine test_usage(error)
       type(error_type), allocatable, intent(out) :: error

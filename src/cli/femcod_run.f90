@@ -120,6 +120,9 @@ contains
          real_option("--tol", "T", "stop when the gap violations over the height range are below T (default 1e-8)", &
             lower=0.0_dp, closed="()", mode="cg"), &
          integer_option("--max-iterations", "N", "iterations on the finest grid (default 2000)", lower=1, mode="cg"), &
+         real_option("--kernel-radius", "R", "truncate the Love kernel beyond R pixels (an approximation: the "// &
+            "thesis' open question 5.2.2 iii, measured by femcod bench frontier; default: the whole kernel)", &
+            lower=0.0_dp, closed="()", mode="cg"), &
          text_option("--fftw-wisdom", "FILE", "FFTW measures its plans once and keeps them in FILE and FILE.float32 "// &
             "(seconds of planning the first time, faster transforms)", mode="cg"), &
          text_option("--lower", "FILE", "lower surface heights: an ASCII matrix (a Gwyddion export with its "// &
@@ -209,6 +212,7 @@ contains
          call get_option(parsed, "--checkpoint-interval", o%checkpoint_interval)
          call get_option(parsed, "--tol", o%cg%tol)
          call get_option(parsed, "--max-iterations", o%cg%max_iterations)
+         call get_option(parsed, "--kernel-radius", o%cg%kernel_radius)
          o%cg%measure_plans = len(settings%wisdom) > 0
       end associate
       lower = ""
@@ -643,7 +647,8 @@ contains
          trim(merge("plastic|", "        ", options%plastic))//trim(merge("periodic|", "         ", &
          options%boundary == "periodic"))// &
          format_real(options%tie_tolerance)//"|"//merge("T", "F", options%final_check)//"|"// &
-         trim(options%event_search)//"|"//format_real(options%cg%tol)//"|"//int_str(options%cg%max_iterations)//"|"
+         trim(options%event_search)//"|"//format_real(options%cg%tol)//"|"//int_str(options%cg%max_iterations)//"|"// &
+         format_real(options%cg%kernel_radius)//"|"
       do k = 1, size(digests)
          ! The digest without the file's path: a moved input is the same input.
          at = index(digests(k)%s, " sha256 ", back=.true.)

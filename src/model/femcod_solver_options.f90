@@ -52,6 +52,10 @@ module femcod_solver_options
       !> Let FFTW time its plans (FFTW_MEASURE) instead of estimating them; worth it
       !> with a wisdom file (`femcod run --fftw-wisdom`), which keeps the plans.
       logical :: measure_plans = .false.
+      !> The Love kernel truncated beyond this many pixels (0: the whole kernel): an
+      !> approximation whose error the thesis left open (section 5.2.2 iii) and `femcod
+      !> bench frontier` measures. The convolution stays an FFT (same cost).
+      real(dp) :: kernel_radius = 0
    end type cg_settings
 
    !> The options of a run. Units: nN, GPa, s.

@@ -423,9 +423,23 @@ contains
       else
          grid%table(:, :) = offset_table(grid%np)
       end if
+      if (how%kernel_radius > 0) call truncate_table(grid%table, how%kernel_radius*problem%pixel/pixel)
       call convolution_setup(grid%conv, grid%table, how%single_until > 0, how%measure_plans, periodic)
       if (how%precondition) call inverse_kernel_taps(grid%conv, grid%taps, grid%preconditioned)
    end subroutine make_grid
+
+   !> The kernel truncated: entries at offsets beyond `radius` pixels set to 0 (--kernel-
+   !> radius, in the finest grid's pixels; a coarser grid's radius is scaled to its pixel).
+   pure subroutine truncate_table(table, radius)
+      real(dp), intent(inout) :: table(0:, 0:)
+      real(dp), intent(in) :: radius
+      integer :: p, q
+      do q = 0, size(table, 2) - 1
+         do p = 0, size(table, 1) - 1
+            if (real(p, dp)**2 + real(q, dp)**2 > radius**2) table(p, q) = 0
+         end do
+      end do
+   end subroutine truncate_table
 
    !> Start: the load spread over the pixels within a tenth of the height range of the
    !> first touch.

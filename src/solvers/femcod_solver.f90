@@ -111,6 +111,9 @@ contains
          if (.not. options%plastic) lines = [lines, string_type("no plastic cap: pressures are elastic, "// &
             "n_above_hardness counts the pixels above the hardness (--plastic caps them)")]
          if (options%boundary == "periodic") lines = [lines, periodic_note(problem%np, "cg")]
+         if (options%cg%kernel_radius > 0) lines = [lines, string_type("Love kernel truncated beyond "// &
+            sig_str(options%cg%kernel_radius, 4)//" pixels (--kernel-radius): an approximation, the convolution "// &
+            "still by FFT; its error on the benchmark surface: doc/performance.md, the frontier")]
          return
       end select
       c1 = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel)
