@@ -24,7 +24,7 @@ module femcod_bench
    use femcod_random, only: random_stream, seed_stream, uniform
    use femcod_clock, only: wall_clock
    use femcod_deck, only: write_deck
-   use femcod_files, only: write_file
+   use femcod_files, only: write_file, file_part
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
    use femcod_svg, only: svg_pressure_map, svg_series, add_series, svg_multi_plot
    use femcod_resolution_study, only: level_deck
@@ -683,7 +683,8 @@ contains
       integer, intent(out) :: code
       integer :: np, k, f, m, factor, method
       real(dp), allocatable :: fractions(:), g0(:, :)
-      character(len=:), allocatable :: svg_path
+      character(len=:), allocatable :: svg_path, deck_path, case_label
+      real(dp) :: deck_load
       type(contact_problem) :: deck, coarse
       type(status_type) :: status
       type(contact_options) :: options
@@ -698,6 +699,8 @@ contains
       np = 256
       fractions = [1.0_dp, 5.0_dp]
       svg_path = ""
+      deck_path = "input/sphere_d1.deck"
+      deck_load = 1000
       if (help_requested(args)) then
          write(output_unit, '(a)') &
             "usage: femcod bench frontier [--np 256] [--contact 1,5] [--svg FILE]", &
@@ -708,7 +711,9 @@ contains
             "1e-2 to 1e-10 with and without float32 transforms and the nested start; cg with the Love", &
             "kernel truncated at 28, 64, 128, 283 pixels (--kernel-radius); the event path on the", &
             "image down-sampled by 2, 4, 8 (2 x 2 averages and odd/odd subsampling); the uncoupled voxel", &
-            "model (its approach at F by bisection); McCool's Greenwood-Williamson estimate (area only).", &
+            "model (its approach at F, exact between sorted gaps); McCool's Greenwood-Williamson estimate", &
+            "(area only). Then a thesis deck (--deck, at --deck-load) the same ways and by the Appendix B", &
+            "program (--solver legacy).", &
             "--svg FILE: log time against log area error, one marker per method and the Pareto front.", ""
          call print_lines(option_help(bench_frontier_table(), ""))
          write(output_unit, '(a)') "Run it with the release build."
@@ -724,6 +729,8 @@ contains
       call get_option(parsed, "--np", np)
       call get_option(parsed, "--contact", fractions)
       call get_option(parsed, "--svg", svg_path)
+      call get_option(parsed, "--deck", deck_path)
+      call get_option(parsed, "--deck-load", deck_load)
       call benchmark_surface(np, "bench frontier", deck, status)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod bench frontier: "//status%message
@@ -732,101 +739,29 @@ contains
       end if
       deck%maxcont = np*np
       call linear_law(deck, estar, slope, g0)
-      write(output_unit, '(a)') "| contact % | method | wall (s) | approach error | area error | note |"
+      write(output_unit, '(a)') "| case | method | wall (s) | approach error | area error | note |"
       write(output_unit, '(a)') "|---|---|---|---|---|---|"
       allocate(series(0))
       do f = 1, size(fractions)
          load = fractions(f)/100*estar*slope/2*BENCH_LENGTH**2
-         allocate(times(0), errors(0))
-         ! The reference: the event-exact state at F.
-         options = contact_options()
-         options%loads = [load]
-         call timed_solve(deck, options, res, t1)
+         case_label = fixed_str(fractions(f), 1)//" %"
+         call frontier_case(load, .false.)
          if (status%code /= 0) return
-         a_ref = res%states(1)%approach
-         c_ref = res%states(1)%contacts*deck%pixel**2
-         call frontier_row("event-exact (reference)", t1, 0.0_dp, 0.0_dp, "F = "//real_str(load, 6)//" nN, "// &
-            int_str(res%states(1)%contacts)//" contacts")
-         ! cg at each tolerance, with and without float32 and the nested start.
-         do m = 1, 4
-            do k = 1, size(tols)
-               options = contact_options()
-               options%solver = "cg"
-               options%loads = [load]
-               options%cg = cg_settings()
-               options%cg%tol = tols(k)
-               options%cg%max_iterations = 5000
-               if (m == 2 .or. m == 4) options%cg%single_until = 0
-               if (m >= 3) options%cg%nested = .false.
-               call timed_solve(deck, options, res, t1)
-               if (status%code /= 0) then
-                  call frontier_row("cg tol "//real_str(tols(k), 1), -1.0_dp, -1.0_dp, -1.0_dp, status%message)
-                  status = status_type()
-                  cycle
-               end if
-               call frontier_row("cg tol "//real_str(tols(k), 1)//trim(merge(", no float32", "            ", &
-                  m == 2 .or. m == 4))//trim(merge(", no nested start", "                 ", m >= 3)), t1, &
-                  rel(res%states(1)%approach, a_ref), rel(res%states(1)%contacts*deck%pixel**2, c_ref), &
-                  int_str(res%states(1)%iterations)//" iterations")
-            end do
-         end do
-         ! The Love kernel truncated (the thesis' 28 and 283 pixels, section 5.2.2 iii).
-         do k = 1, size(radii)
-            options = contact_options()
-            options%solver = "cg"
-            options%loads = [load]
-            options%cg = cg_settings()
-            options%cg%max_iterations = 5000
-            options%cg%kernel_radius = radii(k)
-            call timed_solve(deck, options, res, t1)
-            if (status%code /= 0) then
-               call frontier_row("cg, kernel truncated at "//int_str(nint(radii(k)))//" pixels", -1.0_dp, -1.0_dp, &
-                  -1.0_dp, status%message)
-               status = status_type()
-               cycle
-            end if
-            call frontier_row("cg, kernel truncated at "//int_str(nint(radii(k)))//" pixels", t1, &
-               rel(res%states(1)%approach, a_ref), rel(res%states(1)%contacts*deck%pixel**2, c_ref), &
-               int_str(res%states(1)%iterations)//" iterations, tol 1e-8")
-         end do
-         ! The image down-sampled, the event path at the same load.
-         do method = 1, size(methods)
-            factor = 2
-            do while (factor <= 8 .and. np/factor >= 8)
-               call wall_clock(t0)
-               call level_deck(deck, np/factor, trim(methods(method)), coarse, status)
-               options = contact_options()
-               options%loads = [load]
-               if (status%code == 0) call solve_contact(coarse, options, res, status)
-               call wall_clock(t1)
-               if (status%code /= 0 .or. .not. res%states(1)%reached) then
-                  call frontier_row("down-sampled 1/"//int_str(factor)//", "//trim(methods(method)), -1.0_dp, &
-                     -1.0_dp, -1.0_dp, "not reached: "//status%message)
-                  status = status_type()
-               else
-                  call frontier_row("down-sampled 1/"//int_str(factor)//", "//trim(methods(method)), t1 - t0, &
-                     rel(res%states(1)%approach, a_ref), rel(res%states(1)%contacts*coarse%pixel**2, c_ref), &
-                     int_str(np/factor)//"^2 pixels")
-               end if
-               factor = 2*factor
-            end do
-         end do
-         ! The uncoupled voxels: the approach where their load is F, by bisection.
-         call wall_clock(t0)
-         call uncoupled_at(load, approach, area)
-         call wall_clock(t1)
-         call frontier_row("uncoupled voxels", t1 - t0, rel(approach, a_ref), rel(area, c_ref), &
-            "single-pixel compliance, no coupling")
-         ! McCool's Greenwood-Williamson model: the area at the nominal pressure.
-         call wall_clock(t0)
-         call mccool_at(load, area)
-         call wall_clock(t1)
-         call frontier_row("McCool (Greenwood-Williamson)", t1 - t0, -1.0_dp, rel(area, c_ref), "area only")
-         call add_series(series, fixed_str(fractions(f), 0)//" % contact", times, errors, dashed=.true.)
-         call add_series(series, "Pareto front, "//fixed_str(fractions(f), 0)//" %", pack(times, front(times, errors)), &
-            pack(errors, front(times, errors)), markers=.false.)
-         deallocate(times, errors)
       end do
+      ! One thesis deck, with the Appendix B program among the methods.
+      if (len(deck_path) > 0) then
+         call read_deck(deck_path, deck, status)
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod bench frontier: "//status%message
+            code = status%code
+            return
+         end if
+         np = deck%np
+         g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
+         case_label = file_part(deck_path)
+         call frontier_case(deck_load, .true.)
+         if (status%code /= 0) return
+      end if
       if (len(svg_path) > 0) then
          call write_file(svg_path, svg_multi_plot("speed against error: approach and area at load F (NP = "// &
             int_str(np)//")", "wall time (s)", "relative error of the contact area", series, .true., .true.), status)
@@ -836,6 +771,115 @@ contains
          end if
       end if
    contains
+      !> Every method at load F on `deck` (np, g0 its grid and gaps), rows labelled
+      !> case_label; with `legacy`, the Appendix B program as well.
+      subroutine frontier_case(load, legacy)
+         real(dp), intent(in) :: load
+         logical, intent(in) :: legacy
+         allocate(times(0), errors(0))
+            ! The reference: the event-exact state at F.
+            options = contact_options()
+            options%loads = [load]
+            call timed_solve(deck, options, res, t1)
+            if (status%code /= 0) return
+            a_ref = res%states(1)%approach
+            c_ref = res%states(1)%contacts*deck%pixel**2
+            call frontier_row("event-exact (reference)", t1, 0.0_dp, 0.0_dp, "F = "//real_str(load, 6)//" nN, "// &
+               int_str(res%states(1)%contacts)//" contacts")
+            ! cg at each tolerance, with and without float32 and the nested start.
+            do m = 1, 4
+               do k = 1, size(tols)
+                  options = contact_options()
+                  options%solver = "cg"
+                  options%loads = [load]
+                  options%cg = cg_settings()
+                  options%cg%tol = tols(k)
+                  options%cg%max_iterations = 5000
+                  if (m == 2 .or. m == 4) options%cg%single_until = 0
+                  if (m >= 3) options%cg%nested = .false.
+                  call timed_solve(deck, options, res, t1)
+                  if (status%code /= 0) then
+                     call frontier_row("cg tol "//real_str(tols(k), 1), -1.0_dp, -1.0_dp, -1.0_dp, status%message)
+                     status = status_type()
+                     cycle
+                  end if
+                  call frontier_row("cg tol "//real_str(tols(k), 1)//trim(merge(", no float32", "            ", &
+                     m == 2 .or. m == 4))//trim(merge(", no nested start", "                 ", m >= 3)), t1, &
+                     rel(res%states(1)%approach, a_ref), rel(res%states(1)%contacts*deck%pixel**2, c_ref), &
+                     int_str(res%states(1)%iterations)//" iterations")
+               end do
+            end do
+            ! The Love kernel truncated (the thesis' 28 and 283 pixels, section 5.2.2 iii).
+            do k = 1, size(radii)
+               options = contact_options()
+               options%solver = "cg"
+               options%loads = [load]
+               options%cg = cg_settings()
+               options%cg%max_iterations = 5000
+               options%cg%kernel_radius = radii(k)
+               call timed_solve(deck, options, res, t1)
+               if (status%code /= 0) then
+                  call frontier_row("cg, kernel truncated at "//int_str(nint(radii(k)))//" pixels", -1.0_dp, -1.0_dp, &
+                     -1.0_dp, status%message)
+                  status = status_type()
+                  cycle
+               end if
+               call frontier_row("cg, kernel truncated at "//int_str(nint(radii(k)))//" pixels", t1, &
+                  rel(res%states(1)%approach, a_ref), rel(res%states(1)%contacts*deck%pixel**2, c_ref), &
+                  int_str(res%states(1)%iterations)//" iterations, tol 1e-8")
+            end do
+            ! The image down-sampled, the event path at the same load.
+            do method = 1, size(methods)
+               factor = 2
+               do while (factor <= 8 .and. np/factor >= 8 .and. mod(np, factor) == 0)
+                  call wall_clock(t0)
+                  call level_deck(deck, np/factor, trim(methods(method)), coarse, status)
+                  options = contact_options()
+                  options%loads = [load]
+                  if (status%code == 0) call solve_contact(coarse, options, res, status)
+                  call wall_clock(t1)
+                  if (status%code /= 0 .or. .not. res%states(1)%reached) then
+                     call frontier_row("down-sampled 1/"//int_str(factor)//", "//trim(methods(method)), -1.0_dp, &
+                        -1.0_dp, -1.0_dp, "not reached: "//status%message)
+                     status = status_type()
+                  else
+                     call frontier_row("down-sampled 1/"//int_str(factor)//", "//trim(methods(method)), t1 - t0, &
+                        rel(res%states(1)%approach, a_ref), rel(res%states(1)%contacts*coarse%pixel**2, c_ref), &
+                        int_str(np/factor)//"^2 pixels")
+                  end if
+                  factor = 2*factor
+               end do
+            end do
+            ! The uncoupled voxels: the approach where their load is F, by bisection.
+            call wall_clock(t0)
+            call uncoupled_at(load, approach, area)
+            call wall_clock(t1)
+            call frontier_row("uncoupled voxels", t1 - t0, rel(approach, a_ref), rel(area, c_ref), &
+               "single-pixel compliance, no coupling")
+            ! McCool's Greenwood-Williamson model: the area at the nominal pressure.
+            call wall_clock(t0)
+            call mccool_at(load, area)
+            call wall_clock(t1)
+            call frontier_row("McCool (Greenwood-Williamson)", t1 - t0, -1.0_dp, rel(area, c_ref), "area only")
+            if (legacy) then
+               options = contact_options()
+               options%solver = "legacy"
+               options%loads = [load]
+               call timed_solve(deck, options, res, t1)
+               if (status%code /= 0) then
+                  call frontier_row("legacy (Appendix B)", -1.0_dp, -1.0_dp, -1.0_dp, status%message)
+                  status = status_type()
+               else
+                  call frontier_row("legacy (Appendix B)", t1, rel(res%states(1)%approach, a_ref), &
+                     rel(res%states(1)%contacts*deck%pixel**2, c_ref), int_str(res%nsteps)//" steps")
+               end if
+            end if
+            call add_series(series, case_label, times, errors, dashed=.true.)
+            call add_series(series, "Pareto front, "//case_label, pack(times, front(times, errors)), &
+               pack(errors, front(times, errors)), markers=.false.)
+            deallocate(times, errors)
+      end subroutine frontier_case
+
       real(dp) function rel(x, reference)
          real(dp), intent(in) :: x, reference
          rel = abs(x - reference)/abs(reference)
@@ -865,9 +909,9 @@ contains
          if (approach_error >= 0) ta = real_str(approach_error, 2)
          if (area_error >= 0) tc = real_str(area_error, 2)
          if (seconds < 0) then
-            write(output_unit, '(a)') "| "//fixed_str(fractions(f), 1)//" | "//name//" | failed | | | "//note//" |"
+            write(output_unit, '(a)') "| "//case_label//" | "//name//" | failed | | | "//note//" |"
          else
-            write(output_unit, '(a)') "| "//fixed_str(fractions(f), 1)//" | "//name//" | "//real_str(seconds, 3)// &
+            write(output_unit, '(a)') "| "//case_label//" | "//name//" | "//real_str(seconds, 3)// &
                " | "//ta//" | "//tc//" | "//note//" |"
             if (area_error >= 0) then
                times = [times, max(seconds, 1.0e-6_dp)]
@@ -936,7 +980,10 @@ contains
       type(option_spec), allocatable :: table(:)
       table = [integer_option("--np", "N", "pixels per side of the benchmark surface (default 256)", lower=16), &
          real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,5)", lower=0.0_dp), &
-         text_option("--svg", "FILE", "write the figure (log time against log area error, Pareto front)")]
+         text_option("--svg", "FILE", "write the figure (log time against log area error, Pareto front)"), &
+         text_option("--deck", "FILE", "a thesis deck solved the same ways, the Appendix B program too (default "// &
+            "input/sphere_d1.deck; an empty name for none)"), &
+         real_option("--deck-load", "F", "the deck's load in nN (default 1000)", lower=0.0_dp, closed="()")]
    end function bench_frontier_table
 
    !> `femcod bench cg`: the fixed-load solver on self-affine surfaces of growing size at
