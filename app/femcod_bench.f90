@@ -501,11 +501,11 @@ contains
       real(dp) :: estar, pstar, lambda, ratio, closed, slope, load, peak
       real(dp), allocatable :: approach_error(:)
       real(dp) :: tol, pressure, fraction
-      character(len=:), allocatable :: python, path, peer_out
+      character(len=:), allocatable :: python, path
       character(len=512) :: line
       character(len=64) :: words(8)
       character(len=*), parameter :: peers(2) = [character(len=25) :: "tamaas", "contactmechanics-periodic"]
-      integer :: n, np, j, k, b, width, i, unit, ios
+      integer :: n, np, j, k, b, width, i, ios
       sizes = [64, 128, 256, 512, 1024]
       rough_sizes = [512, 1024]
       fractions = [1.0_dp, 10.0_dp, 30.0_dp]
@@ -604,12 +604,8 @@ contains
             return
          end if
          call linear_law(deck, estar, slope, g0)
-         if (len(python) > 0) then
-            path = "femcod-bench-gaps.f64"
-            open(newunit=unit, file=path, access="stream", form="unformatted", status="replace", action="write")
-            write(unit) g0
-            close(unit)
-         end if
+         path = "femcod-bench-gaps.f64"
+         if (len(python) > 0) call write_peer_gaps(path, g0)
          do k = 1, size(fractions)
             pressure = fractions(k)/100*estar*slope/2
             load = pressure*BENCH_LENGTH**2
@@ -637,16 +633,7 @@ contains
             end do
             if (len(python) == 0) cycle
             do i = 1, size(peers)
-               peer_out = "femcod-bench-peer.txt"
-               call execute_command_line(python//" app/femcod_peers.py "//trim(peers(i))//" "//path//" "// &
-                  int_str(np)//" "//real_str(deck%pixel, 16)//" "//real_str(estar, 16)//" "// &
-                  real_str(pressure, 16)//" "//real_str(tol, 3)//" > "//peer_out, exitstat=ios)
-               line = trim(peers(i))//" - - - - - failed -"
-               open(newunit=unit, file=peer_out, action="read", status="old", iostat=ios)
-               if (ios == 0) then
-                  read(unit, '(a)', iostat=ios) line
-                  close(unit, status="delete")
-               end if
+               line = peer_line(python, trim(peers(i)), path, np, deck%pixel, estar, pressure, tol)
                words = "-"
                read(line, *, iostat=ios) words
                read(words(5), *, iostat=ios) fraction
@@ -657,10 +644,7 @@ contains
                flush(output_unit)
             end do
          end do
-         if (len(python) > 0) then
-            open(newunit=unit, file=path, status="old", iostat=ios)
-            if (ios == 0) close(unit, status="delete")
-         end if
+         if (len(python) > 0) call remove_file_quietly(path)
       end do
    end subroutine bench_periodic
 
@@ -994,7 +978,7 @@ contains
       integer, intent(out) :: code
       integer, allocatable :: sizes(:)
       real(dp), allocatable :: fractions(:), g0(:, :)
-      character(len=:), allocatable :: python, path, peer_out, wisdom
+      character(len=:), allocatable :: python, path, wisdom
       type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(status_type) :: status
@@ -1002,7 +986,7 @@ contains
       type(contact_result) :: res
       type(parsed_options) :: parsed
       real(dp) :: tol, estar, slope, pressure, load, length, peak
-      integer :: i, n, k, np, unit, ios
+      integer :: i, n, k, np
       logical :: loaded
       character(len=512) :: line
       character(len=*), parameter :: peers(2) = [character(len=16) :: "aspher", "contactmechanics"]
@@ -1078,12 +1062,8 @@ contains
             return
          end if
          call linear_law(deck, estar, slope, g0)
-         if (len(python) > 0) then
-            path = "femcod-bench-gaps.f64"
-            open(newunit=unit, file=path, access="stream", form="unformatted", status="replace", action="write")
-            write(unit) g0
-            close(unit)
-         end if
+         path = "femcod-bench-gaps.f64"
+         if (len(python) > 0) call write_peer_gaps(path, g0)
          do k = 1, size(fractions)
             pressure = fractions(k)/100*estar*slope/2
             load = pressure*length**2
@@ -1108,23 +1088,11 @@ contains
             if (len(python) == 0) cycle
             do i = 1, size(peers)
                if (trim(peers(i)) == "contactmechanics" .and. np > 512) cycle
-               peer_out = "femcod-bench-peer.txt"
-               call execute_command_line(python//" app/femcod_peers.py "//trim(peers(i))//" "//path//" "// &
-                  int_str(np)//" "//real_str(deck%pixel, 16)//" "//real_str(estar, 16)//" "// &
-                  real_str(pressure, 16)//" "//real_str(tol, 3)//" > "//peer_out, exitstat=ios)
-               line = trim(peers(i))//" - - - - - failed"
-               open(newunit=unit, file=peer_out, action="read", status="old", iostat=ios)
-               if (ios == 0) then
-                  read(unit, '(a)', iostat=ios) line
-                  close(unit, status="delete")
-               end if
+               line = peer_line(python, trim(peers(i)), path, np, deck%pixel, estar, pressure, tol)
                call peer_row(np, fractions(k), line)
             end do
          end do
-         if (len(python) > 0) then
-            open(newunit=unit, file=path, status="old", iostat=ios)
-            if (ios == 0) close(unit, status="delete")
-         end if
+         if (len(python) > 0) call remove_file_quietly(path)
       end do
    contains
       logical function switch(name)
@@ -1233,6 +1201,43 @@ contains
 
    !> One table row from the peer script's line "peer seconds iterations residual fraction
    !> peak status" (fraction as a share, printed in percent).
+   !> The gaps (nm) for the peers, NP*NP float64 in Fortran order (app/femcod_peers.py).
+   subroutine write_peer_gaps(path, g0)
+      character(len=*), intent(in) :: path
+      real(dp), intent(in) :: g0(:, :)
+      integer :: unit
+      open(newunit=unit, file=path, access="stream", form="unformatted", status="replace", action="write")
+      write(unit) g0
+      close(unit)
+   end subroutine write_peer_gaps
+
+   subroutine remove_file_quietly(path)
+      character(len=*), intent(in) :: path
+      integer :: unit, ios
+      open(newunit=unit, file=path, status="old", iostat=ios)
+      if (ios == 0) close(unit, status="delete")
+   end subroutine remove_file_quietly
+
+   !> One peer's answer line (app/femcod_peers.py) on the gaps in `path`, or
+   !> "PEER - - - - - failed -" when it gave none.
+   function peer_line(python, peer, path, np, pixel, estar, pressure, tol) result(line)
+      character(len=*), intent(in) :: python, peer, path
+      integer, intent(in) :: np
+      real(dp), intent(in) :: pixel, estar, pressure, tol
+      character(len=512) :: line
+      character(len=*), parameter :: peer_out = "femcod-bench-peer.txt"
+      integer :: unit, ios
+      call execute_command_line(python//" app/femcod_peers.py "//peer//" "//path//" "//int_str(np)//" "// &
+         real_str(pixel, 16)//" "//real_str(estar, 16)//" "//real_str(pressure, 16)//" "//real_str(tol, 3)// &
+         " > "//peer_out, exitstat=ios)
+      line = peer//" - - - - - failed -"
+      open(newunit=unit, file=peer_out, action="read", status="old", iostat=ios)
+      if (ios == 0) then
+         read(unit, '(a)', iostat=ios) line
+         close(unit, status="delete")
+      end if
+   end function peer_line
+
    subroutine peer_row(np, target, line)
       integer, intent(in) :: np
       real(dp), intent(in) :: target

@@ -192,22 +192,14 @@ contains
       logical, intent(in) :: bounded
       integer :: s
       real(dp) :: dl
-      real(dp), allocatable :: f(:)
       do s = 1, size(res%states)
          if (res%states(s)%reached) cycle
          if (bounded .and. res%states(s)%load > total + lam) cycle
          dl = max(res%states(s)%load - total, 0.0_dp)
-         f = ftot + dl*funit
          res%states(s)%approach = approach + dl*delta
-         res%states(s)%contacts = size(ftot)
-         res%states(s)%max_pressure = maxval(f)/pixel**2
-         res%states(s)%n_above_hardness = count(f/pixel**2 > hardness)
-         res%states(s)%reached = .true.
-         res%states(s)%i = ic
-         res%states(s)%j = jc
-         res%states(s)%force = f
+         call fill_state(res%states(s), ftot + dl*funit, pixel, hardness, ic, jc)
          if (res%states(s)%load == maxval(res%states%load)) then
-            res%contact_force = f
+            res%contact_force = res%states(s)%force
             res%reported_load = res%states(s)%load
          end if
       end do
@@ -224,28 +216,35 @@ contains
       logical, intent(in) :: bounded
       integer :: s
       real(dp) :: dl
-      real(dp), allocatable :: f(:)
       if (.not. delta > 0) return
       do s = 1, size(res%states)
          if (res%states(s)%reached) cycle
          dl = max(res%states(s)%approach - approach, 0.0_dp)/delta
          if (bounded .and. dl > lam) cycle
-         f = ftot + dl*funit
          res%states(s)%load = total + dl
-         res%states(s)%contacts = size(ftot)
-         res%states(s)%max_pressure = 0
-         if (size(f) > 0) res%states(s)%max_pressure = maxval(f)/pixel**2
-         res%states(s)%n_above_hardness = count(f/pixel**2 > hardness)
-         res%states(s)%reached = .true.
-         res%states(s)%i = ic
-         res%states(s)%j = jc
-         res%states(s)%force = f
+         call fill_state(res%states(s), ftot + dl*funit, pixel, hardness, ic, jc)
          if (res%states(s)%approach == maxval(res%states%approach)) then
-            res%contact_force = f
+            res%contact_force = res%states(s)%force
             res%reported_load = res%states(s)%load
          end if
       end do
    end subroutine record_approach_states
+
+   !> A state reached with the contact forces f (nN) at pixels (ic, jc): its contacts,
+   !> largest pressure and count above the hardness (GPa), pixel d (nm).
+   pure subroutine fill_state(state, f, pixel, hardness, ic, jc)
+      type(load_state), intent(inout) :: state
+      real(dp), intent(in) :: f(:), pixel, hardness
+      integer, intent(in) :: ic(:), jc(:)
+      state%contacts = size(f)
+      state%max_pressure = 0
+      if (size(f) > 0) state%max_pressure = maxval(f)/pixel**2
+      state%n_above_hardness = count(f/pixel**2 > hardness)
+      state%reached = .true.
+      state%i = ic
+      state%j = jc
+      state%force = f
+   end subroutine fill_state
 
    !> Store the contact pixels; the forces at the end when no requested load set them.
    pure subroutine finish_contacts(res, ic, jc, cstep, ftot, total)
