@@ -11,6 +11,7 @@ module test_options
    use femcod_run, only: run_table, run_settings, parse_run_arguments
    use femcod_cli, only: run_femcod, mkdeck_table, parse_mkdeck_arguments
    use femcod_generate, only: scene_spec
+   use test_support, only: scratch_path, read_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -223,7 +224,9 @@ contains
          "--np with a matrix: "//status%message)
    end subroutine test_mkdeck
 
-   !> The help lines are made from the tables, so every option of run and mkdeck appears.
+   !> The help lines are made from the tables, so every option of run and mkdeck appears:
+   !> in the text `femcod run --help` prints (this test program run as femcod), each option
+   !> starts a line of its own, not only a mention in another's help.
    subroutine test_help(error)
       type(error_type), allocatable, intent(out) :: error
       type(option_spec), allocatable :: t(:)
@@ -244,6 +247,25 @@ contains
             "run --help lists "//t(k)%name)
          if (allocated(error)) return
       end do
+      block
+         character(len=:), allocatable :: self, printed, path
+         integer :: length, code
+         call get_command_argument(0, length=length)
+         allocate(character(len=length) :: self)
+         call get_command_argument(0, self)
+         path = scratch_path("run-help.txt")
+         call execute_command_line(self//" --femcod run --help > "//path, exitstat=code)
+         call check(error, code, 0, "femcod run --help")
+         if (allocated(error)) return
+         printed = new_line("a")//read_text(path)
+         do k = 1, size(t)
+            call check(error, index(printed, new_line("a")//"  "//t(k)%name//" ") > 0 .or. &
+               index(printed, new_line("a")//"  "//t(k)%name//new_line("a")) > 0 .or. &
+               (len(t(k)%alias) > 0 .and. index(printed, new_line("a")//"  "//t(k)%alias//", "//t(k)%name) > 0), &
+               "femcod run --help has a line for "//t(k)%name)
+            if (allocated(error)) return
+         end do
+      end block
       t = mkdeck_table()
       call check(error, size(t) > 20, "mkdeck has its table: "//to_string(size(t)))
    end subroutine test_help

@@ -150,6 +150,8 @@ contains
       call print_lines(option_help(run_table(), "event"))
       write(output_unit, '(a)') "", "incremental solver:"
       call print_lines(option_help(run_table(), "incremental"))
+      write(output_unit, '(a)') "", "incremental and cg solvers (not the legacy one):"
+      call print_lines(option_help(run_table(), "cg|incremental"))
       write(output_unit, '(a)') "", "cg solver (needs --loads or --approach; MAXCONT and --max-contacts do not apply):"
       call print_lines(option_help(run_table(), "cg"))
       write(output_unit, '(a)') "", "scene options, with --lower/--upper only (one scene; -o defaults to the first", &
