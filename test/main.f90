@@ -18,6 +18,7 @@ program tester
    use test_stability, only: collect_stability
    use test_cg, only: collect_cg
    use test_periodic, only: collect_periodic
+   use test_adhesion, only: collect_adhesion
    use test_studies, only: collect_studies
    use test_options, only: collect_options
    use test_heights, only: collect_heights
@@ -46,6 +47,7 @@ program tester
       new_testsuite("stability", collect_stability), &
       new_testsuite("cg", collect_cg), &
       new_testsuite("periodic", collect_periodic), &
+      new_testsuite("adhesion", collect_adhesion), &
       new_testsuite("studies", collect_studies), &
       new_testsuite("options", collect_options), &
       new_testsuite("heights", collect_heights), &

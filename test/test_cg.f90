@@ -24,7 +24,7 @@ module test_cg
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
-   public :: collect_cg
+   public :: collect_cg, rough_scene
 
 contains
 

@@ -117,12 +117,20 @@ contains
          flag_option("--restart", "continue from PREFIX.ckpt.h5 if it exists (refused if it belongs to another deck "// &
             "or other options); the run ends exactly as an uninterrupted one. Complete results of the same inputs "// &
             "and options: nothing to do; of others: refused", mode="incremental"), &
-         real_option("--tol", "T", "stop when the gap violations over the height range are below T (default 1e-8)", &
+         real_option("--tol", "T", "stop when the gap violations over the height range are below T (default 1e-8; "// &
+            "with --adhesion the force-balance violations over the largest pixel force)", &
             lower=0.0_dp, closed="()", mode="cg"), &
          integer_option("--max-iterations", "N", "iterations on the finest grid (default 2000)", lower=1, mode="cg"), &
          real_option("--kernel-radius", "R", "truncate the Love kernel beyond R pixels (an approximation: the "// &
             "thesis' open question 5.2.2 iii, measured by femcod bench frontier; default: the whole kernel)", &
             lower=0.0_dp, closed="()", mode="cg"), &
+         choice_option("--adhesion", "dugdale|exponential", "adhesive interface, with --approach, --work and "// &
+            "--range: Dugdale, a tension W/R wherever 0 < gap < R; exponential, a tension (W/R) exp(-gap/R); the "// &
+            "approaches are followed in the order given, each from the last (loading and unloading branches, "// &
+            "jumps into contact and pull-off)", mode="cg"), &
+         real_option("--work", "W", "work of adhesion in J/m^2 (= nN/nm), with --adhesion", lower=0.0_dp, mode="cg"), &
+         real_option("--range", "R", "range of the adhesion law in nm, with --adhesion", lower=0.0_dp, closed="()", &
+            mode="cg"), &
          text_option("--fftw-wisdom", "FILE", "FFTW measures its plans once and keeps them in FILE and FILE.float32 "// &
             "(seconds of planning the first time, faster transforms)", mode="cg"), &
          text_option("--lower", "FILE", "lower surface heights: an ASCII matrix (a Gwyddion export with its "// &
@@ -215,6 +223,9 @@ contains
          call get_option(parsed, "--tol", o%cg%tol)
          call get_option(parsed, "--max-iterations", o%cg%max_iterations)
          call get_option(parsed, "--kernel-radius", o%cg%kernel_radius)
+         if (option_given(parsed, "--adhesion")) o%adhesion = option_value(parsed, "--adhesion")
+         call get_option(parsed, "--work", o%work)
+         call get_option(parsed, "--range", o%range)
          o%cg%measure_plans = len(settings%wisdom) > 0
       end associate
       lower = ""
@@ -275,6 +286,22 @@ contains
       else if (settings%solve%solver == "cg" .and. requested_states(settings%solve) == 0) then
          call set_error(status, STATUS_USAGE, "--solver cg solves at given loads or approaches: add --loads F1,F2,... "// &
             "or --approach D1,D2,...")
+      else if (settings%solve%adhesion /= "none" .and. .not. (option_given(parsed, "--work") .and. &
+         option_given(parsed, "--range"))) then
+         call set_error(status, STATUS_USAGE, "--adhesion needs --work W (J/m^2) and --range R (nm)")
+      else if (settings%solve%adhesion == "none" .and. (option_given(parsed, "--work") .or. &
+         option_given(parsed, "--range"))) then
+         call set_error(status, STATUS_USAGE, "--work and --range describe an adhesion law: add --adhesion "// &
+            "dugdale|exponential")
+      else if (settings%solve%adhesion /= "none" .and. size(settings%solve%approaches) == 0) then
+         call set_error(status, STATUS_USAGE, "--adhesion needs --approach D1,D2,... (displacement control: under "// &
+            "load control the pull-off is an instability)")
+      else if (settings%solve%adhesion /= "none" .and. settings%solve%plastic) then
+         call set_error(status, STATUS_USAGE, "--adhesion with --plastic: the adhesive solver caps no pressure; run "// &
+            "one or the other")
+      else if (settings%solve%adhesion /= "none" .and. settings%solve%cg%kernel_radius > 0) then
+         call set_error(status, STATUS_USAGE, "--adhesion with --kernel-radius: the adhesive solver uses the whole "// &
+            "Love kernel")
       else if (settings%solve%plastic .and. size(settings%solve%approaches) > 1) then
          if (any(settings%solve%approaches(2:) < settings%solve%approaches(:size(settings%solve%approaches) - 1))) &
             call set_error(status, STATUS_USAGE, "--approach with --plastic: give the approaches in increasing order "// &
@@ -579,6 +606,9 @@ contains
          info%version = FEMCOD_VERSION
          info%solver = trim(options%solver)
          info%boundary = trim(options%boundary)
+         info%adhesion = trim(options%adhesion)
+         info%work = options%work
+         info%range = options%range
          info%options = settings%command_line
          info%command_line = "femcod run "//settings%command_line
          info%host = host_name()
@@ -650,7 +680,8 @@ contains
          options%boundary == "periodic"))// &
          format_real(options%tie_tolerance)//"|"//merge("T", "F", options%final_check)//"|"// &
          trim(options%event_search)//"|"//format_real(options%cg%tol)//"|"//int_str(options%cg%max_iterations)//"|"// &
-         format_real(options%cg%kernel_radius)//"|"
+         format_real(options%cg%kernel_radius)//"|"//trim(options%adhesion)//"|"//format_real(options%work)//"|"// &
+         format_real(options%range)//"|"
       do k = 1, size(digests)
          ! The digest without the file's path: a moved input is the same input.
          at = index(digests(k)%s, " sha256 ", back=.true.)
@@ -758,7 +789,20 @@ contains
          if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
             " of them plastic (at the hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "// &
             sig_str(res%states(k)%plastic_volume, 4)//" nm^3"
+         if (options%adhesion /= "none") then
+            write(output_unit, '(a)') "              "//int_str(res%states(k)%attractive)//" pixels off contact within the "// &
+               "range ("//sig_str(res%states(k)%attractive*problem%pixel**2, 4)//" nm^2), load off contact "// &
+               sig_str(res%states(k)%attractive_load, 4)//" nN, mean gap "//sig_str(res%states(k)%mean_gap, 4)//" nm"
+            if (res%states(k)%jump /= 0 .and. k > 1) write(output_unit, '(a)') "              "// &
+               trim(merge("contact appears ", "contact vanishes", res%states(k)%jump > 0))//" since the approach "// &
+               sig_str(res%states(k - 1)%approach, 6)//" nm ("//int_str(res%states(k - 1)%contacts)//" -> "// &
+               int_str(res%states(k)%contacts)//" contact pixels, load "//sig_str(res%states(k - 1)%load, 4)// &
+               " -> "//sig_str(res%states(k)%load, 4)//" nN)"
+         end if
       end do
+      if (options%adhesion /= "none") write(output_unit, '(a)') "  adhesion  : least load "// &
+         sig_str(minval(res%states%load, mask=res%states%reached), 6)//" nN over the approaches (the pull-off force "// &
+         "where they pass it)"
       if (options%solver == "cg") then
          write(output_unit, '(a)') "  wall time : "//sig_str(res%wall_seconds, 3)//" s"
       else

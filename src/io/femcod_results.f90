@@ -30,6 +30,10 @@ module femcod_results
       character(len=:), allocatable :: version, solver, options
       !> The lateral boundary, "free" or "periodic" (--boundary).
       character(len=:), allocatable :: boundary
+      !> The adhesion law (--adhesion: "dugdale" or "exponential"; unallocated or "none":
+      !> no adhesion), its work (J/m^2) and range (nm).
+      character(len=:), allocatable :: adhesion
+      real(dp) :: work = 0, range = 0
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
       !> The input files, one line each: the deck, or what each height file gave
@@ -361,6 +365,12 @@ contains
                call h5_attribute(file, g, "cg_contact_gap_nm", s%contact_gap, local)
                call h5_attribute(file, g, "cg_load_error", s%load_error, local)
             end if
+            if (has_adhesion(info)) then
+               call h5_attribute(file, g, "attractive_pixels", s%attractive, local)
+               call h5_attribute(file, g, "attractive_load_nN", s%attractive_load, local)
+               call h5_attribute(file, g, "mean_gap_nm", s%mean_gap, local)
+               call h5_attribute(file, g, "jump", s%jump, local)
+            end if
             call h5_write(file, g//"/pressure", maps(k)%pressure, "GPa", local)
             call h5_write(file, g//"/gap", maps(k)%gap, "nm", local)
             if (allocated(s%plastic)) call h5_write(file, g//"/plastic_displacement", s%plastic, "nm", local)
@@ -375,6 +385,11 @@ contains
       if (allocated(info%finished)) call h5_attribute(file, "/run", "finished", info%finished, local)
       call h5_attribute(file, "/run", "solver", info%solver, local)
       call h5_attribute(file, "/run", "boundary", run_boundary(info), local)
+      if (has_adhesion(info)) then
+         call h5_attribute(file, "/run", "adhesion", info%adhesion, local)
+         call h5_attribute(file, "/run", "work_of_adhesion_J_m2", info%work, local)
+         call h5_attribute(file, "/run", "adhesion_range_nm", info%range, local)
+      end if
       call h5_attribute(file, "/run", "options", info%options, local)
       call h5_attribute(file, "/run", "wall_time_s", res%wall_seconds, local)
       call h5_attribute(file, "/run", "stop_reason", stop_reason_text(res%stop_reason), local)
@@ -571,6 +586,9 @@ contains
                ', "n_above_hardness": '//int_str(s%n_above_hardness)//', "n_plastic": '// &
                int_str(s%n_plastic)//', "plastic_volume_nm3": '//json_number(s%plastic_volume)//', "hdf5_group": '// &
                json_string(load_group(k, size(res%states)))
+            if (s%reached .and. has_adhesion(info)) loads = loads//', "attractive_pixels": '// &
+               int_str(s%attractive)//', "attractive_load_nN": '//json_number(s%attractive_load)// &
+               ', "mean_gap_nm": '//json_number(s%mean_gap)//', "jump": '//int_str(s%jump)
             loads = loads//'}'//trim(merge(",", " ", k < size(res%states)))//nl
          end associate
       end do
@@ -590,6 +608,7 @@ contains
          ', "contact": '//json_number(deck%poisson(3))//'}},'//nl// &
          '  "solver": '//json_string(info%solver)//','//nl// &
          '  "boundary": '//json_string(run_boundary(info))//','//nl// &
+         adhesion_json(info)// &
          '  "steps": '//int_str(last)//','//nl// &
          '  "stopped": '//json_string(stop_reason_text(res%stop_reason))//','//nl
       if (last > 0) then
@@ -683,4 +702,20 @@ contains
       text = "free"
       if (allocated(info%boundary)) text = info%boundary
    end function run_boundary
+   !> Whether the run had an adhesion law.
+   pure logical function has_adhesion(info)
+      type(run_info), intent(in) :: info
+      has_adhesion = .false.
+      if (allocated(info%adhesion)) has_adhesion = info%adhesion /= "none"
+   end function has_adhesion
+
+   !> The summary file's adhesion fields (a line each, with the comma), or nothing.
+   function adhesion_json(info) result(text)
+      type(run_info), intent(in) :: info
+      character(len=:), allocatable :: text
+      text = ""
+      if (has_adhesion(info)) text = '  "adhesion": {"law": '//json_string(info%adhesion)// &
+         ', "work_of_adhesion_J_m2": '//json_number(info%work)//', "range_nm": '//json_number(info%range)//'},'// &
+         new_line("a")
+   end function adhesion_json
 end module femcod_results

@@ -22,6 +22,13 @@ module femcod_contact_result
       !> capped pixels' interpenetrations times d^2.
       integer :: n_plastic = 0, plastic_rounds = 0
       real(dp) :: plastic_volume = 0
+      !> With adhesion (--adhesion): the pixels off contact within the law's range
+      !> (0 < gap < R: the attractive area), the load off contact (nN, negative: the
+      !> adhesive pull outside the contact), the mean gap over the grid
+      !> (nm), and a jump from the previous approach's state: 1 into contact (from no
+      !> contact), -1 pull-off (to no contact), 0 none.
+      integer :: attractive = 0, jump = 0
+      real(dp) :: attractive_load = 0, mean_gap = 0
       logical :: reached = .false.
       !> Fixed-load solver only: iterations, relative complementarity residual, deepest
       !> penetration (nm), largest |gap| on contact (nm), relative load error.

@@ -18,7 +18,8 @@ module femcod_generate
       self_affine_surface, remove_plane
    implicit none
    private
-   public :: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, RIGID_FACTOR, THESIS_RIGID_FACTOR, KINDS
+   public :: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, RIGID_FACTOR, THESIS_RIGID_FACTOR, KINDS, &
+      paraboloid_problem
 
    !> Modulus ratio of a rigid body to the elastic one (thesis section 4.4).
    real(dp), parameter :: RIGID_FACTOR = 1.0e10_dp, THESIS_RIGID_FACTOR = 1.0e5_dp
@@ -278,4 +279,28 @@ contains
       end do
    end function pixels_within
 
+   !> A rigid paraboloid z = -r^2/(2 radius) (nm) over an elastic flat (E = young GPa,
+   !> nu = 0, a rigid contact material), np x np pixels of `pixel` nm, centred between the
+   !> middle pixels: the adhesion checks' sphere (Maugis-Dugdale is a paraboloid's theory).
+   function paraboloid_problem(np, pixel, radius, young) result(deck)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: pixel, radius, young
+      type(contact_problem) :: deck
+      integer :: i, j
+      real(dp) :: c
+      deck%label = "paraboloid R = "//format_real(radius)//" nm"
+      deck%np = np
+      deck%pixel = pixel
+      deck%maxcont = np**2
+      deck%young = [young, 1.0e300_dp, 1.0e300_dp]
+      deck%poisson = 0
+      allocate(deck%lower(np, np), deck%upper(np, np))
+      deck%lower = 0
+      c = (np + 1)/2.0_dp
+      do j = 1, np
+         do i = 1, np
+            deck%upper(i, j) = -((i - c)**2 + (j - c)**2)*pixel**2/(2*radius)
+         end do
+      end do
+   end function paraboloid_problem
 end module femcod_generate

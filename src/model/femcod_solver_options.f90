@@ -77,6 +77,11 @@ module femcod_solver_options
       !> `hardness`; a capped pixel keeps the force H d^2 and interpenetrates (its
       !> plastic displacement). The cg solver only.
       logical :: plastic = .false.
+      !> Adhesion (femcod_adhesion): "none", "dugdale" or "exponential", with the work of
+      !> adhesion (nN/nm = J/m^2) and the range (nm) of the law. With --approach and the
+      !> cg solver only.
+      character(len=11) :: adhesion = "none"
+      real(dp) :: work = 0, range = 0
       !> Candidates whose closing load is within this fraction of the total load of the
       !> smallest one join in the same step (ties).
       real(dp) :: tie_tolerance = 1.0e-9_dp

@@ -17,6 +17,7 @@ module femcod_solver
    use femcod_incremental, only: solve_incremental
    use femcod_incremental_state, only: incremental_state
    use femcod_cg, only: solve_cg
+   use femcod_adhesion, only: solve_adhesive, pixel_stiffness_ratio
    implicit none
    private
    public :: solve_contact, model_notes, report_lines, report_line
@@ -65,6 +66,26 @@ contains
             "of the free half-space; use --solver incremental or cg")
          return
       end if
+      if (options%adhesion /= "none") then
+         if (options%solver /= "cg") then
+            call set_error(status, STATUS_USAGE, "--adhesion: the event solvers follow a path of contact events "// &
+               "without tension; use --solver cg")
+         else if (options%plastic) then
+            call set_error(status, STATUS_USAGE, "--adhesion with --plastic: the adhesive solver caps no "// &
+               "pressure; run one or the other")
+         else if (.not. allocated(options%approaches)) then
+            call set_error(status, STATUS_USAGE, "--adhesion needs --approach: under load control the pull-off "// &
+               "is an instability")
+         else if (options%cg%kernel_radius > 0) then
+            call set_error(status, STATUS_USAGE, "--adhesion with --kernel-radius: the adhesive solver uses the "// &
+               "whole Love kernel")
+         else if (present(observer)) then
+            call solve_adhesive(problem, options, res, status, observer)
+         else
+            call solve_adhesive(problem, options, res, status, nobody)
+         end if
+         return
+      end if
       if (present(resume) .and. options%solver /= "incremental") then
          call set_error(status, STATUS_USAGE, "only the incremental solver continues from a stored state")
          return
@@ -100,7 +121,8 @@ contains
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       type(string_type), allocatable :: lines(:)
-      real(dp) :: c1, c2, s, cself
+      real(dp) :: c1, c2, s, cself, ratio
+      character(len=:), allocatable :: verdict
       select case (options%solver)
       case ("legacy")
          lines = [string_type("nothing: the legacy solver models every node and spring of Appendix B")]
@@ -108,6 +130,19 @@ contains
       case ("cg")
          lines = [string_type("handles and springs condensed: one composite compliance c1 + c2 with the springs' "// &
             "3/k on the diagonal, one composite gap")]
+         if (options%adhesion /= "none") then
+            ratio = pixel_stiffness_ratio(problem, options%work, options%range)
+            if (ratio < 1) then
+               verdict = " (below 1: the discrete problem is convex at the pixel scale)"
+            else
+               verdict = " (above 1: single pixels may snap; a finer pixel resolves the range)"
+            end if
+            lines = [lines, string_type(trim(options%adhesion)//" adhesion: W = "//sig_str(options%work, 4)// &
+               " J/m^2, range "//sig_str(options%range, 4)//" nm; displacement control, each approach from the last "// &
+               "(gap-variable constrained CG, Rey, Anciaux and Molinari 2017)"), &
+               string_type("adhesion_convexity: one pixel's adhesive stiffness d^2 W/R^2 over its elastic "// &
+               "stiffness = "//sig_str(ratio, 3)//verdict)]
+         end if
          if (.not. options%plastic) lines = [lines, string_type("no plastic cap: pressures are elastic, "// &
             "n_above_hardness counts the pixels above the hardness (--plastic caps them)")]
          if (options%boundary == "periodic") lines = [lines, periodic_note(problem%np, "cg")]
@@ -191,6 +226,12 @@ contains
                "every load one elastic solve, with no plastic bookkeeping")
          end if
          do k = 1, size(res%states)
+            if (options%adhesion /= "none") then
+               call add("cg", "approach "//sig_str(res%states(k)%approach, 6)//" nm: "// &
+                  int_str(res%states(k)%iterations)//" iterations, residual "//sig_str(res%states(k)%residual, 2)// &
+                  " (force balance over the largest pixel force)")
+               cycle
+            end if
             rounds = ""
             if (options%plastic) rounds = ", in "//int_str(res%states(k)%plastic_rounds)//" round"// &
                trim(merge("s", " ", res%states(k)%plastic_rounds /= 1))//" of the plastic set"
