@@ -5,7 +5,8 @@ module femcod_bench
    use femcod_status, only: status_type
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
-   use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR, RIGID_FACTOR, verification_spec
+   use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR, RIGID_FACTOR, verification_spec, &
+      paraboloid_problem
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options, cg_settings
    use femcod_solver, only: solve_contact
@@ -14,7 +15,7 @@ module femcod_bench
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, flag_option, real_option, &
       integer_option, text_option, choice_option, real_list_option, integer_list_option, get_option, option_given
    use femcod_thesis, only: TABLE_4_1_APPROACH, TABLE_4_2_APPROACH
-   use femcod_analytic, only: segedin_sphere
+   use femcod_analytic, only: segedin_sphere, maugis_pull_off
    use femcod_scene, only: initial_gaps
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
@@ -33,6 +34,7 @@ module femcod_bench
    use femcod_spring, only: spring_stiffness
    use femcod_scene, only: flip_upper
    use femcod_sort, only: merge_sort_index
+   use femcod_adhesion, only: pixel_stiffness_ratio
    implicit none
    private
    public :: bench_command
@@ -78,6 +80,10 @@ contains
             call bench_frontier(args(2:), code)
             return
          end if
+         if (args(1)%s == "adhesion") then
+            call bench_adhesion(args(2:), code)
+            return
+         end if
       end if
       legacy_contacts = 300
       full = .false.
@@ -88,6 +94,7 @@ contains
             "       femcod bench io [--np LIST] [--dir DIR]  (--help for more)", &
             "       femcod bench periodic [--np LIST] [--contact LIST]  (--help for more)", &
             "       femcod bench frontier [--np N] [--contact LIST] [--svg FILE]  (--help for more)", &
+            "       femcod bench adhesion [--full]  (--help for more)", &
             "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
             "event, peak memory (resident, per case), error against the reference. The rough surface:", &
             "self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa, nu = 0.25, against a", &
@@ -1220,16 +1227,21 @@ contains
 
    !> One peer's answer line (app/femcod_peers.py) on the gaps in `path`, or
    !> "PEER - - - - - failed -" when it gave none.
-   function peer_line(python, peer, path, np, pixel, estar, pressure, tol) result(line)
+   function peer_line(python, peer, path, np, pixel, estar, pressure, tol, extra) result(line)
       character(len=*), intent(in) :: python, peer, path
       integer, intent(in) :: np
       real(dp), intent(in) :: pixel, estar, pressure, tol
+      !> More arguments for the peer (tamaas-adhesion: LAW W RANGE).
+      character(len=*), intent(in), optional :: extra
       character(len=512) :: line
+      character(len=:), allocatable :: more
       character(len=*), parameter :: peer_out = "femcod-bench-peer.txt"
       integer :: unit, ios
+      more = ""
+      if (present(extra)) more = " "//extra
       call execute_command_line(python//" app/femcod_peers.py "//peer//" "//path//" "//int_str(np)//" "// &
          real_str(pixel, 16)//" "//real_str(estar, 16)//" "//real_str(pressure, 16)//" "//real_str(tol, 3)// &
-         " > "//peer_out, exitstat=ios)
+         more//" > "//peer_out, exitstat=ios)
       line = peer//" - - - - - failed -"
       open(newunit=unit, file=peer_out, action="read", status="old", iostat=ios)
       if (ios == 0) then
@@ -1303,4 +1315,245 @@ contains
       end do
       close(unit)
    end function peak_mb
+   !> `femcod bench adhesion`: the adhesive solver's resolution study (issue 20's checks).
+   !> 1. The Maugis-Dugdale sphere: the least load over an unloading path against the
+   !>    theory's pull-off (analytic/maugis_minimum) at lambda = 0.1, 1, 2, pixels halved,
+   !>    with the first-order extrapolation of each pair. 2. The Contact Mechanics
+   !>    Challenge's interaction (E* = 25 MPa, W = 0.05 J/m^2, exponential range 2.071 nm)
+   !>    on a self-affine surface at 250 kPa, pixels of 4, 2, 1 nm (2 x 2 averages).
+   subroutine bench_adhesion(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      real(dp), parameter :: pi = acos(-1.0_dp), work = 0.01_dp, young = 1
+      real(dp), parameter :: lambdas(3) = [0.1_dp, 1.0_dp, 2.0_dp], radii(3) = [100.0_dp, 1000.0_dp, 1000.0_dp], &
+         boxes(3) = [64.0_dp, 128.0_dp, 128.0_dp]
+      type(parsed_options) :: parsed
+      type(status_type) :: status
+      type(contact_problem) :: deck, fine
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(scene_spec) :: spec
+      real(dp), allocatable :: pixels(:), path(:)
+      real(dp) :: theory, pmin, previous, t0, t1, target, w, radius, limit
+      character(len=:), allocatable :: python
+      logical :: full
+      integer :: c, k, np, n, i, j, cmc_np
+      full = .false.
+      if (help_requested(args)) then
+         write(output_unit, '(a)') "usage: femcod bench adhesion [--full]", &
+            "1. A rigid paraboloid on a flat (E* = 1 GPa, W = 0.01 J/m^2, Dugdale range for the Maugis", &
+            "   parameter lambda = 0.1, 1, 2; R = 100, 1000, 1000 nm; boxes of 64, 128, 128 nm) loaded to", &
+            "   1 nm and unloaded in steps of 0.025 or 0.05 nm past the pull-off, pixels of 2, 1, 0.5 nm", &
+            "   (and 0.25 with --full): the least load over pi W R against Maugis-Dugdale (Maugis 1992),", &
+            "   the first-order extrapolation 2 P(d) - P(2d), iterations, wall time.", &
+            "2. The Contact Mechanics Challenge's interaction, E* = 25 MPa, W = 0.05 J/m^2, exponential", &
+            "   range 2.071 nm, on a self-affine surface (H = 0.8, rms 40 nm, 256 nm square, seed 1) and", &
+            "   its 2 x 2 averages (pixels 1, 2, 4 nm; 512^2 at 0.5 nm with --full): loaded in approach", &
+            "   steps of 2.5 nm to 250 kPa mean pressure; area, attractive area and mean gap there", &
+            "   (linear between the two approaches around it), the convexity ratio, iterations, time.", &
+            "3. With --peers PYTHON: the lambda = 0.5 sphere (R = 100 nm, d = 1 nm, 64^2) on a periodic cell at", &
+            "   approaches 1, 0.5, 0.25 nm, W = 0.01 and 0, femcod beside tamaas' Maugis functional at the same", &
+            "   mean gap (app/femcod_peers.py; tamaas from the undeformed surfaces, femcod along the path).", ""
+         call print_lines(option_help(bench_adhesion_table(), ""))
+         write(output_unit, '(a)') "Run it with the release build."
+         return
+      end if
+      call parse_options(bench_adhesion_table(), args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench adhesion: "//bad_arguments(status, parsed)//" (--help)"
+         code = 2
+         return
+      end if
+      call get_option(parsed, "--full", full)
+      python = ""
+      call get_option(parsed, "--peers", python)
+      options%solver = "cg"
+      options%adhesion = "dugdale"
+      options%work = work
+      options%cg = cg_settings()
+      options%cg%max_iterations = 20000
+      allocate(options%loads(0))
+      write(output_unit, '(a)') "Maugis-Dugdale sphere: least load over pi W R along the unloading path", ""
+      write(output_unit, '(a)') "| lambda | R (nm) | d (nm) | NP | least load | Maugis-Dugdale | error | "// &
+         "2 P(d) - P(2d) | its error | iterations | wall (s) |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|---|---|"
+      pixels = [2.0_dp, 1.0_dp, 0.5_dp]
+      if (full) pixels = [pixels, 0.25_dp]
+      do c = 1, size(lambdas)
+         radius = radii(c)
+         theory = maugis_pull_off(lambdas(c))
+         options%range = work/lambdas(c)*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
+         if (c == 1) then
+            path = [1.0_dp, (-0.05_dp - 0.025_dp*k, k = 0, 12)]
+         else
+            path = [1.0_dp, (-0.2_dp - 0.05_dp*k, k = 0, 7)]
+         end if
+         options%approaches = path
+         do k = 1, size(pixels)
+            np = nint(boxes(c)/pixels(k))
+            deck = paraboloid_problem(np, pixels(k), radius, young)
+            call wall_clock(t0)
+            call solve_contact(deck, options, res, status)
+            call wall_clock(t1)
+            if (status%code /= 0) then
+               write(error_unit, '(a)') "femcod bench adhesion: "//status%message
+               code = status%code
+               return
+            end if
+            pmin = minval(res%states%load)/(pi*work*radius)
+            if (k == 1) then
+               write(output_unit, '(a)') "| "//fixed_str(lambdas(c), 1)//" | "//int_str(nint(radius))//" | "// &
+                  fixed_str(pixels(k), 2)//" | "//int_str(np)//" | "//fixed_str(pmin, 4)//" | "// &
+                  fixed_str(theory, 4)//" | "//real_str(abs(pmin/theory - 1), 2)//" | | | "// &
+                  int_str(sum(res%states%iterations))//" | "//fixed_str(t1 - t0, 2)//" |"
+            else
+               write(output_unit, '(a)') "| "//fixed_str(lambdas(c), 1)//" | "//int_str(nint(radius))//" | "// &
+                  fixed_str(pixels(k), 2)//" | "//int_str(np)//" | "//fixed_str(pmin, 4)//" | "// &
+                  fixed_str(theory, 4)//" | "//real_str(abs(pmin/theory - 1), 2)//" | "// &
+                  fixed_str(2*pmin - previous, 4)//" | "//real_str(abs((2*pmin - previous)/theory - 1), 2)//" | "// &
+                  int_str(sum(res%states%iterations))//" | "//fixed_str(t1 - t0, 2)//" |"
+            end if
+            previous = pmin
+         end do
+      end do
+      ! 2. The Contact Mechanics Challenge's interaction on a self-affine surface.
+      cmc_np = merge(512, 256, full)
+      spec%kind = "self-affine"
+      spec%np = cmc_np
+      spec%pixel = 256.0_dp/cmc_np
+      spec%hurst = 0.8_dp
+      spec%rms = 40
+      spec%seed = 1
+      spec%young = 0.025_dp
+      spec%poisson = 0
+      spec%shape_on = "lower"
+      spec%rigid = "upper"
+      spec%label = "bench adhesion"
+      spec%matrix_file = ""
+      spec%maxcont = cmc_np**2
+      call build_problem(spec, fine, status)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench adhesion: "//status%message
+         code = status%code
+         return
+      end if
+      target = 2.5e-4_dp
+      options%adhesion = "exponential"
+      options%work = 0.05_dp
+      options%range = 2.071_dp
+      write(output_unit, '(a)') "", "Contact Mechanics Challenge interaction (E* = 25 MPa, W = 0.05 J/m^2, "// &
+         "exponential range 2.071 nm), self-affine surface, 250 kPa", ""
+      write(output_unit, '(a)') "| d (nm) | NP | convexity d^2 W/R^2 : k_pixel | approach (nm) | contact % | "// &
+         "attractive % | mean gap (nm) | states | iterations | wall (s) |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|---|"
+      n = cmc_np
+      do while (n >= 64)
+         call level_deck(fine, n, "average", deck, status)
+         if (status%code /= 0) exit
+         ! Loading from 0 in steps of 2.5 nm to 20 nm, 40 nm, ... until the mean pressure
+         ! passes the target; i the first state past it.
+         limit = 20
+         do
+            path = [(2.5_dp*k, k = 0, nint(limit/2.5_dp))]
+            options%approaches = path
+            call wall_clock(t0)
+            call solve_contact(deck, options, res, status)
+            call wall_clock(t1)
+            if (status%code /= 0) exit
+            i = findloc(res%states%load/(real(deck%np, dp)*deck%pixel)**2 >= target, .true., 1)
+            if (i > 0 .or. limit > 300) exit
+            limit = 2*limit
+         end do
+         if (status%code /= 0) exit
+         if (i == 0) i = size(path)
+         j = max(1, i - 1)
+         associate(a => res%states(j), b => res%states(i))
+            w = 1
+            if (b%load /= a%load) w = (target*(real(deck%np, dp)*deck%pixel)**2 - a%load)/(b%load - a%load)
+            write(output_unit, '(a)') "| "//fixed_str(deck%pixel, 1)//" | "//int_str(deck%np)//" | "// &
+               fixed_str(convexity(deck), 2)//" | "//fixed_str(a%approach + w*(b%approach - a%approach), 2)//" | "// &
+               fixed_str(100*(a%contacts + w*(b%contacts - a%contacts))/real(deck%np, dp)**2, 2)//" | "// &
+               fixed_str(100*(a%attractive + w*(b%attractive - a%attractive))/real(deck%np, dp)**2, 2)//" | "// &
+               fixed_str(a%mean_gap + w*(b%mean_gap - a%mean_gap), 2)//" | "//int_str(i)//" | "// &
+               int_str(sum(res%states%iterations))//" | "//fixed_str(t1 - t0, 2)//" |"
+         end associate
+         n = n/2
+         if (n < 64) exit
+      end do
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench adhesion: "//status%message
+         code = status%code
+         return
+      end if
+      if (len(python) > 0) call side_by_side()
+   contains
+      !> Part 3: femcod and tamaas on the periodic sphere at the same mean gaps.
+      subroutine side_by_side()
+         real(dp), parameter :: approaches(3) = [1.0_dp, 0.5_dp, 0.25_dp], works(3) = [0.01_dp, 0.01_dp, 0.0_dp]
+         character(len=*), parameter :: laws(3) = [character(len=11) :: "dugdale", "exponential", "dugdale"]
+         character(len=*), parameter :: path = "femcod-bench-gaps.f64"
+         character(len=512) :: line
+         character(len=64) :: words(8)
+         real(dp), allocatable :: g0(:, :)
+         real(dp) :: range
+         integer :: iw, ia, ios
+         deck = paraboloid_problem(64, 1.0_dp, 100.0_dp, young)
+         g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [64, 64]))
+         call write_peer_gaps(path, g0)
+         write(output_unit, '(a)') "", "Periodic sphere (R = 100 nm, d = 1 nm, 64^2), femcod beside tamaas "// &
+            "(Maugis or exponential functional, PolonskyKeerRey on gaps)", "", &
+            "| law | W (J/m^2) | range (nm) | approach (nm) | femcod load (nN) | tamaas load (nN) | "// &
+            "difference / (pi W R) | femcod contact % | tamaas contact % | tamaas (s) |", &
+            "|---|---|---|---|---|---|---|---|---|---|"
+         do iw = 1, size(works)
+            ! Dugdale at lambda = 0.5; the exponential law with the same work and range.
+            range = 0.01_dp/0.5_dp*(9*100/(2*pi*0.01_dp*young**2))**(1.0_dp/3)
+            options = contact_options()
+            options%solver = "cg"
+            options%boundary = "periodic"
+            allocate(options%loads(0))
+            options%adhesion = laws(iw)
+            options%work = works(iw)
+            options%range = range
+            options%cg%tol = 1.0e-10_dp
+            options%approaches = approaches
+            call solve_contact(deck, options, res, status)
+            if (status%code /= 0) then
+               write(error_unit, '(a)') "femcod bench adhesion: "//status%message
+               code = status%code
+               return
+            end if
+            do ia = 1, size(approaches)
+               line = peer_line(python, "tamaas-adhesion", path, 64, 1.0_dp, young, sum(g0)/64**2 - approaches(ia), &
+                  1.0e-10_dp, trim(laws(iw))//" "//real_str(works(iw), 16)//" "//real_str(range, 16))
+               words = "-"
+               read(line, *, iostat=ios) words
+               read(words(8), *, iostat=ios) w
+               if (ios /= 0) w = huge(1.0_dp)
+               read(words(5), *, iostat=ios) theory
+               write(output_unit, '(a)') "| "//trim(laws(iw))//" | "//fixed_str(works(iw), 2)//" | "// &
+                  fixed_str(range, 3)//" | "//fixed_str(approaches(ia), 2)//" | "// &
+                  fixed_str(res%states(ia)%load, 4)//" | "//fixed_str(w, 4)//" | "// &
+                  fixed_str((res%states(ia)%load - w)/(pi*0.01_dp*100), 4)//" | "// &
+                  fixed_str(100*res%states(ia)%contacts/64.0_dp**2, 2)//" | "//fixed_str(100*theory, 2)//" | "// &
+                  trim(words(2))//" |"
+               flush(output_unit)
+            end do
+         end do
+         call remove_file_quietly(path)
+      end subroutine side_by_side
+
+      real(dp) function convexity(problem)
+         type(contact_problem), intent(in) :: problem
+         convexity = pixel_stiffness_ratio(problem, options%work, options%range)
+      end function convexity
+   end subroutine bench_adhesion
+
+   function bench_adhesion_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [flag_option("--full", "add the 0.25 nm sphere grids and the 512^2 rough grid (minutes more)"), &
+         text_option("--peers", "PYTHON", "a Python with tamaas installed: part 3, tamaas beside femcod")]
+   end function bench_adhesion_table
+
 end module femcod_bench

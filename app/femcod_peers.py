@@ -6,6 +6,7 @@ the Python of a separate virtual environment where the peers are installed (neve
 dependency, see doc/performance.md):
 
     PYTHON app/femcod_peers.py PEER GAPS NP PIXEL ESTAR PRESSURE TOL
+    PYTHON app/femcod_peers.py tamaas-adhesion GAPS NP PIXEL ESTAR MEAN_GAP TOL LAW W RANGE
 
 GAPS is NP*NP float64 values (Fortran order, nm): the initial gap between the elastic
 surface and the rigid flat, 0 at the first touch; PIXEL in nm, ESTAR = E/(1-nu^2) in GPa, PRESSURE the nominal mean pressure in GPa,
@@ -17,6 +18,13 @@ TOL the solver tolerance. Output, one line:
 high-water mark. A peer that is not installed prints `peer - - - - - missing`. The
 periodic peers add an eighth field, the mean gap (nm) of the solution: the mean over the
 cell of the separation of the deformed surfaces (0 in contact).
+
+`tamaas-adhesion` (called by `femcod bench adhesion --peers PYTHON`) solves the periodic
+cell at a prescribed mean gap MEAN_GAP (nm) with tamaas' adhesion functional, LAW `dugdale`
+(MaugisAdhesionFunctional) or `exponential` (ExponentialAdhesionFunctional), work W
+(J/m^2 = nN/nm) and range RANGE (nm; W = 0: no functional), by its gap-variable solver
+(Rey, Anciaux and Molinari 2017), from the undeformed surfaces; its eighth field is the
+total load (nN, the mean traction times the cell's area).
 """
 import contextlib
 import os
@@ -108,6 +116,29 @@ def run_contactmechanics_periodic(gap, n, pixel, estar, pressure, tol):
             float(separation.mean()))
 
 
+def run_tamaas_adhesion(gap, n, pixel, estar, mean_gap, tol, law, work, rho):
+    import tamaas as tm
+    height = np.ascontiguousarray(gap.max() - gap)
+    length = n * pixel
+    model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [length, length], [n, n])
+    model.E = estar
+    model.nu = 0.0
+    solver = tm.PolonskyKeerRey(model, height, tol, tm.PolonskyKeerRey.gap, tm.PolonskyKeerRey.gap)
+    solver.max_iter = 20000
+    if work > 0:
+        functional = (tm.MaugisAdhesionFunctional if law == "dugdale" else tm.ExponentialAdhesionFunctional)(height)
+        functional.setParameters({"rho": rho, "surface_energy": work})
+        solver.addFunctionalTerm(functional)
+    with quiet_stdout():
+        t0 = time.perf_counter()
+        error = solver.solve(mean_gap)
+        t1 = time.perf_counter()
+    separation = np.asarray(model.displacement) - height
+    load = float(np.asarray(model.traction).mean()) * length ** 2
+    contact = np.count_nonzero(separation <= 1e-12 * max(rho, 1.0)) / n ** 2
+    return t1 - t0, "-", float(error), contact, "converged" if error < tol else "not_converged", load
+
+
 PEERS = {"aspher": run_aspher, "contactmechanics": run_contactmechanics, "tamaas": run_tamaas,
          "contactmechanics-periodic": run_contactmechanics_periodic}
 
@@ -117,7 +148,12 @@ def main():
     n = int(n)
     gap = np.fromfile(path, dtype="<f8").reshape((n, n), order="F")
     try:
-        answer = PEERS[peer](gap, n, float(pixel), float(estar), float(pressure), float(tol))
+        if peer == "tamaas-adhesion":
+            law, work, rho = sys.argv[8:11]
+            answer = run_tamaas_adhesion(gap, n, float(pixel), float(estar), float(pressure), float(tol), law,
+                                         float(work), float(rho))
+        else:
+            answer = PEERS[peer](gap, n, float(pixel), float(estar), float(pressure), float(tol))
     except ImportError:
         print(peer, "-", "-", "-", "-", "-", "missing")
         return
