@@ -12,6 +12,7 @@ module test_adhesion
    use femcod_solver, only: solve_contact
    use femcod_analytic, only: maugis_pull_off, maugis_at_load
    use femcod_generate, only: paraboloid_problem
+   use femcod_scene, only: initial_gaps
    use test_cg, only: rough_scene
    use test_support, only: scratch_path, read_text, file_exists, remove_scratch
    use femcod_strings, only: string_type
@@ -35,6 +36,9 @@ contains
          new_unittest("zero work: the non-adhesive cg answers; unloading retraces loading", test_zero_work), &
          new_unittest("rough surface: hysteresis between loading and unloading, pull-off", test_hysteresis), &
          new_unittest("periodic cell: a small sphere pulls off as on the free half-space", test_periodic_sphere), &
+         new_unittest("plastic cap on the path: loading equals the event path, unloading the deformed surface", &
+            test_plastic_path), &
+         new_unittest("plastic flattening then adhesion: a larger pull-off", test_plastic_adhesion), &
          new_unittest("femcod run --adhesion: law and attractive area recorded; misuse refused (exit 2)", &
             test_run_adhesion) &
          ]
@@ -213,7 +217,8 @@ contains
    !> 4 nm adhesion holds more contact and pulls harder than on the way in (measured: 953
    !> against 924 pixels, -17281 against -16815 nN; required: more pixels and 1 % more
    !> pull); at -6 nm every contact has let go (pull-off) and the state equals the first
-   !> one (the only state so far apart) to 1e-8; every state converged.
+   !> one (the only state so far apart) to 1e-7 (tolerance 1e-10; measured 8e-9); every
+   !> state converged.
    subroutine test_hysteresis(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_problem) :: deck
@@ -227,6 +232,7 @@ contains
       options%work = 0.5_dp
       options%range = 1
       options%approaches = [-6.0_dp, 1.0_dp, 4.0_dp, 1.0_dp, -6.0_dp]
+      options%cg%tol = 1.0e-10_dp
       call solve_contact(deck, options, res, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -242,7 +248,7 @@ contains
       if (allocated(error)) return
       call check(error, res%states(5)%contacts == 0 .and. res%states(5)%jump == -1, "no pull-off at -6 nm")
       if (allocated(error)) return
-      call check(error, res%states(5)%load, res%states(1)%load, rel=.true., thr=1.0e-8_dp, &
+      call check(error, res%states(5)%load, res%states(1)%load, rel=.true., thr=1.0e-7_dp, &
          message="at -6 nm, unloaded against the first state")
    end subroutine test_hysteresis
 
@@ -272,11 +278,123 @@ contains
          message="least load, periodic against free")
    end subroutine test_periodic_sphere
 
+   !> The plastic cap on the path (W = 0: the non-adhesive interface), on a 32 x 32 rough
+   !> surface with H = 20 GPa. Loading to 0.7, 1.2, 2 nm: the states equal the event path's
+   !> (--plastic --approach, exact; it too keeps a capped pixel's plastic displacement) to
+   !> 1e-8 of the load, with the same plastic pixels. Unloading to 1.2 and 0.7 nm and
+   !> below first touch: the interface is elastic again, so each state equals the event
+   !> path's elastic state on the surface deformed by the plastic displacement of the
+   !> path (the heights lowered by it, the approach shifted by the fall of the highest
+   !> point), to 1e-8; at -0.5 nm no load, the plastic displacement kept.
+   subroutine test_plastic_path(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck, deformed
+      type(contact_options) :: options
+      type(contact_result) :: path, exact, elastic
+      type(status_type) :: status
+      real(dp), parameter :: up(3) = [0.7_dp, 1.2_dp, 2.0_dp], down(3) = [1.2_dp, 0.7_dp, -0.5_dp]
+      real(dp), allocatable :: total(:, :), plastic(:, :)
+      real(dp) :: shift
+      integer :: k
+      call rough_scene(32, 5, deck)
+      options%solver = "cg"
+      options%loads = [real(dp) ::]
+      options%plastic = .true.
+      options%hardness = 20
+      options%adhesion = "dugdale"
+      options%work = 0
+      options%range = 1
+      options%cg%tol = 1.0e-11_dp
+      options%approaches = [up, down]
+      call solve_contact(deck, options, path, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, path%states(3)%n_plastic > 0, "no plastic pixel at 2 nm")
+      if (allocated(error)) return
+      options%solver = "incremental"
+      options%adhesion = "none"
+      options%approaches = up
+      call solve_contact(deck, options, exact, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      do k = 1, 3
+         call check(error, path%states(k)%n_plastic, exact%states(k)%n_plastic, "plastic pixels at "// &
+            to_string(up(k)))
+         if (allocated(error)) return
+         call check(error, path%states(k)%contacts, exact%states(k)%contacts, "contacts at "//to_string(up(k)))
+         if (allocated(error)) return
+         call check(error, path%states(k)%load, exact%states(k)%load, rel=.true., thr=1.0e-8_dp, &
+            message="load at "//to_string(up(k)))
+         if (allocated(error)) return
+      end do
+      ! The surface deformed by the path's plastic displacement (shape on the lower body).
+      plastic = path%states(6)%plastic
+      deformed = deck
+      deformed%lower = deck%lower - plastic
+      ! The deformed gaps are g0 + plastic - shift (shift: how far the highest point fell),
+      ! so the approach A of the path is A - shift there.
+      total = transpose(reshape(initial_gaps(deck%lower, deck%upper), [32, 32]))
+      shift = maxval(transpose(reshape(initial_gaps(deformed%lower, deformed%upper), [32, 32])) - total - plastic)
+      options%plastic = .false.
+      options%approaches = down + shift
+      call solve_contact(deformed, options, elastic, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      do k = 1, 3
+         call check(error, path%states(3 + k)%contacts, elastic%states(k)%contacts, "unloading: contacts at "// &
+            to_string(down(k)))
+         if (allocated(error)) return
+         call check(error, abs(path%states(3 + k)%load - elastic%states(k)%load) <= 1.0e-8_dp*path%states(3)%load, &
+            "unloading: load at "//to_string(down(k))//": "//to_string(path%states(3 + k)%load)//" against "// &
+            to_string(elastic%states(k)%load))
+         if (allocated(error)) return
+         call check(error, path%states(3 + k)%n_plastic, 0, "unloading: pixels still at the cap")
+         if (allocated(error)) return
+      end do
+      call check(error, path%states(6)%plastic_volume, path%states(3)%plastic_volume, rel=.true., thr=1.0e-12_dp, &
+         message="the plastic volume changed on unloading")
+   end subroutine test_plastic_path
+
+   !> Adhesion after plastic flattening: the lambda = 1 sphere (R = 1000 nm, d = 2 nm)
+   !> loaded to 1 nm with a hardness the contact reaches (0.015 GPa, E* = 1 GPa; Hertz's
+   !> peak there is 0.020 GPa) and unloaded
+   !> pulls off harder than without the cap (the flattened contact is wider: Maugis and
+   !> Pollock 1984; measured -66.3 against -51.7 nN, 1004 of 1828 contact pixels capped at
+   !> 1 nm), and keeps its plastic volume.
+   subroutine test_plastic_adhesion(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      type(contact_result) :: capped, elastic
+      type(status_type) :: status
+      real(dp), parameter :: radius = 1000, work = 0.01_dp, young = 1, lambda = 1
+      integer :: k
+      options%solver = "cg"
+      options%adhesion = "dugdale"
+      options%work = work
+      options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
+      options%approaches = [1.0_dp, (-0.1_dp*k, k = 0, 12)]
+      call solve_contact(paraboloid_problem(64, 2.0_dp, radius, young), options, elastic, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      options%plastic = .true.
+      options%hardness = 0.015_dp
+      call solve_contact(paraboloid_problem(64, 2.0_dp, radius, young), options, capped, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, capped%states(1)%n_plastic > 0, "no pixel reached the hardness at 1 nm")
+      if (allocated(error)) return
+      call check(error, minval(capped%states%load) < 1.05_dp*minval(elastic%states%load), "pull-off "// &
+         to_string(minval(capped%states%load))//" nN with the cap, "//to_string(minval(elastic%states%load))// &
+         " without")
+      if (allocated(error)) return
+      call check(error, capped%states(size(capped%states))%plastic_volume > 0, "no plastic volume left")
+   end subroutine test_plastic_adhesion
+
    !> From the command line: a Dugdale run on the thesis' sphere deck (exit 0) records the
    !> law in the summary file and /run, each approach's attractive pixels and mean gap
    !> in the summary file, and pull-off as a jump; what does not apply is refused with
    !> exit code 2 and writes nothing: --adhesion without --approach, with the incremental
-   !> solver, with --plastic, without --range; --work without --adhesion.
+   !> solver, with --kernel-radius, without --range; --work without --adhesion.
    subroutine test_run_adhesion(error)
       type(error_type), allocatable, intent(out) :: error
       type(string_type), allocatable :: base(:)
@@ -303,7 +421,8 @@ contains
          string_type("10")]
       cases(2)%extra = [string_type("--adhesion"), string_type("dugdale"), string_type("--work"), string_type("1"), &
          string_type("--range"), string_type("0.5"), string_type("--approach"), string_type("0.5")]
-      cases(3)%extra = [cases(1)%extra(1:8), string_type("--plastic"), string_type("--approach"), string_type("0.5")]
+      cases(3)%extra = [cases(1)%extra(1:8), string_type("--kernel-radius"), string_type("10"), &
+         string_type("--approach"), string_type("0.5")]
       cases(4)%extra = [cases(1)%extra(1:6), string_type("--approach"), string_type("0.5")]
       cases(5)%extra = [string_type("--solver"), string_type("cg"), string_type("--work"), string_type("1"), &
          string_type("--approach"), string_type("0.5")]

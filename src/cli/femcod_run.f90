@@ -118,7 +118,7 @@ contains
             "or other options); the run ends exactly as an uninterrupted one. Complete results of the same inputs "// &
             "and options: nothing to do; of others: refused", mode="incremental"), &
          real_option("--tol", "T", "stop when the gap violations over the height range are below T (default 1e-8; "// &
-            "with --adhesion the force-balance violations over the largest pixel force)", &
+            "with --adhesion the force-balance violations times a pixel's compliance)", &
             lower=0.0_dp, closed="()", mode="cg"), &
          integer_option("--max-iterations", "N", "iterations on the finest grid (default 2000)", lower=1, mode="cg"), &
          real_option("--kernel-radius", "R", "truncate the Love kernel beyond R pixels (an approximation: the "// &
@@ -296,16 +296,14 @@ contains
       else if (settings%solve%adhesion /= "none" .and. size(settings%solve%approaches) == 0) then
          call set_error(status, STATUS_USAGE, "--adhesion needs --approach D1,D2,... (displacement control: under "// &
             "load control the pull-off is an instability)")
-      else if (settings%solve%adhesion /= "none" .and. settings%solve%plastic) then
-         call set_error(status, STATUS_USAGE, "--adhesion with --plastic: the adhesive solver caps no pressure; run "// &
-            "one or the other")
       else if (settings%solve%adhesion /= "none" .and. settings%solve%cg%kernel_radius > 0) then
          call set_error(status, STATUS_USAGE, "--adhesion with --kernel-radius: the adhesive solver uses the whole "// &
             "Love kernel")
-      else if (settings%solve%plastic .and. size(settings%solve%approaches) > 1) then
+      else if (settings%solve%plastic .and. size(settings%solve%approaches) > 1 .and. &
+         settings%solve%adhesion == "none") then
          if (any(settings%solve%approaches(2:) < settings%solve%approaches(:size(settings%solve%approaches) - 1))) &
-            call set_error(status, STATUS_USAGE, "--approach with --plastic: give the approaches in increasing order "// &
-            "(unloading a plastic interface is not modelled)")
+            call set_error(status, STATUS_USAGE, "--approach with --plastic: give the approaches in increasing order, "// &
+            "or unload along a path with --solver cg --adhesion dugdale --work 0 --range 1 (--work 0: no adhesion)")
       else if (size(settings%decks) > 1 .and. settings%prefix /= "" .and. .not. settings%from_files) then
          call set_error(status, STATUS_USAGE, "-o PREFIX names the outputs of one deck; with several decks each "// &
             "deck's outputs are named after it (--outdir DIR puts them in DIR)")

@@ -35,8 +35,9 @@
 !> otherwise (Rey et al.).
 !>
 !> Stopping rule: the largest violation of the conditions above, |r| on a pixel off
-!> contact or on the padding, max(-r, 0) on a contact, relative to the largest pixel force
-!> (or to the adhesive tension d^2 phi'(0) when larger), below `tol`.
+!> contact or on the padding, max(-r, 0) on a contact, times one pixel's compliance
+!> c I(0,0) + s (the gap it would move) over the height range, below `tol`: the fixed-load
+!> solver's measure.
 !>
 !> Bugnicourt et al. (Tribol. Lett. 66, 2018, 29) show that such solutions converge with
 !> the mesh only when the pixel resolves the range, and that the iteration converges while
@@ -63,6 +64,9 @@ module femcod_adhesion
    public :: solve_adhesive, ADHESION_NAMES, adhesive_tension, pixel_stiffness_ratio
 
    !> The adhesion laws by name ("none": no adhesion).
+   !> Rounds of the capped set per solve at most.
+   integer, parameter :: MAX_ROUNDS = 200
+
    character(len=*), parameter :: ADHESION_NAMES(3) = [character(len=11) :: "none", "dugdale", "exponential"]
 
    !> The operators on the transform grid: FFTW plans and buffers, the compliance and
@@ -71,6 +75,9 @@ module femcod_adhesion
       integer :: np = 0, m = 0
       !> One cell of a periodic surface (no padding; the mean gap is held, above).
       logical :: periodic = .false.
+      !> One pixel's compliance c I(0,0) + s (nm/nN): a force residual times it is the gap
+      !> it would move.
+      real(dp) :: pixel_compliance = 0
       real(dp), allocatable :: compliance(:, :), stiffness(:, :)
       type(c_ptr) :: forward, backward, real_mem, complex_mem
       real(c_double), pointer :: field(:, :) => null()
@@ -122,8 +129,9 @@ contains
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
       type(fourier_grid) :: grid
-      real(dp), allocatable :: g0(:, :), x(:, :), g(:, :), force(:, :)
-      real(dp) :: tstart, t0, t1, area
+      real(dp), allocatable :: g0(:, :), x(:, :), g(:, :), force(:, :), plastic(:, :)
+      logical, allocatable :: cap(:, :)
+      real(dp) :: tstart, t0, t1, area, fmax
       integer :: np, k, m, i, j, nc, previous_contacts, nsub, sub, iterations
       real(dp) :: last, target
       !> Substeps between two approaches at most (each at most half the range otherwise).
@@ -149,8 +157,17 @@ contains
       g0 = transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np]))
       call make_fourier_grid(grid, problem, options%boundary == "periodic", status)
       if (status%code /= 0) return
-      allocate(res%states(m), x(grid%m, grid%m), g(np, np), force(np, np))
+      allocate(res%states(m), x(grid%m, grid%m), g(np, np), force(np, np), plastic(np, np), cap(np, np))
+      cap = .false.
       x = 0
+      ! The plastic cap: a pixel's force at most H d^2; its plastic displacement (nm) is
+      ! permanent and raises its initial gap for the rest of the path.
+      plastic = 0
+      fmax = huge(1.0_dp)
+      if (options%plastic) then
+         fmax = options%hardness*area
+         allocate(res%step_plastic(0))
+      end if
       previous_contacts = -1
       last = 0
       do k = 1, m
@@ -165,10 +182,16 @@ contains
          do sub = 1, nsub
             target = a
             if (sub < nsub) target = last + (a - last)*real(sub, dp)/nsub
-            call adhesive_cg(grid, g0, target, law, options%work, options%range, area, options%cg%tol, &
-               options%cg%max_iterations, x, g, force, iterations, st%residual, status, observer)
+            call adhesive_cg(grid, g0 + plastic, target, law, options%work, options%range, area, fmax, &
+               options%cg%tol, options%cg%max_iterations, x, g, force, cap, iterations, st%residual, status, observer)
             st%iterations = st%iterations + iterations
             if (status%code /= 0) exit
+            ! Return mapping: a pixel that yielded keeps its interpenetration as plastic
+            ! displacement, and its gap (of the deformed surfaces) is 0.
+            if (options%plastic) then
+               plastic = plastic + max(-g, 0.0_dp)
+               g = max(g, 0.0_dp)
+            end if
          end do
          if (status%code /= 0) exit
          last = a
@@ -184,6 +207,13 @@ contains
          if (st%contacts > 0) st%max_pressure = maxval(force, mask=g == 0)/area
          st%n_above_hardness = count(force/area > options%hardness)
          st%gap = g
+         if (options%plastic) then
+            ! The pixels at the cap now, and the plastic displacement of the whole path.
+            st%n_plastic = count(cap)
+            st%plastic_volume = sum(plastic)*area
+            st%plastic = plastic
+            res%step_plastic = [res%step_plastic, st%n_plastic]
+         end if
          allocate(st%i(st%contacts), st%j(st%contacts), st%force(st%contacts))
          nc = 0
          do i = 1, np
@@ -254,6 +284,7 @@ contains
       else
          table(:, :) = offset_table(np)
       end if
+      grid%pixel_compliance = c*table(0, 0) + s
       grid%real_mem = fftw_alloc_real(int(m, c_size_t)**2)
       grid%complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
       call c_f_pointer(grid%real_mem, grid%field, [m, m])
@@ -318,6 +349,11 @@ contains
       out = grid%field
    end subroutine apply_operator
 
+   !> With the plastic cap fmax, by rounds on the capped set as the fixed-load solver's
+   !> capped_solve: the capped pixels carry fmax whatever their gap (a constant gradient,
+   !> unbounded: below 0 they interpenetrate), the others are solved as above; then the
+   !> contacts above fmax join the set and the capped pixels whose gap opened leave it,
+   !> until neither happens (at most MAX_ROUNDS).
    !> The constrained conjugate gradients at approach `a` (nm) from the separations x
    !> (nm, transform grid; returned: the solution). Returned besides: the gaps g (nm, the
    !> NP x NP grid, exactly 0 on the contact) and the pixel forces (nN).
@@ -326,14 +362,18 @@ contains
    !> the mean force is the constraint's multiplier mu: the gradient is r = K x + mu +
    !> d^2 phi'(g), mu making its mean over the open pixels zero; directions have zero
    !> mean; after a projection the open gaps are shifted back to the mean gap (Rey et al.).
-   subroutine adhesive_cg(grid, g0, a, law, work, range, area, tol, max_iterations, x, g, force, iterations, &
-         residual, status, observer)
+   subroutine adhesive_cg(grid, g0, a, law, work, range, area, fmax, tol, max_iterations, x, g, force, cap, &
+         iterations, residual, status, observer)
       type(fourier_grid), intent(inout) :: grid
-      real(dp), intent(in) :: g0(:, :), a, work, range, area, tol
+      !> fmax: the plastic cap H d^2 (nN; huge: none). A pixel may then interpenetrate
+      !> (g < 0) carrying fmax: the potential continues below g = 0 as -fmax g / d^2.
+      real(dp), intent(in) :: g0(:, :), a, work, range, area, fmax, tol
       character(len=*), intent(in) :: law
       integer, intent(in) :: max_iterations
       real(dp), intent(inout) :: x(:, :)
       real(dp), intent(out) :: g(:, :), force(:, :)
+      !> The capped pixels (with the cap): carried from the last state, returned updated.
+      logical, intent(inout) :: cap(:, :)
       integer, intent(out) :: iterations
       real(dp), intent(out) :: residual
       type(status_type), intent(inout) :: status
@@ -342,8 +382,9 @@ contains
          curvature(:, :)
       logical, allocatable :: free(:, :)
       real(dp) :: rz, rz_old, beta, curv, tau, scale, worst, mu, mean_gap
-      integer :: np, m
-      logical :: clipped
+      integer :: np, m, round
+      logical :: clipped, capped
+      logical, allocatable :: join(:, :), leave(:, :)
       np = grid%np
       m = grid%m
       allocate(kx(m, m), r(m, m), z(m, m), d(m, m), w(m, m), r_old(m, m), free(m, m), &
@@ -357,6 +398,10 @@ contains
             return
          end if
       end if
+      capped = fmax < huge(1.0_dp)
+      if (.not. capped) cap = .false.
+      round = 1
+      scale = max(maxval(g0) - minval(g0), tiny(1.0_dp))
       g = g0 - a + x(1:np, 1:np)
       call project(g)
       x(1:np, 1:np) = g - g0 + a
@@ -366,7 +411,14 @@ contains
       rz_old = 0
       iterations = 0
       do
-         call adhesive_tension(law, work, range, area, g, tension, curvature)
+         call adhesive_tension(law, work, range, area, max(g, 0.0_dp), tension, curvature)
+         if (capped) then
+            ! A capped pixel carries fmax whatever its gap: a constant gradient, no bound.
+            where (cap)
+               tension = -fmax
+               curvature = 0
+            end where
+         end if
          r = kx
          r(1:np, 1:np) = r(1:np, 1:np) + tension
          mu = 0
@@ -379,15 +431,24 @@ contains
             r = r + mu
          end if
          free = .true.
-         free(1:np, 1:np) = g > 0 .or. r(1:np, 1:np) < 0
-         ! The largest violation of the conditions, relative to the force scale.
-         scale = max(maxval(abs(kx(1:np, 1:np) + mu)), area*work/range)
+         free(1:np, 1:np) = g > 0 .or. r(1:np, 1:np) < 0 .or. cap
+         ! The largest violation of the conditions, as the gap it would move on one pixel,
+         ! over the height range (the fixed-load solver's measure).
          worst = maxval(abs(r), mask=free)
          if (any(.not. free)) worst = max(worst, maxval(-r(1:np, 1:np), mask=.not. free(1:np, 1:np)))
-         if (scale > 0) then
-            residual = worst/scale
-         else
-            residual = 0
+         residual = worst*grid%pixel_compliance/scale
+         if (residual <= tol .and. capped) then
+            ! A round of the capped set ends: pixels in contact above the cap join it,
+            ! capped pixels whose gap opened leave it; converged when neither happens.
+            join = .not. cap .and. g == 0 .and. kx(1:np, 1:np) + mu > fmax
+            leave = cap .and. g > 0
+            if ((any(join) .or. any(leave)) .and. round < MAX_ROUNDS) then
+               round = round + 1
+               cap = (cap .or. join) .and. .not. leave
+               d = 0
+               rz_old = 0
+               cycle
+            end if
          end if
          if (residual <= tol .or. iterations >= max_iterations) exit
          if (observer%stop_requested()) then
@@ -423,7 +484,7 @@ contains
          x = x + tau*d
          ! The gaps move with the separations; a contact off the free set keeps g = 0.
          g = g + tau*d(1:np, 1:np)
-         clipped = any(g < 0)
+         clipped = any(g < 0 .and. .not. cap)
          if (clipped) then
             call project(g)
             x(1:np, 1:np) = g - g0 + a
@@ -437,18 +498,20 @@ contains
       call apply_operator(grid, grid%stiffness, x, kx)
       force = kx(1:np, 1:np) + mu
    contains
-      !> g >= 0; on a periodic cell the open gaps then shifted to the mean gap, and again,
-      !> until no gap is negative.
+      !> g >= 0 off the capped set; on a periodic cell the open gaps then shifted to the
+      !> mean gap, and again, until no open gap went below 0.
       subroutine project(gaps)
          real(dp), intent(inout) :: gaps(:, :)
          integer :: pass
-         gaps = max(gaps, 0.0_dp)
+         logical :: open(np, np)
+         where (.not. cap) gaps = max(gaps, 0.0_dp)
          if (.not. grid%periodic) return
          do pass = 1, 100
-            if (.not. any(gaps > 0)) exit
-            where (gaps > 0) gaps = gaps + (mean_gap - sum(gaps)/real(np, dp)**2)*real(np, dp)**2/count(gaps > 0)
-            if (.not. any(gaps < 0)) exit
-            gaps = max(gaps, 0.0_dp)
+            open = gaps > 0 .and. .not. cap
+            if (.not. any(open)) exit
+            where (open) gaps = gaps + (mean_gap - sum(gaps)/real(np, dp)**2)*real(np, dp)**2/count(open)
+            if (.not. any(open .and. gaps < 0)) exit
+            where (open .and. gaps < 0) gaps = 0
          end do
       end subroutine project
 

@@ -70,9 +70,6 @@ contains
          if (options%solver /= "cg") then
             call set_error(status, STATUS_USAGE, "--adhesion: the event solvers follow a path of contact events "// &
                "without tension; use --solver cg")
-         else if (options%plastic) then
-            call set_error(status, STATUS_USAGE, "--adhesion with --plastic: the adhesive solver caps no "// &
-               "pressure; run one or the other")
          else if (.not. allocated(options%approaches)) then
             call set_error(status, STATUS_USAGE, "--adhesion needs --approach: under load control the pull-off "// &
                "is an instability")
@@ -229,7 +226,7 @@ contains
             if (options%adhesion /= "none") then
                call add("cg", "approach "//sig_str(res%states(k)%approach, 6)//" nm: "// &
                   int_str(res%states(k)%iterations)//" iterations, residual "//sig_str(res%states(k)%residual, 2)// &
-                  " (force balance over the largest pixel force)")
+                  " (force balance, as a gap over the height range)")
                cycle
             end if
             rounds = ""
