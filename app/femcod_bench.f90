@@ -1353,7 +1353,9 @@ contains
             "   (linear between the two approaches around it), the convexity ratio, iterations, time.", &
             "3. With --peers PYTHON: the lambda = 0.5 sphere (R = 100 nm, d = 1 nm, 64^2) on a periodic cell at", &
             "   approaches 1, 0.5, 0.25 nm, W = 0.01 and 0, femcod beside tamaas' Maugis functional at the same", &
-            "   mean gap (app/femcod_peers.py; tamaas from the undeformed surfaces, femcod along the path).", ""
+            "   mean gap (app/femcod_peers.py; tamaas from the undeformed surfaces, femcod along the path);", &
+            "   then the rough surface of part 2 as a periodic cell with the CMC interaction at 10, 20, 30 nm,", &
+            "   each approach from the undeformed surfaces in both.", ""
          call print_lines(option_help(bench_adhesion_table(), ""))
          write(output_unit, '(a)') "Run it with the release build."
          return
@@ -1540,6 +1542,46 @@ contains
                   trim(words(2))//" |"
                flush(output_unit)
             end do
+         end do
+         ! The rough surface of part 2 (1 nm pixels) as a periodic cell, each mean gap
+         ! solved from the undeformed surfaces by both (one approach per femcod run).
+         write(output_unit, '(a)') "", "The same rough surface as a periodic cell, CMC interaction, each "// &
+            "approach from the undeformed surfaces", "", &
+            "| approach (nm) | femcod load (nN) | tamaas load (nN) | difference / load | femcod contact % | "// &
+            "tamaas contact % | femcod (s) | tamaas (s) |", "|---|---|---|---|---|---|---|---|"
+         g0 = transpose(reshape(initial_gaps(fine%lower, fine%upper), [fine%np, fine%np]))
+         call write_peer_gaps(path, g0)
+         do ia = 1, 3
+            options = contact_options()
+            options%solver = "cg"
+            options%boundary = "periodic"
+            allocate(options%loads(0))
+            options%adhesion = "exponential"
+            options%work = 0.05_dp
+            options%range = 2.071_dp
+            options%cg%max_iterations = 20000
+            options%approaches = [10.0_dp*ia]
+            call wall_clock(t0)
+            call solve_contact(fine, options, res, status)
+            call wall_clock(t1)
+            if (status%code /= 0) then
+               write(error_unit, '(a)') "femcod bench adhesion: "//status%message
+               code = status%code
+               return
+            end if
+            line = peer_line(python, "tamaas-adhesion", path, fine%np, fine%pixel, fine%young(1), &
+               sum(g0)/real(fine%np, dp)**2 - options%approaches(1), 1.0e-8_dp, "exponential 0.05 2.071")
+            words = "-"
+            read(line, *, iostat=ios) words
+            read(words(8), *, iostat=ios) w
+            if (ios /= 0) w = huge(1.0_dp)
+            read(words(5), *, iostat=ios) theory
+            write(output_unit, '(a)') "| "//fixed_str(options%approaches(1), 1)//" | "// &
+               fixed_str(res%states(1)%load, 3)//" | "//fixed_str(w, 3)//" | "// &
+               real_str(abs(res%states(1)%load - w)/abs(w), 2)//" | "// &
+               fixed_str(100*res%states(1)%contacts/real(fine%np, dp)**2, 2)//" | "//fixed_str(100*theory, 2)// &
+               " | "//fixed_str(t1 - t0, 2)//" | "//trim(words(2))//" |"
+            flush(output_unit)
          end do
          call remove_file_quietly(path)
       end subroutine side_by_side
