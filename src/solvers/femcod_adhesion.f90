@@ -53,12 +53,14 @@ module femcod_adhesion
    use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
    use femcod_fftw, only: fftw_plan_dft_r2c_2d, fftw_plan_dft_c2r_2d, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
-      fftw_destroy_plan, fftw_alloc_real, fftw_alloc_complex, fftw_free, FFTW_ESTIMATE
+      fftw_destroy_plan, fftw_alloc_real, fftw_alloc_complex, fftw_free, FFTW_ESTIMATE, fftw_init_threads, &
+      fftw_plan_with_nthreads
    use femcod_contact_result, only: contact_result, append_step, STOP_LOADS
    use femcod_solver_options, only: contact_options
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
+   !$ use omp_lib, only: omp_get_max_threads
    implicit none
    private
    public :: solve_adhesive, ADHESION_NAMES, adhesive_tension, pixel_stiffness_ratio
@@ -102,6 +104,22 @@ contains
          curvature = -tension/range
       end select
    end subroutine adhesive_tension
+
+   !> adhesive_tension with the law as a code (1 Dugdale, 2 exponential, else none), for
+   !> the solver's inner loops.
+   pure subroutine pixel_tension(code, work, range, area, g, tension, curvature)
+      integer, intent(in) :: code
+      real(dp), intent(in) :: work, range, area, g
+      real(dp), intent(out) :: tension, curvature
+      tension = 0
+      curvature = 0
+      if (code == 1) then
+         if (g < range) tension = area*work/range
+      else if (code == 2) then
+         tension = area*(work/range)*exp(-g/range)
+         curvature = -tension/range
+      end if
+   end subroutine pixel_tension
 
    !> The ratio of one pixel's largest adhesive stiffness, d^2 W / R^2, to its elastic
    !> stiffness 1/(c I(0,0) + s) (nondimensional): the iteration is safely convex below 1
@@ -269,7 +287,7 @@ contains
       type(status_type), intent(inout) :: status
       real(dp), allocatable :: table(:, :)
       real(dp) :: c, s
-      integer :: np, m, p, q, i, j
+      integer :: np, m, p, q, i, j, threads
       np = problem%np
       m = merge(np, 2*np, periodic)
       grid%np = np
@@ -289,8 +307,15 @@ contains
       grid%complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
       call c_f_pointer(grid%real_mem, grid%field, [m, m])
       call c_f_pointer(grid%complex_mem, grid%spectrum, [m/2 + 1, m])
+      ! The transforms on OpenMP's threads (FFTW's threaded plans); plans made after
+      ! these two are single-threaded again, as the convolution module's blocks expect.
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      if (fftw_init_threads() == 0) threads = 1
+      call fftw_plan_with_nthreads(int(threads, c_int))
       grid%forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), grid%field, grid%spectrum, FFTW_ESTIMATE)
       grid%backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), grid%spectrum, grid%field, FFTW_ESTIMATE)
+      call fftw_plan_with_nthreads(1_c_int)
       ! The kernel on the transform grid: offsets 0..NP-1 and -(NP-1)..-1 wrapped (free;
       ! offset NP is never reached by two pixels of the grid), or the periodic cell.
       grid%field = 0
@@ -342,11 +367,30 @@ contains
       type(fourier_grid), intent(inout) :: grid
       real(dp), intent(in) :: multiplier(:, :), in(:, :)
       real(dp), intent(out) :: out(:, :)
-      grid%field = in
+      integer :: i, j
+      !$omp parallel do private(i)
+      do j = 1, grid%m
+         do i = 1, grid%m
+            grid%field(i, j) = in(i, j)
+         end do
+      end do
+      !$omp end parallel do
       call fftw_execute_dft_r2c(grid%forward, grid%field, grid%spectrum)
-      grid%spectrum = grid%spectrum*multiplier
+      !$omp parallel do private(i)
+      do j = 1, grid%m
+         do i = 1, grid%m/2 + 1
+            grid%spectrum(i, j) = grid%spectrum(i, j)*multiplier(i, j)
+         end do
+      end do
+      !$omp end parallel do
       call fftw_execute_dft_c2r(grid%backward, grid%spectrum, grid%field)
-      out = grid%field
+      !$omp parallel do private(i)
+      do j = 1, grid%m
+         do i = 1, grid%m
+            out(i, j) = grid%field(i, j)
+         end do
+      end do
+      !$omp end parallel do
    end subroutine apply_operator
 
    !> With the plastic cap fmax, by rounds on the capped set as the fixed-load solver's
@@ -381,8 +425,8 @@ contains
       real(dp), allocatable :: kx(:, :), r(:, :), z(:, :), d(:, :), w(:, :), r_old(:, :), tension(:, :), &
          curvature(:, :)
       logical, allocatable :: free(:, :)
-      real(dp) :: rz, rz_old, beta, curv, tau, scale, worst, mu, mean_gap
-      integer :: np, m, round
+      real(dp) :: rz, rz_old, rzo, rd, beta, curv, adhesive_curv, tau, scale, worst, mu, mean_gap, open_sum, t, cv
+      integer :: np, m, round, i, j, open_count, law_code
       logical :: clipped, capped
       logical, allocatable :: join(:, :), leave(:, :)
       np = grid%np
@@ -410,32 +454,64 @@ contains
       r_old = 0
       rz_old = 0
       iterations = 0
+      law_code = 0
+      if (law == "dugdale") law_code = 1
+      if (law == "exponential") law_code = 2
       do
-         call adhesive_tension(law, work, range, area, max(g, 0.0_dp), tension, curvature)
-         if (capped) then
-            ! A capped pixel carries fmax whatever its gap: a constant gradient, no bound.
-            where (cap)
-               tension = -fmax
-               curvature = 0
-            end where
-         end if
-         r = kx
-         r(1:np, 1:np) = r(1:np, 1:np) + tension
+         ! The gradient r = K x (+ the adhesive tension, or -fmax on a capped pixel); the
+         ! open pixels' sum for a periodic cell's multiplier.
+         open_sum = 0
+         open_count = 0
+         !$omp parallel do private(i, t, cv) reduction(+:open_sum, open_count)
+         do j = 1, m
+            do i = 1, m
+               if (i <= np .and. j <= np) then
+                  if (cap(i, j)) then
+                     t = -fmax
+                     cv = 0
+                  else
+                     call pixel_tension(law_code, work, range, area, max(g(i, j), 0.0_dp), t, cv)
+                  end if
+                  curvature(i, j) = cv
+                  r(i, j) = kx(i, j) + t
+                  if (g(i, j) > 0) then
+                     open_sum = open_sum + r(i, j)
+                     open_count = open_count + 1
+                  end if
+               else
+                  r(i, j) = kx(i, j)
+               end if
+            end do
+         end do
+         !$omp end parallel do
          mu = 0
          if (grid%periodic) then
-            if (any(g > 0)) then
-               mu = -sum(r, mask=g > 0)/count(g > 0)
+            if (open_count > 0) then
+               mu = -open_sum/open_count
             else
                mu = -sum(r)/real(np, dp)**2
             end if
-            r = r + mu
          end if
-         free = .true.
-         free(1:np, 1:np) = g > 0 .or. r(1:np, 1:np) < 0 .or. cap
-         ! The largest violation of the conditions, as the gap it would move on one pixel,
-         ! over the height range (the fixed-load solver's measure).
-         worst = maxval(abs(r), mask=free)
-         if (any(.not. free)) worst = max(worst, maxval(-r(1:np, 1:np), mask=.not. free(1:np, 1:np)))
+         ! The free set, and the largest violation of the conditions, as the gap it would
+         ! move on one pixel, over the height range (the fixed-load solver's measure).
+         worst = 0
+         !$omp parallel do private(i) reduction(max:worst)
+         do j = 1, m
+            do i = 1, m
+               r(i, j) = r(i, j) + mu
+               if (i <= np .and. j <= np) then
+                  free(i, j) = g(i, j) > 0 .or. r(i, j) < 0 .or. cap(i, j)
+               else
+                  free(i, j) = .true.
+               end if
+               if (free(i, j)) then
+                  worst = max(worst, abs(r(i, j)))
+               else
+                  worst = max(worst, -r(i, j))
+               end if
+            end do
+         end do
+         !$omp end parallel do
          residual = worst*grid%pixel_compliance/scale
          if (residual <= tol .and. capped) then
             ! A round of the capped set ends: pixels in contact above the cap join it,
@@ -458,39 +534,62 @@ contains
          end if
          iterations = iterations + 1
          ! Preconditioned direction on the free set: z = C r there.
-         where (.not. free) r = 0
+         !$omp parallel do private(i)
+         do j = 1, m
+            do i = 1, m
+               if (.not. free(i, j)) r(i, j) = 0
+            end do
+         end do
+         !$omp end parallel do
          call apply_operator(grid, grid%compliance, r, z)
-         where (.not. free) z = 0
-         rz = sum(r*z)
+         rz = 0
+         rzo = 0
+         !$omp parallel do private(i) reduction(+:rz, rzo)
+         do j = 1, m
+            do i = 1, m
+               if (.not. free(i, j)) z(i, j) = 0
+               rz = rz + r(i, j)*z(i, j)
+               rzo = rzo + z(i, j)*r_old(i, j)
+            end do
+         end do
+         !$omp end parallel do
          beta = 0
-         if (rz_old > 0) beta = max(0.0_dp, (rz - sum(z*r_old))/rz_old)
-         where (free)
-            d = -z + beta*d
-         elsewhere
-            d = 0
-         end where
-         if (grid%periodic) call centre(d)
-         if (sum(r*d) >= 0) then
-            d = -z
-            if (grid%periodic) call centre(d)
-         end if
+         if (rz_old > 0) beta = max(0.0_dp, (rz - rzo)/rz_old)
+         call new_direction(beta)
+         if (rd >= 0) call new_direction(0.0_dp)
          rz_old = rz
-         r_old = r
          call apply_operator(grid, grid%stiffness, d, w)
-         curv = sum(d*w)
-         if (curv + sum(curvature*d(1:np, 1:np)**2) > 0.5_dp*curv) curv = curv + sum(curvature*d(1:np, 1:np)**2)
+         curv = 0
+         adhesive_curv = 0
+         !$omp parallel do private(i) reduction(+:curv, adhesive_curv)
+         do j = 1, m
+            do i = 1, m
+               curv = curv + d(i, j)*w(i, j)
+               if (i <= np .and. j <= np) adhesive_curv = adhesive_curv + curvature(i, j)*d(i, j)**2
+            end do
+         end do
+         !$omp end parallel do
+         if (curv + adhesive_curv > 0.5_dp*curv) curv = curv + adhesive_curv
          if (.not. curv > 0) exit
-         tau = -sum(r*d)/curv
-         x = x + tau*d
+         tau = -rd/curv
          ! The gaps move with the separations; a contact off the free set keeps g = 0.
-         g = g + tau*d(1:np, 1:np)
-         clipped = any(g < 0 .and. .not. cap)
+         clipped = .false.
+         !$omp parallel do private(i) reduction(.or.:clipped)
+         do j = 1, m
+            do i = 1, m
+               x(i, j) = x(i, j) + tau*d(i, j)
+               kx(i, j) = kx(i, j) + tau*w(i, j)
+               if (i <= np .and. j <= np) then
+                  g(i, j) = g(i, j) + tau*d(i, j)
+                  clipped = clipped .or. (g(i, j) < 0 .and. .not. cap(i, j))
+               end if
+            end do
+         end do
+         !$omp end parallel do
          if (clipped) then
             call project(g)
             x(1:np, 1:np) = g - g0 + a
             call apply_operator(grid, grid%stiffness, x, kx)
-         else
-            kx = kx + tau*w
          end if
       end do
       ! The answer's forces from a fresh transform of its separations (on a periodic cell
@@ -515,10 +614,39 @@ contains
          end do
       end subroutine project
 
-      !> A direction with zero mean over its free pixels (the mean gap is held).
-      subroutine centre(dir)
-         real(dp), intent(inout) :: dir(:, :)
-         where (free) dir = dir - sum(dir, mask=free)/count(free)
-      end subroutine centre
+      !> d = -z + beta d on the free set (0 elsewhere), with zero mean over the free set
+      !> on a periodic cell (the mean gap is held); rd = r.d; r_old = r.
+      subroutine new_direction(b)
+         real(dp), intent(in) :: b
+         real(dp) :: total, shift
+         integer :: nfree, ii, jj
+         total = 0
+         nfree = 0
+         !$omp parallel do private(ii) reduction(+:total, nfree)
+         do jj = 1, m
+            do ii = 1, m
+               if (free(ii, jj)) then
+                  d(ii, jj) = -z(ii, jj) + b*d(ii, jj)
+                  total = total + d(ii, jj)
+                  nfree = nfree + 1
+               else
+                  d(ii, jj) = 0
+               end if
+            end do
+         end do
+         !$omp end parallel do
+         shift = 0
+         if (grid%periodic .and. nfree > 0) shift = total/nfree
+         rd = 0
+         !$omp parallel do private(ii) reduction(+:rd)
+         do jj = 1, m
+            do ii = 1, m
+               if (free(ii, jj)) d(ii, jj) = d(ii, jj) - shift
+               rd = rd + r(ii, jj)*d(ii, jj)
+               r_old(ii, jj) = r(ii, jj)
+            end do
+         end do
+         !$omp end parallel do
+      end subroutine new_direction
    end subroutine adhesive_cg
 end module femcod_adhesion
