@@ -103,10 +103,7 @@ contains
          write(output_unit, '(a)') "Run it with the release build: fpm run --profile release -- bench"
          return
       end if
-      call parse_options(bench_table(), args, parsed, status)
-      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod bench: "//bad_arguments(status, parsed)//" (femcod bench --help)"
+      if (.not. bench_arguments(bench_table(), args, "femcod bench", parsed)) then
          code = 2
          return
       end if
@@ -273,6 +270,21 @@ contains
    end function bench_convolution_table
 
    !> The message of a failed parse, or of an argument the bench takes no positional for.
+   !> Parse a bench command's arguments against its option table; false, with the
+   !> message on standard error, when they do not fit it (or a positional is given).
+   logical function bench_arguments(table, args, command, parsed) result(ok)
+      type(option_spec), intent(in) :: table(:)
+      type(string_type), intent(in) :: args(:)
+      character(len=*), intent(in) :: command
+      type(parsed_options), intent(out) :: parsed
+      type(status_type) :: status
+      call parse_options(table, args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
+      ok = status%code == 0
+      if (.not. ok) write(error_unit, '(a)') command//": "//bad_arguments(status, parsed)//" ("// &
+         trim(merge("femcod bench --help", "--help             ", command == "femcod bench"))//")"
+   end function bench_arguments
+
    function bad_arguments(status, parsed) result(text)
       type(status_type), intent(in) :: status
       type(parsed_options), intent(in) :: parsed
@@ -359,10 +371,7 @@ contains
             "text files and figures (the rest is starting the process and checks); figure s, largest figure KB."
          return
       end if
-      call parse_options(bench_io_table(), args, parsed, status)
-      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod bench io: "//bad_arguments(status, parsed)//" (--help)"
+      if (.not. bench_arguments(bench_io_table(), args, "femcod bench io", parsed)) then
          code = 2
          return
       end if
@@ -536,10 +545,7 @@ contains
          write(output_unit, '(a)') "Run it with the release build."
          return
       end if
-      call parse_options(bench_periodic_table(), args, parsed, status)
-      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod bench periodic: "//bad_arguments(status, parsed)//" (--help)"
+      if (.not. bench_arguments(bench_periodic_table(), args, "femcod bench periodic", parsed)) then
          code = 2
          return
       end if
@@ -710,10 +716,7 @@ contains
          write(output_unit, '(a)') "Run it with the release build."
          return
       end if
-      call parse_options(bench_frontier_table(), args, parsed, status)
-      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod bench frontier: "//bad_arguments(status, parsed)//" (--help)"
+      if (.not. bench_arguments(bench_frontier_table(), args, "femcod bench frontier", parsed)) then
          code = 2
          return
       end if
@@ -1017,10 +1020,7 @@ contains
             "Columns: NP, target %, solver, wall (s), iterations, residual, contact %, peak RSS (MB)."
          return
       end if
-      call parse_options(bench_cg_table(), args, parsed, status)
-      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod bench cg: "//bad_arguments(status, parsed)//" (--help)"
+      if (.not. bench_arguments(bench_cg_table(), args, "femcod bench cg", parsed)) then
          code = 2
          return
       end if
@@ -1140,10 +1140,7 @@ contains
          write(output_unit, '(a)') "Run it with the release build."
          return
       end if
-      call parse_options(bench_convolution_table(), args, parsed, status)
-      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod bench convolution: "//bad_arguments(status, parsed)//" (--help)"
+      if (.not. bench_arguments(bench_convolution_table(), args, "femcod bench convolution", parsed)) then
          code = 2
          return
       end if
@@ -1360,10 +1357,7 @@ contains
          write(output_unit, '(a)') "Run it with the release build."
          return
       end if
-      call parse_options(bench_adhesion_table(), args, parsed, status)
-      if (status%code == 0 .and. size(parsed%positional) > 0) status%code = 2
-      if (status%code /= 0) then
-         write(error_unit, '(a)') "femcod bench adhesion: "//bad_arguments(status, parsed)//" (--help)"
+      if (.not. bench_arguments(bench_adhesion_table(), args, "femcod bench adhesion", parsed)) then
          code = 2
          return
       end if
