@@ -7,7 +7,8 @@ module femcod_contact_result
    implicit none
    private
    public :: contact_result, load_state, append_step, visit_result, record_approach_states
-   public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text, record_load_states, finish_contacts
+   public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text, record_load_states, finish_contacts, &
+      gather_contacts
 
    integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3
 
@@ -281,4 +282,25 @@ contains
          text = "not run"
       end select
    end function stop_reason_text
+   !> The state's contacts from a map: the pixels (row, column) where `in_contact` holds,
+   !> row by row, with their forces (nN) from `force`; and their count.
+   pure subroutine gather_contacts(state, in_contact, force)
+      type(load_state), intent(inout) :: state
+      logical, intent(in) :: in_contact(:, :)
+      real(dp), intent(in) :: force(:, :)
+      integer :: i, j, nc
+      state%contacts = count(in_contact)
+      allocate(state%i(state%contacts), state%j(state%contacts), state%force(state%contacts))
+      nc = 0
+      do i = 1, size(in_contact, 1)
+         do j = 1, size(in_contact, 2)
+            if (in_contact(i, j)) then
+               nc = nc + 1
+               state%i(nc) = i
+               state%j(nc) = j
+               state%force(nc) = force(i, j)
+            end if
+         end do
+      end do
+   end subroutine gather_contacts
 end module femcod_contact_result

@@ -55,7 +55,7 @@ module femcod_adhesion
    use femcod_fftw, only: fftw_plan_dft_r2c_2d, fftw_plan_dft_c2r_2d, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
       fftw_destroy_plan, fftw_alloc_real, fftw_alloc_complex, fftw_free, FFTW_ESTIMATE, fftw_init_threads, &
       fftw_plan_with_nthreads
-   use femcod_contact_result, only: contact_result, append_step, STOP_LOADS
+   use femcod_contact_result, only: contact_result, append_step, STOP_LOADS, gather_contacts
    use femcod_solver_options, only: contact_options
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
@@ -150,7 +150,7 @@ contains
       real(dp), allocatable :: g0(:, :), x(:, :), g(:, :), force(:, :), plastic(:, :)
       logical, allocatable :: cap(:, :)
       real(dp) :: tstart, t0, t1, area, fmax
-      integer :: np, k, m, i, j, nc, previous_contacts, nsub, sub, iterations
+      integer :: np, k, m, i, previous_contacts, nsub, sub, iterations
       real(dp) :: last, target
       !> Substeps between two approaches at most (each at most half the range otherwise).
       integer, parameter :: MAX_SUBSTEPS = 1000
@@ -232,18 +232,7 @@ contains
             st%plastic = plastic
             res%step_plastic = [res%step_plastic, st%n_plastic]
          end if
-         allocate(st%i(st%contacts), st%j(st%contacts), st%force(st%contacts))
-         nc = 0
-         do i = 1, np
-            do j = 1, np
-               if (g(i, j) == 0) then
-                  nc = nc + 1
-                  st%i(nc) = i
-                  st%j(nc) = j
-                  st%force(nc) = force(i, j)
-               end if
-            end do
-         end do
+         call gather_contacts(st, g == 0, force)
          ! A contact set that appears from none, or vanishes, between two approaches is a
          ! jump (into contact, or pull-off): the state left its branch.
          st%jump = 0

@@ -54,7 +54,7 @@ module femcod_cg
    use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
-   use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS
+   use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts
    use femcod_solver_options, only: contact_options, cg_settings
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
@@ -106,7 +106,7 @@ contains
       logical, allocatable :: capped(:, :)
       integer, allocatable :: order(:)
       real(dp) :: load, tstart, t0, t1, approach
-      integer :: np, k, kk, m, i, j, nc
+      integer :: np, k, kk, m, i, j
       logical :: by_approach
       call wall_clock(tstart)
       associate(how => options%cg, tol => options%cg%tol, max_iterations => options%cg%max_iterations)
@@ -182,18 +182,7 @@ contains
                st%n_plastic = count(capped)
                st%plastic_volume = sum(st%plastic)*problem%pixel**2
             end if
-            allocate(st%i(st%contacts), st%j(st%contacts), st%force(st%contacts))
-            nc = 0
-            do i = 1, np
-               do j = 1, np
-                  if (p(i, j) > 0) then
-                     nc = nc + 1
-                     st%i(nc) = i
-                     st%j(nc) = j
-                     st%force(nc) = p(i, j)
-                  end if
-               end do
-            end do
+            call gather_contacts(st, p > 0, p)
             call append_step(res, st%contacts, st%n_above_hardness, load, st%approach, t1 - t0)
             if (options%plastic) res%step_plastic = [res%step_plastic, st%n_plastic]
             call observer%progress(kk, st%contacts, load, t1 - tstart)
