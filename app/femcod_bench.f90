@@ -724,6 +724,7 @@ contains
       call get_option(parsed, "--contact", fractions)
       call get_option(parsed, "--svg", svg_path)
       call get_option(parsed, "--deck", deck_path)
+      if (option_given(parsed, "--no-deck")) deck_path = ""
       call get_option(parsed, "--deck-load", deck_load)
       call benchmark_surface(np, "bench frontier", deck, status)
       if (status%code /= 0) then
@@ -976,7 +977,8 @@ contains
          real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,5)", lower=0.0_dp), &
          text_option("--svg", "FILE", "write the figure (log time against log area error, Pareto front)"), &
          text_option("--deck", "FILE", "a thesis deck solved the same ways, the Appendix B program too (default "// &
-            "input/sphere_d1.deck; an empty name for none)"), &
+            "input/sphere_d1.deck)"), &
+         flag_option("--no-deck", "the benchmark surface only (no thesis deck, no Appendix B program)"), &
          real_option("--deck-load", "F", "the deck's load in nN (default 1000)", lower=0.0_dp, closed="()")]
    end function bench_frontier_table
 
