@@ -49,7 +49,7 @@ module femcod_adhesion
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
-   use femcod_love, only: offset_table, surface_compliance
+   use femcod_love, only: offset_table, surface_compliance, love_influence
    use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
    use femcod_fftw, only: fftw_plan_dft_r2c_2d, fftw_plan_dft_c2r_2d, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
@@ -63,13 +63,10 @@ module femcod_adhesion
    !$ use omp_lib, only: omp_get_max_threads
    implicit none
    private
-   public :: solve_adhesive, ADHESION_NAMES, adhesive_tension, pixel_stiffness_ratio
+   public :: solve_adhesive, pixel_stiffness_ratio
 
-   !> The adhesion laws by name ("none": no adhesion).
    !> Rounds of the capped set per solve at most.
    integer, parameter :: MAX_ROUNDS = 200
-
-   character(len=*), parameter :: ADHESION_NAMES(3) = [character(len=11) :: "none", "dugdale", "exponential"]
 
    !> The operators on the transform grid: FFTW plans and buffers, the compliance and
    !> stiffness spectra (each divided by M^2 for FFTW's unnormalised transforms).
@@ -89,24 +86,8 @@ module femcod_adhesion
 contains
 
    !> The adhesive tension d^2 phi'(g) of one pixel (nN, positive: it pulls the surfaces
-   !> together), and the curvature d^2 phi''(g) (nN/nm), for gap g >= 0 (nm).
-   elemental subroutine adhesive_tension(law, work, range, area, g, tension, curvature)
-      character(len=*), intent(in) :: law
-      real(dp), intent(in) :: work, range, area, g
-      real(dp), intent(out) :: tension, curvature
-      tension = 0
-      curvature = 0
-      select case (law)
-      case ("dugdale")
-         if (g < range) tension = area*work/range
-      case ("exponential")
-         tension = area*(work/range)*exp(-g/range)
-         curvature = -tension/range
-      end select
-   end subroutine adhesive_tension
-
-   !> adhesive_tension with the law as a code (1 Dugdale, 2 exponential, else none), for
-   !> the solver's inner loops.
+   !> together), and the curvature d^2 phi''(g) (nN/nm), for gap g >= 0 (nm); the law as
+   !> a code (1 Dugdale, 2 exponential, else none) for the solver's inner loops.
    pure subroutine pixel_tension(code, work, range, area, g, tension, curvature)
       integer, intent(in) :: code
       real(dp), intent(in) :: work, range, area, g
@@ -131,13 +112,8 @@ contains
       c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
          surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
       pixel_stiffness_ratio = problem%pixel**2*work/range**2* &
-         (c*self_influence() + 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel))
+         (c*love_influence(0, 0) + 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel))
    end function pixel_stiffness_ratio
-
-   !> Love's I(0, 0) for a square pixel: 4 asinh(1).
-   pure real(dp) function self_influence()
-      self_influence = 4*asinh(1.0_dp)
-   end function self_influence
 
    !> The states at options%approaches (nm), in the order given, each from the last.
    subroutine solve_adhesive(problem, options, res, status, observer)
@@ -217,7 +193,7 @@ contains
          st%reached = .true.
          st%approach = a
          st%load = sum(force)
-         st%contacts = count(g == 0)
+         call gather_contacts(st, g == 0, force)
          st%attractive = count(g > 0 .and. g < options%range)
          st%attractive_load = sum(force, mask=g > 0)
          st%mean_gap = sum(g)/real(np, dp)**2
@@ -232,7 +208,6 @@ contains
             st%plastic = plastic
             res%step_plastic = [res%step_plastic, st%n_plastic]
          end if
-         call gather_contacts(st, g == 0, force)
          ! A contact set that appears from none, or vanishes, between two approaches is a
          ! jump (into contact, or pull-off): the state left its branch.
          st%jump = 0
