@@ -7,18 +7,22 @@
 #   bash setup.sh --no-run        the same without the run (CI)
 #   bash setup.sh --prefix DIR    install femcod into DIR/bin (default: /usr/local as root,
 #                                 ~/.local otherwise)
+#   bash setup.sh --mpi           also OpenMPI, FFTW-MPI and the OpenMPI HDF5, and femcod-mpi
+#                                 (mpi/, doc/cluster.md) next to femcod; tests: bash mpi/test.sh
 # fpm comes from PyPI into its own virtual environment (Debian's pip refuses system
 # installs, PEP 668), linked into PREFIX/bin.
 set -euo pipefail
 cd "$(dirname "$0")"
 
 run_main=1
+mpi=0
 if [ "$(id -u)" -eq 0 ]; then prefix=/usr/local; else prefix="$HOME/.local"; fi
 while [ $# -gt 0 ]; do
   case "$1" in
     --no-run) run_main=0; shift ;;
+    --mpi) mpi=1; shift ;;
     --prefix) [ $# -ge 2 ] || { echo "setup: --prefix needs a directory" >&2; exit 2; }; prefix=$2; shift 2 ;;
-    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "setup: unknown argument $1 (setup.sh --help)" >&2; exit 2 ;;
   esac
 done
@@ -29,6 +33,7 @@ sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 
 debian_packages=(gfortran liblapack-dev libopenblas-dev libhdf5-dev libfftw3-dev pkg-config hdf5-tools zlib1g-dev libssl-dev
   python3-venv)
+if [ "$mpi" -eq 1 ]; then debian_packages+=(libopenmpi-dev openmpi-bin libfftw3-mpi-dev libhdf5-openmpi-dev); fi
 missing=()
 for p in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -38,6 +43,15 @@ if [ ${#missing[@]} -gt 0 ]; then
   export DEBIAN_FRONTEND=noninteractive
   sudo_if_needed apt-get update -qq >/dev/null
   sudo_if_needed apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The serial build takes HDF5 from pkg-config's hdf5.pc. Installing libhdf5-openmpi-dev
+# switches that alternative to the MPI HDF5, which the serial build would then pick up
+# silently: point it back at the serial one (femcod-mpi finds its own, mpi/environment.sh).
+pc_dir=$(pkg-config --variable=pcfiledir hdf5-serial)
+if [ -e "$pc_dir/hdf5.pc" ] && [ "$(readlink -f "$pc_dir/hdf5.pc")" != "$(readlink -f "$pc_dir/hdf5-serial.pc")" ]; then
+  sudo_if_needed update-alternatives --set hdf5.pc "$pc_dir/hdf5-serial.pc" >/dev/null
+  echo "setup: hdf5.pc pointed at $(readlink -f "$pc_dir/hdf5.pc"); set back to the serial HDF5"
 fi
 
 if ! command -v fpm >/dev/null 2>&1; then
@@ -57,6 +71,13 @@ case ":$(printenv PATH):" in
   *":$prefix/bin:"*) ;;
   *) echo "setup: femcod is installed in $prefix/bin; add it to PATH (export PATH=\"$prefix/bin:\$PATH\")" ;;
 esac
+if [ "$mpi" -eq 1 ]; then
+  (cd mpi && source ./environment.sh &&
+    fpm build --profile release --flag "$FEMCOD_MPI_FLAGS" >/dev/null 2>build.log &&
+    fpm install --profile release --flag "$FEMCOD_MPI_FLAGS" --prefix "$prefix" >/dev/null 2>>build.log) ||
+    { cat mpi/build.log >&2; echo "setup: the MPI build failed" >&2; exit 1; }
+  rm -f mpi/build.log
+fi
 if [ "$run_main" -eq 1 ]; then
   mkdir -p out
   "$prefix/bin/femcod" run input/sphere_d1.deck -o out/sphere_d1 --loads 100,1000,5000 --force

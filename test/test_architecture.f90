@@ -1,5 +1,6 @@
 !> The shape of src/ (doc/architecture.md): the layers core < model < legacy < solvers <
 !> io < studies < cli, each a folder; a module uses only its own layer and those below.
+!> femcod-mpi's modules (mpi/src, built apart with MPI) are one more layer on top.
 !> The numerical core keeps no state between calls (no module-level save variables) and
 !> never stops the program.
 module test_architecture
@@ -10,8 +11,8 @@ module test_architecture
    private
    public :: collect_architecture
 
-   character(len=*), parameter :: LAYERS(7) = [character(len=7) :: "core", "model", "legacy", "solvers", "io", &
-      "studies", "cli"]
+   character(len=*), parameter :: LAYERS(8) = [character(len=7) :: "core", "model", "legacy", "solvers", "io", &
+      "studies", "cli", "mpi"]
 
 contains
 
@@ -23,13 +24,13 @@ contains
          ]
    end subroutine collect_architecture
 
-   !> The source files under src/ (one per line), from `find`.
+   !> The source files under src/ and mpi/src/ (one per line), from `find`.
    function sources() result(files)
       type(string_type), allocatable :: files(:)
       character(len=:), allocatable :: list, text
       integer :: start, k
       list = scratch_path("sources.txt")
-      call execute_command_line("find src -name '*.[fF]90' | sort > "//list)
+      call execute_command_line("find src mpi/src -name '*.[fF]90' | sort > "//list)
       text = read_text(list)
       allocate(files(0))
       start = 1
@@ -41,7 +42,7 @@ contains
       end do
    end function sources
 
-   !> The layer of a path src/LAYER/file (0 when not a layer folder).
+   !> The layer of a path src/LAYER/file, or mpi/src/file (0 when not a layer folder).
    integer function layer_of(path)
       character(len=*), intent(in) :: path
       integer :: k
@@ -49,6 +50,7 @@ contains
       do k = 1, size(LAYERS)
          if (index(path, "src/"//trim(LAYERS(k))//"/") == 1) layer_of = k
       end do
+      if (index(path, "mpi/src/") == 1) layer_of = size(LAYERS)
    end function layer_of
 
    !> The lower-case words after "module" and "use" at the start of each code line.

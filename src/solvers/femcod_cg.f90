@@ -61,7 +61,7 @@ module femcod_cg
    use femcod_clock, only: wall_clock
    implicit none
    private
-   public :: solve_cg
+   public :: solve_cg, coarse_start_forces
 
    !> What the CG solver reached at one load.
    type :: cg_residuals
@@ -482,6 +482,34 @@ contains
          end do
       end do
    end subroutine nested_start
+
+   !> The forces (nN) at total load P (nN) on a grid of gaps g0 (nm) and pixel `pixel`
+   !> (nm), free surface, solved from its own nested start to how%coarse_tol: the start
+   !> that the distributed solver (femcod-mpi) hands down to its finer grid, as
+   !> nested_start does here. `iterations`: on this grid and all coarser ones.
+   subroutine coarse_start_forces(g0, problem, pixel, total_load, how, p, iterations, status, observer)
+      real(dp), intent(in) :: g0(:, :)
+      type(contact_problem), intent(in) :: problem
+      real(dp), intent(in) :: pixel, total_load
+      type(cg_settings), intent(in) :: how
+      real(dp), intent(out) :: p(:, :)
+      integer, intent(out) :: iterations
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      type(cg_grid) :: grid
+      type(cg_residuals) :: rep
+      real(dp) :: approach
+      call make_grid(grid, g0, problem, pixel, how, .false.)
+      if (how%nested) then
+         call nested_start(grid, problem, total_load, how, p, rep, status, observer)
+      else
+         call first_guess(grid, total_load, p)
+      end if
+      if (status%code == 0) call constrained_cg(grid, total_load, how%coarse_tol, 10000, how, p, approach, rep, &
+         status, observer)
+      call convolution_free(grid%conv)
+      iterations = rep%iterations + rep%coarse_iterations
+   end subroutine coarse_start_forces
 
    !> Polonsky-Keer constrained CG on `grid` at total load P from the forces p (nN, any
    !> positive start; returned: the solution). `approach` (nm) is the mean gap of the

@@ -1,0 +1,282 @@
+!> femcod-mpi: the fixed-load solver (`femcod run --solver cg`) on MPI ranks, for grids
+!> beyond one node's memory or time. Run it under mpirun with the options of `femcod run`:
+!>     mpirun -np 4 femcod-mpi DECK --loads F1,F2 [-o PREFIX] [--tol T] ...
+!>     mpirun -np 4 femcod-mpi --lower scan.h5:/heights --pixel 2 --loads F
+!> Rank 0 reads the deck or height files (one copy of the heights, on rank 0 only) and
+!> sends each rank its columns; all ranks solve (femcod_mpi_cg) and write PREFIX.h5 together
+!> (femcod_mpi_results); rank 0 writes PREFIX.summary.json and prints the summary.
+!> Exit codes as femcod's: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O,
+!> 128 + the signal's number after SIGTERM, SIGINT or SIGUSR1 (no checkpoint: cg keeps none).
+program femcod_mpi
+   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+   use, intrinsic :: iso_c_binding, only: c_int
+   use mpi_f08
+   use omp_lib, only: omp_get_max_threads
+   use femcod_fftw_mpi, only: fftw_init_threads, fftw_plan_with_nthreads, fftw_mpi_init, fftw_mpi_cleanup
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
+   use femcod_strings, only: string_type, int_str, sig_str, format_real, json_string, json_number
+   use femcod_cli, only: command_arguments
+   use femcod_run, only: run_settings, parse_run_arguments
+   use femcod_problem, only: contact_problem
+   use femcod_deck, only: read_deck
+   use femcod_heights, only: load_scene
+   use femcod_files, only: path_exists, remove_file, atomic_rename, write_file, acquire_lock, release_lock, &
+      default_prefix
+   use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
+   use femcod_mpi_observer, only: signal_observer
+   use femcod_clock, only: wall_clock
+   use femcod_about, only: FEMCOD_VERSION
+   use femcod_exit, only: exit_program
+   use femcod_help, only: help_requested
+   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, distribute_problem
+   use femcod_mpi_results, only: distributed_run_info, write_distributed_results
+   implicit none
+
+   type(string_type), allocatable :: args(:)
+   type(run_settings) :: settings
+   type(status_type) :: status
+   type(contact_problem) :: problem
+   type(distributed_grid) :: grid
+   type(distributed_state), allocatable :: states(:)
+   type(distributed_run_info) :: info
+   type(signal_observer) :: observer
+   type(string_type), allocatable :: warnings(:)
+   character(len=:), allocatable :: prefix, notice, started
+   real(dp) :: t_start, t_read, t_solve, t_write, peak
+   integer :: provided, rank, ranks, np, block, code, k
+   logical :: locked
+
+   call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
+   call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+   call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+   call wall_clock(t_start)
+   started = local_time_iso()
+   if (fftw_init_threads() == 0) call finish(STATUS_USAGE, "FFTW's threads would not start")
+   call fftw_mpi_init()
+   call fftw_plan_with_nthreads(int(omp_get_max_threads(), c_int))
+   call catch_stop_signals()
+   locked = .false.
+
+   args = command_arguments()
+   if (help_requested(args)) then
+      if (rank == 0) call print_help()
+      call finish(0, "")
+   end if
+   ! The solver is cg; `--solver cg` may be given, no other.
+   if (.not. any([(args(k)%s == "--solver", k = 1, size(args))])) &
+      args = [string_type("--solver"), string_type("cg"), args]
+   call parse_run_arguments(args, settings, status)
+   if (status%code == 0) call refuse_unsupported(settings, status)
+   if (status%code /= 0) call finish(status%code, status%message//" (femcod-mpi --help)")
+   prefix = settings%prefixes(1)%s
+
+   ! Rank 0 reads the inputs and checks the outputs; the others wait for its verdict.
+   if (rank == 0) then
+      if (settings%decks(1)%s == "") then
+         call load_scene(settings%scene, problem, status, warnings=warnings)
+         if (allocated(warnings)) then
+            do k = 1, size(warnings)
+               write(error_unit, '(a)') "femcod-mpi: warning: "//warnings(k)%s
+            end do
+         end if
+      else
+         call read_deck(settings%decks(1)%s, problem, status)
+      end if
+      if (status%code == 0 .and. .not. settings%force) then
+         if (path_exists(prefix//".h5") .or. path_exists(prefix//".summary.json")) call set_error(status, STATUS_IO, &
+            prefix//".h5 or "//prefix//".summary.json exists; --force replaces them, or give another -o")
+      end if
+      if (status%code == 0) then
+         call acquire_lock(prefix//".lock", status, notice)
+         locked = status%code == 0
+         if (notice /= "") write(error_unit, '(a)') "femcod-mpi: "//notice
+      end if
+      if (status%code == 0) info%label = problem%label
+   end if
+   call agree(status)
+   if (status%code /= 0) call finish(status%code, status%message)
+
+   call distribute_problem(problem, MPI_COMM_WORLD, settings%solve%cg, grid, block, status)
+   np = grid%np
+   call wall_clock(t_read)
+   if (status%code == 0) call solve_loads(grid, problem, settings%solve%loads, settings%solve%cg, block, states, &
+      status, observer)
+   call wall_clock(t_solve)
+   if (status%code /= 0) then
+      if (status%code == STATUS_INTERRUPTED) call finish(128 + stop_signal(), signal_name(stop_signal())//": "// &
+         status%message)
+      call finish(status%code, status%message)
+   end if
+
+   ! Results: PREFIX.h5 by all ranks (into a temporary name, renamed by rank 0), then the
+   ! summary.
+   peak = peak_memory_mb()
+   allocate(info%peak_mb(ranks))
+   call MPI_Gather(peak, 1, MPI_DOUBLE_PRECISION, info%peak_mb, 1, MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD)
+   info%version = FEMCOD_VERSION
+   info%command_line = "femcod-mpi "//settings%command_line
+   info%host = host_name()
+   info%started = started
+   info%finished = local_time_iso()
+   info%ranks = ranks
+   info%threads = omp_get_max_threads()
+   if (.not. allocated(info%label)) info%label = ""
+   info%wall_seconds = t_solve - t_start
+   call write_distributed_results(prefix//".h5.part", grid, states, info, status)
+   if (rank == 0) then
+      if (status%code == 0) call atomic_rename(prefix//".h5.part", prefix//".h5", status)
+      if (status%code /= 0) call remove_file(prefix//".h5.part")
+      call wall_clock(t_write)
+      if (status%code == 0) call write_file(prefix//".summary.json", summary_json(), status)
+      if (status%code /= 0) call remove_file(prefix//".h5")
+      if (status%code == 0 .and. .not. settings%quiet) call print_summary()
+   end if
+   call agree(status)
+   call grid_free(grid)
+   if (status%code /= 0) call finish(status%code, status%message)
+   call finish(0, "")
+
+contains
+
+   !> The options femcod run has and femcod-mpi does not (yet): refused, not ignored.
+   subroutine refuse_unsupported(settings, status)
+      type(run_settings), intent(in) :: settings
+      type(status_type), intent(inout) :: status
+      associate(o => settings%solve)
+         if (o%solver /= "cg") then
+            call set_error(status, STATUS_USAGE, "--solver: the MPI ranks run the fixed-load solver only (cg); "// &
+               "the event solvers run on one node: femcod run")
+         else if (size(settings%decks) /= 1) then
+            call set_error(status, STATUS_USAGE, "one deck per run: run several decks as a job array "// &
+               "(doc/cluster.md)")
+         else if (size(o%loads) == 0) then
+            call set_error(status, STATUS_USAGE, "give the loads: --loads F1,F2,... "// &
+               "(--approach runs on one node: femcod run --solver cg)")
+         else if (o%boundary /= "free") then
+            call set_error(status, STATUS_USAGE, "--boundary periodic: the MPI solver has the free surface only; "// &
+               "a periodic cell runs on one node: femcod run --solver cg --boundary periodic")
+         else if (o%adhesion /= "none" .or. o%plastic .or. o%cg%kernel_radius > 0) then
+            call set_error(status, STATUS_USAGE, "--adhesion, --plastic and --kernel-radius are not in the MPI solver; "// &
+               "these run on one node: femcod run --solver cg")
+         end if
+      end associate
+   end subroutine refuse_unsupported
+
+   !> Rank 0's failure, on every rank.
+   subroutine agree(status)
+      type(status_type), intent(inout) :: status
+      integer :: code
+      character(len=1024) :: message
+      code = status%code
+      message = ""
+      if (code /= 0) message = status%message
+      call MPI_Bcast(code, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD)
+      if (code /= 0 .and. status%code == 0) call set_error(status, code, trim(message))
+   end subroutine agree
+
+   !> Releases the lock, reports `message` (rank 0), ends MPI and exits with `code`.
+   subroutine finish(code, message)
+      integer, intent(in) :: code
+      character(len=*), intent(in) :: message
+      if (rank == 0 .and. locked) call release_lock(prefix//".lock")
+      if (rank == 0 .and. code /= 0 .and. message /= "") write(error_unit, '(a)') "femcod-mpi: "//message
+      call fftw_mpi_cleanup()
+      call MPI_Finalize()
+      call exit_program(code)
+   end subroutine finish
+
+   !> This process's peak resident memory (MB), from /proc/self/status (VmHWM); 0 where
+   !> the system has no such file.
+   real(dp) function peak_memory_mb()
+      character(len=256) :: line
+      integer :: unit, ios
+      real(dp) :: kb
+      peak_memory_mb = 0
+      open(newunit=unit, file="/proc/self/status", status="old", action="read", iostat=ios)
+      if (ios /= 0) return
+      do
+         read(unit, '(a)', iostat=ios) line
+         if (ios /= 0) exit
+         if (line(1:6) == "VmHWM:") then
+            read(line(7:), *, iostat=ios) kb
+            if (ios == 0) peak_memory_mb = kb/1024
+            exit
+         end if
+      end do
+      close(unit)
+   end function peak_memory_mb
+
+   !> The summary as JSON: numbers with their units in the names.
+   function summary_json() result(text)
+      character(len=:), allocatable :: text
+      integer :: s
+      text = '{"femcod_version": '//json_string(FEMCOD_VERSION)//', "solver": "cg (femcod-mpi)", '// &
+         '"label": '//json_string(info%label)//', "NP": '//int_str(np)//', "pixel_nm": '//json_number(grid%pixel)// &
+         ', "mpi_ranks": '//int_str(ranks)//', "threads_per_rank": '//int_str(info%threads)// &
+         ', "wall_time_s": '//json_number(t_write - t_start)//', "read_time_s": '//json_number(t_read - t_start)// &
+         ', "solve_time_s": '//json_number(t_solve - t_read)//', "write_time_s": '//json_number(t_write - t_solve)// &
+         ', "peak_memory_MB_per_rank": ['
+      do s = 1, ranks
+         text = text//json_number(info%peak_mb(s))//trim(merge(", ", "  ", s < ranks))
+      end do
+      text = trim(text)//'], "loads": ['
+      do s = 1, size(states)
+         associate(st => states(s))
+            text = text//'{"load_nN": '//json_number(st%load)//', "approach_nm": '//json_number(st%approach)// &
+               ', "contacts": '//int_str(st%contacts)//', "area_fraction": '// &
+               json_number(real(st%contacts, dp)/real(np, dp)**2)//', "max_pressure_GPa": '// &
+               json_number(st%max_pressure)//', "iterations": '//int_str(st%iterations)// &
+               ', "coarse_iterations": '//int_str(st%coarse_iterations)//', "convolutions": '// &
+               int_str(st%convolutions)//', "residual": '//json_number(st%residual)//', "time_s": '// &
+               json_number(st%seconds)//', "transform_s": '//json_number(st%transform_seconds)// &
+               ', "communication_s": '//json_number(st%communication_seconds)//'}'
+         end associate
+         if (s < size(states)) text = text//', '
+      end do
+      text = text//']}'//new_line('a')
+   end function summary_json
+
+   subroutine print_summary()
+      integer :: s
+      write(output_unit, '(a)') "femcod-mpi: "//info%label
+      write(output_unit, '(a)') "  grid "//int_str(np)//" x "//int_str(np)//", pixel "//format_real(grid%pixel)// &
+         " nm, free surface; "//int_str(ranks)//" MPI ranks x "//int_str(info%threads)//" threads"
+      do s = 1, size(states)
+         associate(st => states(s))
+            write(output_unit, '(a)') "  load "//format_real(st%load)//" nN: approach "//sig_str(st%approach, 10)// &
+               " nm, "//int_str(st%contacts)//" contacts ("//sig_str(100*real(st%contacts, dp)/real(np, dp)**2, 4)// &
+               " % of the area), max pressure "//sig_str(st%max_pressure, 4)//" GPa"
+            write(output_unit, '(a)') "    "//int_str(st%iterations)//" iterations (+ "//int_str(st%coarse_iterations)// &
+               " on coarser grids), "//int_str(st%convolutions)//" fresh convolutions, residual "// &
+               sig_str(st%residual, 2)//", "//sig_str(st%seconds, 3)//" s (rank 0: transforms "// &
+               sig_str(st%transform_seconds, 3)//" s, communication "//sig_str(st%communication_seconds, 3)//" s)"
+         end associate
+      end do
+      write(output_unit, '(a)') "  peak memory per rank: "//sig_str(maxval(info%peak_mb), 4)//" MB (largest), "// &
+         sig_str(minval(info%peak_mb), 4)//" MB (smallest)"
+      write(output_unit, '(a)') "  wall time "//sig_str(t_write - t_start, 3)//" s: reading "// &
+         sig_str(t_read - t_start, 3)//" s, solving "//sig_str(t_solve - t_read, 3)//" s, writing "// &
+         sig_str(t_write - t_solve, 3)//" s"
+      write(output_unit, '(a)') "  results: "//prefix//".h5, "//prefix//".summary.json"
+   end subroutine print_summary
+
+   subroutine print_help()
+      write(output_unit, '(a)') "usage: mpirun -np P femcod-mpi DECK --loads F1,F2,... [options]"
+      write(output_unit, '(a)') "       mpirun -np P femcod-mpi --lower FILE[:DATASET] --pixel D --loads F1,... [options]"
+      write(output_unit, '(a)') ""
+      write(output_unit, '(a)') "The fixed-load solver (femcod run --solver cg) with the grid split in column slabs"
+      write(output_unit, '(a)') "across MPI ranks: FFTW-MPI transforms, parallel HDF5 output. The options are those"
+      write(output_unit, '(a)') "of femcod run (femcod run --help) for the cg solver on a free surface:"
+      write(output_unit, '(a)') "  --loads F1,F2,...  total loads (nN); --tol T (default 1e-8); --max-iterations N"
+      write(output_unit, '(a)') "  -o PREFIX, --outdir DIR, --force, --quiet; the height-file options (--lower,"
+      write(output_unit, '(a)') "  --upper, --pixel, --young, --poisson, --height-unit, ...)"
+      write(output_unit, '(a)') "Refused (they run on one node with femcod run): --approach, --boundary periodic,"
+      write(output_unit, '(a)') "--adhesion, --plastic, --kernel-radius, several decks, the event solvers."
+      write(output_unit, '(a)') "Writes PREFIX.h5 (/deck, /loads/<kkk> with pressure and gap maps, /run with the"
+      write(output_unit, '(a)') "peak memory of every rank) and PREFIX.summary.json. Exit codes: 0 ok, 2 usage,"
+      write(output_unit, '(a)') "3 bad input, 4 numerical failure, 5 I/O, 128 + signal after SIGTERM/SIGINT/SIGUSR1."
+      write(output_unit, '(a)') "Ranks and threads: doc/cluster.md."
+   end subroutine print_help
+end program femcod_mpi

@@ -1,0 +1,196 @@
+!> femcod-mpi's result file, written by all ranks into one PREFIX.h5 with parallel HDF5:
+!> rank 0 writes the groups and attributes (the serial writer's names: /deck, /loads/<kkk>,
+!> /run), then every rank writes its columns of each load's pressure and gap maps as a
+!> hyperslab of one dataset, collectively (MPI-IO). The maps are stored transposed like
+!> the serial writer's (femcod_hdf5): C order [i][j], row i of the figures first.
+module femcod_mpi_results
+   use mpi_f08
+   use hdf5, only: hid_t, hsize_t, h5open_f, h5pcreate_f, h5pset_fapl_mpio_f, h5pset_dxpl_mpio_f, h5pclose_f, &
+      h5fopen_f, h5fclose_f, h5screate_simple_f, h5sselect_hyperslab_f, h5sclose_f, h5dcreate_f, h5dwrite_f, &
+      h5dclose_f, H5P_FILE_ACCESS_F, H5P_DATASET_XFER_F, H5FD_MPIO_COLLECTIVE_F, H5F_ACC_RDWR_F, H5S_SELECT_SET_F, &
+      H5T_NATIVE_DOUBLE
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_IO
+   use femcod_strings, only: int_str
+   use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_attribute
+   use femcod_mpi_cg, only: distributed_grid, distributed_state
+   implicit none
+   private
+   public :: distributed_run_info, write_distributed_results, load_group
+
+   !> What /run records of a distributed run.
+   type :: distributed_run_info
+      character(len=:), allocatable :: version, command_line, host, started, finished, label
+      integer :: ranks = 1, threads = 1
+      real(dp) :: wall_seconds = 0
+      !> Peak resident memory of each rank (MB).
+      real(dp), allocatable :: peak_mb(:)
+   end type distributed_run_info
+
+contains
+
+   !> "/loads/<k>", zero-padded to at least three digits (the serial writer's names).
+   pure function load_group(k, n) result(g)
+      integer, intent(in) :: k, n
+      character(len=:), allocatable :: g
+      integer :: width
+      width = max(3, len(int_str(n)))
+      g = int_str(k)
+      g = "/loads/"//repeat("0", width - len(g))//g
+   end function load_group
+
+   !> Write `path` (collective; `status` the same on every rank afterwards).
+   subroutine write_distributed_results(path, grid, states, info, status)
+      character(len=*), intent(in) :: path
+      type(distributed_grid), intent(in) :: grid
+      type(distributed_state), intent(in) :: states(:)
+      type(distributed_run_info), intent(in) :: info
+      type(status_type), intent(inout) :: status
+      type(h5_file) :: file
+      character(len=:), allocatable :: g
+      integer :: k, code
+      if (grid%rank == 0) then
+         call h5_create(path, file, status)
+         call h5_group(file, "/deck", status)
+         call h5_attribute(file, "/deck", "label", info%label, status)
+         call h5_attribute(file, "/deck", "NP", grid%np, status)
+         call h5_attribute(file, "/deck", "pixel_nm", grid%pixel, status)
+         call h5_group(file, "/loads", status)
+         do k = 1, size(states)
+            g = load_group(k, size(states))
+            associate(s => states(k))
+               call h5_group(file, g, status)
+               call h5_attribute(file, g, "index", k, status)
+               call h5_attribute(file, g, "load_nN", s%load, status)
+               call h5_attribute(file, g, "approach_nm", s%approach, status)
+               call h5_attribute(file, g, "contacts", s%contacts, status)
+               call h5_attribute(file, g, "area_nm2", s%contacts*grid%pixel**2, status)
+               call h5_attribute(file, g, "max_pressure_GPa", s%max_pressure, status)
+               call h5_attribute(file, g, "cg_iterations", s%iterations, status)
+               call h5_attribute(file, g, "cg_residual", s%residual, status)
+               call h5_attribute(file, g, "cg_penetration_nm", s%penetration, status)
+               call h5_attribute(file, g, "cg_contact_gap_nm", s%contact_gap, status)
+               call h5_attribute(file, g, "cg_load_error", s%load_error, status)
+            end associate
+         end do
+         call h5_group(file, "/run", status)
+         call h5_attribute(file, "/run", "femcod_version", info%version, status)
+         call h5_attribute(file, "/run", "command_line", info%command_line, status)
+         call h5_attribute(file, "/run", "host", info%host, status)
+         call h5_attribute(file, "/run", "started", info%started, status)
+         call h5_attribute(file, "/run", "finished", info%finished, status)
+         call h5_attribute(file, "/run", "solver", "cg (femcod-mpi)", status)
+         call h5_attribute(file, "/run", "boundary", "free", status)
+         call h5_attribute(file, "/run", "mpi_ranks", info%ranks, status)
+         call h5_attribute(file, "/run", "threads_per_rank", info%threads, status)
+         call h5_attribute(file, "/run", "wall_time_s", info%wall_seconds, status)
+         call h5_close(file, status)
+      end if
+      call agree(status, grid%comm)
+      if (status%code /= 0) return
+      if (grid%rank == 0) then
+         ! The peak memory of every rank, a small dataset: written by rank 0 alone.
+         call write_peaks(path, info%peak_mb, status)
+      end if
+      call agree(status, grid%comm)
+      if (status%code /= 0) return
+      call write_maps(path, grid, states, status)
+      code = status%code
+      call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, grid%comm)
+      if (code /= 0 .and. status%code == 0) call set_error(status, code, path//": another rank failed to write its maps")
+   end subroutine write_distributed_results
+
+   !> /run/peak_memory_MB, one value per rank.
+   subroutine write_peaks(path, peak_mb, status)
+      use femcod_hdf5, only: h5_write
+      use hdf5, only: h5fopen_f, H5F_ACC_RDWR_F
+      character(len=*), intent(in) :: path
+      real(dp), intent(in) :: peak_mb(:)
+      type(status_type), intent(inout) :: status
+      type(h5_file) :: file
+      integer :: error
+      file%path = path
+      call h5fopen_f(path, H5F_ACC_RDWR_F, file%id, error)
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot reopen the file")
+         return
+      end if
+      call h5_write(file, "/run/peak_memory_MB", peak_mb, "MB", status)
+      call h5_close(file, status)
+   end subroutine write_peaks
+
+   !> Each load's /pressure (GPa) and /gap (nm): every rank its columns, collectively.
+   subroutine write_maps(path, grid, states, status)
+      character(len=*), intent(in) :: path
+      type(distributed_grid), intent(in) :: grid
+      type(distributed_state), intent(in) :: states(:)
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: fapl, dxpl, fid
+      type(h5_file) :: file
+      character(len=:), allocatable :: g
+      integer :: error, k
+      call h5open_f(error)
+      call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, error)
+      call h5pset_fapl_mpio_f(fapl, grid%comm%MPI_VAL, MPI_INFO_NULL%MPI_VAL, error)
+      call h5fopen_f(path, H5F_ACC_RDWR_F, fid, error, access_prp=fapl)
+      call h5pclose_f(fapl, error)
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot open the file on every rank (MPI-IO)")
+         return
+      end if
+      call h5pcreate_f(H5P_DATASET_XFER_F, dxpl, error)
+      call h5pset_dxpl_mpio_f(dxpl, H5FD_MPIO_COLLECTIVE_F, error)
+      file%id = fid
+      file%path = path
+      do k = 1, size(states)
+         g = load_group(k, size(states))
+         call write_map(g//"/pressure", states(k)%force/grid%pixel**2, "GPa")
+         call write_map(g//"/gap", states(k)%gap, "nm")
+      end do
+      call h5pclose_f(dxpl, error)
+      call h5fclose_f(fid, error)
+      if (error /= 0 .and. status%code == 0) call set_error(status, STATUS_IO, path//": error closing the file")
+   contains
+      subroutine write_map(name, local, units)
+         character(len=*), intent(in) :: name, units
+         real(dp), intent(in) :: local(:, :)
+         integer(hid_t) :: fspace, mspace, dset
+         integer(hsize_t) :: dims(2), block(2), offset(2)
+         real(dp), allocatable :: stored(:, :)
+         integer :: e(6)
+         if (status%code /= 0) return
+         dims = [integer(hsize_t) :: grid%np, grid%np]
+         block = [integer(hsize_t) :: grid%nj, grid%np]
+         offset = [integer(hsize_t) :: grid%j0, 0]
+         stored = transpose(local)
+         call h5screate_simple_f(2, dims, fspace, e(1))
+         call h5screate_simple_f(2, block, mspace, e(2))
+         call h5dcreate_f(fid, name, H5T_NATIVE_DOUBLE, fspace, dset, e(3))
+         call h5sselect_hyperslab_f(fspace, H5S_SELECT_SET_F, offset, block, e(4))
+         call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored, block, e(5), mem_space_id=mspace, file_space_id=fspace, &
+            xfer_prp=dxpl)
+         call h5dclose_f(dset, e(6))
+         call h5sclose_f(mspace, error)
+         call h5sclose_f(fspace, error)
+         if (any(e /= 0)) then
+            call set_error(status, STATUS_IO, path//":"//name//": cannot write the map")
+            return
+         end if
+         call h5_attribute(file, name, "units", units, status)
+      end subroutine write_map
+   end subroutine write_maps
+
+   !> The first failure of any rank, on every rank (rank 0's message when it failed).
+   subroutine agree(status, comm)
+      type(status_type), intent(inout) :: status
+      type(MPI_Comm), intent(in) :: comm
+      integer :: code
+      character(len=512) :: message
+      code = status%code
+      message = ""
+      if (code /= 0) message = status%message
+      call MPI_Bcast(code, 1, MPI_INTEGER, 0, comm)
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, comm)
+      if (code /= 0 .and. status%code == 0) call set_error(status, code, trim(message))
+   end subroutine agree
+end module femcod_mpi_results

@@ -1,0 +1,255 @@
+!> The distributed fixed-load solver (femcod_mpi_cg) on the ranks it is run with. Every
+!> test is collective: all ranks make the same calls, and a check's value is the same on
+!> every rank (reduced before it is checked), so that no rank leaves a test early.
+module test_distributed
+   use mpi_f08
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, STATUS_USAGE
+   use femcod_love, only: love_influence
+   use femcod_problem, only: contact_problem
+   use femcod_deck, only: read_deck
+   use femcod_generate, only: scene_spec, build_problem
+   use femcod_analytic, only: hertz_approach
+   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_contact_result, only: contact_result
+   use femcod_solver, only: solve_contact
+   use femcod_observer, only: solver_observer
+   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, &
+      coarse_factor, distribute_problem, distributed_convolve
+   implicit none
+   private
+   public :: collect_distributed
+
+contains
+
+   subroutine collect_distributed(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest("column split and coarse width follow their definitions", test_split), &
+         new_unittest("convolution = direct sum of Love's influence coefficients", test_convolution), &
+         new_unittest("too few columns for the ranks: refused on every rank", test_too_few_columns), &
+         new_unittest("Hertz at 1000 nN on the 0.5 nm sphere deck", test_hertz), &
+         new_unittest("the serial cg solver's answer on 1, 2 and 4 ranks, rough surface", test_against_serial) &
+         ]
+   end subroutine collect_distributed
+
+   !> column_split: counts add up to NP, multiples of the block, within one block of each
+   !> other; coarse_factor: the smallest power of two f >= 2 with f^2 >= ranks, 1 when
+   !> NP is not a multiple of it or below 2 x the coarsest grid (64).
+   subroutine test_split(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, allocatable :: first(:), count(:)
+      type(cg_settings) :: how
+      integer :: ranks, block, r
+      do ranks = 1, 7
+         do block = 1, 4
+            call column_split(24*block, ranks, block, first, count)
+            call check(error, sum(count) == 24*block .and. all(mod(count, block) == 0) .and. &
+               maxval(count) - minval(count) <= block .and. first(ranks - 1) + count(ranks - 1) == 24*block .and. &
+               all([(first(r) == first(r - 1) + count(r - 1), r = 1, ranks - 1)]), &
+               "split of "//to_string(24*block)//" columns in blocks of "//to_string(block)//" over "// &
+               to_string(ranks)//" ranks")
+            if (allocated(error)) return
+         end do
+      end do
+      call check(error, coarse_factor(256, 1, how), 2)
+      if (allocated(error)) return
+      call check(error, coarse_factor(256, 4, how), 2)
+      if (allocated(error)) return
+      call check(error, coarse_factor(256, 5, how), 4)
+      if (allocated(error)) return
+      call check(error, coarse_factor(256, 17, how), 8)
+      if (allocated(error)) return
+      call check(error, coarse_factor(100, 2, how), 1)
+      if (allocated(error)) return
+      call check(error, coarse_factor(130, 5, how), 1)
+   end subroutine test_split
+
+   !> The distributed padded convolution of a force field equals the direct sum
+   !> u(i, j) = sum F(k, l) I(i - k, j - l) with Love's closed-form coefficients
+   !> (femcod_love), NP = 10 (non-periodic: no image terms), to 1e-12 of max |u|.
+   subroutine test_convolution(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: np = 10
+      type(distributed_grid) :: grid
+      type(status_type) :: status
+      real(dp), allocatable :: f(:, :), mine(:, :), out(:, :)
+      integer, allocatable :: first(:), count(:)
+      integer :: ranks, rank, i, j, k, l
+      real(dp) :: direct, worst(2)
+      call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+      call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+      allocate(f(np, np))
+      do j = 1, np
+         do i = 1, np
+            f(i, j) = sin(1.3_dp*i + 0.7_dp*j)**2 + 0.1_dp*i
+         end do
+      end do
+      call column_split(np, ranks, 1, first, count)
+      mine = f(:, first(rank) + 1:first(rank) + count(rank))
+      allocate(out(np, count(rank)))
+      if (2*ranks <= np) then
+         call grid_setup(grid, MPI_COMM_WORLD, np, 1, 0*mine, 1.0_dp, 1.0_dp, 0.0_dp, cg_settings(), status)
+         call distributed_convolve(grid, mine, out, 1.0_dp)
+         worst = 0
+         do j = 1, count(rank)
+            do i = 1, np
+               direct = 0
+               do l = 1, np
+                  do k = 1, np
+                     direct = direct + f(k, l)*love_influence(i - k, first(rank) + j - l)
+                  end do
+               end do
+               worst = max(worst, [abs(out(i, j) - direct), abs(direct)])
+            end do
+         end do
+         call MPI_Allreduce(MPI_IN_PLACE, worst, 2, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+         call grid_free(grid)
+         call check(error, status%code, 0)
+         if (allocated(error)) return
+         call check(error, worst(1) <= 1.0e-12_dp*worst(2), "largest difference "//to_string(worst(1))// &
+            " of max |u| "//to_string(worst(2)))
+      end if
+   end subroutine test_convolution
+
+   !> Each rank needs two columns (the preconditioner's halo): NP = 2 P - 1 is refused,
+   !> with the usage code, on every rank.
+   subroutine test_too_few_columns(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(distributed_grid) :: grid
+      type(status_type) :: status
+      integer, allocatable :: first(:), count(:)
+      integer :: ranks, rank, np, code
+      call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+      call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+      np = 2*ranks - 1
+      call column_split(np, ranks, 1, first, count)
+      call grid_setup(grid, MPI_COMM_WORLD, np, 1, spread(spread(0.0_dp, 1, np), 2, count(rank)), 1.0_dp, 1.0_dp, &
+         0.0_dp, cg_settings(), status)
+      code = status%code
+      call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MIN, MPI_COMM_WORLD)
+      call check(error, code, STATUS_USAGE, "the smallest status code over the ranks")
+   end subroutine test_too_few_columns
+
+   !> input/sphere_d05.deck (R = 15 nm, 0.5 nm pixels) at 1000 nN: Hertz's approach
+   !> (eq. 4.14, femcod_analytic) within 1 %, the serial solver's tolerance (test_cg).
+   subroutine test_hertz(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      type(distributed_grid) :: grid
+      type(distributed_state), allocatable :: states(:)
+      type(cg_settings) :: how
+      type(solver_observer) :: observer
+      integer :: rank, block
+      real(dp) :: estar
+      call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+      if (rank == 0) call read_deck("../input/sphere_d05.deck", deck, status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      how%tol = 1.0e-8_dp
+      call distribute_problem(deck, MPI_COMM_WORLD, how, grid, block, status)
+      if (status%code == 0) call solve_loads(grid, deck, [1000.0_dp], how, block, states, status, observer)
+      call grid_free(grid)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      estar = 200/(1 - 0.25_dp**2)
+      call check(error, states(1)%approach, hertz_approach(1000.0_dp, 15.0_dp, estar), rel=.true., thr=0.01_dp, &
+         message="Hertz at 1000 nN")
+   end subroutine test_hertz
+
+   !> A self-affine surface (NP = 128: the coarse start at work) at two loads, on every
+   !> sub-communicator of 1, 2 and 4 ranks the run has: the approach within 1e-10 of the
+   !> height range of the serial cg solver's (femcod_cg, solved on each group's rank 0),
+   !> and the same contact set, pixel by pixel (both at --tol 1e-12).
+   subroutine test_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: np = 128
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status, serial_status
+      type(distributed_grid) :: grid
+      type(distributed_state), allocatable :: states(:)
+      type(solver_observer) :: observer
+      type(MPI_Comm) :: group
+      real(dp), allocatable :: forces(:, :)
+      integer, allocatable :: firsts(:), counts(:)
+      integer :: ranks, rank, group_size, group_rank, block, k, worst_code
+      real(dp) :: range, bad(3)
+      real(dp), parameter :: loads(2) = [3.0e3_dp, 2.0e4_dp]
+      call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+      call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+      spec%kind = "self-affine"
+      spec%label = "test"
+      spec%np = np
+      spec%pixel = 2
+      spec%seed = 3
+      call build_problem(spec, deck, status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      range = maxval(deck%upper) - minval(deck%upper)
+      options%solver = "cg"
+      options%loads = loads
+      options%cg%tol = 1.0e-12_dp
+      options%cg%max_iterations = 5000
+      group_size = 1
+      do while (group_size <= min(ranks, 4))
+         ! Groups of `group_size` ranks (the ranks beyond the last whole group sit this one out).
+         call MPI_Comm_split(MPI_COMM_WORLD, merge(rank/group_size, MPI_UNDEFINED, rank/group_size < ranks/group_size), rank, group)
+         bad = 0
+         worst_code = 0
+         if (group /= MPI_COMM_NULL) then
+            call MPI_Comm_rank(group, group_rank)
+            call distribute_problem(deck, group, options%cg, grid, block, status)
+            if (status%code == 0) call solve_loads(grid, deck, loads, options%cg, block, states, status, observer)
+            call grid_free(grid)
+            worst_code = status%code
+            if (group_rank == 0) call solve_contact(deck, options, res, serial_status)
+            if (group_rank == 0) worst_code = max(worst_code, serial_status%code)
+            if (worst_code == 0) then
+               call column_split(np, group_size, block, firsts, counts)
+               do k = 1, 2
+                  allocate(forces(np, np))
+                  call MPI_Gatherv(states(k)%force, np*counts(group_rank), MPI_DOUBLE_PRECISION, forces, np*counts, &
+                     np*firsts, MPI_DOUBLE_PRECISION, 0, group)
+                  if (group_rank == 0) then
+                     bad(1) = max(bad(1), abs(states(k)%approach - res%states(k)%approach)/range)
+                     bad(2) = bad(2) + count_differences(forces, res%states(k)%i, res%states(k)%j)
+                     bad(3) = bad(3) + abs(states(k)%contacts - res%states(k)%contacts)
+                  end if
+                  deallocate(forces)
+               end do
+            end if
+            call MPI_Comm_free(group)
+         end if
+         call MPI_Allreduce(MPI_IN_PLACE, bad, 3, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+         call MPI_Allreduce(MPI_IN_PLACE, worst_code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
+         call check(error, worst_code, 0, "solve on "//to_string(group_size)//" ranks")
+         if (allocated(error)) return
+         call check(error, bad(1) <= 1.0e-10_dp, "approach on "//to_string(group_size)//" ranks off by "// &
+            to_string(bad(1))//" of the height range")
+         if (allocated(error)) return
+         call check(error, bad(2) == 0 .and. bad(3) == 0, "contact sets on "//to_string(group_size)//" ranks: "// &
+            to_string(nint(bad(2)))//" pixels differ")
+         if (allocated(error)) return
+         group_size = 2*group_size
+      end do
+   contains
+      !> Pixels in contact in one answer and not in the other.
+      real(dp) function count_differences(forces, ci, cj) result(n)
+         real(dp), intent(in) :: forces(:, :)
+         integer, intent(in) :: ci(:), cj(:)
+         logical, allocatable :: serial(:, :)
+         integer :: q
+         allocate(serial(np, np))
+         serial = .false.
+         do q = 1, size(ci)
+            serial(ci(q), cj(q)) = .true.
+         end do
+         n = count(serial .neqv. forces > 0)
+      end function count_differences
+   end subroutine test_against_serial
+end module test_distributed

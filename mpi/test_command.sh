@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# The femcod-mpi command against the serial femcod on a deck of input/, and its refusals:
+# the same approaches (to 1e-10 nm) and contact counts from summary.json; usage errors
+# exit 2, a bad deck 3, an existing result set 5, each with no result file left behind.
+# Run by test.sh (sourced environment.sh, from mpi/).
+set -euo pipefail
+femcod_mpi=$PWD/$(fpm run --profile release --flag "$FEMCOD_MPI_FLAGS" --runner echo 2>/dev/null | tail -1)
+femcod=$(cd .. && pwd)/$(cd .. && env -u FPM_FC -u PKG_CONFIG_PATH fpm run --profile release --runner echo 2>/dev/null | tail -1)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+mpirun_2() { OMP_NUM_THREADS=1 mpirun $FEMCOD_MPIRUN_FLAGS -np 2 "$@"; }
+failed=0
+expect() { # expect CODE DESCRIPTION COMMAND...: the exit code, and no PREFIX.* left
+  local want=$1 what=$2; shift 2
+  local got=0
+  "$@" >"$work/out.txt" 2>&1 || got=$?
+  if [ "$got" -ne "$want" ]; then
+    echo "  FAILED   $what: exit $got, expected $want"; sed 's/^/           /' "$work/out.txt" | head -5; failed=1
+  elif [ "$want" -ne 0 ] && ls "$work"/bad.* >/dev/null 2>&1; then
+    echo "  FAILED   $what: left $(ls "$work"/bad.*)"; failed=1
+  else
+    echo "  passed   $what"
+  fi
+}
+echo "# femcod-mpi command"
+deck=../input/sphere_d1.deck
+"$femcod" run "$deck" --solver cg --loads 50,200,1000 --tol 1e-12 -o "$work/serial" --quiet
+expect 0 "2 ranks on $deck" mpirun_2 "$femcod_mpi" "$deck" --loads 50,200,1000 --tol 1e-12 -o "$work/mpi" --quiet
+if python3 - "$work/serial.summary.json" "$work/mpi.summary.json" <<'PY'
+import json, sys
+serial = json.load(open(sys.argv[1]))
+mpi = json.load(open(sys.argv[2]))
+def loads(doc):
+    for key in ("loads", "states"):
+        if key in doc:
+            return doc[key]
+    raise SystemExit("no loads in the summary")
+a, b = loads(serial), loads(mpi)
+assert len(a) == len(b) == 3, (len(a), len(b))
+for x, y in zip(a, b):
+    da = abs(x["approach_nm"] - y["approach_nm"])
+    assert da <= 1e-10, ("approach", x["approach_nm"], y["approach_nm"])
+    assert x["contacts"] == y["contacts"], ("contacts", x["contacts"], y["contacts"])
+PY
+then echo "  passed   the serial solver's approaches and contacts"; else echo "  FAILED   the serial solver's approaches and contacts"; failed=1; fi
+expect 2 "--approach refused" mpirun_2 "$femcod_mpi" "$deck" --approach 0.5 -o "$work/bad"
+expect 2 "--boundary periodic refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 --boundary periodic -o "$work/bad"
+expect 2 "two decks refused" mpirun_2 "$femcod_mpi" "$deck" ../input/sphere_d2.deck --loads 10
+expect 2 "the event solver refused" mpirun_2 "$femcod_mpi" "$deck" --solver incremental --loads 10 -o "$work/bad"
+printf 'a deck\n3 1 x\n' >"$work/broken.deck"
+expect 3 "a broken deck" mpirun_2 "$femcod_mpi" "$work/broken.deck" --loads 10 -o "$work/bad"
+printf '1 2 3\n4 5 6\n7 8 9\n' >"$work/tiny.txt"
+expect 2 "a grid narrower than two columns per rank" mpirun_2 "$femcod_mpi" --lower "$work/tiny.txt" --pixel 1 \
+  --loads 1 -o "$work/bad"
+expect 5 "existing results without --force" mpirun_2 "$femcod_mpi" "$deck" --loads 50 -o "$work/mpi"
+exit $failed
