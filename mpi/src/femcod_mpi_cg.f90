@@ -2,14 +2,15 @@
 !> problem, method, stopping rule and residuals, with the NP x NP grid split in column slabs
 !> across the ranks of a communicator.
 !>
-!> - The Love-kernel convolution on the zero-padded (2 NP)^2 grid is one FFTW-MPI r2c / c2r
-!>   pair with FFTW_MPI_TRANSPOSED_OUT / _IN (the spectrum stays transposed: no global
-!>   transpose back and forth); the kernel's spectrum is made distributed, each rank from
-!>   its own rows of the padded table. FFTW-MPI gives each rank an equal share of the
-!>   padded rows, so the physical columns (the first NP of 2 NP) would sit on half of the
-!>   ranks: the solver keeps its fields in an even column split instead, and one
-!>   MPI_Alltoallv per transform moves each column to and from the rank that transforms it
-!>   (NP^2 values, a quarter of what the transform itself moves).
+!> - The Love-kernel convolution on the zero-padded (2 NP)^2 grid, pruned as the serial
+!>   one is (femcod_convolution): real-to-complex transforms of length 2 NP down this
+!>   rank's columns (only NP of the 2 NP are not zero), FFTW-MPI's distributed transpose of
+!>   the (NP + 1) x NP half spectrum, complex transforms of length 2 NP along the rows of
+!>   this rank's frequencies, the kernel, and back the same way. Only the non-zero half is
+!>   transformed and moved: the full FFTW-MPI r2c of the padded grid transforms and
+!>   transposes twice as much, and hands the physical columns to half of the ranks. The
+!>   kernel's spectrum is made the same way from the even extension of the Love table,
+!>   each rank from its own columns. FFTW's threads within a rank.
 !> - Sums and maxima by MPI_Allreduce; the preconditioner's 13-point stencil reads two
 !>   columns of each neighbour (MPI_Sendrecv).
 !> - The first load starts from a coarse solution on rank 0 (femcod_cg's own nested start
@@ -26,9 +27,10 @@ module femcod_mpi_cg
       c_f_pointer, c_associated, c_size_t
    use mpi_f08
    use omp_lib, only: omp_get_max_threads
-   use femcod_fftw_mpi, only: fftw_mpi_local_size_2d_transposed, fftw_mpi_plan_dft_r2c_2d, fftw_mpi_plan_dft_c2r_2d, &
-      fftw_mpi_execute_dft_r2c, fftw_mpi_execute_dft_c2r, fftw_alloc_complex, fftw_free, fftw_destroy_plan, &
-      FFTW_ESTIMATE, FFTW_MEASURE, FFTW_MPI_TRANSPOSED_OUT, FFTW_MPI_TRANSPOSED_IN
+   use femcod_fftw_mpi, only: fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, fftw_mpi_execute_r2r, &
+      fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
+      fftw_execute_dft, fftw_alloc_complex, fftw_free, fftw_destroy_plan, FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, &
+      FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
@@ -59,24 +61,24 @@ module femcod_mpi_cg
       real(dp), allocatable :: g0(:, :)
       logical :: preconditioned = .false.
       real(dp) :: taps(0:2, 0:2) = 0
-      !> The padded side m = 2 np, its half spectrum mh = m/2 + 1; this rank's padded rows
-      !> (columns in Fortran order) and transposed frequencies.
-      integer :: m = 0, mh = 0
-      integer :: row_start = 0, rows = 0, freq_start = 0, freqs = 0, physical_rows = 0
-      !> Every rank's padded rows: first (0-based) and number.
-      integer, allocatable :: pad_first(:), pad_count(:)
-      type(c_ptr) :: memory = c_null_ptr, forward = c_null_ptr, backward = c_null_ptr
-      real(c_double), pointer :: real_buffer(:, :) => null()
-      complex(c_double_complex), pointer :: spectrum(:, :) => null()
+      !> Columns per rank (the last ranks may have fewer): FFTW-MPI's block size.
+      integer :: block_columns = 0
+      !> The padded side m = 2 np, its half spectrum mh = np + 1; this rank's frequencies
+      !> kx (0-based first, number) after the transpose.
+      integer :: m = 0, mh = 0, freq_start = 0, freqs = 0
+      !> Down the columns: in-place r2c / c2r, the real view (2 mh, nj), the complex
+      !> (mh, nj); along the rows: the complex view (m, freqs), its first np*freqs values
+      !> the transpose's (np, freqs).
+      type(c_ptr) :: column_memory = c_null_ptr, row_memory = c_null_ptr
+      real(c_double), pointer :: column_real(:, :) => null(), column_flat(:) => null(), row_flat(:) => null()
+      complex(c_double_complex), pointer :: columns(:, :) => null(), rows(:, :) => null(), row_values(:) => null()
+      type(c_ptr) :: columns_forward = c_null_ptr, columns_backward = c_null_ptr, rows_forward = c_null_ptr, &
+         rows_backward = c_null_ptr, to_rows = c_null_ptr, to_columns = c_null_ptr
       !> The kernel's spectrum over m^2 (real: the table is even), (m, freqs).
       real(dp), allocatable :: kernel(:, :)
-      !> Columns on their way to and from the transform: (np, rows).
-      real(dp), allocatable :: staging(:, :)
-      type(MPI_Datatype) :: column
-      integer, allocatable :: send_counts(:), send_displs(:), recv_counts(:), recv_displs(:)
-      !> Wall seconds so far in the transforms (FFTW-MPI's execute, its own transposes
-      !> included) and in the solver's communication (the column exchange, sums, halos;
-      !> waiting for slower ranks included).
+      !> Wall seconds so far in the transforms (the 1-D transforms and FFTW-MPI's
+      !> transposes) and in the solver's other communication (sums, halos; waiting for
+      !> slower ranks included).
       real(dp) :: transform_seconds = 0, communication_seconds = 0
    end type distributed_grid
 
@@ -106,25 +108,25 @@ contains
       if (.not. how%nested .or. mod(np, f) /= 0 .or. np < 2*how%coarsest) f = 1
    end function coarse_factor
 
-   !> The column split: blocks of `block` columns dealt out as evenly as they go, the
-   !> first ranks one more. first and count are 0-based, (0:ranks-1).
+   !> The column split, FFTW-MPI's block distribution: every rank the same number of
+   !> columns, a multiple of `block` (the coarse start's width), ceil(np / ranks) rounded
+   !> up to it, the last ranks what is left (possibly none). first and count are 0-based,
+   !> (0:ranks-1).
    pure subroutine column_split(np, ranks, block, first, count)
       integer, intent(in) :: np, ranks, block
       integer, allocatable, intent(out) :: first(:), count(:)
-      integer :: r, nb
+      integer :: r, width
       allocate(first(0:ranks - 1), count(0:ranks - 1))
-      nb = np/block
+      width = block*((np + block*ranks - 1)/(block*ranks))
       do r = 0, ranks - 1
-         count(r) = block*(nb/ranks + merge(1, 0, r < mod(nb, ranks)))
-      end do
-      first(0) = 0
-      do r = 1, ranks - 1
-         first(r) = first(r - 1) + count(r - 1)
+         first(r) = min(r*width, np)
+         count(r) = max(0, min(width, np - r*width))
       end do
    end subroutine column_split
 
    !> The distributed grid from this rank's initial gaps (g0 of the columns `first`..)
-   !> and the global constants; makes the FFTW-MPI plans and the kernel's spectrum.
+   !> and the global constants; makes the FFTW plans (the transposes FFTW-MPI's) and the
+   !> kernel's spectrum.
    !> Collective over `comm`.
    subroutine grid_setup(grid, comm, np, block, g0, pixel, c, s, how, status)
       type(distributed_grid), intent(inout) :: grid
@@ -134,11 +136,11 @@ contains
       real(dp), intent(in) :: pixel, c, s
       type(cg_settings), intent(in) :: how
       type(status_type), intent(inout) :: status
-      integer(c_intptr_t) :: alloc, n0, n1, local_rows, row_start, local_freqs, freq_start
+      integer(c_intptr_t) :: alloc, dims(2), local_columns, column_start, local_freqs, freq_start
       integer(c_int) :: flags
       real(dp) :: lo, hi, kmin
       real(dp), allocatable :: line(:)
-      integer :: r, lo_col, hi_col, jj, jpad, q, i, p
+      integer :: jj, q, i, p
       call grid_free(grid)
       grid%comm = comm
       call MPI_Comm_size(comm, grid%ranks)
@@ -172,69 +174,76 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, lo, 1, MPI_DOUBLE_PRECISION, MPI_MIN, comm)
       call MPI_Allreduce(MPI_IN_PLACE, hi, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       grid%scale = max(hi - lo, tiny(1.0_dp))
-      ! The padded grid: C order [m][m] is Fortran (i, j); FFTW-MPI splits j (its n0).
+      grid%block_columns = grid%count(0)
       grid%m = 2*np
       grid%mh = np + 1
-      n0 = grid%m
-      n1 = grid%mh
-      alloc = fftw_mpi_local_size_2d_transposed(n0, n1, comm%MPI_VAL, local_rows, row_start, local_freqs, freq_start)
-      grid%rows = int(local_rows)
-      grid%row_start = int(row_start)
-      grid%freqs = int(local_freqs)
-      grid%freq_start = int(freq_start)
-      grid%physical_rows = max(0, min(grid%row_start + grid%rows, np) - grid%row_start)
-      allocate(grid%pad_first(0:grid%ranks - 1), grid%pad_count(0:grid%ranks - 1))
-      call MPI_Allgather(grid%row_start, 1, MPI_INTEGER, grid%pad_first, 1, MPI_INTEGER, comm)
-      call MPI_Allgather(grid%rows, 1, MPI_INTEGER, grid%pad_count, 1, MPI_INTEGER, comm)
-      grid%memory = fftw_alloc_complex(int(max(alloc, 1_c_intptr_t), c_size_t))
-      call c_f_pointer(grid%memory, grid%real_buffer, [2*grid%mh, max(grid%rows, 1)])
-      call c_f_pointer(grid%memory, grid%spectrum, [grid%m, max(grid%freqs, 1)])
-      flags = FFTW_ESTIMATE
-      if (how%measure_plans) flags = FFTW_MEASURE
-      grid%forward = fftw_mpi_plan_dft_r2c_2d(n0, n0, grid%real_buffer, grid%spectrum, comm%MPI_VAL, &
-         ior(flags, FFTW_MPI_TRANSPOSED_OUT))
-      grid%backward = fftw_mpi_plan_dft_c2r_2d(n0, n0, grid%spectrum, grid%real_buffer, comm%MPI_VAL, &
-         ior(flags, FFTW_MPI_TRANSPOSED_IN))
-      if (.not. (c_associated(grid%forward) .and. c_associated(grid%backward))) then
-         call set_error(status, STATUS_NUMERICAL, "FFTW-MPI made no plan for the "//int_str(grid%m)// &
-            " x "//int_str(grid%m)//" grid")
+      ! The transpose of the half spectrum: [np][mh] complex by columns (blocks of
+      ! block_columns) to [mh][np] by frequencies (FFTW's default block).
+      dims = [integer(c_intptr_t) :: np, grid%mh]
+      alloc = fftw_mpi_local_size_many_transposed(2_c_int, dims, 2_c_intptr_t, int(grid%block_columns, c_intptr_t), &
+         FFTW_MPI_DEFAULT_BLOCK, comm%MPI_VAL, local_columns, column_start, local_freqs, freq_start)
+      if (int(local_columns) /= grid%nj .or. int(column_start) /= grid%j0) then
+         call set_error(status, STATUS_NUMERICAL, "FFTW-MPI splits the columns otherwise than the solver: rank "// &
+            int_str(grid%rank)//" has "//int_str(int(local_columns))//" from "//int_str(int(column_start)))
          return
       end if
-      ! Columns to and from the transforming ranks, counted in columns of np values.
-      call MPI_Type_contiguous(np, MPI_DOUBLE_PRECISION, grid%column)
-      call MPI_Type_commit(grid%column)
-      allocate(grid%send_counts(0:grid%ranks - 1), grid%send_displs(0:grid%ranks - 1), &
-         grid%recv_counts(0:grid%ranks - 1), grid%recv_displs(0:grid%ranks - 1))
-      do r = 0, grid%ranks - 1
-         ! Mine to rank r: my columns among r's padded rows.
-         lo_col = max(grid%j0, grid%pad_first(r))
-         hi_col = min(grid%j0 + grid%nj, grid%pad_first(r) + grid%pad_count(r), np)
-         grid%send_counts(r) = max(0, hi_col - lo_col)
-         grid%send_displs(r) = max(0, lo_col - grid%j0)
-         ! Rank r's to me: its columns among my padded rows.
-         lo_col = max(grid%first(r), grid%row_start)
-         hi_col = min(grid%first(r) + grid%count(r), grid%row_start + grid%rows, np)
-         grid%recv_counts(r) = max(0, hi_col - lo_col)
-         grid%recv_displs(r) = max(0, lo_col - grid%row_start)
-      end do
-      allocate(grid%staging(np, max(grid%physical_rows, 1)))
-      ! The kernel: the Love table at offsets -(np-1)..np-1 wrapped onto the padded grid
-      ! (offset +-np stays 0), this rank's padded rows; its spectrum over m^2.
+      grid%freqs = int(local_freqs)
+      grid%freq_start = int(freq_start)
+      grid%column_memory = fftw_alloc_complex(int(max(alloc/2, int(grid%mh, c_intptr_t)*grid%nj, 1_c_intptr_t), c_size_t))
+      grid%row_memory = fftw_alloc_complex(int(max(alloc/2, int(grid%m, c_intptr_t)*grid%freqs, 1_c_intptr_t), c_size_t))
+      call c_f_pointer(grid%column_memory, grid%column_real, [2*grid%mh, grid%nj])
+      call c_f_pointer(grid%column_memory, grid%column_flat, [2*grid%mh*grid%nj])
+      call c_f_pointer(grid%column_memory, grid%columns, [grid%mh, grid%nj])
+      call c_f_pointer(grid%row_memory, grid%rows, [grid%m, max(grid%freqs, 1)])
+      call c_f_pointer(grid%row_memory, grid%row_values, [grid%m*max(grid%freqs, 1)])
+      call c_f_pointer(grid%row_memory, grid%row_flat, [2*grid%m*max(grid%freqs, 1)])
+      flags = FFTW_ESTIMATE
+      if (how%measure_plans) flags = FFTW_MEASURE
+      grid%columns_forward = fftw_plan_many_dft_r2c(1_c_int, [int(grid%m, c_int)], int(grid%nj, c_int), &
+         grid%column_real, [int(2*grid%mh, c_int)], 1_c_int, int(2*grid%mh, c_int), grid%columns, &
+         [int(grid%mh, c_int)], 1_c_int, int(grid%mh, c_int), flags)
+      grid%columns_backward = fftw_plan_many_dft_c2r(1_c_int, [int(grid%m, c_int)], int(grid%nj, c_int), &
+         grid%columns, [int(grid%mh, c_int)], 1_c_int, int(grid%mh, c_int), grid%column_real, &
+         [int(2*grid%mh, c_int)], 1_c_int, int(2*grid%mh, c_int), flags)
+      if (grid%freqs > 0) then
+         grid%rows_forward = fftw_plan_many_dft(1_c_int, [int(grid%m, c_int)], int(grid%freqs, c_int), grid%rows, &
+            [int(grid%m, c_int)], 1_c_int, int(grid%m, c_int), grid%rows, [int(grid%m, c_int)], 1_c_int, &
+            int(grid%m, c_int), FFTW_FORWARD, flags)
+         grid%rows_backward = fftw_plan_many_dft(1_c_int, [int(grid%m, c_int)], int(grid%freqs, c_int), grid%rows, &
+            [int(grid%m, c_int)], 1_c_int, int(grid%m, c_int), grid%rows, [int(grid%m, c_int)], 1_c_int, &
+            int(grid%m, c_int), FFTW_BACKWARD, flags)
+      end if
+      grid%to_rows = fftw_mpi_plan_many_transpose(int(np, c_intptr_t), int(grid%mh, c_intptr_t), 2_c_intptr_t, &
+         int(grid%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, grid%column_flat, grid%row_flat, comm%MPI_VAL, flags)
+      grid%to_columns = fftw_mpi_plan_many_transpose(int(grid%mh, c_intptr_t), int(np, c_intptr_t), 2_c_intptr_t, &
+         FFTW_MPI_DEFAULT_BLOCK, int(grid%block_columns, c_intptr_t), grid%row_flat, grid%column_flat, comm%MPI_VAL, flags)
+      if (.not. (c_associated(grid%columns_forward) .and. c_associated(grid%columns_backward) .and. &
+         c_associated(grid%to_rows) .and. c_associated(grid%to_columns) .and. (grid%freqs == 0 .or. &
+         (c_associated(grid%rows_forward) .and. c_associated(grid%rows_backward))))) then
+         call set_error(status, STATUS_NUMERICAL, "FFTW made no plan for the "//int_str(grid%m)//" x "// &
+            int_str(grid%m)//" grid")
+         return
+      end if
+      ! The kernel: the Love table's even extension (offsets -(np-1)..np-1, offset +-np
+      ! 0) through the same transforms; its spectrum over m^2, real.
       allocate(line(0:np - 1))
-      grid%real_buffer = 0
-      do jj = 1, grid%rows
-         jpad = grid%row_start + jj - 1
-         if (jpad == np) cycle
-         q = merge(jpad, grid%m - jpad, jpad < np)
+      do jj = 1, grid%nj
+         q = grid%j0 + jj - 1
          line = love_influence([(p, p = 0, np - 1)], q)
-         grid%real_buffer(1:np, jj) = line
+         grid%column_real(1:np, jj) = line
+         grid%column_real(np + 1, jj) = 0
          do i = np + 2, grid%m
-            grid%real_buffer(i, jj) = line(grid%m - i + 1)
+            grid%column_real(i, jj) = line(grid%m - i + 1)
          end do
       end do
-      call fftw_mpi_execute_dft_r2c(grid%forward, grid%real_buffer, grid%spectrum)
+      call fftw_execute_dft_r2c(grid%columns_forward, grid%column_real, grid%columns)
+      call fftw_mpi_execute_r2r(grid%to_rows, grid%column_flat, grid%row_flat)
+      call expand_rows(grid, even=.true.)
       allocate(grid%kernel(grid%m, grid%freqs))
-      grid%kernel = real(grid%spectrum(:, 1:grid%freqs), dp)/real(grid%m, dp)**2
+      if (grid%freqs > 0) then
+         call fftw_execute_dft(grid%rows_forward, grid%rows, grid%rows)
+         grid%kernel = real(grid%rows(:, 1:grid%freqs), dp)/real(grid%m, dp)**2
+      end if
       grid%preconditioned = .false.
       grid%taps = 0
       if (how%precondition .and. np >= 3) then
@@ -314,56 +323,102 @@ contains
    !> Frees the plans, the transform memory and the column type; the grid is empty after.
    subroutine grid_free(grid)
       type(distributed_grid), intent(inout) :: grid
-      if (c_associated(grid%forward)) call fftw_destroy_plan(grid%forward)
-      if (c_associated(grid%backward)) call fftw_destroy_plan(grid%backward)
-      if (c_associated(grid%memory)) call fftw_free(grid%memory)
-      grid%forward = c_null_ptr
-      grid%backward = c_null_ptr
-      grid%memory = c_null_ptr
-      nullify(grid%real_buffer, grid%spectrum)
-      if (allocated(grid%send_counts)) call MPI_Type_free(grid%column)
-      grid = distributed_grid(comm=MPI_COMM_NULL, column=MPI_DATATYPE_NULL)
+      integer :: k
+      type(c_ptr) :: plans(6)
+      plans = [grid%columns_forward, grid%columns_backward, grid%rows_forward, grid%rows_backward, grid%to_rows, &
+         grid%to_columns]
+      do k = 1, size(plans)
+         if (c_associated(plans(k))) call fftw_destroy_plan(plans(k))
+      end do
+      if (c_associated(grid%column_memory)) call fftw_free(grid%column_memory)
+      if (c_associated(grid%row_memory)) call fftw_free(grid%row_memory)
+      grid = distributed_grid(comm=MPI_COMM_NULL)
    end subroutine grid_free
 
-   !> out = factor (I * f) on this rank's columns: the columns to the transforming ranks,
-   !> the padded transform, the kernel, the inverse, and back.
+   !> out = factor (I * f) on this rank's columns (np, nj): down the columns, transpose,
+   !> along the rows, the kernel, and back. Collective.
    subroutine distributed_convolve(grid, f, out, factor)
       type(distributed_grid), intent(inout) :: grid
       real(dp), intent(in) :: f(:, :)
       real(dp), intent(out) :: out(:, :)
       real(dp), intent(in) :: factor
-      integer :: j, k
+      integer :: j, k, np
       real(dp) :: t0, t1, t2, t3
+      np = grid%np
       call wall_clock(t0)
-      call MPI_Alltoallv(f, grid%send_counts, grid%send_displs, grid%column, grid%staging, grid%recv_counts, &
-         grid%recv_displs, grid%column, grid%comm)
       !$omp parallel do
-      do j = 1, grid%rows
-         if (j <= grid%physical_rows) then
-            grid%real_buffer(1:grid%np, j) = grid%staging(:, j)
-            grid%real_buffer(grid%np + 1:, j) = 0
+      do j = 1, grid%nj
+         grid%column_real(1:np, j) = f(:, j)
+         grid%column_real(np + 1:, j) = 0
+      end do
+      call fftw_execute_dft_r2c(grid%columns_forward, grid%column_real, grid%columns)
+      call wall_clock(t1)
+      call fftw_mpi_execute_r2r(grid%to_rows, grid%column_flat, grid%row_flat)
+      call wall_clock(t2)
+      call expand_rows(grid, even=.false.)
+      if (grid%freqs > 0) then
+         call fftw_execute_dft(grid%rows_forward, grid%rows, grid%rows)
+         !$omp parallel do
+         do k = 1, grid%freqs
+            grid%rows(:, k) = grid%rows(:, k)*(factor*grid%kernel(:, k))
+         end do
+         call fftw_execute_dft(grid%rows_backward, grid%rows, grid%rows)
+      end if
+      call compress_rows(grid)
+      call wall_clock(t3)
+      grid%transform_seconds = grid%transform_seconds + (t1 - t0) + (t3 - t2)
+      grid%communication_seconds = grid%communication_seconds + (t2 - t1)
+      call wall_clock(t0)
+      call fftw_mpi_execute_r2r(grid%to_columns, grid%row_flat, grid%column_flat)
+      call wall_clock(t1)
+      call fftw_execute_dft_c2r(grid%columns_backward, grid%columns, grid%column_real)
+      !$omp parallel do
+      do j = 1, grid%nj
+         out(:, j) = grid%column_real(1:np, j)
+      end do
+      call wall_clock(t2)
+      grid%transform_seconds = grid%transform_seconds + (t2 - t1)
+      grid%communication_seconds = grid%communication_seconds + (t1 - t0)
+   end subroutine distributed_convolve
+
+   !> The transposed rows (np values per frequency, packed) spread in place to rows of m:
+   !> zero-padded (even = false) or evenly extended, x(m - q) = x(q), with x(np) = 0
+   !> (even = true). From the last row down, each from its end: nothing is overwritten
+   !> before it is read.
+   subroutine expand_rows(grid, even)
+      type(distributed_grid), intent(inout) :: grid
+      logical, intent(in) :: even
+      integer :: k, i, np, m
+      np = grid%np
+      m = grid%m
+      do k = grid%freqs, 1, -1
+         do i = np, 1, -1
+            grid%row_values((k - 1)*m + i) = grid%row_values((k - 1)*np + i)
+         end do
+         grid%row_values((k - 1)*m + np + 1) = 0
+         if (even) then
+            do i = np + 2, m
+               grid%row_values((k - 1)*m + i) = grid%row_values((k - 1)*m + m - i + 2)
+            end do
          else
-            grid%real_buffer(:, j) = 0
+            grid%row_values((k - 1)*m + np + 2:k*m) = 0
          end if
       end do
-      call wall_clock(t1)
-      call fftw_mpi_execute_dft_r2c(grid%forward, grid%real_buffer, grid%spectrum)
-      !$omp parallel do
+   end subroutine expand_rows
+
+   !> The first np values of each row of m packed again for the transpose back (from the
+   !> first row up: nothing is overwritten before it is read).
+   subroutine compress_rows(grid)
+      type(distributed_grid), intent(inout) :: grid
+      integer :: k, i, np, m
+      np = grid%np
+      m = grid%m
       do k = 1, grid%freqs
-         grid%spectrum(:, k) = grid%spectrum(:, k)*(factor*grid%kernel(:, k))
+         do i = 1, np
+            grid%row_values((k - 1)*np + i) = grid%row_values((k - 1)*m + i)
+         end do
       end do
-      call fftw_mpi_execute_dft_c2r(grid%backward, grid%spectrum, grid%real_buffer)
-      call wall_clock(t2)
-      !$omp parallel do
-      do j = 1, grid%physical_rows
-         grid%staging(:, j) = grid%real_buffer(1:grid%np, j)
-      end do
-      call MPI_Alltoallv(grid%staging, grid%recv_counts, grid%recv_displs, grid%column, out, grid%send_counts, &
-         grid%send_displs, grid%column, grid%comm)
-      call wall_clock(t3)
-      grid%transform_seconds = grid%transform_seconds + (t2 - t1)
-      grid%communication_seconds = grid%communication_seconds + (t1 - t0) + (t3 - t2)
-   end subroutine distributed_convolve
+   end subroutine compress_rows
 
    !> Every load of `loads` (nN, solved in ascending order, each warm-started from the
    !> last; states in the order given). `problem` is read on rank 0 only (the materials,
