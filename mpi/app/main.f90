@@ -43,7 +43,7 @@ program femcod_mpi
    type(signal_observer) :: observer
    type(string_type), allocatable :: warnings(:)
    character(len=:), allocatable :: prefix, notice, started
-   real(dp) :: t_start, t_read, t_solve, t_write, peak
+   real(dp) :: t_start, t_read, t_solve, t_write, peak, read_peak
    integer :: provided, rank, ranks, np, block, code, k
    logical :: locked
 
@@ -99,6 +99,11 @@ program femcod_mpi
 
    call distribute_problem(problem, MPI_COMM_WORLD, settings%solve%cg, grid, block, status)
    np = grid%np
+   ! Every rank has its columns now: rank 0 keeps the materials only. Its peak so far is
+   ! what reading the inputs took.
+   read_peak = peak_memory_mb()
+   if (allocated(problem%lower)) deallocate(problem%lower)
+   if (allocated(problem%upper)) deallocate(problem%upper)
    call wall_clock(t_read)
    if (status%code == 0) call solve_loads(grid, problem, settings%solve%loads, settings%solve%cg, block, states, &
       status, observer)
@@ -221,7 +226,7 @@ contains
       do s = 1, ranks
          text = text//json_number(info%peak_mb(s))//trim(merge(", ", "  ", s < ranks))
       end do
-      text = trim(text)//'], "loads": ['
+      text = trim(text)//'], "read_peak_memory_MB": '//json_number(read_peak)//', "loads": ['
       do s = 1, size(states)
          associate(st => states(s))
             text = text//'{"load_nN": '//json_number(st%load)//', "approach_nm": '//json_number(st%approach)// &

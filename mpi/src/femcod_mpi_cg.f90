@@ -35,7 +35,6 @@ module femcod_mpi_cg
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
    use femcod_spring, only: spring_stiffness
-   use femcod_scene, only: initial_gaps
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: cg_settings
    use femcod_cg, only: coarse_start_forces
@@ -295,13 +294,30 @@ contains
       type(status_type), intent(inout) :: status
       real(dp), allocatable :: g0(:, :), local(:, :)
       integer, allocatable :: first(:), count(:)
-      real(dp) :: scalars(4)
-      integer :: rank, ranks, np
+      real(dp) :: scalars(4), lower_top, upper_top, top
+      integer :: rank, ranks, np, i, j
       call MPI_Comm_rank(comm, rank)
       call MPI_Comm_size(comm, ranks)
       if (rank == 0) then
          np = problem%np
-         g0 = transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np]))
+         ! femcod_scene's initial_gaps, element by element and without its row-wise
+         ! numbering (the same values, no temporary copies of the grid).
+         allocate(g0(np, np))
+         lower_top = maxval(problem%lower)
+         upper_top = maxval(problem%upper)
+         !$omp parallel do private(i)
+         do j = 1, np
+            do i = 1, np
+               g0(i, j) = (problem%lower(i, j) - lower_top) + (problem%upper(np + 1 - i, j) - upper_top)
+            end do
+         end do
+         top = maxval(g0)
+         !$omp parallel do private(i)
+         do j = 1, np
+            do i = 1, np
+               g0(i, j) = top - g0(i, j)
+            end do
+         end do
          scalars = [real(np, dp), problem%pixel, &
             surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
             surface_compliance(problem%young(2), problem%poisson(2), problem%pixel), &
