@@ -52,5 +52,15 @@ expect 3 "a broken deck" mpirun_2 "$femcod_mpi" "$work/broken.deck" --loads 10 -
 printf '1 2 3\n4 5 6\n7 8 9\n' >"$work/tiny.txt"
 expect 2 "a grid narrower than two columns per rank" mpirun_2 "$femcod_mpi" --lower "$work/tiny.txt" --pixel 1 \
   --loads 1 -o "$work/bad"
+# doc/cluster/mpi.sbatch as Slurm would run it (no Slurm here: its variables made up).
+if SLURM_CPUS_PER_TASK=1 INPUT="$deck" FEMCOD_MPI="$femcod_mpi" FEMCOD_ARGS="--loads 50,200,1000 --tol 1e-12 --quiet" \
+  PREFIX="$work/sbatch/run" MPIRUN="mpirun $FEMCOD_MPIRUN_FLAGS -np 2" bash ../doc/cluster/mpi.sbatch >"$work/out.txt" 2>&1 \
+  && cmp -s <(python3 -c 'import json,sys; print([l["approach_nm"] for l in json.load(open(sys.argv[1]))["loads"]])' \
+  "$work/mpi.summary.json") <(python3 -c 'import json,sys; print([l["approach_nm"] for l in json.load(open(sys.argv[1]))["loads"]])' \
+  "$work/sbatch/run.summary.json"); then
+  echo "  passed   doc/cluster/mpi.sbatch: the same approaches as the command"
+else
+  echo "  FAILED   doc/cluster/mpi.sbatch"; sed 's/^/           /' "$work/out.txt" | head -5; failed=1
+fi
 expect 5 "existing results without --force" mpirun_2 "$femcod_mpi" "$deck" --loads 50 -o "$work/mpi"
 exit $failed
