@@ -43,6 +43,14 @@ for x, y in zip(a, b):
     assert x["contacts"] == y["contacts"], ("contacts", x["contacts"], y["contacts"])
 PY
 then echo "  passed   the serial solver's approaches and contacts"; else echo "  FAILED   the serial solver's approaches and contacts"; failed=1; fi
+# loads.csv: the serial writer's header, the same contact counts; one figure per load.
+if [ "$(head -1 "$work/mpi.loads.csv")" = "$(head -1 "$work/serial.loads.csv")" ] && \
+   [ "$(cut -d, -f3 "$work/mpi.loads.csv")" = "$(cut -d, -f3 "$work/serial.loads.csv")" ] && \
+   [ -s "$work/mpi.pressure_1.svg" ] && [ -s "$work/mpi.pressure_3.svg" ]; then
+  echo "  passed   loads.csv as the serial one's, a pressure figure per load"
+else
+  echo "  FAILED   loads.csv or the figures"; failed=1
+fi
 expect 2 "--approach refused" mpirun_2 "$femcod_mpi" "$deck" --approach 0.5 -o "$work/bad"
 expect 2 "--boundary periodic refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 --boundary periodic -o "$work/bad"
 expect 2 "two decks refused" mpirun_2 "$femcod_mpi" "$deck" ../input/sphere_d2.deck --loads 10

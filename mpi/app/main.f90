@@ -30,7 +30,9 @@ program femcod_mpi
    use femcod_exit, only: exit_program
    use femcod_help, only: help_requested
    use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, distribute_problem
-   use femcod_mpi_results, only: distributed_run_info, write_distributed_results
+   use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block
+   use femcod_svg, only: svg_pressure_map
+   use femcod_maps, only: state_maps
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -42,9 +44,10 @@ program femcod_mpi
    type(distributed_run_info) :: info
    type(signal_observer) :: observer
    type(string_type), allocatable :: warnings(:)
-   character(len=:), allocatable :: prefix, notice, started
+   character(len=:), allocatable :: prefix, notice, started, blocks_note
    real(dp) :: t_start, t_read, t_solve, t_write, peak, read_peak
-   integer :: provided, rank, ranks, np, block, code, k
+   type(state_maps), allocatable :: figures(:)
+   integer :: provided, rank, ranks, np, block, code, k, figure
    logical :: locked
 
    call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
@@ -84,8 +87,9 @@ program femcod_mpi
          call read_deck(settings%decks(1)%s, problem, status)
       end if
       if (status%code == 0 .and. .not. settings%force) then
-         if (path_exists(prefix//".h5") .or. path_exists(prefix//".summary.json")) call set_error(status, STATUS_IO, &
-            prefix//".h5 or "//prefix//".summary.json exists; --force replaces them, or give another -o")
+         if (path_exists(prefix//".h5") .or. path_exists(prefix//".summary.json") .or. &
+            path_exists(prefix//".loads.csv")) call set_error(status, STATUS_IO, &
+            prefix//".h5, .summary.json or .loads.csv exists; --force replaces them, or give another -o")
       end if
       if (status%code == 0) then
          call acquire_lock(prefix//".lock", status, notice)
@@ -106,7 +110,7 @@ program femcod_mpi
    if (allocated(problem%upper)) deallocate(problem%upper)
    call wall_clock(t_read)
    if (status%code == 0) call solve_loads(grid, problem, settings%solve%loads, settings%solve%cg, block, states, &
-      status, observer)
+      status, observer, settings%solve%hardness)
    call wall_clock(t_solve)
    if (status%code /= 0) then
       if (status%code == STATUS_INTERRUPTED) call finish(128 + stop_signal(), signal_name(stop_signal())//": "// &
@@ -129,12 +133,35 @@ program femcod_mpi
    if (.not. allocated(info%label)) info%label = ""
    info%wall_seconds = t_solve - t_start
    call write_distributed_results(prefix//".h5.part", grid, states, info, status)
+   ! The figures: each load's pressure map as the serial writer draws it (largest
+   ! pressure of each block, at most 1024 blocks per side), gathered block by block.
+   figure = figure_block(np)
+   allocate(figures(size(states)))
+   do k = 1, size(states)
+      call gather_block_maxima(grid, states(k)%force/grid%pixel**2, figure, figures(k)%pressure)
+   end do
    if (rank == 0) then
       if (status%code == 0) call atomic_rename(prefix//".h5.part", prefix//".h5", status)
       if (status%code /= 0) call remove_file(prefix//".h5.part")
+      if (status%code == 0) call write_file(prefix//".loads.csv", loads_csv(), status)
+      blocks_note = ""
+      if (figure > 1) blocks_note = ", "//int_str(figure)//" x "//int_str(figure)//" blocks"
+      do k = 1, size(states)
+         if (status%code == 0) call write_file(prefix//".pressure_"//int_str(k)//".svg", svg_pressure_map( &
+            "contact pressure at "//sig_str(states(k)%load, 6)//" nN (approach "//sig_str(states(k)%approach, 4)// &
+            " nm, "//int_str(states(k)%contacts)//" contacts"//blocks_note//")", figures(k)%pressure, &
+            np*grid%pixel), status)
+      end do
       call wall_clock(t_write)
       if (status%code == 0) call write_file(prefix//".summary.json", summary_json(), status)
-      if (status%code /= 0) call remove_file(prefix//".h5")
+      if (status%code /= 0) then
+         ! No partial result set: what was written goes.
+         call remove_file(prefix//".h5")
+         call remove_file(prefix//".loads.csv")
+         do k = 1, size(states)
+            call remove_file(prefix//".pressure_"//int_str(k)//".svg")
+         end do
+      end if
       if (status%code == 0 .and. .not. settings%quiet) call print_summary()
    end if
    call agree(status)
@@ -213,6 +240,22 @@ contains
       close(unit)
    end function peak_memory_mb
 
+   !> PREFIX.loads.csv, the serial writer's columns (no plastic cap here: n_plastic and
+   !> plastic_volume_nm3 are 0).
+   function loads_csv() result(text)
+      character(len=:), allocatable :: text
+      integer :: s
+      text = "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
+         "plastic_volume_nm3"//new_line('a')
+      do s = 1, size(states)
+         associate(st => states(s))
+            text = text//format_real(st%load)//","//format_real(st%approach)//","//int_str(st%contacts)//","// &
+               format_real(st%contacts*grid%pixel**2)//","//format_real(real(st%contacts, dp)/real(np, dp)**2)//","// &
+               format_real(st%max_pressure)//","//int_str(st%above_hardness)//",0,0"//new_line('a')
+         end associate
+      end do
+   end function loads_csv
+
    !> The summary as JSON: numbers with their units in the names.
    function summary_json() result(text)
       character(len=:), allocatable :: text
@@ -264,7 +307,7 @@ contains
       write(output_unit, '(a)') "  wall time "//sig_str(t_write - t_start, 3)//" s: reading "// &
          sig_str(t_read - t_start, 3)//" s, solving "//sig_str(t_solve - t_read, 3)//" s, writing "// &
          sig_str(t_write - t_solve, 3)//" s"
-      write(output_unit, '(a)') "  results: "//prefix//".h5, "//prefix//".summary.json"
+      write(output_unit, '(a)') "  results: "//prefix//".h5, .summary.json, .loads.csv, .pressure_<k>.svg"
    end subroutine print_summary
 
    subroutine print_help()

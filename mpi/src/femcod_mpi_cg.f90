@@ -88,6 +88,8 @@ module femcod_mpi_cg
       !> Of `seconds`: in the transforms and in communication (distributed_grid).
       real(dp) :: transform_seconds = 0, communication_seconds = 0
       integer :: contacts = 0, iterations = 0, coarse_iterations = 0, convolutions = 0
+      !> Pixels whose pressure is above the hardness given to solve_loads (all ranks).
+      integer :: above_hardness = 0
       !> This rank's columns: contact forces (nN) and gaps (nm, 0 at the contacts).
       real(dp), allocatable :: force(:, :), gap(:, :)
    end type distributed_state
@@ -439,10 +441,12 @@ contains
    !> Every load of `loads` (nN, solved in ascending order, each warm-started from the
    !> last; states in the order given). `problem` is read on rank 0 only (the materials,
    !> for the coarse start). Collective.
-   subroutine solve_loads(grid, problem, loads, how, block, states, status, observer)
+   subroutine solve_loads(grid, problem, loads, how, block, states, status, observer, hardness)
       type(distributed_grid), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: loads(:)
+      !> GPa: the pressure above_hardness counts beyond (default: none counted).
+      real(dp), intent(in), optional :: hardness
       type(cg_settings), intent(in) :: how
       !> The coarse start's averaging width (coarse_factor; 1: no coarse start).
       integer, intent(in) :: block
@@ -489,8 +493,10 @@ contains
             st%force = p
             st%contacts = count(p > 0)
             total = [real(st%contacts, dp), 0.0_dp]
+            if (present(hardness)) total(2) = count(p/grid%pixel**2 > hardness)
             call MPI_Allreduce(MPI_IN_PLACE, total, 2, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
             st%contacts = nint(total(1))
+            st%above_hardness = nint(total(2))
             st%max_pressure = maxval(p)/grid%pixel**2
             call MPI_Allreduce(MPI_IN_PLACE, st%max_pressure, 1, MPI_DOUBLE_PRECISION, MPI_MAX, grid%comm)
             call wall_clock(t1)

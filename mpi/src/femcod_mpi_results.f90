@@ -16,7 +16,7 @@ module femcod_mpi_results
    use femcod_mpi_cg, only: distributed_grid, distributed_state
    implicit none
    private
-   public :: distributed_run_info, write_distributed_results, load_group
+   public :: distributed_run_info, write_distributed_results, load_group, gather_block_maxima, figure_block
 
    !> What /run records of a distributed run.
    type :: distributed_run_info
@@ -179,6 +179,49 @@ contains
          call h5_attribute(file, name, "units", units, status)
       end subroutine write_map
    end subroutine write_maps
+
+   !> The block width of a map figure: the serial figures' (femcod_svg): at most 1024
+   !> blocks per side.
+   pure integer function figure_block(np)
+      integer, intent(in) :: np
+      figure_block = (np + 1023)/1024
+   end function figure_block
+
+   !> The largest value of each f x f block of the distributed map (np, nj per rank) on
+   !> rank 0, (m, m) with m = ceil(np / f) (partial blocks at the far edges); the other
+   !> ranks get a (0, 0) array. Collective; rank 0 holds m x np values on the way.
+   subroutine gather_block_maxima(grid, local, f, blocks)
+      type(distributed_grid), intent(in) :: grid
+      real(dp), intent(in) :: local(:, :)
+      integer, intent(in) :: f
+      real(dp), allocatable, intent(out) :: blocks(:, :)
+      real(dp), allocatable :: columns(:, :), all_columns(:, :)
+      integer :: m, i, j
+      m = (grid%np + f - 1)/f
+      allocate(columns(m, grid%nj))
+      do j = 1, grid%nj
+         do i = 1, m
+            columns(i, j) = maxval(local((i - 1)*f + 1:min(grid%np, i*f), j))
+         end do
+      end do
+      if (grid%rank == 0) then
+         allocate(all_columns(m, grid%np))
+      else
+         allocate(all_columns(1, 1))
+      end if
+      call MPI_Gatherv(columns, m*grid%nj, MPI_DOUBLE_PRECISION, all_columns, m*grid%count, m*grid%first, &
+         MPI_DOUBLE_PRECISION, 0, grid%comm)
+      if (grid%rank /= 0) then
+         allocate(blocks(0, 0))
+         return
+      end if
+      allocate(blocks(m, m))
+      do j = 1, m
+         do i = 1, m
+            blocks(i, j) = maxval(all_columns(i, (j - 1)*f + 1:min(grid%np, j*f)))
+         end do
+      end do
+   end subroutine gather_block_maxima
 
    !> The first failure of any rank, on every rank (rank 0's message when it failed).
    subroutine agree(status, comm)
