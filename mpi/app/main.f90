@@ -12,9 +12,10 @@ program femcod_mpi
    use, intrinsic :: iso_c_binding, only: c_int
    use mpi_f08
    use omp_lib, only: omp_get_max_threads
-   use femcod_fftw_mpi, only: fftw_init_threads, fftw_plan_with_nthreads, fftw_mpi_init, fftw_mpi_cleanup
+   use femcod_fftw_mpi, only: fftw_init_threads, fftw_plan_with_nthreads, fftw_mpi_init, fftwf_init_threads, &
+      fftwf_plan_with_nthreads, fftwf_mpi_init, fftw_mpi_cleanup
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED, STATUS_NUMERICAL
    use femcod_strings, only: string_type, int_str, sig_str, format_real, json_string, json_number
    use femcod_cli, only: command_arguments
    use femcod_run, only: run_settings, parse_run_arguments
@@ -55,9 +56,12 @@ program femcod_mpi
    call MPI_Comm_size(MPI_COMM_WORLD, ranks)
    call wall_clock(t_start)
    started = local_time_iso()
-   if (fftw_init_threads() == 0) call finish(STATUS_USAGE, "FFTW's threads would not start")
+   if (fftw_init_threads() == 0) call finish(STATUS_NUMERICAL, "FFTW's threads would not start")
    call fftw_mpi_init()
+   if (fftwf_init_threads() == 0) call finish(STATUS_NUMERICAL, "FFTW's float32 threads would not start")
+   call fftwf_mpi_init()
    call fftw_plan_with_nthreads(int(omp_get_max_threads(), c_int))
+   call fftwf_plan_with_nthreads(int(omp_get_max_threads(), c_int))
    call catch_stop_signals()
    locked = .false.
 

@@ -16,21 +16,26 @@
 !> - The first load starts from a coarse solution on rank 0 (femcod_cg's own nested start
 !>   at NP/f, f the smallest power of two with f^2 >= ranks, so that it needs no more memory
 !>   than a rank's share): with up to 4 ranks the same start as the serial solver's.
-!> - All transforms in double precision, and every force the projection changes brings a
-!>   fresh convolution (the serial solver adds up to `direct_corrections` of them from the
-!>   Love table, which would be NP^2 values on every rank): more convolutions, the same
-!>   answer (to the tolerance).
+!> - float32 transforms (FFTW's fftwf, the transposes fftwf_mpi) where the serial solver
+!>   uses them: the search directions always, the forces' own displacements while the
+!>   residual is above `single_until`; every switch and the final answer from a fresh
+!>   double convolution.
+!> - Every force the projection changes brings a fresh convolution (the serial solver adds
+!>   up to `direct_corrections` of them from the Love table, which would be NP^2 values on
+!>   every rank): more convolutions, the same answer (to the tolerance).
 !>
 !> No I/O and no stop: errors come back in a status, identical on every rank.
 module femcod_mpi_cg
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_intptr_t, c_int, &
-      c_f_pointer, c_associated, c_size_t
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_float, c_float_complex, &
+      c_intptr_t, c_int, c_f_pointer, c_associated, c_size_t
    use mpi_f08
    use omp_lib, only: omp_get_max_threads
    use femcod_fftw_mpi, only: fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, fftw_mpi_execute_r2r, &
       fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
       fftw_execute_dft, fftw_alloc_complex, fftw_free, fftw_destroy_plan, FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, &
-      FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK
+      FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK, fftwf_mpi_plan_many_transpose, fftwf_mpi_execute_r2r, &
+      fftwf_plan_many_dft_r2c, fftwf_plan_many_dft_c2r, fftwf_plan_many_dft, fftwf_execute_dft_r2c, &
+      fftwf_execute_dft_c2r, fftwf_execute_dft, fftwf_destroy_plan
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
@@ -43,6 +48,8 @@ module femcod_mpi_cg
    use femcod_clock, only: wall_clock
    implicit none
    private
+   !> float32, for the transforms of the search directions (as femcod_convolution's).
+   integer, parameter :: sp = kind(1.0)
    public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor
    public :: distribute_problem, distributed_convolve
 
@@ -75,6 +82,15 @@ module femcod_mpi_cg
          rows_backward = c_null_ptr, to_rows = c_null_ptr, to_columns = c_null_ptr
       !> The kernel's spectrum over m^2 (real: the table is even), (m, freqs).
       real(dp), allocatable :: kernel(:, :)
+      !> float32 transforms (cg_settings%single_until > 0): views of the same memory, their
+      !> own plans, the kernel rounded to float32.
+      logical :: has_single = .false.
+      real(c_float), pointer :: column32_real(:, :) => null(), column32_flat(:) => null(), row32_flat(:) => null()
+      complex(c_float_complex), pointer :: columns32(:, :) => null(), rows32(:, :) => null(), &
+         row32_values(:) => null()
+      type(c_ptr) :: columns_forward32 = c_null_ptr, columns_backward32 = c_null_ptr, rows_forward32 = c_null_ptr, &
+         rows_backward32 = c_null_ptr, to_rows32 = c_null_ptr, to_columns32 = c_null_ptr
+      real(sp), allocatable :: kernel32(:, :)
       !> Wall seconds so far in the transforms (the 1-D transforms and FFTW-MPI's
       !> transposes) and in the solver's other communication (sums, halos; waiting for
       !> slower ranks included).
@@ -245,6 +261,43 @@ contains
          call fftw_execute_dft(grid%rows_forward, grid%rows, grid%rows)
          grid%kernel = real(grid%rows(:, 1:grid%freqs), dp)/real(grid%m, dp)**2
       end if
+      grid%has_single = how%single_until > 0
+      if (grid%has_single) then
+         call c_f_pointer(grid%column_memory, grid%column32_real, [2*grid%mh, grid%nj])
+         call c_f_pointer(grid%column_memory, grid%column32_flat, [2*grid%mh*grid%nj])
+         call c_f_pointer(grid%column_memory, grid%columns32, [grid%mh, grid%nj])
+         call c_f_pointer(grid%row_memory, grid%rows32, [grid%m, max(grid%freqs, 1)])
+         call c_f_pointer(grid%row_memory, grid%row32_values, [grid%m*max(grid%freqs, 1)])
+         call c_f_pointer(grid%row_memory, grid%row32_flat, [2*grid%m*max(grid%freqs, 1)])
+         grid%columns_forward32 = fftwf_plan_many_dft_r2c(1_c_int, [int(grid%m, c_int)], int(grid%nj, c_int), &
+            grid%column32_real, [int(2*grid%mh, c_int)], 1_c_int, int(2*grid%mh, c_int), grid%columns32, &
+            [int(grid%mh, c_int)], 1_c_int, int(grid%mh, c_int), flags)
+         grid%columns_backward32 = fftwf_plan_many_dft_c2r(1_c_int, [int(grid%m, c_int)], int(grid%nj, c_int), &
+            grid%columns32, [int(grid%mh, c_int)], 1_c_int, int(grid%mh, c_int), grid%column32_real, &
+            [int(2*grid%mh, c_int)], 1_c_int, int(2*grid%mh, c_int), flags)
+         if (grid%freqs > 0) then
+            grid%rows_forward32 = fftwf_plan_many_dft(1_c_int, [int(grid%m, c_int)], int(grid%freqs, c_int), &
+               grid%rows32, [int(grid%m, c_int)], 1_c_int, int(grid%m, c_int), grid%rows32, [int(grid%m, c_int)], &
+               1_c_int, int(grid%m, c_int), FFTW_FORWARD, flags)
+            grid%rows_backward32 = fftwf_plan_many_dft(1_c_int, [int(grid%m, c_int)], int(grid%freqs, c_int), &
+               grid%rows32, [int(grid%m, c_int)], 1_c_int, int(grid%m, c_int), grid%rows32, [int(grid%m, c_int)], &
+               1_c_int, int(grid%m, c_int), FFTW_BACKWARD, flags)
+         end if
+         grid%to_rows32 = fftwf_mpi_plan_many_transpose(int(np, c_intptr_t), int(grid%mh, c_intptr_t), 2_c_intptr_t, &
+            int(grid%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, grid%column32_flat, grid%row32_flat, &
+            comm%MPI_VAL, flags)
+         grid%to_columns32 = fftwf_mpi_plan_many_transpose(int(grid%mh, c_intptr_t), int(np, c_intptr_t), &
+            2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(grid%block_columns, c_intptr_t), grid%row32_flat, &
+            grid%column32_flat, comm%MPI_VAL, flags)
+         if (.not. (c_associated(grid%columns_forward32) .and. c_associated(grid%columns_backward32) .and. &
+            c_associated(grid%to_rows32) .and. c_associated(grid%to_columns32) .and. (grid%freqs == 0 .or. &
+            (c_associated(grid%rows_forward32) .and. c_associated(grid%rows_backward32))))) then
+            call set_error(status, STATUS_NUMERICAL, "FFTW made no float32 plan for the "//int_str(grid%m)//" x "// &
+               int_str(grid%m)//" grid")
+            return
+         end if
+         grid%kernel32 = real(grid%kernel, sp)
+      end if
       grid%preconditioned = .false.
       grid%taps = 0
       if (how%precondition .and. np >= 3) then
@@ -348,6 +401,11 @@ contains
       do k = 1, size(plans)
          if (c_associated(plans(k))) call fftw_destroy_plan(plans(k))
       end do
+      plans = [grid%columns_forward32, grid%columns_backward32, grid%rows_forward32, grid%rows_backward32, &
+         grid%to_rows32, grid%to_columns32]
+      do k = 1, size(plans)
+         if (c_associated(plans(k))) call fftwf_destroy_plan(plans(k))
+      end do
       if (c_associated(grid%column_memory)) call fftw_free(grid%column_memory)
       if (c_associated(grid%row_memory)) call fftw_free(grid%row_memory)
       grid = distributed_grid(comm=MPI_COMM_NULL)
@@ -355,13 +413,21 @@ contains
 
    !> out = factor (I * f) on this rank's columns (np, nj): down the columns, transpose,
    !> along the rows, the kernel, and back. Collective.
-   subroutine distributed_convolve(grid, f, out, factor)
+   subroutine distributed_convolve(grid, f, out, factor, single)
       type(distributed_grid), intent(inout) :: grid
       real(dp), intent(in) :: f(:, :)
       real(dp), intent(out) :: out(:, :)
       real(dp), intent(in) :: factor
+      !> In float32 (the grid made with has_single): the same steps, half the bytes.
+      logical, intent(in), optional :: single
       integer :: j, k, np
       real(dp) :: t0, t1, t2, t3
+      if (present(single)) then
+         if (single .and. grid%has_single) then
+            call convolve_single(grid, f, out, factor)
+            return
+         end if
+      end if
       np = grid%np
       call wall_clock(t0)
       !$omp parallel do
@@ -398,6 +464,63 @@ contains
       grid%transform_seconds = grid%transform_seconds + (t2 - t1)
       grid%communication_seconds = grid%communication_seconds + (t1 - t0)
    end subroutine distributed_convolve
+
+   !> distributed_convolve in float32.
+   subroutine convolve_single(grid, f, out, factor)
+      type(distributed_grid), intent(inout) :: grid
+      real(dp), intent(in) :: f(:, :)
+      real(dp), intent(out) :: out(:, :)
+      real(dp), intent(in) :: factor
+      integer :: j, k, i, np, m
+      real(dp) :: t0, t1, t2, t3
+      np = grid%np
+      m = grid%m
+      call wall_clock(t0)
+      !$omp parallel do
+      do j = 1, grid%nj
+         grid%column32_real(1:np, j) = real(f(:, j), sp)
+         grid%column32_real(np + 1:, j) = 0
+      end do
+      call fftwf_execute_dft_r2c(grid%columns_forward32, grid%column32_real, grid%columns32)
+      call wall_clock(t1)
+      call fftwf_mpi_execute_r2r(grid%to_rows32, grid%column32_flat, grid%row32_flat)
+      call wall_clock(t2)
+      ! As expand_rows (zero padding), in float32.
+      do k = grid%freqs, 1, -1
+         do i = np, 1, -1
+            grid%row32_values((k - 1)*m + i) = grid%row32_values((k - 1)*np + i)
+         end do
+         grid%row32_values((k - 1)*m + np + 1:k*m) = 0
+      end do
+      if (grid%freqs > 0) then
+         call fftwf_execute_dft(grid%rows_forward32, grid%rows32, grid%rows32)
+         !$omp parallel do
+         do k = 1, grid%freqs
+            grid%rows32(:, k) = grid%rows32(:, k)*(real(factor, sp)*grid%kernel32(:, k))
+         end do
+         call fftwf_execute_dft(grid%rows_backward32, grid%rows32, grid%rows32)
+      end if
+      ! As compress_rows, in float32.
+      do k = 1, grid%freqs
+         do i = 1, np
+            grid%row32_values((k - 1)*np + i) = grid%row32_values((k - 1)*m + i)
+         end do
+      end do
+      call wall_clock(t3)
+      grid%transform_seconds = grid%transform_seconds + (t1 - t0) + (t3 - t2)
+      grid%communication_seconds = grid%communication_seconds + (t2 - t1)
+      call wall_clock(t0)
+      call fftwf_mpi_execute_r2r(grid%to_columns32, grid%row32_flat, grid%column32_flat)
+      call wall_clock(t1)
+      call fftwf_execute_dft_c2r(grid%columns_backward32, grid%columns32, grid%column32_real)
+      !$omp parallel do
+      do j = 1, grid%nj
+         out(:, j) = real(grid%column32_real(1:np, j), dp)
+      end do
+      call wall_clock(t2)
+      grid%transform_seconds = grid%transform_seconds + (t2 - t1)
+      grid%communication_seconds = grid%communication_seconds + (t1 - t0)
+   end subroutine convolve_single
 
    !> The transposed rows (np values per frequency, packed) spread in place to rows of m:
    !> zero-padded (even = false) or evenly extended, x(m - q) = x(q), with x(np) = 0
@@ -611,7 +734,7 @@ contains
       real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, residual, &
          contact_gap, penetration, alpha, pn, lin, entry, zbar, cross, nc, nchanged, entered, sums(4), maxima(2), t0, t1
       integer :: np, nj, i, j, it
-      logical :: restart, fresh, fresh_double, stalled, keep_old
+      logical :: restart, fresh, fresh_double, stalled, keep_old, single
       np = grid%np
       nj = grid%nj
       c = grid%c
@@ -631,6 +754,7 @@ contains
       psum = sum(p)
       call reduce_one(psum, MPI_SUM)
       alpha = total_load/psum
+      single = how%single_until > 0 .and. grid%has_single
       fresh = .true.
       restart = .true.
       big_g_old = 1
@@ -641,9 +765,9 @@ contains
       stalled = .false.
       do
          if (fresh) then
-            call distributed_convolve(grid, p, w, c)
+            call distributed_convolve(grid, p, w, c, single)
             state%convolutions = state%convolutions + 1
-            fresh_double = .true.
+            fresh_double = .not. single
             fresh = .false.
             stalled = .false.
          end if
@@ -703,11 +827,18 @@ contains
          penetration = maxima(2)
          residual = max(contact_gap, penetration)/grid%scale
          if (residual < tol .or. it >= max_iterations .or. stalled) then
+            ! Accept only on displacements from a fresh double-precision convolution.
             if (.not. fresh_double) then
+               single = .false.
                fresh = .true.
                cycle
             end if
             exit
+         end if
+         if (single .and. residual < how%single_until) then
+            single = .false.
+            fresh = .true.
+            cycle
          end if
          if (grid%preconditioned) then
             call wall_clock(t0)
@@ -748,7 +879,9 @@ contains
                end if
             end do
          end do
-         call distributed_convolve(grid, t, r, c)
+         ! The search direction's displacements in float32 whenever float32 is on (as the
+         ! serial solver: their round-off scales with the step).
+         call distributed_convolve(grid, t, r, c, grid%has_single .and. how%single_until > 0)
          fresh_double = .false.
          rt = 0
          rsum = 0

@@ -5,7 +5,8 @@ program mpi_tester
    use, intrinsic :: iso_c_binding, only: c_int
    use mpi_f08
    use omp_lib, only: omp_get_max_threads
-   use femcod_fftw_mpi, only: fftw_init_threads, fftw_plan_with_nthreads, fftw_mpi_init
+   use femcod_fftw_mpi, only: fftw_init_threads, fftw_plan_with_nthreads, fftw_mpi_init, fftwf_init_threads, &
+      fftwf_plan_with_nthreads, fftwf_mpi_init
    use testdrive, only: run_testsuite, count_tests
    use test_distributed, only: collect_distributed
    use femcod_exit, only: exit_program
@@ -17,7 +18,10 @@ program mpi_tester
    call MPI_Comm_size(MPI_COMM_WORLD, ranks)
    if (fftw_init_threads() == 0) error stop "FFTW's threads would not start"
    call fftw_mpi_init()
+   if (fftwf_init_threads() == 0) error stop "FFTW's float32 threads would not start"
+   call fftwf_mpi_init()
    call fftw_plan_with_nthreads(int(omp_get_max_threads(), c_int))
+   call fftwf_plan_with_nthreads(int(omp_get_max_threads(), c_int))
    if (rank == 0) then
       unit = output_unit
       write(unit, '(a)') "# suite distributed ("//int_str(ranks)//" MPI ranks)"

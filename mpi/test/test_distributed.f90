@@ -28,6 +28,7 @@ contains
       testsuite = [ &
          new_unittest("column split and coarse width follow their definitions", test_split), &
          new_unittest("convolution = direct sum of Love's influence coefficients", test_convolution), &
+         new_unittest("float32 convolution within float32's round-off of the double one", test_single), &
          new_unittest("too few columns for the ranks: refused on every rank", test_too_few_columns), &
          new_unittest("Hertz at 1000 nN on the 0.5 nm sphere deck", test_hertz), &
          new_unittest("the serial cg solver's answer on 1, 2 and 4 ranks, rough surface", test_against_serial) &
@@ -114,6 +115,40 @@ contains
             " of max |u| "//to_string(worst(2)))
       end if
    end subroutine test_convolution
+
+   !> The float32 transforms (the search directions' convolution) against the double ones
+   !> on a 64 x 64 field: the largest difference between 1e-9 (so that float32 was used)
+   !> and 1e-5 of max |u| (float32's 6e-8 times the transforms' depth, 2 log2(128) = 14,
+   !> with margin).
+   subroutine test_single(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: np = 64
+      type(distributed_grid) :: grid
+      type(status_type) :: status
+      real(dp), allocatable :: mine(:, :), double(:, :), single(:, :)
+      integer, allocatable :: first(:), count(:)
+      integer :: ranks, rank, i, j
+      real(dp) :: worst(2)
+      call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+      call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+      call column_split(np, ranks, 1, first, count)
+      allocate(mine(np, count(rank)), double(np, count(rank)), single(np, count(rank)))
+      do j = 1, count(rank)
+         do i = 1, np
+            mine(i, j) = cos(0.37_dp*i*(first(rank) + j))**2
+         end do
+      end do
+      call grid_setup(grid, MPI_COMM_WORLD, np, 1, 0*mine, 1.0_dp, 1.0_dp, 0.0_dp, cg_settings(), status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      call distributed_convolve(grid, mine, double, 1.0_dp)
+      call distributed_convolve(grid, mine, single, 1.0_dp, single=.true.)
+      call grid_free(grid)
+      worst = [maxval(abs(single - double)), maxval(abs(double))]
+      call MPI_Allreduce(MPI_IN_PLACE, worst, 2, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+      call check(error, worst(1) > 1.0e-9_dp*worst(2) .and. worst(1) <= 1.0e-5_dp*worst(2), &
+         "float32 - double: "//to_string(worst(1)/worst(2))//" of max |u|")
+   end subroutine test_single
 
    !> Each rank needs two columns (the preconditioner's halo): NP = 2 P - 1 is refused,
    !> with the usage code, on every rank.
