@@ -31,7 +31,8 @@ program femcod_mpi
    use femcod_exit, only: exit_program
    use femcod_help, only: help_requested
    use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, distribute_problem
-   use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block
+   use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, &
+      agree
    use femcod_svg, only: svg_pressure_map
    use femcod_maps, only: state_maps
    implicit none
@@ -102,7 +103,7 @@ program femcod_mpi
       end if
       if (status%code == 0) info%label = problem%label
    end if
-   call agree(status)
+   call agree(status, MPI_COMM_WORLD)
    if (status%code /= 0) call finish(status%code, status%message)
 
    call distribute_problem(problem, MPI_COMM_WORLD, settings%solve%cg, grid, block, status)
@@ -168,7 +169,7 @@ program femcod_mpi
       end if
       if (status%code == 0 .and. .not. settings%quiet) call print_summary()
    end if
-   call agree(status)
+   call agree(status, MPI_COMM_WORLD)
    call grid_free(grid)
    if (status%code /= 0) call finish(status%code, status%message)
    call finish(0, "")
@@ -198,19 +199,6 @@ contains
          end if
       end associate
    end subroutine refuse_unsupported
-
-   !> Rank 0's failure, on every rank.
-   subroutine agree(status)
-      type(status_type), intent(inout) :: status
-      integer :: code
-      character(len=1024) :: message
-      code = status%code
-      message = ""
-      if (code /= 0) message = status%message
-      call MPI_Bcast(code, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
-      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, MPI_COMM_WORLD)
-      if (code /= 0 .and. status%code == 0) call set_error(status, code, trim(message))
-   end subroutine agree
 
    !> Releases the lock, reports `message` (rank 0), ends MPI and exits with `code`.
    subroutine finish(code, message)

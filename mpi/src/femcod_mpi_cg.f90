@@ -719,8 +719,8 @@ contains
       end do
    end subroutine coarse_start
 
-   !> femcod_cg's constrained_cg on the distributed grid (double precision throughout, a
-   !> fresh convolution whenever the projection changed a force).
+   !> femcod_cg's constrained_cg on the distributed grid, step by step (a change there
+   !> belongs here too), with a fresh convolution whenever the projection changed a force.
    subroutine distributed_cg(grid, total_load, tol, max_iterations, how, p, state, status, observer)
       type(distributed_grid), intent(inout) :: grid
       real(dp), intent(in) :: total_load, tol

@@ -13,10 +13,11 @@ module femcod_mpi_results
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_strings, only: int_str
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_attribute
+   use femcod_results, only: load_group
    use femcod_mpi_cg, only: distributed_grid, distributed_state
    implicit none
    private
-   public :: distributed_run_info, write_distributed_results, load_group, gather_block_maxima, figure_block
+   public :: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, agree
 
    !> What /run records of a distributed run.
    type :: distributed_run_info
@@ -28,16 +29,6 @@ module femcod_mpi_results
    end type distributed_run_info
 
 contains
-
-   !> "/loads/<k>", zero-padded to at least three digits (the serial writer's names).
-   pure function load_group(k, n) result(g)
-      integer, intent(in) :: k, n
-      character(len=:), allocatable :: g
-      integer :: width
-      width = max(3, len(int_str(n)))
-      g = int_str(k)
-      g = "/loads/"//repeat("0", width - len(g))//g
-   end function load_group
 
    !> Write `path` (collective; `status` the same on every rank afterwards).
    subroutine write_distributed_results(path, grid, states, info, status)
@@ -223,7 +214,7 @@ contains
       end do
    end subroutine gather_block_maxima
 
-   !> The first failure of any rank, on every rank (rank 0's message when it failed).
+   !> Rank 0's failure (code and message), on every rank of `comm`. Collective.
    subroutine agree(status, comm)
       type(status_type), intent(inout) :: status
       type(MPI_Comm), intent(in) :: comm

@@ -23,7 +23,7 @@ module femcod_results
    use femcod_richardson, only: power_law_fit
    implicit none
    private
-   public :: write_results, run_info, result_files, write_file_set, stored_fingerprint
+   public :: write_results, run_info, result_files, write_file_set, stored_fingerprint, load_group
 
    !> What the run was, for /run in the HDF5 file.
    type :: run_info

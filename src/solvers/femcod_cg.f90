@@ -511,6 +511,8 @@ contains
       iterations = rep%iterations + rep%coarse_iterations
    end subroutine coarse_start_forces
 
+   !> (femcod-mpi's distributed_cg, mpi/src/femcod_mpi_cg.f90, follows this routine step
+   !> by step with the sums over MPI ranks: a change here belongs there too.)
    !> Polonsky-Keer constrained CG on `grid` at total load P from the forces p (nN, any
    !> positive start; returned: the solution). `approach` (nm) is the mean gap of the
    !> contact pixels before the rigid shift, i.e. the approach from first touch.
