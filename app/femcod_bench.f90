@@ -504,9 +504,9 @@ contains
             "(the method is printed).", ""
          call print_lines(option_help(bench_mpi_table(), ""))
          write(output_unit, '(a)') "Columns: NP, run, ranks x threads, whole command s, solve s, transforms % and", &
-            "communication % of the solve (rank 0: FFTW-MPI's execute with its own transposes; the column", &
-            "exchange, sums and halos, waiting included), iterations (+ coarse, fresh convolutions), peak MB", &
-            "of the largest rank, contact %, approach's difference from the serial run's (relative)."
+            "communication % of the solve (rank 0: the 1-D FFTs; FFTW-MPI's transposes, the sums and halos,", &
+            "waiting included), iterations (+ coarse, fresh convolutions), peak MB of the largest rank,", &
+            "contact %, approach's difference from the serial run's (relative)."
          return
       end if
       if (.not. bench_arguments(bench_mpi_table(), args, "femcod bench mpi", parsed)) then

@@ -29,7 +29,6 @@ module femcod_mpi_cg
    use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_float, c_float_complex, &
       c_intptr_t, c_int, c_f_pointer, c_associated, c_size_t
    use mpi_f08
-   use omp_lib, only: omp_get_max_threads
    use femcod_fftw_mpi, only: fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, fftw_mpi_execute_r2r, &
       fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
       fftw_execute_dft, fftw_alloc_complex, fftw_free, fftw_destroy_plan, FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, &
