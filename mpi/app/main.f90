@@ -30,7 +30,7 @@ program femcod_mpi
    use femcod_about, only: FEMCOD_VERSION
    use femcod_exit, only: exit_program
    use femcod_help, only: help_requested
-   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, distribute_problem
+   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, scatter_problem, grid_setup
    use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, &
       agree
    use femcod_svg, only: svg_pressure_map
@@ -47,7 +47,8 @@ program femcod_mpi
    type(signal_observer) :: observer
    type(string_type), allocatable :: warnings(:)
    character(len=:), allocatable :: prefix, notice, started, blocks_note
-   real(dp) :: t_start, t_read, t_solve, t_write, peak, read_peak
+   real(dp) :: t_start, t_read, t_solve, t_write, peak, read_peak, constants(4)
+   real(dp), allocatable :: local(:, :)
    type(state_maps), allocatable :: figures(:)
    integer :: provided, rank, ranks, np, block, code, k, figure
    logical :: locked
@@ -106,13 +107,16 @@ program femcod_mpi
    call agree(status, MPI_COMM_WORLD)
    if (status%code /= 0) call finish(status%code, status%message)
 
-   call distribute_problem(problem, MPI_COMM_WORLD, settings%solve%cg, grid, block, status)
-   np = grid%np
+   call scatter_problem(problem, MPI_COMM_WORLD, settings%solve%cg, local, constants, block)
+   np = nint(constants(1))
    ! Every rank has its columns now: rank 0 keeps the materials only. Its peak so far is
    ! what reading the inputs took.
    read_peak = peak_memory_mb()
    if (allocated(problem%lower)) deallocate(problem%lower)
    if (allocated(problem%upper)) deallocate(problem%upper)
+   call grid_setup(grid, MPI_COMM_WORLD, np, block, local, constants(2), constants(3), constants(4), &
+      settings%solve%cg, status)
+   deallocate(local)
    call wall_clock(t_read)
    if (status%code == 0) call solve_loads(grid, problem, settings%solve%loads, settings%solve%cg, block, states, &
       status, observer, settings%solve%hardness)

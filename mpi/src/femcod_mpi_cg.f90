@@ -50,7 +50,7 @@ module femcod_mpi_cg
    !> float32, for the transforms of the search directions (as femcod_convolution's).
    integer, parameter :: sp = kind(1.0)
    public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor
-   public :: distribute_problem, distributed_convolve
+   public :: distribute_problem, scatter_problem, distributed_convolve
 
    !> One rank's part of the problem and of the distributed convolution.
    type :: distributed_grid
@@ -336,9 +336,8 @@ contains
    end subroutine inverse_taps
 
    !> The grid of `problem` (read on rank 0 only; the others' is not looked at) spread over
-   !> the ranks of `comm`: rank 0 forms the composite gaps (nm), the compliance and the
-   !> springs' compliance (nm/nN), and sends each rank its columns. `block` (out): the
-   !> coarse start's width, coarse_factor. Collective.
+   !> the ranks of `comm` (scatter_problem), and the distributed grid made of it
+   !> (grid_setup). `block` (out): the coarse start's width, coarse_factor. Collective.
    subroutine distribute_problem(problem, comm, how, grid, block, status)
       type(contact_problem), intent(in) :: problem
       type(MPI_Comm), intent(in) :: comm
@@ -346,9 +345,27 @@ contains
       type(distributed_grid), intent(inout) :: grid
       integer, intent(out) :: block
       type(status_type), intent(inout) :: status
-      real(dp), allocatable :: g0(:, :), local(:, :)
+      real(dp), allocatable :: local(:, :)
+      real(dp) :: constants(4)
+      call scatter_problem(problem, comm, how, local, constants, block)
+      call grid_setup(grid, comm, nint(constants(1)), block, local, constants(2), constants(3), constants(4), how, &
+         status)
+   end subroutine distribute_problem
+
+   !> Rank 0 forms the composite gaps (nm) of `problem` and sends each rank of `comm` its
+   !> columns (`local`); every rank gets `constants` = [NP, pixel (nm), compliance c and
+   !> the springs' compliance s (nm/nN)] and the coarse start's width `block`
+   !> (coarse_factor). The column split is column_split's. Collective.
+   subroutine scatter_problem(problem, comm, how, local, constants, block)
+      type(contact_problem), intent(in) :: problem
+      type(MPI_Comm), intent(in) :: comm
+      type(cg_settings), intent(in) :: how
+      real(dp), allocatable, intent(out) :: local(:, :)
+      real(dp), intent(out) :: constants(4)
+      integer, intent(out) :: block
+      real(dp), allocatable :: g0(:, :)
       integer, allocatable :: first(:), count(:)
-      real(dp) :: scalars(4), lower_top, upper_top, top
+      real(dp) :: lower_top, upper_top, top
       integer :: rank, ranks, np, i, j
       call MPI_Comm_rank(comm, rank)
       call MPI_Comm_size(comm, ranks)
@@ -372,23 +389,21 @@ contains
                g0(i, j) = top - g0(i, j)
             end do
          end do
-         scalars = [real(np, dp), problem%pixel, &
+         constants = [real(np, dp), problem%pixel, &
             surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
             surface_compliance(problem%young(2), problem%poisson(2), problem%pixel), &
             3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)]
       else
          allocate(g0(1, 1))
       end if
-      call MPI_Bcast(scalars, 4, MPI_DOUBLE_PRECISION, 0, comm)
-      np = nint(scalars(1))
+      call MPI_Bcast(constants, 4, MPI_DOUBLE_PRECISION, 0, comm)
+      np = nint(constants(1))
       block = coarse_factor(np, ranks, how)
       call column_split(np, ranks, block, first, count)
       allocate(local(np, count(rank)))
       call MPI_Scatterv(g0, np*count, np*first, MPI_DOUBLE_PRECISION, local, np*count(rank), MPI_DOUBLE_PRECISION, 0, &
          comm)
-      deallocate(g0)
-      call grid_setup(grid, comm, np, block, local, scalars(2), scalars(3), scalars(4), how, status)
-   end subroutine distribute_problem
+   end subroutine scatter_problem
 
    !> Frees the plans, the transform memory and the column type; the grid is empty after.
    subroutine grid_free(grid)
