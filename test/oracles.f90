@@ -12,7 +12,7 @@ module oracles
    implicit none
    private
    public :: love_quad, love_table, composite_compliance, spring_compliance, reference_gaps, exact_state, &
-      gaps_at_state, appendix_b_condition, first_touch_gaps
+      gaps_at_state, appendix_b_condition, first_touch_gaps, grid_stiffness
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -225,4 +225,27 @@ contains
          k(q, p) = k(q, p) - ks
       end subroutine spring
    end function appendix_b_condition
+
+   !> The dense stiffness of a whole np x np grid, the inverse of the compliance matrix
+   !> C(a, b) = I(|i_a - i_b|, |j_a - j_b|) + spring on the diagonal (dimensionless,
+   !> in units of the pixel's Love factor; I from love_table), pixels in column order.
+   !> By LU (dgetrf) and the explicit inverse (dgetri).
+   function grid_stiffness(np, spring) result(s)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: spring
+      real(dp), allocatable :: s(:, :), table(:, :), work(:)
+      integer, allocatable :: ipiv(:)
+      integer :: a, b, n, info
+      n = np*np
+      allocate(table(0:np - 1, 0:np - 1), s(n, n), ipiv(n), work(64*n))
+      table(:, :) = love_table(np)
+      do b = 1, n
+         do a = 1, n
+            s(a, b) = table(abs(mod(a - 1, np) - mod(b - 1, np)), abs((a - 1)/np - (b - 1)/np))
+         end do
+         s(b, b) = s(b, b) + spring
+      end do
+      call dgetrf(n, n, s, n, ipiv, info)
+      call dgetri(n, s, n, ipiv, work, size(work), info)
+   end function grid_stiffness
 end module oracles

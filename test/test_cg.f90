@@ -18,6 +18,8 @@ module test_cg
    use femcod_scene, only: initial_gaps
    use femcod_random, only: random_stream, seed_stream, uniform
    use test_support, only: scratch_path, file_exists, remove_scratch, read_text
+   use oracles, only: grid_stiffness, love_quad
+   use, intrinsic :: iso_fortran_env, only: real128
    use femcod_analytic, only: hertz_approach, segedin_sphere
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
    use femcod_status, only: STATUS_BAD_INPUT
@@ -58,7 +60,11 @@ contains
          new_unittest("pruned padded FFT convolution equals the direct sum (NP 7, 8, 33)", test_convolution), &
          new_unittest("preconditioner taps equal the inverse of a direct DFT (NP 4, 5, 9)", test_inverse_taps), &
          new_unittest("every acceleration, alone and together, keeps the event-exact answer", test_accelerations), &
-         new_unittest("--fftw-wisdom writes both wisdom files and leaves the answer unchanged", test_wisdom) &
+         new_unittest("--fftw-wisdom writes both wisdom files and leaves the answer unchanged", test_wisdom), &
+         new_unittest("error bound's premise: the grid stiffness is an M-matrix with positive row sums", &
+         test_stiffness_m_matrix), &
+         new_unittest("error bound: the event-exact approach lies within the printed bound (tol 1e-3..1e-7)", &
+         test_approach_bound) &
          ]
    end subroutine collect_cg
 
@@ -1045,6 +1051,101 @@ contains
          end do
       end do
    end subroutine test_accelerations
+
+   !> The premise of the cg error bound (femcod_cg, doc/solver.md): the stiffness of the
+   !> whole grid, the inverse of the Love compliance plus the springs' diagonal, has no
+   !> positive entry off its diagonal and positive row sums. Computed densely by the
+   !> oracle (quadruple-precision Love coefficients, LU inverse), NP = 12 and 20, without
+   !> springs, with the thesis decks' stiff interface springs (2.38e-5 of the self-
+   !> compliance, the summary's model line) and with springs as soft as the pixel itself.
+   subroutine test_stiffness_m_matrix(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), allocatable :: s(:, :)
+      real(dp) :: spring(3), worst, least, self
+      integer :: nps(2), a, b, v, m
+      nps = [12, 20]
+      do m = 1, size(nps)
+         self = real(love_quad(0.0_real128, 0.0_real128), dp)
+         spring = [0.0_dp, 2.38e-5_dp*self, self]
+         do v = 1, size(spring)
+            s = grid_stiffness(nps(m), spring(v))
+            worst = -huge(1.0_dp)
+            do b = 1, size(s, 2)
+               do a = 1, size(s, 1)
+                  if (a /= b) worst = max(worst, s(a, b)/s(b, b))
+               end do
+            end do
+            least = minval(sum(s, dim=2))/maxval(sum(s, dim=2))
+            call check(error, worst < 0, "NP "//to_string(nps(m))//", spring "//to_string(spring(v))// &
+               ": largest off-diagonal stiffness / diagonal "//to_string(worst))
+            if (allocated(error)) return
+            call check(error, least > 0, "NP "//to_string(nps(m))//", spring "//to_string(spring(v))// &
+               ": smallest row sum / largest "//to_string(least))
+            if (allocated(error)) return
+         end do
+      end do
+   end subroutine test_stiffness_m_matrix
+
+   !> The approach's error bound against an independent answer: on a 64 x 64 self-affine
+   !> surface, at loads inside steps of the event-exact history (exact to round-off, a
+   !> different algorithm: Cholesky factors of the contact set), cg with all its
+   !> accelerations at tolerances 1e-3, 1e-5 and 1e-7 misses the event-exact approach by
+   !> no more than the bound it reports; under --approach it reports none.
+   subroutine test_approach_bound(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: inc, cg
+      type(status_type) :: status
+      real(dp) :: tols(3), miss
+      integer :: v, k, n, s
+      spec%kind = "self-affine"
+      spec%np = 64
+      spec%pixel = 10
+      spec%hurst = 0.8_dp
+      spec%rms = 3
+      spec%seed = 11
+      spec%shape_on = "lower"
+      spec%rigid = "upper"
+      spec%label = "test"
+      spec%matrix_file = ""
+      spec%maxcont = 300
+      call build_problem(spec, deck, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      options%loads = [real(dp) ::]
+      options%solver = "incremental"
+      call solve_contact(deck, options, inc, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      n = inc%nsteps
+      options%loads = [((inc%step_load(s) + inc%step_load(s + 1))/2, s=n/8, n - 1, n/4)]
+      call solve_contact(deck, options, inc, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      tols = [1.0e-3_dp, 1.0e-5_dp, 1.0e-7_dp]
+      do v = 1, size(tols)
+         options%solver = "cg"
+         options%cg = cg_settings()
+         options%cg%tol = tols(v)
+         call solve_contact(deck, options, cg, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         do k = 1, size(options%loads)
+            miss = abs(cg%states(k)%approach - inc%states(k)%approach)
+            call check(error, cg%states(k)%approach_bound >= 0 .and. miss <= cg%states(k)%approach_bound, &
+               "tol "//to_string(tols(v))//", load "//to_string(options%loads(k))//": approach off by "// &
+               to_string(miss)//" nm, bound "//to_string(cg%states(k)%approach_bound)//" nm")
+            if (allocated(error)) return
+         end do
+      end do
+      options%approaches = [inc%states(1)%approach]
+      call solve_contact(deck, options, cg, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, cg%states(1)%approach_bound < 0, "--approach: a bound of the approach was reported")
+   end subroutine test_approach_bound
 
    !> `--fftw-wisdom FILE`: both files written; a second run that reads them gives the
    !> same approach (plans change the round-off only: 1e-12 relative).

@@ -35,6 +35,7 @@ program femcod_mpi
       agree
    use femcod_svg, only: svg_pressure_map
    use femcod_maps, only: state_maps
+   use femcod_cg, only: approach_error_bound
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -269,7 +270,8 @@ contains
       do s = 1, size(states)
          associate(st => states(s))
             text = text//'{"load_nN": '//json_number(st%load)//', "approach_nm": '//json_number(st%approach)// &
-               ', "contacts": '//int_str(st%contacts)//', "area_fraction": '// &
+               ', "approach_error_bound_nm": '//json_number(approach_error_bound(st%penetration, st%contact_gap, &
+               st%load_error, st%approach))//', "contacts": '//int_str(st%contacts)//', "area_fraction": '// &
                json_number(real(st%contacts, dp)/real(np, dp)**2)//', "max_pressure_GPa": '// &
                json_number(st%max_pressure)//', "iterations": '//int_str(st%iterations)// &
                ', "coarse_iterations": '//int_str(st%coarse_iterations)//', "convolutions": '// &
@@ -290,7 +292,8 @@ contains
       do s = 1, size(states)
          associate(st => states(s))
             write(output_unit, '(a)') "  load "//format_real(st%load)//" nN: approach "//sig_str(st%approach, 10)// &
-               " nm, "//int_str(st%contacts)//" contacts ("//sig_str(100*real(st%contacts, dp)/real(np, dp)**2, 4)// &
+               " nm (+- "//sig_str(approach_error_bound(st%penetration, st%contact_gap, st%load_error, st%approach), 2)// &
+               " nm), "//int_str(st%contacts)//" contacts ("//sig_str(100*real(st%contacts, dp)/real(np, dp)**2, 4)// &
                " % of the area), max pressure "//sig_str(st%max_pressure, 4)//" GPa"
             write(output_unit, '(a)') "    "//int_str(st%iterations)//" iterations (+ "//int_str(st%coarse_iterations)// &
                " on coarser grids), "//int_str(st%convolutions)//" fresh convolutions, residual "// &

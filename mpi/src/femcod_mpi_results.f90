@@ -12,6 +12,7 @@ module femcod_mpi_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_strings, only: int_str
+   use femcod_cg, only: approach_error_bound
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_attribute
    use femcod_results, only: load_group
    use femcod_mpi_cg, only: distributed_grid, distributed_state
@@ -62,6 +63,8 @@ contains
                call h5_attribute(file, g, "cg_penetration_nm", s%penetration, status)
                call h5_attribute(file, g, "cg_contact_gap_nm", s%contact_gap, status)
                call h5_attribute(file, g, "cg_load_error", s%load_error, status)
+               call h5_attribute(file, g, "approach_error_bound_nm", approach_error_bound(s%penetration, &
+                  s%contact_gap, s%load_error, s%approach), status)
             end associate
          end do
          call h5_group(file, "/run", status)

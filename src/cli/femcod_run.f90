@@ -781,7 +781,8 @@ contains
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          write(output_unit, '(a)') "  at load   : "//sig_str(res%states(k)%load, 6)//" nN: approach "// &
-            sig_str(res%states(k)%approach, 6)//" nm, "//int_str(res%states(k)%contacts)//" contacts ("// &
+            sig_str(res%states(k)%approach, 6)//" nm"//trim(bound_text(res%states(k)%approach_bound))//", "// &
+            int_str(res%states(k)%contacts)//" contacts ("// &
             sig_str(res%states(k)%contacts*problem%pixel**2, 4)//" nm^2), max pressure "// &
             sig_str(res%states(k)%max_pressure, 4)//" GPa"
          if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
@@ -863,6 +864,14 @@ contains
       class(run_observer), intent(inout) :: self
       signal_arrived = stop_signal() /= 0
    end function signal_arrived
+
+   !> " (+- B nm)" after an approach the solver bounds (B >= 0), "" otherwise.
+   function bound_text(bound) result(text)
+      real(dp), intent(in) :: bound
+      character(len=:), allocatable :: text
+      text = ""
+      if (bound >= 0) text = " (+- "//sig_str(bound, 2)//" nm)"
+   end function bound_text
 
    !> How a deck is named in messages.
    function deck_label(path) result(name)

@@ -364,6 +364,7 @@ contains
                call h5_attribute(file, g, "cg_penetration_nm", s%penetration, local)
                call h5_attribute(file, g, "cg_contact_gap_nm", s%contact_gap, local)
                call h5_attribute(file, g, "cg_load_error", s%load_error, local)
+               call h5_attribute(file, g, "approach_error_bound_nm", s%approach_bound, local)
             end if
             if (has_adhesion(info)) then
                call h5_attribute(file, g, "attractive_pixels", s%attractive, local)
@@ -586,6 +587,8 @@ contains
                ', "n_above_hardness": '//int_str(s%n_above_hardness)//', "n_plastic": '// &
                int_str(s%n_plastic)//', "plastic_volume_nm3": '//json_number(s%plastic_volume)//', "hdf5_group": '// &
                json_string(load_group(k, size(res%states)))
+            if (s%reached .and. s%approach_bound >= 0) loads = loads//', "approach_error_bound_nm": '// &
+               json_number(s%approach_bound)
             if (s%reached .and. has_adhesion(info)) loads = loads//', "attractive_pixels": '// &
                int_str(s%attractive)//', "attractive_load_nN": '//json_number(s%attractive_load)// &
                ', "mean_gap_nm": '//json_number(s%mean_gap)//', "jump": '//int_str(s%jump)

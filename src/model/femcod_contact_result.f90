@@ -35,6 +35,10 @@ module femcod_contact_result
       !> penetration (nm), largest |gap| on contact (nm), relative load error.
       integer :: iterations = 0
       real(dp) :: residual = 0, penetration = 0, contact_gap = 0, load_error = 0
+      !> Fixed-load solver at a given load (elastic, full kernel, not periodic): the
+      !> approach is within approach_bound (nm) of the exact answer of the discrete
+      !> problem (femcod_cg's approach_error_bound); -1 where the solver has no bound.
+      real(dp) :: approach_bound = -1
       !> Fixed-load solver only: iterations on all coarser grids together, and fresh
       !> convolutions of the forces on the finest grid.
       integer :: coarse_iterations = 0, convolutions = 0

@@ -44,6 +44,15 @@
 !> evaluated on displacements from a fresh double-precision convolution of the final
 !> forces, with the load balanced to round-off by construction. The residuals reached
 !> are returned: max penetration (nm), largest |gap| on contact (nm), load error, r.
+!>
+!> Error bound of the approach (approach_error_bound): the forces returned are the exact
+!> answer for gaps g0 moved by at most eps = max(penetration, |gap| on contact) at every
+!> pixel (a backward error), and the exact approach moves by at most eps when g0 does:
+!> the stiffness S = (c I + s)^-1 has no positive entry off its diagonal and positive
+!> row sums (an M-matrix; test_cg checks both on a dense grid), so the displacements are
+!> the least supersolution of the obstacle problem, monotone in the obstacle, and the
+!> load, the sum of S times them, is monotone too; moving all of g0 by eps moves the
+!> approach by exactly eps.
 module femcod_cg
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
@@ -61,7 +70,7 @@ module femcod_cg
    use femcod_clock, only: wall_clock
    implicit none
    private
-   public :: solve_cg, coarse_start_forces
+   public :: solve_cg, coarse_start_forces, approach_error_bound
 
    !> What the CG solver reached at one load.
    type :: cg_residuals
@@ -89,6 +98,17 @@ module femcod_cg
    end type cg_grid
 
 contains
+
+   !> The approach (nm) of a fixed-load answer lies within this many nm of the exact
+   !> answer of the discrete problem (module header): the largest gap violation eps =
+   !> max(penetration, contact_gap) (nm), plus the load error's share, load_error times
+   !> the approach (a relative load error e moves the approach by at most e times it while
+   !> the load-approach curve is convex from first touch, the contact stiffness growing
+   !> with the contact; e is round-off, 1e-16, by construction).
+   pure real(dp) function approach_error_bound(penetration, contact_gap, load_error, approach) result(bound)
+      real(dp), intent(in) :: penetration, contact_gap, load_error, approach
+      bound = max(penetration, contact_gap) + load_error*abs(approach)
+   end function approach_error_bound
 
    !> Solve at every requested load (ascending order of computation; results in the
    !> order given, with the residuals reached in each load state). A load whose residual
@@ -173,6 +193,9 @@ contains
             st%penetration = report(k)%penetration
             st%contact_gap = report(k)%contact_gap
             st%load_error = report(k)%load_error
+            if (.not. (by_approach .or. options%plastic .or. options%boundary == "periodic" .or. &
+               how%kernel_radius > 0)) st%approach_bound = approach_error_bound(st%penetration, &
+               st%contact_gap, st%load_error, st%approach)
             st%coarse_iterations = report(k)%coarse_iterations
             st%convolutions = report(k)%convolutions
             st%contacts = count(p > 0)
