@@ -1108,7 +1108,8 @@ contains
                   call frontier_row("cg tol "//real_str(tols(k), 1)//trim(merge(", no float32", "            ", &
                      m == 2 .or. m == 4))//trim(merge(", no nested start", "                 ", m >= 3)), t1, &
                      rel(res%states(1)%approach, a_ref), rel(res%states(1)%contacts*deck%pixel**2, c_ref), &
-                     int_str(res%states(1)%iterations)//" iterations")
+                     int_str(res%states(1)%iterations)//" iterations, approach bound "// &
+                     real_str(res%states(1)%approach_bound/abs(a_ref), 2))
                end do
             end do
             ! The Love kernel truncated (the thesis' 28 and 283 pixels, section 5.2.2 iii).
