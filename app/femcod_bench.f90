@@ -926,6 +926,8 @@ contains
          call linear_law(deck, estar, slope, g0)
          path = "femcod-bench-gaps.f64"
          if (len(python) > 0) call write_peer_gaps(path, g0)
+         ! The peers read the file: the bench's own copy of the gaps is not the solver's.
+         deallocate(g0)
          do k = 1, size(fractions)
             pressure = fractions(k)/100*estar*slope/2
             load = pressure*BENCH_LENGTH**2
@@ -1381,6 +1383,8 @@ contains
          call linear_law(deck, estar, slope, g0)
          path = "femcod-bench-gaps.f64"
          if (len(python) > 0) call write_peer_gaps(path, g0)
+         ! The peers read the file: the bench's own copy of the gaps is not the solver's.
+         deallocate(g0)
          do k = 1, size(fractions)
             pressure = fractions(k)/100*estar*slope/2
             load = pressure*length**2
