@@ -35,7 +35,7 @@ module femcod_mpi_cg
       FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK, fftwf_mpi_plan_many_transpose, fftwf_mpi_execute_r2r, &
       fftwf_plan_many_dft_r2c, fftwf_plan_many_dft_c2r, fftwf_plan_many_dft, fftwf_execute_dft_r2c, &
       fftwf_execute_dft_c2r, fftwf_execute_dft, fftwf_destroy_plan
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
    use femcod_spring, only: spring_stiffness
@@ -47,8 +47,6 @@ module femcod_mpi_cg
    use femcod_clock, only: wall_clock
    implicit none
    private
-   !> float32, for the transforms of the search directions (as femcod_convolution's).
-   integer, parameter :: sp = kind(1.0)
    public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor
    public :: distribute_problem, scatter_problem, distributed_convolve
 

@@ -32,7 +32,7 @@
 module femcod_convolution
    use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_float, c_double_complex, c_float_complex, c_int, &
       c_size_t, c_f_pointer
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, sp
    use femcod_fftw, only: fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, &
       fftw_execute_dft_r2c, fftw_execute_dft_c2r, fftw_execute_dft, &
       fftwf_plan_many_dft_r2c, fftwf_plan_many_dft_c2r, fftwf_plan_many_dft, &
@@ -44,8 +44,6 @@ module femcod_convolution
    private
    public :: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, convolution_free, &
       inverse_kernel_taps
-
-   integer, parameter :: sp = kind(1.0)
 
    !> Lines per block in every pass: 8 lines of M = 8192 are 0.5 MB of float32 complex, in
    !> L2 cache; 4 and 16 were slower at NP = 4096 (doc/performance.md, the convolution).
@@ -75,9 +73,8 @@ module femcod_convolution
       !> Per thread: a real block (M x block) and a complex block (M x block).
       type(c_ptr), allocatable :: real_mem(:), complex_mem(:)
       !> Real kernel spectrum divided by M^2, transposed: kernel(k2, k1), k2 = 0..M/2,
-      !> k1 = 1..MH; and its float32 copy.
+      !> k1 = 1..MH (rounded to float32 where a float32 convolution uses it: no copy).
       real(dp), allocatable :: kernel(:, :)
-      real(sp), allocatable :: kernel32(:, :)
    end type love_convolution
 
 contains
@@ -182,10 +179,6 @@ contains
       !$omp end parallel
       ! A periodic table has zero mean (round-off aside): no zero-frequency response.
       if (conv%periodic) conv%kernel(0, 1) = 0
-      if (conv%has_single) then
-         allocate(conv%kernel32(0:kh, mh))
-         conv%kernel32(:, :) = real(conv%kernel, sp)
-      end if
    end subroutine convolution_setup
 
    !> The double-precision plans, made on thread 0's buffers.
@@ -309,12 +302,14 @@ contains
    end subroutine convolution_apply
 
    !> As convolution_apply, with float32 transforms (needs setup with single = .true.).
-   subroutine convolution_apply_single(conv, field, result, factor)
+   !> The result in double (`result`) or, rounded once more, in float32 (`result32`).
+   subroutine convolution_apply_single(conv, field, result, factor, result32)
       type(love_convolution), intent(inout) :: conv
       real(dp), intent(in) :: field(:, :)
-      real(dp), intent(out) :: result(:, :)
+      real(dp), intent(out), optional :: result(:, :)
       !> Multiplies the result (default 1): a compliance, folded into the last pass.
       real(dp), intent(in), optional :: factor
+      real(sp), intent(out), optional :: result32(:, :)
       real(c_float), pointer :: lines(:, :)
       complex(c_float_complex), pointer :: half(:, :)
       real(dp) :: f
@@ -354,8 +349,8 @@ contains
          half(:, nb + 1:) = 0
          call fftwf_execute_dft(conv%single%rows_forward, half, half)
          do j = 1, nb
-            half(1:kh + 1, j) = half(1:kh + 1, j)*conv%kernel32(:, j0 + j)
-            half(kh + 2:m, j) = half(kh + 2:m, j)*conv%kernel32(m - kh - 1:1:-1, j0 + j)
+            half(1:kh + 1, j) = half(1:kh + 1, j)*real(conv%kernel(:, j0 + j), sp)
+            half(kh + 2:m, j) = half(kh + 2:m, j)*real(conv%kernel(m - kh - 1:1:-1, j0 + j), sp)
          end do
          call fftwf_execute_dft(conv%single%rows_backward, half, half)
          do j = 1, np
@@ -371,7 +366,11 @@ contains
          half(:, 1:nb) = conv%spectrum32(:, j0 + 1:j0 + nb)
          half(:, nb + 1:) = 0
          call fftwf_execute_dft_c2r(conv%single%columns_backward, half, lines)
-         result(:, j0 + 1:j0 + nb) = f*real(lines(1:np, 1:nb), dp)
+         if (present(result32)) then
+            result32(:, j0 + 1:j0 + nb) = real(f*real(lines(1:np, 1:nb), dp), sp)
+         else
+            result(:, j0 + 1:j0 + nb) = f*real(lines(1:np, 1:nb), dp)
+         end if
       end do
       !$omp end do
       !$omp end parallel
@@ -446,7 +445,6 @@ contains
       call fftw_free(conv%spectrum_mem)
       nullify(conv%spectrum, conv%spectrum32)
       if (allocated(conv%kernel)) deallocate(conv%kernel)
-      if (allocated(conv%kernel32)) deallocate(conv%kernel32)
       conv%m = 0
       conv%has_single = .false.
    end subroutine convolution_free

@@ -54,7 +54,7 @@
 !> load, the sum of S times them, is monotone too; moving all of g0 by eps moves the
 !> approach by exactly eps.
 module femcod_cg
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gaps
@@ -90,7 +90,12 @@ module femcod_cg
       !> The grid is one cell of a periodic surface (periodic table, cyclic convolution).
       logical :: periodic = .false.
       real(dp) :: pixel = 0, c = 0, s = 0, scale = 1
-      real(dp), allocatable :: g0(:, :), table(:, :)
+      real(dp), allocatable :: g0(:, :)
+      !> The Love table I(0:np-1, 0:np-1) for direct corrections, rounded to float32 (its
+      !> double is needed only to set up the convolution; at NP = 4096 the float32 table
+      !> is 67 MB); self = I(0, 0), one pixel's own coefficient, in double.
+      real(sp), allocatable :: table(:, :)
+      real(dp) :: self = 0
       !> Preconditioner taps (inverse_kernel_taps); `preconditioned` false: none.
       logical :: preconditioned = .false.
       real(dp) :: taps(0:2, 0:2) = 0
@@ -291,7 +296,7 @@ contains
          if (sum(p) > 0 .and. approach > 0) then
             trial = sum(p)*(target/approach)**1.5_dp
          else
-            trial = target/(fine%c*fine%table(0, 0) + fine%s)
+            trial = target/(fine%c*fine%self + fine%s)
          end if
          do solve = 1, MAX_SOLVES
             call solve_load(trial, k)
@@ -421,6 +426,7 @@ contains
       real(dp), intent(in) :: pixel
       type(cg_settings), intent(in) :: how
       logical, intent(in) :: periodic
+      real(dp), allocatable :: table(:, :)
       grid%np = size(g0, 1)
       grid%periodic = periodic
       grid%pixel = pixel
@@ -429,14 +435,17 @@ contains
          surface_compliance(problem%young(2), problem%poisson(2), pixel)
       grid%s = 3/spring_stiffness(problem%young(3), problem%poisson(3), pixel, pixel)
       grid%scale = max(maxval(g0) - minval(g0), tiny(1.0_dp))
-      allocate(grid%table(0:grid%np - 1, 0:grid%np - 1))
+      allocate(table(0:grid%np - 1, 0:grid%np - 1))
       if (periodic) then
-         grid%table(:, :) = periodic_offset_table(grid%np)
+         table(:, :) = periodic_offset_table(grid%np)
       else
-         grid%table(:, :) = offset_table(grid%np)
+         table(:, :) = offset_table(grid%np)
       end if
-      if (how%kernel_radius > 0) call truncate_table(grid%table, how%kernel_radius*problem%pixel/pixel)
-      call convolution_setup(grid%conv, grid%table, how%single_until > 0, how%measure_plans, periodic)
+      if (how%kernel_radius > 0) call truncate_table(table, how%kernel_radius*problem%pixel/pixel)
+      call convolution_setup(grid%conv, table, how%single_until > 0, how%measure_plans, periodic)
+      grid%self = table(0, 0)
+      allocate(grid%table(0:grid%np - 1, 0:grid%np - 1))
+      grid%table(:, :) = real(table, sp)
       if (how%precondition) call inverse_kernel_taps(grid%conv, grid%taps, grid%preconditioned)
    end subroutine make_grid
 
@@ -554,22 +563,34 @@ contains
       !> 0 at the contacts: the gap map of this load (solvers/femcod_maps), without a
       !> convolution of its own.
       real(dp), allocatable, intent(out), optional :: final_gap(:, :)
-      real(dp), allocatable :: w(:, :), g(:, :), t(:, :), r(:, :), gm(:, :), z(:, :), g_old(:, :)
+      ! No array of the gaps: they are g0 + w + s p - gbar (gap_at), formed where they are
+      ! used, and gm keeps them in float32 on the contacts (zero elsewhere, two pixels of
+      ! padding for the stencil) for the direction and its step, which the gaps recomputed
+      ! in double each iteration correct; nor of the preconditioned gaps z (stencil_at,
+      ! formed twice). r, the displacements of the direction, is float32 (r32) when the
+      ! transform making it is. At NP = 4096 each NP x NP array is 134 MB in double.
+      real(dp), allocatable :: w(:, :), t(:, :), r(:, :)
+      real(sp), allocatable :: gm(:, :), r32(:, :)
+      !> The previous gaps, for beta and Powell's test only: float32 is enough (67 MB at
+      !> NP = 4096 instead of 134).
+      real(sp), allocatable :: g_old(:, :)
       integer, allocatable :: changed(:, :)
       real(dp), allocatable :: delta(:)
       real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, residual, &
-         contact_gap, penetration, alpha, pn, lin, entry, zbar, cross
+         contact_gap, penetration, alpha, pn, lin, entry, zbar, cross, gij
       integer :: np, i, j, it, nc, nchanged, limit, slot
       logical :: restart, entered, single, fresh, fresh_double, stalled, keep_old
       np = grid%np
       c = grid%c
       s = grid%s
       limit = max(how%direct_corrections, 0)
-      allocate(w(np, np), g(np, np), t(np, np), r(np, np), changed(2, limit), delta(limit))
-      if (grid%preconditioned) then
-         allocate(gm(-1:np + 2, -1:np + 2), z(np, np))
-         gm = 0
+      allocate(w(np, np), t(np, np), gm(-1:np + 2, -1:np + 2), changed(2, limit), delta(limit))
+      if (how%single_until > 0) then
+         allocate(r32(np, np))
+      else
+         allocate(r(np, np))
       end if
+      gm = 0
       ! The previous gradient, for Polak-Ribiere's beta and for Powell's restart test.
       keep_old = how%polak_ribiere .or. how%powell_restart > 0
       if (keep_old) then
@@ -609,10 +630,9 @@ contains
             do i = 1, np
                p(i, j) = alpha*p(i, j)
                w(i, j) = alpha*w(i, j)
-               g(i, j) = grid%g0(i, j) + w(i, j) + s*p(i, j)
                if (p(i, j) > 0) then
                   nc = nc + 1
-                  gbar = gbar + g(i, j)
+                  gbar = gbar + (grid%g0(i, j) + w(i, j) + s*p(i, j))
                end if
             end do
          end do
@@ -629,18 +649,18 @@ contains
          cross = 0
          contact_gap = 0
          penetration = 0
-         !$omp parallel do private(i) reduction(+:big_g, cross) reduction(max:contact_gap, penetration)
+         !$omp parallel do private(i, gij) reduction(+:big_g, cross) reduction(max:contact_gap, penetration)
          do j = 1, np
             do i = 1, np
-               g(i, j) = g(i, j) - gbar
+               gij = gap_at(i, j)
                if (p(i, j) > 0) then
-                  big_g = big_g + g(i, j)**2
-                  if (keep_old .and. .not. grid%preconditioned) cross = cross + g(i, j)*g_old(i, j)
-                  contact_gap = max(contact_gap, abs(g(i, j)))
-                  if (grid%preconditioned) gm(i, j) = g(i, j)
+                  big_g = big_g + gij**2
+                  if (keep_old .and. .not. grid%preconditioned) cross = cross + gij*real(g_old(i, j), dp)
+                  contact_gap = max(contact_gap, abs(gij))
+                  gm(i, j) = real(gij, sp)
                else
-                  penetration = max(penetration, -g(i, j))
-                  if (grid%preconditioned) gm(i, j) = 0
+                  penetration = max(penetration, -gij)
+                  gm(i, j) = 0
                end if
             end do
          end do
@@ -674,14 +694,14 @@ contains
          !$omp parallel do private(i) reduction(+:num)
          do j = 1, np
             do i = 1, np
-               if (keep_old) g_old(i, j) = g(i, j)
+               if (keep_old) g_old(i, j) = real(gap_at(i, j), sp)
                if (p(i, j) > 0) then
                   if (grid%preconditioned) then
-                     t(i, j) = z(i, j) - zbar + beta*t(i, j)
+                     t(i, j) = stencil_at(i, j) - zbar + beta*t(i, j)
                   else
-                     t(i, j) = g(i, j) + beta*t(i, j)
+                     t(i, j) = real(gm(i, j), dp) + beta*t(i, j)
                   end if
-                  num = num + g(i, j)*t(i, j)
+                  num = num + real(gm(i, j), dp)*t(i, j)
                else
                   t(i, j) = 0
                end if
@@ -691,7 +711,12 @@ contains
          ! when float32 is on: its round-off (1e-7 of r) scales with the step, and the
          ! steps shrink with the residual, so it never limits the accuracy; the forces'
          ! own displacements (fresh) switch to double below `single_until`.
-         call convolve(t, r, how%single_until > 0)
+         if (allocated(r32)) then
+            call convolution_apply_single(grid%conv, t, factor=c, result32=r32)
+            fresh_double = .false.
+         else
+            call convolve(t, r, .false.)
+         end if
          rt = 0
          rsum = 0
          tsum = 0
@@ -699,8 +724,8 @@ contains
          do j = 1, np
             do i = 1, np
                if (p(i, j) > 0) then
-                  rt = rt + (r(i, j) + s*t(i, j))*t(i, j)
-                  rsum = rsum + r(i, j) + s*t(i, j)
+                  rt = rt + (r_at(i, j) + s*t(i, j))*t(i, j)
+                  rsum = rsum + r_at(i, j) + s*t(i, j)
                   tsum = tsum + t(i, j)
                end if
             end do
@@ -720,7 +745,7 @@ contains
          nchanged = 0
          entered = .false.
          psum = 0
-         !$omp parallel do private(i, lin, pn, slot) reduction(+:psum) reduction(.or.:entered)
+         !$omp parallel do private(i, lin, pn, slot, gij) reduction(+:psum) reduction(.or.:entered)
          do j = 1, np
             do i = 1, np
                if (p(i, j) > 0) then
@@ -729,13 +754,14 @@ contains
                else
                   lin = 0
                   pn = 0
-                  if (g(i, j) < 0) then
-                     pn = -tau*entry*g(i, j)
+                  gij = gap_at(i, j)
+                  if (gij < 0) then
+                     pn = -tau*entry*gij
                      entered = .true.
                   end if
                end if
                p(i, j) = pn
-               w(i, j) = w(i, j) - tau*r(i, j)
+               w(i, j) = w(i, j) - tau*r_at(i, j)
                psum = psum + pn
                if (pn /= lin) then
                   !$omp atomic capture
@@ -767,41 +793,83 @@ contains
       rep%contact_gap = contact_gap
       rep%penetration = penetration
       rep%load_error = abs(sum(p) - total_load)/total_load
-      if (present(final_gap)) final_gap = merge(0.0_dp, g, p > 0)
+      if (present(final_gap)) then
+         ! Formed in t's storage and handed over: no further NP x NP array at the peak.
+         if (allocated(r)) deallocate(r)
+         if (allocated(r32)) deallocate(r32)
+         if (allocated(g_old)) deallocate(g_old)
+         !$omp parallel do private(i)
+         do j = 1, np
+            do i = 1, np
+               t(i, j) = merge(0.0_dp, gap_at(i, j), p(i, j) > 0)
+            end do
+         end do
+         call move_alloc(t, final_gap)
+      end if
    contains
+      !> The gap (nm) at pixel (i, j) of the current forces p and displacements w, less the
+      !> contacts' mean gap gbar: the same expression, in the same order, wherever used.
+      pure real(dp) function gap_at(i, j)
+         integer, intent(in) :: i, j
+         gap_at = grid%g0(i, j) + w(i, j) + s*p(i, j) - gbar
+      end function gap_at
+
+      !> The displacement (nm) of the search direction at pixel (i, j), from r32 or r.
+      pure real(dp) function r_at(i, j)
+         integer, intent(in) :: i, j
+         if (allocated(r32)) then
+            r_at = real(r32(i, j), dp)
+         else
+            r_at = r(i, j)
+         end if
+      end function r_at
+
+      !> The 13-point stencil of the inverse Love operator on the contacts' gaps gm at
+      !> pixel (i, j): the preconditioned gap z.
+      pure real(dp) function stencil_at(i, j)
+         integer, intent(in) :: i, j
+         associate(a => grid%taps)
+            stencil_at = a(0, 0)*g_at(i, j) + a(1, 0)*(g_at(i - 1, j) + g_at(i + 1, j)) + &
+               a(0, 1)*(g_at(i, j - 1) + g_at(i, j + 1)) + &
+               a(1, 1)*(g_at(i - 1, j - 1) + g_at(i + 1, j - 1) + g_at(i - 1, j + 1) + g_at(i + 1, j + 1)) + &
+               a(2, 0)*(g_at(i - 2, j) + g_at(i + 2, j)) + a(0, 2)*(g_at(i, j - 2) + g_at(i, j + 2))
+         end associate
+      end function stencil_at
+
+      !> The contacts' gap gm at (i, j) in double.
+      pure real(dp) function g_at(i, j)
+         integer, intent(in) :: i, j
+         g_at = real(gm(i, j), dp)
+      end function g_at
+
       !> z = the stencil applied to the contacts' gaps gm (zero off the contacts), on the
       !> contacts; zbar its mean there (the direction is z - zbar); big_g = g . (z - zbar),
       !> the preconditioned norm for beta, and cross = g_old . (z - zbar) for Polak-Ribiere
-      !> and Powell's restart test.
+      !> and Powell's restart test. z is not kept: the direction forms it again.
       subroutine precondition(big_g, zbar, cross)
          real(dp), intent(out) :: big_g, zbar, cross
-         real(dp) :: zsum, gz, gsum, zo, osum
+         real(dp) :: zsum, gz, gsum, zo, osum, zij
          integer :: ii, jj
          zsum = 0
          gz = 0
          gsum = 0
          zo = 0
          osum = 0
-         associate(a => grid%taps)
-            !$omp parallel do private(ii) reduction(+:zsum, gz, gsum, zo, osum)
-            do jj = 1, np
-               do ii = 1, np
-                  if (p(ii, jj) > 0) then
-                     z(ii, jj) = a(0, 0)*gm(ii, jj) + a(1, 0)*(gm(ii - 1, jj) + gm(ii + 1, jj)) + &
-                        a(0, 1)*(gm(ii, jj - 1) + gm(ii, jj + 1)) + &
-                        a(1, 1)*(gm(ii - 1, jj - 1) + gm(ii + 1, jj - 1) + gm(ii - 1, jj + 1) + gm(ii + 1, jj + 1)) + &
-                        a(2, 0)*(gm(ii - 2, jj) + gm(ii + 2, jj)) + a(0, 2)*(gm(ii, jj - 2) + gm(ii, jj + 2))
-                     zsum = zsum + z(ii, jj)
-                     gz = gz + g(ii, jj)*z(ii, jj)
-                     gsum = gsum + g(ii, jj)
-                     if (keep_old) then
-                        zo = zo + g_old(ii, jj)*z(ii, jj)
-                        osum = osum + g_old(ii, jj)
-                     end if
+         !$omp parallel do private(ii, zij) reduction(+:zsum, gz, gsum, zo, osum)
+         do jj = 1, np
+            do ii = 1, np
+               if (p(ii, jj) > 0) then
+                  zij = stencil_at(ii, jj)
+                  zsum = zsum + zij
+                  gz = gz + real(gm(ii, jj), dp)*zij
+                  gsum = gsum + real(gm(ii, jj), dp)
+                  if (keep_old) then
+                     zo = zo + real(g_old(ii, jj), dp)*zij
+                     osum = osum + real(g_old(ii, jj), dp)
                   end if
-               end do
+               end if
             end do
-         end associate
+         end do
          zbar = zsum/nc
          big_g = gz - zbar*gsum
          cross = zo - zbar*osum
@@ -855,7 +923,7 @@ contains
                iq = changed(1, q)
                jq = changed(2, q)
                do ii = 1, np
-                  w(ii, jj) = w(ii, jj) + c*delta(q)*grid%table(abs(ii - iq), abs(jj - jq))
+                  w(ii, jj) = w(ii, jj) + c*delta(q)*real(grid%table(abs(ii - iq), abs(jj - jq)), dp)
                end do
             end do
          end do
