@@ -19,7 +19,7 @@ module test_periodic
    use femcod_deck, only: read_deck
    use femcod_scene, only: initial_gaps
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_read_string_attribute
-   use femcod_status, only: STATUS_BAD_INPUT
+   use femcod_status, only: STATUS_BAD_INPUT, STATUS_USAGE
    use test_support, only: scratch_path, read_text, file_exists, remove_scratch
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -46,7 +46,8 @@ contains
             test_event_path), &
          new_unittest("--plastic on a periodic cell, both solvers: capped at H, the load carried, area >= P/H", &
             test_plastic_periodic), &
-         new_unittest("--approach on the periodic cell: Westergaard's load at the closed-form approach, both", &
+         new_unittest("--approach on the periodic cell: Westergaard's load at the closed-form approach, both; "// &
+            "beyond full contact refused", &
             test_approach_westergaard), &
          new_unittest("femcod run --boundary periodic: maps on the periodic kernel, recorded; legacy refused", &
             test_run_periodic) &
@@ -627,5 +628,16 @@ contains
             message="the two solvers' loads at p/p* = "//to_string(ratios(k)))
          if (allocated(error)) return
       end do
+      ! Full contact comes at the approach h0 = 1 nm, the mean of the gaps 1 - cos (the
+      ! closed form above at p = p*); beyond it no load gives the approach: cg refuses it
+      ! at once instead of iterating to its limit.
+      options = contact_options()
+      options%solver = "cg"
+      options%boundary = "periodic"
+      options%loads = [real(dp) ::]
+      options%approaches = [0.5_dp, 1.01_dp]
+      call solve_contact(problem, options, res(1), status)
+      call check(error, status%code == STATUS_USAGE .and. index(status%message, "full contact") > 0, &
+         "approach 1.01 h0: exit "//to_string(status%code)//", "//status%message)
    end subroutine test_approach_westergaard
 end module test_periodic

@@ -158,6 +158,18 @@ contains
       end if
       call make_grid(fine, transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np])), problem, &
          problem%pixel, how, options%boundary == "periodic")
+      ! A periodic cell is in full contact when the approach (the fall of the mean gap)
+      ! reaches the mean initial gap; there any load above the full-contact load gives
+      ! that approach, and beyond it none does (the elastic displacements have no mean).
+      if (by_approach .and. fine%periodic .and. .not. options%plastic) then
+         if (maxval(targets) >= sum(fine%g0)/real(np, dp)**2) then
+            call set_error(status, STATUS_USAGE, "--approach "//format_real(maxval(targets))//" nm reaches the "// &
+               "periodic cell's mean gap ("//format_real(sum(fine%g0)/real(np, dp)**2)//" nm): full contact, "// &
+               "where the approach no longer determines the load; give --loads for loads beyond full contact")
+            call convolution_free(fine%conv)
+            return
+         end if
+      end if
       allocate(p(np, np))
       if (options%plastic) then
          g0 = fine%g0
