@@ -203,11 +203,12 @@ contains
       end do
    end subroutine test_gap_maps
 
-   !> A rough surface for the plastic checks: self-affine (Hurst 0.8, rms 3 nm), pixel
-   !> 10 nm, against a rigid flat.
-   subroutine rough_scene(np, seed, deck)
+   !> A rough surface for the plastic and accuracy checks: self-affine (Hurst 0.8, rms
+   !> 3 nm), pixel 10 nm, against a rigid flat; MAXCONT `maxcont` (default NP^2).
+   subroutine rough_scene(np, seed, deck, maxcont)
       integer, intent(in) :: np, seed
       type(contact_problem), intent(out) :: deck
+      integer, intent(in), optional :: maxcont
       type(scene_spec) :: spec
       type(status_type) :: status
       spec%kind = "self-affine"
@@ -218,11 +219,32 @@ contains
       spec%seed = seed
       spec%shape_on = "lower"
       spec%rigid = "upper"
-      spec%label = "plastic test"
+      spec%label = "rough test"
       spec%matrix_file = ""
       spec%maxcont = np*np
+      if (present(maxcont)) spec%maxcont = maxcont
       call build_problem(spec, deck, status)
    end subroutine rough_scene
+
+   !> The event path's exact states at loads in the middle of its steps (every n/4-th
+   !> step from n/8 on, n steps to MAXCONT): options%loads set to them, inc their states.
+   subroutine midstep_states(deck, options, inc, error)
+      type(contact_problem), intent(in) :: deck
+      type(contact_options), intent(inout) :: options
+      type(contact_result), intent(out) :: inc
+      type(error_type), allocatable, intent(out) :: error
+      type(status_type) :: status
+      integer :: n, s
+      options%loads = [real(dp) ::]
+      options%solver = "incremental"
+      call solve_contact(deck, options, inc, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      n = inc%nsteps
+      options%loads = [((inc%step_load(s) + inc%step_load(s + 1))/2, s=n/8, n - 1, n/4)]
+      call solve_contact(deck, options, inc, status)
+      call check(error, status%code, 0, status%message)
+   end subroutine midstep_states
 
    !> cg options for the plastic checks.
    function plastic_options(loads, hardness, tol) result(options)
@@ -977,38 +999,17 @@ contains
    !> and the approach to 1e-8 relative (tolerance 1e-10 on the gap residual).
    subroutine test_accelerations(error)
       type(error_type), allocatable, intent(out) :: error
-      type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, cg
       type(cg_settings) :: plain, how(8)
       type(status_type) :: status
       real(dp), allocatable :: loads(:)
-      integer :: v, k, n, s
-      spec%kind = "self-affine"
-      spec%np = 64
-      spec%pixel = 10
-      spec%hurst = 0.8_dp
-      spec%rms = 3
-      spec%seed = 5
-      spec%shape_on = "lower"
-      spec%rigid = "upper"
-      spec%label = "test"
-      spec%matrix_file = ""
-      spec%maxcont = 200
-      call build_problem(spec, deck, status)
-      call check(error, status%code, 0, status%message)
+      integer :: v, k
+      call rough_scene(64, 5, deck, maxcont=200)
+      call midstep_states(deck, options, inc, error)
       if (allocated(error)) return
-      options%loads = [real(dp) ::]
-      options%solver = "incremental"
-      call solve_contact(deck, options, inc, status)
-      call check(error, status%code, 0, status%message)
-      if (allocated(error)) return
-      n = inc%nsteps
-      loads = [((inc%step_load(s) + inc%step_load(s + 1))/2, s=n/8, n - 1, n/4)]
-      options%loads = loads
-      options%solver = "incremental"
-      call solve_contact(deck, options, inc, status)
+      loads = options%loads
       plain = cg_settings(nested=.false., single_until=0, direct_corrections=0, precondition=.false., &
          restart_on_entry=.true., polak_ribiere=.false., powell_restart=0.0_dp)
       how = plain
@@ -1093,36 +1094,14 @@ contains
    !> no more than the bound it reports; under --approach it reports none.
    subroutine test_approach_bound(error)
       type(error_type), allocatable, intent(out) :: error
-      type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, cg
       type(status_type) :: status
       real(dp) :: tols(3), miss
-      integer :: v, k, n, s
-      spec%kind = "self-affine"
-      spec%np = 64
-      spec%pixel = 10
-      spec%hurst = 0.8_dp
-      spec%rms = 3
-      spec%seed = 11
-      spec%shape_on = "lower"
-      spec%rigid = "upper"
-      spec%label = "test"
-      spec%matrix_file = ""
-      spec%maxcont = 300
-      call build_problem(spec, deck, status)
-      call check(error, status%code, 0, status%message)
-      if (allocated(error)) return
-      options%loads = [real(dp) ::]
-      options%solver = "incremental"
-      call solve_contact(deck, options, inc, status)
-      call check(error, status%code, 0, status%message)
-      if (allocated(error)) return
-      n = inc%nsteps
-      options%loads = [((inc%step_load(s) + inc%step_load(s + 1))/2, s=n/8, n - 1, n/4)]
-      call solve_contact(deck, options, inc, status)
-      call check(error, status%code, 0, status%message)
+      integer :: v, k
+      call rough_scene(64, 11, deck, maxcont=300)
+      call midstep_states(deck, options, inc, error)
       if (allocated(error)) return
       tols = [1.0e-3_dp, 1.0e-5_dp, 1.0e-7_dp]
       do v = 1, size(tols)
