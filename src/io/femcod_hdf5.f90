@@ -19,8 +19,10 @@ module femcod_hdf5
       h5pcreate_f, h5pclose_f, h5pset_chunk_f, h5pset_deflate_f, h5pset_shuffle_f, h5pset_virtual_f, &
       h5sselect_all_f, H5P_DATASET_CREATE_F, H5P_DEFAULT_F
    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char, c_size_t, c_int, c_f_pointer, &
-      c_associated, c_null_ptr, c_int64_t
+      c_associated, c_null_ptr, c_int64_t, c_int32_t, c_long
+   use, intrinsic :: iso_fortran_env, only: int64
    use femcod_kinds, only: dp
+   use femcod_zlib, only: c_compress2, c_compress_bound
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_files, only: clear_write_error, write_error_cause
    implicit none
@@ -66,6 +68,22 @@ module femcod_hdf5
       end function c_h5free_memory
    end interface
 
+
+   interface
+      !> herr_t H5Dwrite_chunk(hid_t dset_id, hid_t dxpl_id, uint32_t filters,
+      !>     const hsize_t *offset, size_t data_size, const void *buf): one chunk's bytes as
+      !>     stored, past the filters (HDF5 1.10.3 and later; no Fortran wrapper in 1.10).
+      function h5d_write_chunk(dset, dxpl, filters, offset, data_size, buf) bind(c, name="H5Dwrite_chunk") &
+         result(rc)
+         import :: hid_t, hsize_t, c_int32_t, c_size_t, c_char, c_int
+         integer(hid_t), value :: dset, dxpl
+         integer(c_int32_t), value :: filters
+         integer(hsize_t), intent(in) :: offset(*)
+         integer(c_size_t), value :: data_size
+         character(kind=c_char), intent(in) :: buf(*)
+         integer(c_int) :: rc
+      end function h5d_write_chunk
+   end interface
 contains
 
    !> Open the library. h5dont_atexit_f first (it fails harmlessly once the library is
@@ -176,10 +194,8 @@ contains
       dcpl = H5P_DEFAULT_F
       if (present(compress)) then
          if (compress .and. size(dims) > 0 .and. product(dims) > 0) then
-            ! Chunks of about 1 MiB: whole fastest-varying rows, 2**17 of the others.
             chunk = dims
-            chunk(size(dims)) = min(dims(size(dims)), max(1_hsize_t, 131072_hsize_t/max(1_hsize_t, &
-               product(dims(1:size(dims) - 1)))))
+            chunk(size(dims)) = chunk_rows(dims)
             call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, error)
             call h5pset_chunk_f(dcpl, size(dims), chunk, error)
             call h5pset_shuffle_f(dcpl, error)
@@ -202,6 +218,77 @@ contains
          call set_error(status, STATUS_IO, file%path//":"//name//": cannot create the dataset"//write_error_cause())
       end if
    end subroutine create_dataset
+
+   !> Rows of a compressed dataset's chunk (C order: its slowest dimension, Fortran's
+   !> last; `dims` in Fortran order): whole rows, about 2**17 values (1 MiB of doubles).
+   pure integer(hsize_t) function chunk_rows(dims)
+      integer(hsize_t), intent(in) :: dims(:)
+      chunk_rows = min(dims(size(dims)), max(1_hsize_t, 131072_hsize_t/max(1_hsize_t, product(dims(1:size(dims) - 1)))))
+   end function chunk_rows
+
+   !> The whole of the open dataset `dset`, created with `compress` (chunked, shuffled,
+   !> deflated), from `bytes`: its values in storage order (C order), `elem` bytes each,
+   !> `dims` in Fortran order. Each chunk is shuffled (byte b of every value together:
+   !> HDF5's shuffle filter) and deflated at level 1 (zlib's compress2: HDF5's deflate
+   !> filter) on all threads, then handed to HDF5 as it is stored, in order
+   !> (H5Dwrite_chunk, filter mask 0: every filter applied). HDF5 runs its filters on one
+   !> thread: the 2048^2 mesh took 0.38 s that way. `error` /= 0 if zlib or HDF5 failed.
+   subroutine write_deflated(dset, bytes, elem, dims, error)
+      integer(hid_t), intent(in) :: dset
+      character(kind=c_char), intent(in) :: bytes(:)
+      integer, intent(in) :: elem
+      integer(hsize_t), intent(in) :: dims(:)
+      integer, intent(out) :: error
+      type :: deflated_chunk
+         character(kind=c_char), allocatable :: z(:)
+      end type deflated_chunk
+      type(deflated_chunk), allocatable :: chunks(:)
+      character(kind=c_char), allocatable :: raw(:), shuffled(:), z(:)
+      logical, allocatable :: failed(:)
+      integer(hsize_t) :: per_chunk, offset(size(dims))
+      integer(int64) :: chunk_bytes, values, first, last, e
+      integer(c_long) :: bound, zlen
+      integer :: nchunks, k, b
+      per_chunk = chunk_rows(dims)
+      chunk_bytes = elem*product(dims(1:size(dims) - 1))*per_chunk
+      values = chunk_bytes/elem
+      nchunks = int((dims(size(dims)) + per_chunk - 1)/per_chunk)
+      bound = c_compress_bound(int(chunk_bytes, c_long))
+      allocate(chunks(nchunks), failed(nchunks))
+      !$omp parallel private(raw, shuffled, z, k, first, last, e, b, zlen)
+      allocate(raw(chunk_bytes), shuffled(chunk_bytes), z(bound))
+      !$omp do schedule(dynamic)
+      do k = 1, nchunks
+         first = (k - 1)*chunk_bytes + 1
+         last = min(k*chunk_bytes, size(bytes, kind=int64))
+         raw(1:last - first + 1) = bytes(first:last)
+         ! The last chunk is stored whole: its part beyond the rows is never read.
+         raw(last - first + 2:) = achar(0)
+         do b = 1, elem
+            shuffled((b - 1)*values + 1:b*values) = raw(b::elem)
+         end do
+         zlen = bound
+         failed(k) = c_compress2(z, zlen, shuffled, int(chunk_bytes, c_long), 1_c_int) /= 0
+         chunks(k)%z = z(1:zlen)
+      end do
+      !$omp end do
+      !$omp end parallel
+      error = merge(1, 0, any(failed))
+      do k = 1, nchunks
+         if (error /= 0) exit
+         offset = 0
+         offset(1) = (k - 1)*per_chunk
+         if (h5d_write_chunk(dset, H5P_DEFAULT_F, 0_c_int32_t, offset, size(chunks(k)%z, kind=c_size_t), &
+            chunks(k)%z) < 0) error = 1
+      end do
+   end subroutine write_deflated
+
+   !> Whether the optional `compress` is present and true.
+   pure logical function compressed(compress)
+      logical, intent(in), optional :: compress
+      compressed = .false.
+      if (present(compress)) compressed = compress
+   end function compressed
 
    !> Close a dataset after writing; attach its units.
    subroutine finish_dataset(file, name, dset, error, units, status)
@@ -260,7 +347,8 @@ contains
       logical, intent(in), optional :: compress
       integer(hid_t) :: dset
       integer(hsize_t) :: dims(2)
-      real(dp), allocatable :: stored(:, :)
+      real(dp), allocatable, target :: stored(:, :)
+      character(kind=c_char), pointer :: bytes(:)
       integer :: error
       if (status%code /= 0) return
       dims = [size(map, 2, kind=hsize_t), size(map, 1, kind=hsize_t)]
@@ -268,7 +356,12 @@ contains
       call transpose_into(map, stored)
       call create_dataset(file, name, H5T_NATIVE_DOUBLE, dims, dset, status, compress)
       if (status%code /= 0) return
-      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored, dims, error)
+      if (compressed(compress) .and. size(stored) > 0) then
+         call c_f_pointer(c_loc(stored), bytes, [8*size(stored, kind=int64)])
+         call write_deflated(dset, bytes, 8, dims, error)
+      else
+         call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored, dims, error)
+      end if
       call finish_dataset(file, name, dset, error, units, status)
    end subroutine write_real2
 
@@ -312,14 +405,21 @@ contains
       logical, intent(in), optional :: compress
       integer(hid_t) :: dset
       integer(hsize_t) :: dims(2)
-      integer, allocatable :: stored(:, :)
+      integer, allocatable, target :: stored(:, :)
+      character(kind=c_char), pointer :: bytes(:)
       integer :: error
       if (status%code /= 0) return
       dims = [size(map, 2, kind=hsize_t), size(map, 1, kind=hsize_t)]
-      stored = transpose(map)
+      allocate(stored(size(map, 2), size(map, 1)))
+      stored(:, :) = transpose(map)
       call create_dataset(file, name, H5T_NATIVE_INTEGER, dims, dset, status, compress)
       if (status%code /= 0) return
-      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, stored, dims, error)
+      if (compressed(compress) .and. size(stored) > 0) then
+         call c_f_pointer(c_loc(stored), bytes, [(storage_size(0)/8)*size(stored, kind=int64)])
+         call write_deflated(dset, bytes, storage_size(0)/8, dims, error)
+      else
+         call h5dwrite_f(dset, H5T_NATIVE_INTEGER, stored, dims, error)
+      end if
       call finish_dataset(file, name, dset, error, units, status)
    end subroutine write_int2
 

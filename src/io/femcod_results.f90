@@ -480,16 +480,22 @@ contains
       if (status%code /= 0) return
       n = deck%np
       allocate(nodes((n + 1)**2, 2), quads(n*n, 4))
+      !$omp parallel do private(b)
       do a = 0, n
          do b = 0, n
-            nodes(a*(n + 1) + b + 1, :) = [b*deck%pixel, (n - a)*deck%pixel]
+            nodes(a*(n + 1) + b + 1, 1) = b*deck%pixel
+            nodes(a*(n + 1) + b + 1, 2) = (n - a)*deck%pixel
          end do
       end do
+      !$omp parallel do private(j, c)
       do i = 1, n
          do j = 1, n
             c = (i - 1)*n + j
             ! Counter-clockwise seen from +z: top-left, bottom-left, bottom-right, top-right.
-            quads(c, :) = [(i - 1)*(n + 1) + (j - 1), i*(n + 1) + (j - 1), i*(n + 1) + j, (i - 1)*(n + 1) + j]
+            quads(c, 1) = (i - 1)*(n + 1) + (j - 1)
+            quads(c, 2) = i*(n + 1) + (j - 1)
+            quads(c, 3) = i*(n + 1) + j
+            quads(c, 4) = (i - 1)*(n + 1) + j
          end do
       end do
       call h5_group(file, "/mesh", status)
