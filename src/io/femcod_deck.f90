@@ -19,6 +19,7 @@ module femcod_deck
    use femcod_files, only: write_file, read_file
    use femcod_strings, only: int_str, parse_real, parse_integer, format_real, format_reals, is_digit, text_builder, &
       add_line, add_text, built_text
+   !$ use omp_lib, only: omp_get_max_threads
    implicit none
    private
    public :: read_deck, write_deck
@@ -249,12 +250,6 @@ contains
       end subroutine add_row
    end subroutine write_deck
 
-
-
-
-
-
-
    !> Refuse what is not a text deck: UTF-16 (a byte order mark, or NUL bytes between
    !> the characters), and binary content (control bytes other than TAB, LF, CR and FF).
    !> A UTF-8 byte order mark is dropped (editors on some systems write one).
@@ -304,48 +299,93 @@ contains
    end function label_of
 
    !> Split everything after line 1 into tokens separated by blanks, tabs, CR, FF or
-   !> commas, recording the line of each token and the number of the last line. One
-   !> pass over the bytes counts the tokens, a second records them (a byte table rather
-   !> than SCAN and VERIFY, which made this a tenth of reading a large deck).
+   !> commas, recording the line of each token and the number of the last line. The text
+   !> is cut at separators into one segment per thread; each thread counts its segment's
+   !> tokens and line ends, then (from the counts before it) records its tokens, on a
+   !> byte table rather than SCAN and VERIFY (which made this a tenth of reading a large
+   !> deck). One thread took 0.2 s of the 0.6 s reading a 2048^2 deck.
    subroutine tokenize(text, ntok, first, last, line, last_line)
       character(len=*), intent(in) :: text
       integer, intent(out) :: ntok, last_line
       integer, allocatable, intent(out) :: first(:), last(:), line(:)
-      logical :: separator(0:255), inside
-      integer :: pass, i, ln, start, n, c
+      logical :: separator(0:255)
+      integer, allocatable :: bounds(:), tokens(:), lines(:), token0(:), line0(:)
+      integer :: nseg, s, p, n, start, count, ends
       separator = .false.
       separator([9, 10, 12, 13, 32, 44]) = .true.
       n = len(text)
       start = index(text, new_line("a"))
       if (start == 0) start = n
-      do pass = 1, 2
-         ntok = 0
-         ln = 2
+      ! Segment s is text(bounds(s - 1) + 1 : bounds(s)); each bound but the last is a
+      ! separator, so no token crosses one.
+      nseg = 1
+      !$ nseg = omp_get_max_threads()
+      nseg = max(1, min(nseg, (n - start)/65536))
+      allocate(bounds(0:nseg), tokens(nseg), lines(nseg))
+      bounds(0) = start
+      do s = 1, nseg - 1
+         p = max(bounds(s - 1), start + int(int(n - start, i8)*s/nseg))
+         do while (p < n)
+            if (separator(iachar(text(p:p)))) exit
+            p = p + 1
+         end do
+         bounds(s) = p
+      end do
+      bounds(nseg) = n
+      !$omp parallel do schedule(static, 1)
+      do s = 1, nseg
+         call scan_segment(bounds(s - 1) + 1, bounds(s), 0, 0, tokens(s), lines(s), .false.)
+      end do
+      ntok = sum(tokens)
+      allocate(first(ntok), last(ntok), line(ntok), token0(nseg), line0(nseg))
+      do s = 1, nseg
+         token0(s) = sum(tokens(1:s - 1))
+         line0(s) = 2 + sum(lines(1:s - 1))
+      end do
+      !$omp parallel do schedule(static, 1) private(count, ends)
+      do s = 1, nseg
+         call scan_segment(bounds(s - 1) + 1, bounds(s), token0(s), line0(s), count, ends, .true.)
+      end do
+      ! The number of the last line that holds anything.
+      last_line = 2 + sum(lines)
+      if (n > 0) then
+         if (text(n:n) == new_line("a")) last_line = last_line - 1
+      end if
+      if (index(text, new_line("a")) == 0) last_line = 1
+   contains
+      !> Tokens and line ends of text(i0:i1): counted, and with `record` recorded from
+      !> token number k0 + 1 and line ln0 on.
+      subroutine scan_segment(i0, i1, k0, ln0, count, ends, record)
+         integer, intent(in) :: i0, i1, k0, ln0
+         integer, intent(out) :: count, ends
+         logical, intent(in) :: record
+         integer :: i, c, k, ln
+         logical :: inside
+         k = k0
+         ln = ln0
+         ends = 0
          inside = .false.
-         do i = start + 1, n
+         do i = i0, i1
             c = iachar(text(i:i))
             if (separator(c)) then
-               if (inside .and. pass == 2) last(ntok) = i - 1
+               if (inside .and. record) last(k) = i - 1
                inside = .false.
-               if (c == 10) ln = ln + 1
+               if (c == 10) then
+                  ln = ln + 1
+                  ends = ends + 1
+               end if
             else if (.not. inside) then
                inside = .true.
-               ntok = ntok + 1
-               if (pass == 2) then
-                  first(ntok) = i
-                  line(ntok) = ln
+               k = k + 1
+               if (record) then
+                  first(k) = i
+                  line(k) = ln
                end if
             end if
          end do
-         if (inside .and. pass == 2) last(ntok) = n
-         if (pass == 1) allocate(first(ntok), last(ntok), line(ntok))
-      end do
-      ! The number of the last line that holds anything.
-      last_line = ln
-      if (n > 0) then
-         if (text(n:n) == new_line("a")) last_line = ln - 1
-      end if
-      if (index(text, new_line("a")) == 0) last_line = 1
+         if (inside .and. record) last(k) = i1
+         count = k - k0
+      end subroutine scan_segment
    end subroutine tokenize
 
 end module femcod_deck
