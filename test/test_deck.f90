@@ -5,7 +5,7 @@ module test_deck
    use femcod_status, only: status_type
    use femcod_deck, only: read_deck, write_deck
    use femcod_problem, only: contact_problem
-   use femcod_strings, only: string_type, format_real, format_reals, int_str
+   use femcod_strings, only: string_type, format_real, format_reals, int_str, parse_real
    use femcod_cli, only: run_femcod
    use test_support, only: write_text, scratch_path, contains_text, file_exists
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
@@ -29,6 +29,7 @@ contains
          new_unittest("write then read is exact", test_roundtrip), &
          new_unittest("shortest round-trip number format", test_format_real), &
          new_unittest("format_real equals a brute-force search on 40000 values", test_format_real_search), &
+         new_unittest("parse_real equals Fortran's READ on 60000 decimals and halfway cases", test_parse_real), &
          new_unittest("int_str equals Fortran's i0 edit descriptor", test_int_str), &
          new_unittest("the first bad height in file order is reported", test_first_bad_height), &
          new_unittest("bad deck: "//"missing value line 2", bad_01), &
@@ -260,6 +261,63 @@ contains
          end if
       end function shortest_by_search
    end subroutine test_format_real_search
+
+   !> parse_real (exact for up to 18 digits in extended precision, else strtod) against
+   !> gfortran's own formatted READ, a conversion of its own (libgfortran): random decimals
+   !> of 1 to 19 digits with the point anywhere or an exponent of -40 to 40 (inside and
+   !> outside the exact path), 17-digit renderings of random doubles as a deck holds
+   !> them, and decimals exactly halfway between two doubles, which round to the even one
+   !> (9007199254740993 = 2**53 + 1 reads as 2**53).
+   subroutine test_parse_real(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=40), allocatable :: texts(:)
+      character(len=40) :: t
+      character(len=19) :: digits
+      real(dp) :: u, v, got, expected
+      integer :: k, nd, j, point, e, nseed
+      integer, allocatable :: seed(:)
+      logical :: ok
+      texts = [character(len=40) :: "9007199254740993", "9007199254740995", "-9007199254740993", &
+         "18014398509481986", "0.5", "-0", "0.000", "1e-27", "999999999999999999e27", "123456789012345678e-27", &
+         "4.9406564584124654e-324", "1.7976931348623157e308", "2.2250738585072014D-308", ".5", "5.", "+3.25e+02"]
+      call random_seed(size=nseed)
+      allocate(seed(nseed))
+      seed = 20261125
+      call random_seed(put=seed)
+      do k = 1, 40000
+         call random_number(u)
+         nd = 1 + int(u*19)
+         do j = 1, nd
+            call random_number(u)
+            digits(j:j) = achar(iachar("0") + int(u*10))
+         end do
+         call random_number(u)
+         point = int(u*(nd + 1))
+         call random_number(v)
+         if (mod(k, 2) == 0) then
+            t = digits(1:point)//"."//digits(point + 1:nd)
+         else
+            e = -40 + int(v*81)
+            t = digits(1:nd)//"e"//int_str(e)
+         end if
+         if (mod(k, 3) == 0) t = "-"//t
+         if (t(1:1) == "." .and. len_trim(t) == 1) t = "0"
+         texts = [texts, t]
+      end do
+      do k = 1, 20000
+         call random_number(u)
+         call random_number(v)
+         write(t, "(es25.16e3)") (u - 0.5_dp)*10.0_dp**(int(v*12) - 3)
+         texts = [texts, adjustl(t)]
+      end do
+      do k = 1, size(texts)
+         call parse_real(trim(texts(k)), got, ok)
+         read(texts(k), *) expected
+         call check(error, ok .and. transfer(got, 1_8) == transfer(expected, 1_8), "parse_real('"// &
+            trim(texts(k))//"') = "//format_real(got)//", READ gives "//format_real(expected))
+         if (allocated(error)) return
+      end do
+   end subroutine test_parse_real
 
    !> int_str against the list-free i0 edit of Fortran's own formatted output, on the
    !> extremes of both kinds and on every power of ten and its neighbours.
