@@ -28,7 +28,8 @@ contains
    !> double-precision convolution).
    subroutine load_maps(problem, states, maps, periodic)
       type(contact_problem), intent(in) :: problem
-      type(load_state), intent(in) :: states(:)
+      !> A gap map a state holds (the cg solver's) is moved into `maps`, not copied.
+      type(load_state), intent(inout) :: states(:)
       type(state_maps), allocatable, intent(out) :: maps(:)
       !> The grid is one cell of a periodic surface (default: free).
       logical, intent(in), optional :: periodic
@@ -36,16 +37,18 @@ contains
       type(love_convolution) :: conv
       real(dp), allocatable :: force(:, :), disp(:, :), g0(:, :), table(:, :)
       real(dp) :: c, spring
+      logical, allocatable :: handed(:)
       integer :: np, k, s
       allocate(maps(size(states)))
       if (.not. any(states%reached)) return
       np = problem%np
+      handed = allocated_gap(states)
       do s = 1, size(states)
          if (.not. states(s)%reached) cycle
          maps(s)%pressure = pressure_map(states(s))
-         if (allocated(states(s)%gap)) maps(s)%gap = states(s)%gap
+         if (handed(s)) call move_alloc(states(s)%gap, maps(s)%gap)
       end do
-      if (all(allocated_gap(states) .or. .not. states%reached)) return
+      if (all(handed .or. .not. states%reached)) return
       cyclic = .false.
       if (present(periodic)) cyclic = periodic
       allocate(force(np, np), disp(np, np), table(0:np - 1, 0:np - 1))
@@ -61,7 +64,7 @@ contains
       g0 = transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np]))
       call convolution_setup(conv, table, periodic=cyclic)
       do s = 1, size(states)
-         if (.not. states(s)%reached .or. allocated(states(s)%gap)) cycle
+         if (.not. states(s)%reached .or. handed(s)) cycle
          force = 0
          do k = 1, size(states(s)%force)
             force(states(s)%i(k), states(s)%j(k)) = states(s)%force(k)
