@@ -257,7 +257,8 @@ contains
       character(len=*), intent(in) :: path
       character(len=:), allocatable, intent(inout) :: text
       type(status_type), intent(inout) :: status
-      integer :: i, line, c
+      logical :: control(0:255)
+      integer :: i, line, c, first
       if (len(text) >= 3) then
          if (text(1:3) == achar(239)//achar(187)//achar(191)) text = text(4:)
       end if
@@ -270,18 +271,24 @@ contains
             return
          end if
       end if
-      line = 1
+      ! The first control byte, looked for on all threads; its line only if there is one.
+      control = .false.
+      control(0:31) = .true.
+      control([9, 10, 12, 13]) = .false.
+      control(127) = .true.
+      first = huge(first)
+      !$omp parallel do reduction(min: first) schedule(static)
       do i = 1, len(text)
-         c = iachar(text(i:i))
-         if (c == 10) then
-            line = line + 1
-         else if ((c < 32 .and. c /= 9 .and. c /= 13 .and. c /= 12) .or. c == 127) then
-            call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(line)// &
-               ": expected a text deck, found a binary control character (code "//int_str(c)//") at byte "// &
-               int_str(i))
-            return
-         end if
+         if (control(iachar(text(i:i)))) first = min(first, i)
       end do
+      if (first == huge(first)) return
+      c = iachar(text(first:first))
+      line = 1
+      do i = 1, first - 1
+         if (text(i:i) == new_line("a")) line = line + 1
+      end do
+      call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(line)// &
+         ": expected a text deck, found a binary control character (code "//int_str(c)//") at byte "//int_str(first))
    end subroutine check_text
 
    !> The first line without its line end.
