@@ -3,7 +3,7 @@ module test_sort
    use femcod_kinds, only: dp
    use femcod_sort, only: merge_sort_index
    use femcod_random, only: random_stream, seed_stream, uniform
-   use femcod_sha256, only: sha256_hex
+   use femcod_sha256, only: sha256_hex, file_sha256_hex
    use testdrive, only: new_unittest, unittest_type, error_type, check
    implicit none
    private
@@ -17,7 +17,8 @@ contains
          new_unittest("ties keep row-wise order", test_ties), &
          new_unittest("sorted and reversed input", test_sorted_reversed), &
          new_unittest("random input against insertion sort", test_random), &
-         new_unittest("SHA-256 of the FIPS 180-4 examples", test_sha256) &
+         new_unittest("SHA-256 of the FIPS 180-4 examples", test_sha256), &
+         new_unittest("SHA-256 of files read in blocks: FIPS 180-4's million a, 3 MiB + 5", test_sha256_file) &
          ]
    end subroutine collect_sort
 
@@ -88,4 +89,31 @@ contains
       call check(error, sha256_hex(repeat("a", 1000000)), &
          "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0", "a million a")
    end subroutine test_sha256
+
+   !> The digest of a file read in 1 MiB blocks: a file of a million "a" has FIPS 180-4's
+   !> digest; a file of 3 MiB + 5 bytes (four blocks, the last of 5 bytes) the digest of
+   !> the same bytes hashed whole; a missing file gives "".
+   subroutine test_sha256_file(error)
+      use test_support, only: scratch_path
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: path, bytes
+      integer :: unit, k
+      path = scratch_path("sha256-million-a")
+      open(newunit=unit, file=path, access="stream", form="unformatted", status="replace")
+      write(unit) repeat("a", 1000000)
+      close(unit)
+      call check(error, file_sha256_hex(path), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0", &
+         "a million a")
+      if (allocated(error)) return
+      allocate(character(len=3*1048576 + 5) :: bytes)
+      do k = 1, len(bytes)
+         bytes(k:k) = achar(mod(k*7 + k/1000, 256))
+      end do
+      open(newunit=unit, file=path, access="stream", form="unformatted", status="replace")
+      write(unit) bytes
+      close(unit)
+      call check(error, file_sha256_hex(path), sha256_hex(bytes), "3 MiB + 5 bytes")
+      if (allocated(error)) return
+      call check(error, file_sha256_hex(path//".missing"), "", "a missing file")
+   end subroutine test_sha256_file
 end module test_sort

@@ -13,9 +13,9 @@ module femcod_run
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
    use femcod_strings, only: sig_str, string_type, int_str, format_real, append_string
    use femcod_files, only: remove_file, path_exists, path_is_directory, default_prefix, file_part, canonical_path, &
-      acquire_lock, release_lock, read_file, make_directories
+      acquire_lock, release_lock, make_directories
    use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
-   use femcod_sha256, only: sha256_hex
+   use femcod_sha256, only: sha256_hex, file_sha256_hex
    use femcod_clock, only: wall_clock
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
@@ -707,17 +707,15 @@ contains
    subroutine input_digests(files, digests)
       type(string_type), intent(in) :: files(:)
       type(string_type), allocatable, intent(out) :: digests(:)
-      character(len=:), allocatable :: bytes
-      type(status_type) :: st
+      character(len=64) :: hex
       integer :: k
       allocate(digests(size(files)))
       do k = 1, size(files)
-         call read_file(files(k)%s, "an input file", bytes, st)
-         if (st%code == 0) then
-            digests(k)%s = files(k)%s//" sha256 "//sha256_hex(bytes)
+         hex = file_sha256_hex(files(k)%s)
+         if (len_trim(hex) == 64) then
+            digests(k)%s = files(k)%s//" sha256 "//hex
          else
             digests(k)%s = files(k)%s//" (unreadable)"
-            st = status_type()
          end if
       end do
    end subroutine input_digests

@@ -3,10 +3,10 @@
 !> results belong to the same inputs and options. The digest is OpenSSL's
 !> (femcod_digest.c); the test suite checks it against the FIPS 180-4 examples.
 module femcod_sha256
-   use, intrinsic :: iso_c_binding, only: c_char, c_size_t, c_int, c_signed_char
+   use, intrinsic :: iso_c_binding, only: c_char, c_size_t, c_int, c_signed_char, c_null_char
    implicit none
    private
-   public :: sha256_hex
+   public :: sha256_hex, file_sha256_hex
 
    interface
       !> femcod_digest.c: the 32-byte digest of n bytes; 0 on success.
@@ -17,6 +17,13 @@ module femcod_sha256
          integer(c_signed_char), intent(out) :: digest(32)
          integer(c_int) :: failed
       end function c_sha256
+      !> femcod_digest.c: the 32-byte digest of a file, read in blocks; 0 on success.
+      function c_sha256_file(path, digest) bind(c, name="femcod_sha256_file") result(failed)
+         import :: c_char, c_int, c_signed_char
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_signed_char), intent(out) :: digest(32)
+         integer(c_int) :: failed
+      end function c_sha256_file
    end interface
 
 contains
@@ -25,10 +32,8 @@ contains
    function sha256_hex(bytes) result(hex)
       character(len=*), intent(in) :: bytes
       character(len=64) :: hex
-      character(len=16), parameter :: digits = "0123456789abcdef"
       character(kind=c_char, len=1) :: empty(1)
       integer(c_signed_char) :: digest(32)
-      integer :: j, b
       hex = ""
       if (len(bytes) == 0) then
          empty = c_char_"x"
@@ -36,9 +41,29 @@ contains
       else
          if (c_sha256(bytes, int(len(bytes), c_size_t), digest) /= 0) return
       end if
+      hex = hex_of(digest)
+   end function sha256_hex
+
+   !> The digest of the file at `path`, read in blocks (the whole file is never held);
+   !> "" when it cannot be read.
+   function file_sha256_hex(path) result(hex)
+      character(len=*), intent(in) :: path
+      character(len=64) :: hex
+      integer(c_signed_char) :: digest(32)
+      hex = ""
+      if (c_sha256_file(path//c_null_char, digest) /= 0) return
+      hex = hex_of(digest)
+   end function file_sha256_hex
+
+   !> 32 bytes as 64 lower-case hex digits.
+   pure function hex_of(digest) result(hex)
+      integer(c_signed_char), intent(in) :: digest(32)
+      character(len=64) :: hex
+      character(len=16), parameter :: digits = "0123456789abcdef"
+      integer :: j, b
       do j = 1, 32
          b = iand(int(digest(j)), 255)
          hex(2*j - 1:2*j) = digits(b/16 + 1:b/16 + 1)//digits(mod(b, 16) + 1:mod(b, 16) + 1)
       end do
-   end function sha256_hex
+   end function hex_of
 end module femcod_sha256
