@@ -17,7 +17,7 @@ module femcod_hdf5
       H5S_SCALAR_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_INTEGER_F, H5T_FLOAT_F, H5T_STRING_F, &
       H5T_COMPOUND_F, H5T_ENUM_F, H5T_C_S1, h5tset_cset_f, H5T_CSET_UTF8_F, h5tis_variable_str_f, h5aget_type_f, &
       h5pcreate_f, h5pclose_f, h5pset_chunk_f, h5pset_deflate_f, h5pset_shuffle_f, h5pset_virtual_f, &
-      h5sselect_all_f, H5P_DATASET_CREATE_F, H5P_DEFAULT_F
+      h5sselect_all_f, H5P_DATASET_CREATE_F, H5P_DEFAULT_F, h5sselect_hyperslab_f, H5S_SELECT_SET_F
    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char, c_size_t, c_int, c_f_pointer, &
       c_associated, c_null_ptr, c_int64_t, c_int32_t, c_long
    use, intrinsic :: iso_fortran_env, only: int64
@@ -227,43 +227,66 @@ contains
    end function chunk_rows
 
    !> The whole of the open dataset `dset`, created with `compress` (chunked, shuffled,
-   !> deflated), from `bytes`: its values in storage order (C order), `elem` bytes each,
-   !> `dims` in Fortran order. Each chunk is shuffled (byte b of every value together:
-   !> HDF5's shuffle filter) and deflated at level 1 (zlib's compress2: HDF5's deflate
-   !> filter) on all threads, then handed to HDF5 as it is stored, in order
-   !> (H5Dwrite_chunk, filter mask 0: every filter applied). HDF5 runs its filters on one
-   !> thread: the 2048^2 mesh took 0.38 s that way. `error` /= 0 if zlib or HDF5 failed.
-   subroutine write_deflated(dset, bytes, elem, dims, error)
+   !> deflated), from `real_map` or `int_map` (one of them), stored transposed so that
+   !> C-order readers see map(i, j) at [i - 1, j - 1]; `dims` as create_dataset had them.
+   !> Each chunk (whole rows of the map) is transposed into the thread's buffer, shuffled
+   !> (byte b of every value together: HDF5's shuffle filter) and deflated at level 1
+   !> (zlib's compress2: HDF5's deflate filter) on all threads, then handed to HDF5 as it
+   !> is stored, in order (H5Dwrite_chunk, filter mask 0: every filter applied). HDF5 runs
+   !> its filters on one thread: the 2048^2 mesh took 0.38 s that way. `error` /= 0 if
+   !> zlib or HDF5 failed.
+   subroutine write_deflated(dset, dims, error, real_map, int_map)
       integer(hid_t), intent(in) :: dset
-      character(kind=c_char), intent(in) :: bytes(:)
-      integer, intent(in) :: elem
-      integer(hsize_t), intent(in) :: dims(:)
+      integer(hsize_t), intent(in) :: dims(2)
       integer, intent(out) :: error
+      real(dp), intent(in), optional :: real_map(:, :)
+      integer, intent(in), optional :: int_map(:, :)
       type :: deflated_chunk
          character(kind=c_char), allocatable :: z(:)
       end type deflated_chunk
       type(deflated_chunk), allocatable :: chunks(:)
-      character(kind=c_char), allocatable :: raw(:), shuffled(:), z(:)
+      real(dp), allocatable, target :: real_rows(:, :)
+      integer, allocatable, target :: int_rows(:, :)
+      character(kind=c_char), pointer :: raw(:)
+      character(kind=c_char), allocatable :: shuffled(:), z(:)
       logical, allocatable :: failed(:)
-      integer(hsize_t) :: per_chunk, offset(size(dims))
-      integer(int64) :: chunk_bytes, values, first, last, e
+      integer(hsize_t) :: per_chunk, offset(2)
+      integer(int64) :: chunk_bytes, values
       integer(c_long) :: bound, zlen
-      integer :: nchunks, k, b
+      integer :: nchunks, k, b, elem, r0, nr, j
       per_chunk = chunk_rows(dims)
-      chunk_bytes = elem*product(dims(1:size(dims) - 1))*per_chunk
-      values = chunk_bytes/elem
-      nchunks = int((dims(size(dims)) + per_chunk - 1)/per_chunk)
+      elem = 8
+      if (present(int_map)) elem = storage_size(0)/8
+      values = dims(1)*per_chunk
+      chunk_bytes = elem*values
+      nchunks = int((dims(2) + per_chunk - 1)/per_chunk)
       bound = c_compress_bound(int(chunk_bytes, c_long))
       allocate(chunks(nchunks), failed(nchunks))
-      !$omp parallel private(raw, shuffled, z, k, first, last, e, b, zlen)
-      allocate(raw(chunk_bytes), shuffled(chunk_bytes), z(bound))
+      !$omp parallel private(real_rows, int_rows, raw, shuffled, z, k, b, zlen, r0, nr, j)
+      if (present(int_map)) then
+         allocate(int_rows(dims(1), per_chunk))
+         call c_f_pointer(c_loc(int_rows), raw, [chunk_bytes])
+      else
+         allocate(real_rows(dims(1), per_chunk))
+         call c_f_pointer(c_loc(real_rows), raw, [chunk_bytes])
+      end if
+      allocate(shuffled(chunk_bytes), z(bound))
       !$omp do schedule(dynamic)
       do k = 1, nchunks
-         first = (k - 1)*chunk_bytes + 1
-         last = min(k*chunk_bytes, size(bytes, kind=int64))
-         raw(1:last - first + 1) = bytes(first:last)
+         r0 = int((k - 1)*per_chunk)
+         nr = int(min(per_chunk, dims(2) - r0))
          ! The last chunk is stored whole: its part beyond the rows is never read.
-         raw(last - first + 2:) = achar(0)
+         if (present(int_map)) then
+            do j = 1, int(dims(1))
+               int_rows(j, 1:nr) = int_map(r0 + 1:r0 + nr, j)
+            end do
+            int_rows(:, nr + 1:) = 0
+         else
+            do j = 1, int(dims(1))
+               real_rows(j, 1:nr) = real_map(r0 + 1:r0 + nr, j)
+            end do
+            real_rows(:, nr + 1:) = 0
+         end if
          do b = 1, elem
             shuffled((b - 1)*values + 1:b*values) = raw(b::elem)
          end do
@@ -276,8 +299,7 @@ contains
       error = merge(1, 0, any(failed))
       do k = 1, nchunks
          if (error /= 0) exit
-         offset = 0
-         offset(1) = (k - 1)*per_chunk
+         offset = [(k - 1)*per_chunk, 0_hsize_t]
          if (h5d_write_chunk(dset, H5P_DEFAULT_F, 0_c_int32_t, offset, size(chunks(k)%z, kind=c_size_t), &
             chunks(k)%z) < 0) error = 1
       end do
@@ -345,22 +367,39 @@ contains
       type(status_type), intent(inout) :: status
       !> Chunked and deflated (create_dataset).
       logical, intent(in), optional :: compress
-      integer(hid_t) :: dset
-      integer(hsize_t) :: dims(2)
-      real(dp), allocatable, target :: stored(:, :)
-      character(kind=c_char), pointer :: bytes(:)
-      integer :: error
+      integer(hid_t) :: dset, filespace, memspace
+      integer(hsize_t) :: dims(2), block(2)
+      real(dp), allocatable :: stored(:, :)
+      integer :: error, e, rows, r0, nr
       if (status%code /= 0) return
       dims = [size(map, 2, kind=hsize_t), size(map, 1, kind=hsize_t)]
-      allocate(stored(size(map, 2), size(map, 1)))
-      call transpose_into(map, stored)
       call create_dataset(file, name, H5T_NATIVE_DOUBLE, dims, dset, status, compress)
       if (status%code /= 0) return
-      if (compressed(compress) .and. size(stored) > 0) then
-         call c_f_pointer(c_loc(stored), bytes, [8*size(stored, kind=int64)])
-         call write_deflated(dset, bytes, 8, dims, error)
-      else
+      if (compressed(compress) .and. size(map) > 0) then
+         call write_deflated(dset, dims, error, real_map=map)
+      else if (size(map) == 0) then
+         allocate(stored(size(map, 2), size(map, 1)))
          call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored, dims, error)
+      else
+         ! In blocks of whole rows (about 1 MiB), each transposed into the same buffer:
+         ! no second copy of the map in fresh memory.
+         rows = int(max(1_hsize_t, min(dims(2), 131072_hsize_t/dims(1))))
+         allocate(stored(size(map, 2), rows))
+         call h5dget_space_f(dset, filespace, error)
+         do r0 = 1, size(map, 1), rows
+            nr = min(rows, size(map, 1) - r0 + 1)
+            call transpose_into(map(r0:r0 + nr - 1, :), stored(:, 1:nr))
+            block = [dims(1), int(nr, hsize_t)]
+            call h5screate_simple_f(2, block, memspace, e)
+            if (e == 0) call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, [0_hsize_t, int(r0 - 1, hsize_t)], &
+               block, e)
+            if (e == 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored(:, 1:nr), block, e, mem_space_id=memspace, &
+               file_space_id=filespace)
+            call h5sclose_f(memspace, error)
+            error = e
+            if (error /= 0) exit
+         end do
+         call h5sclose_f(filespace, e)
       end if
       call finish_dataset(file, name, dset, error, units, status)
    end subroutine write_real2
@@ -405,19 +444,17 @@ contains
       logical, intent(in), optional :: compress
       integer(hid_t) :: dset
       integer(hsize_t) :: dims(2)
-      integer, allocatable, target :: stored(:, :)
-      character(kind=c_char), pointer :: bytes(:)
+      integer, allocatable :: stored(:, :)
       integer :: error
       if (status%code /= 0) return
       dims = [size(map, 2, kind=hsize_t), size(map, 1, kind=hsize_t)]
-      allocate(stored(size(map, 2), size(map, 1)))
-      stored(:, :) = transpose(map)
       call create_dataset(file, name, H5T_NATIVE_INTEGER, dims, dset, status, compress)
       if (status%code /= 0) return
-      if (compressed(compress) .and. size(stored) > 0) then
-         call c_f_pointer(c_loc(stored), bytes, [(storage_size(0)/8)*size(stored, kind=int64)])
-         call write_deflated(dset, bytes, storage_size(0)/8, dims, error)
+      if (compressed(compress) .and. size(map) > 0) then
+         call write_deflated(dset, dims, error, int_map=map)
       else
+         allocate(stored(size(map, 2), size(map, 1)))
+         stored(:, :) = transpose(map)
          call h5dwrite_f(dset, H5T_NATIVE_INTEGER, stored, dims, error)
       end if
       call finish_dataset(file, name, dset, error, units, status)
