@@ -16,6 +16,11 @@ module femcod_strings
    !> format in gfortran on x86-64), for exact_decimal; else double, and then
    !> exact_decimal leaves every value to strtod.
    integer, parameter :: xp = merge(selected_real_kind(18), dp, selected_real_kind(18) > 0)
+   !> 10**0 .. 10**27, exact in that kind (5**27 < 2**64).
+   real(xp), parameter :: powers_of_ten(0:27) = [1.0e0_xp, 1.0e1_xp, 1.0e2_xp, 1.0e3_xp, 1.0e4_xp, 1.0e5_xp, &
+      1.0e6_xp, 1.0e7_xp, 1.0e8_xp, 1.0e9_xp, 1.0e10_xp, 1.0e11_xp, 1.0e12_xp, 1.0e13_xp, 1.0e14_xp, &
+      1.0e15_xp, 1.0e16_xp, 1.0e17_xp, 1.0e18_xp, 1.0e19_xp, 1.0e20_xp, 1.0e21_xp, 1.0e22_xp, 1.0e23_xp, &
+      1.0e24_xp, 1.0e25_xp, 1.0e26_xp, 1.0e27_xp]
 
    !> A string of any length, for lists of arguments.
    !> An integer (default or 64-bit) without blanks.
@@ -289,8 +294,7 @@ contains
          buf = good
       else
          n = 17
-         clength = c_decimal_e(x, 17_c_int, cbuf, int(len(cbuf), c_int))
-         buf = cbuf(1:max(0, min(clength, len(cbuf) - 1)))
+         call decimal_e(x, 17, buf)
       end if
       ! buf holds "-d.ddde+XX" for n digits: the exponent e, the mantissa buf(1:nm)
       ! without trailing zeros (and without a trailing point).
@@ -382,31 +386,104 @@ contains
    end subroutine format_reals
 
    !> Whether `x` with `digits` significant digits reads back to `x`; `buf` holds that
-   !> decimal.
+   !> decimal (decimal_e's form).
    logical function reads_back(x, digits, buf)
       real(dp), intent(in) :: x
       integer, intent(in) :: digits
       character(len=40), intent(out) :: buf
-      character(kind=c_char, len=40) :: cbuf
-      integer(c_int) :: length
-      logical :: halting
-      buf = ""
-      length = c_decimal_e(x, int(digits, c_int), cbuf, int(len(cbuf), c_int))
+      real(dp) :: y
+      logical :: ok
+      integer :: n
+      call decimal_e(x, digits, buf)
       reads_back = .false.
+      n = len_trim(buf)
+      if (n == 0) return
+      ! parse_real refuses a decimal rounded up past the largest double (not finite) and
+      ! keeps strtod's overflow from trapping under -ffpe-trap=overflow.
+      call parse_real(buf(1:n), y, ok)
+      reads_back = ok .and. y == x
+   end function reads_back
+
+   !> x (finite, not 0) with `ndigits` (1 to 17) significant digits in C's "%.*e" form
+   !> ("-d.ddde+XX", correctly rounded, ties to even) in buf; blank if C fails. Where
+   !> 10**k that scales x to `digits` digits is exact in a real kind of 64 significand
+   !> bits (|k| <= 27), x 10**k is formed there with one rounding (an error below 2**-64
+   !> of it) and rounded to an integer, unless its fraction lies within one unit of that
+   !> kind of a half, where the error could decide the rounding; otherwise, and then, C's
+   !> snprintf. glibc's printf forms every digit in multi-precision arithmetic: it was
+   !> most of writing a deck or PREFIX.contacts.csv.
+   subroutine decimal_e(x, ndigits, buf)
+      real(dp), intent(in) :: x
+      integer, intent(in) :: ndigits
+      character(len=40), intent(out) :: buf
+      character(kind=c_char, len=40) :: cbuf
+      character(len=20) :: q_text
+      integer(c_int) :: length
+      real(xp) :: scaled, fraction_part, low, high
+      integer(i8) :: q
+      integer :: e10, k, tries, at, m, n
+      logical :: done
+      buf = ""
+      done = .false.
+      if (digits(1.0_xp) >= 64 .and. ieee_is_finite(x) .and. x /= 0) then
+         e10 = floor(log10(abs(x)))
+         low = powers_of_ten(ndigits - 1)
+         high = powers_of_ten(ndigits)
+         do tries = 1, 2
+            k = ndigits - 1 - e10
+            if (abs(k) > 27) exit
+            if (k >= 0) then
+               scaled = abs(real(x, xp))*powers_of_ten(k)
+            else
+               scaled = abs(real(x, xp))/powers_of_ten(-k)
+            end if
+            ! log10 may be one off near a power of ten: then scale once more.
+            if (scaled < low) then
+               e10 = e10 - 1
+               cycle
+            else if (scaled >= high) then
+               e10 = e10 + 1
+               cycle
+            end if
+            q = int(scaled, i8)
+            fraction_part = scaled - real(q, xp)
+            ! (scaled epsilon is at least one unit of the kind at `scaled`.)
+            if (abs(fraction_part - 0.5_xp) <= scaled*epsilon(scaled)) exit
+            if (fraction_part > 0.5_xp) q = q + 1
+            if (real(q, xp) >= high) then
+               q = q/10
+               e10 = e10 + 1
+            end if
+            done = .true.
+            exit
+         end do
+      end if
+      if (done) then
+         call integer_text(q, q_text, n)
+         at = 0
+         if (x < 0) call put("-")
+         call put(q_text(1:1))
+         if (ndigits > 1) then
+            call put(".")
+            call put(q_text(2:ndigits))
+         end if
+         call put(merge("e-", "e+", e10 < 0))
+         m = abs(e10)
+         if (m < 10) call put("0")
+         call integer_text(int(m, i8), q_text, n)
+         call put(q_text(1:n))
+         return
+      end if
+      length = c_decimal_e(x, int(ndigits, c_int), cbuf, int(len(cbuf), c_int))
       if (length <= 0 .or. length >= len(cbuf)) return
       buf = cbuf(1:length)
-      if (abs(x) > 1.0e307_dp) then
-         ! Rounded up past the largest double, the decimal reads as infinity: strtod
-         ! raises overflow, which must not trap under -ffpe-trap=overflow.
-         call ieee_get_halting_mode(ieee_overflow, halting)
-         if (halting) call ieee_set_halting_mode(ieee_overflow, .false.)
-         reads_back = c_decimal_read(cbuf) == x
-         call ieee_set_flag(ieee_overflow, .false.)
-         if (halting) call ieee_set_halting_mode(ieee_overflow, .true.)
-      else
-         reads_back = c_decimal_read(cbuf) == x
-      end if
-   end function reads_back
+   contains
+      subroutine put(piece)
+         character(len=*), intent(in) :: piece
+         buf(at + 1:at + len(piece)) = piece
+         at = at + len(piece)
+      end subroutine put
+   end subroutine decimal_e
 
    !> Parse a real token: [sign] digits [. digits] [(e|E|d|D) [sign] digits], at least
    !> one mantissa digit. NaN, Inf, repeat counts and overflow are refused. The result is
@@ -532,9 +609,9 @@ contains
       done = digits(1.0_xp) >= 64 .and. abs(e) <= 27
       if (.not. done) return
       if (e >= 0) then
-         wide = real(m, xp)*10.0_xp**e
+         wide = real(m, xp)*powers_of_ten(e)
       else
-         wide = real(m, xp)/10.0_xp**(-e)
+         wide = real(m, xp)/powers_of_ten(-e)
       end if
       x = real(wide, dp)
       if (real(x, xp) == wide) return
