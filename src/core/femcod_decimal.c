@@ -1,6 +1,8 @@
-/* Correctly rounded decimal conversions of C's library for femcod_strings (format_real):
- * snprintf is variadic, which Fortran cannot call portably, hence this wrapper.
- * glibc's printf and strtod convert exactly (correct rounding, round half to even). */
+/* Correctly rounded decimal conversions of C's library for femcod_strings (format_real,
+ * parse_real), which uses them where its own exact extended-precision path does not apply
+ * (near a rounding tie, more than 18 digits, a decimal exponent beyond 27): snprintf is
+ * variadic, which Fortran cannot call portably, hence this wrapper. glibc's printf and
+ * strtod convert exactly (correct rounding, round half to even). */
 #include <stdio.h>
 #include <stdlib.h>
 
