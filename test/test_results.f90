@@ -24,7 +24,7 @@ contains
       testsuite = [ &
          new_unittest("HDF5: schema, units, maps balance the load", test_hdf5), &
          new_unittest("HDF5: maps in C order (h5dump reads row i, column j)", test_c_order), &
-         new_unittest("HDF5: deflated maps read back through HDF5's own filters", test_deflated), &
+         new_unittest("HDF5: deflated and block-written maps read back exactly", test_deflated), &
          new_unittest("XDMF: one grid of quadrilaterals in the XY plane, rows as in the figures", test_xdmf), &
          new_unittest("SVG: complete documents, fitted exponent and pressure scale", test_svg), &
          new_unittest("pressure figure: its PNG holds the map's 64 levels (decoded by Python)", test_png_levels), &
@@ -255,8 +255,9 @@ contains
    !> A map written with compress (chunks shuffled and deflated on all threads by femcod,
    !> handed to HDF5 as stored) reads back exactly through HDF5's own shuffle and deflate
    !> filters, the independent decoder: 1000 x 300 doubles and integers, in chunks of 436
-   !> rows (131072 values / 300), the last one partial. The expected values are the
-   !> formulas that made the maps; h5dump (HDF5's tools) names both filters.
+   !> rows (131072 values / 300), the last one partial; so does the same map written
+   !> plain (by blocks of 436 rows). The expected values are the formulas that made the
+   !> maps; h5dump (HDF5's tools) names both filters.
    subroutine test_deflated(error)
       type(error_type), allocatable, intent(out) :: error
       type(h5_file) :: file
@@ -264,7 +265,7 @@ contains
       character(len=:), allocatable :: prefix, text
       real(dp) :: map(1000, 300)
       integer :: imap(1000, 300)
-      real(dp), allocatable :: back(:, :), iback(:, :)
+      real(dp), allocatable :: back(:, :), iback(:, :), plain(:, :)
       integer :: i, j, ios
       do j = 1, 300
          do i = 1, 1000
@@ -276,12 +277,14 @@ contains
       call h5_create(prefix//".h5", file, st)
       call h5_write(file, "/real", map, "nm", st, compress=.true.)
       call h5_write(file, "/int", imap, "1", st, compress=.true.)
+      call h5_write(file, "/plain", map, "nm", st)
       call h5_close(file, st)
       call check(error, st%code, 0, "writing")
       if (allocated(error)) return
       call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
       call h5_read(file, "/real", back, st, STATUS_BAD_INPUT)
       call h5_read(file, "/int", iback, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/plain", plain, st, STATUS_BAD_INPUT)
       call h5_close(file, st)
       call check(error, st%code, 0, "reading")
       if (allocated(error)) return
@@ -290,6 +293,10 @@ contains
       call check(error, all(back == map), "the doubles, exactly")
       if (allocated(error)) return
       call check(error, all(iback == real(imap, dp)), "the integers, exactly")
+      if (allocated(error)) return
+      call check(error, all(shape(plain) == [1000, 300]), "the plain map's shape")
+      if (allocated(error)) return
+      call check(error, all(plain == map), "the plain map (written in blocks of 436 rows), exactly")
       if (allocated(error)) return
       call execute_command_line("h5dump -p -H -d /real "//prefix//".h5 > "//prefix//".dump 2>&1", exitstat=ios)
       call check(error, ios, 0, "h5dump (Debian hdf5-tools, installed by setup.sh)")

@@ -68,7 +68,6 @@ module femcod_hdf5
       end function c_h5free_memory
    end interface
 
-
    interface
       !> herr_t H5Dwrite_chunk(hid_t dset_id, hid_t dxpl_id, uint32_t filters,
       !>     const hsize_t *offset, size_t data_size, const void *buf): one chunk's bytes as
@@ -383,23 +382,25 @@ contains
       else
          ! In blocks of whole rows (about 1 MiB), each transposed into the same buffer:
          ! no second copy of the map in fresh memory.
-         rows = int(max(1_hsize_t, min(dims(2), 131072_hsize_t/dims(1))))
+         rows = int(chunk_rows(dims))
          allocate(stored(size(map, 2), rows))
          call h5dget_space_f(dset, filespace, error)
-         do r0 = 1, size(map, 1), rows
-            nr = min(rows, size(map, 1) - r0 + 1)
-            call transpose_into(map(r0:r0 + nr - 1, :), stored(:, 1:nr))
-            block = [dims(1), int(nr, hsize_t)]
-            call h5screate_simple_f(2, block, memspace, e)
-            if (e == 0) call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, [0_hsize_t, int(r0 - 1, hsize_t)], &
-               block, e)
-            if (e == 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored(:, 1:nr), block, e, mem_space_id=memspace, &
-               file_space_id=filespace)
-            call h5sclose_f(memspace, error)
-            error = e
-            if (error /= 0) exit
-         end do
-         call h5sclose_f(filespace, e)
+         if (error == 0) then
+            do r0 = 1, size(map, 1), rows
+               nr = min(rows, size(map, 1) - r0 + 1)
+               call transpose_into(map(r0:r0 + nr - 1, :), stored(:, 1:nr))
+               block = [dims(1), int(nr, hsize_t)]
+               call h5screate_simple_f(2, block, memspace, e)
+               if (e == 0) call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, [0_hsize_t, int(r0 - 1, hsize_t)], &
+                  block, e)
+               if (e == 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, stored(:, 1:nr), block, e, mem_space_id=memspace, &
+                  file_space_id=filespace)
+               call h5sclose_f(memspace, error)
+               error = e
+               if (error /= 0) exit
+            end do
+            call h5sclose_f(filespace, e)
+         end if
       end if
       call finish_dataset(file, name, dset, error, units, status)
    end subroutine write_real2
