@@ -10,6 +10,8 @@ module test_safety
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem
    use femcod_process, only: process_id, host_name
+   use femcod_files, only: acquire_lock, release_lock
+   use femcod_strings, only: int_str
    use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
    use test_results, only: self_command
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
@@ -24,6 +26,7 @@ contains
       testsuite = [ &
          new_unittest("SIGTERM: exit 143, a checkpoint, no result; --restart gives the same bytes", test_sigterm), &
          new_unittest("a prefix is locked: a live holder refuses the run, a dead one is taken over", test_lock), &
+         new_unittest("a lock appears with its line (linked in place), no name of its own left", test_lock_whole), &
          new_unittest("--force replaces the set as a whole (no stale pressure maps)", test_force_set), &
          new_unittest("a checkpoint is not overwritten without --restart or --force", test_checkpoint_kept), &
          new_unittest("--restart on finished results: nothing to do only for the same inputs", test_restart_finished), &
@@ -142,6 +145,36 @@ contains
       call check(error, contains_text(read_text(scratch_path("safety.stderr")), "taken over from process 99999999") &
          .and. file_exists(dir//"/out.h5") .and. .not. file_exists(dir//"/out.lock"), "said, written, released")
    end subroutine test_lock
+
+   !> The lock is written under a name of the process's own and linked to PREFIX.lock, so
+   !> it never exists without its "PID HOST" line (created empty and filled after, a run
+   !> killed in between left a lock every later run refused: doc/results.md). Taken: the
+   !> line names this process and host; taken again while held: refused (exit code 5,
+   !> doc/results.md); either way no PREFIX.lock.PID is left; released: gone.
+   subroutine test_lock_whole(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(status_type) :: st, again
+      character(len=:), allocatable :: dir, notice, mine
+      dir = scratch_path("lock-whole")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      mine = dir//"/out.lock."//int_str(process_id())
+      call acquire_lock(dir//"/out.lock", st, notice)
+      call check(error, st%code, 0, "taken")
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/out.lock"), to_string(process_id())//" "//host_name()//new_line("a"), &
+         "the lock's line")
+      if (allocated(error)) return
+      call check(error, .not. file_exists(mine), "no name of its own left after taking it")
+      if (allocated(error)) return
+      call acquire_lock(dir//"/out.lock", again, notice)
+      call check(error, again%code == 5 .and. index(again%message, "another run writes these results") > 0, &
+         "taken again while held: refused")
+      if (allocated(error)) return
+      call check(error, .not. file_exists(mine), "no name of its own left after a refusal")
+      if (allocated(error)) return
+      call release_lock(dir//"/out.lock")
+      call check(error, .not. file_exists(dir//"/out.lock"), "released")
+   end subroutine test_lock_whole
 
    subroutine test_force_set(error)
       type(error_type), allocatable, intent(out) :: error

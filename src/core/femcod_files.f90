@@ -44,6 +44,12 @@ module femcod_files
          character(kind=c_char), intent(in) :: from(*), to(*)
          integer(c_int) :: rc
       end function c_rename
+      !> link(2): a second name for a file; fails (EEXIST) if `to` exists, atomically.
+      function c_link(from, to) bind(c, name="link") result(rc)
+         import :: c_char, c_int
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: rc
+      end function c_link
       function c_realpath(path, resolved) bind(c, name="realpath") result(p)
          import :: c_char, c_ptr
          character(kind=c_char), intent(in) :: path(*)
@@ -252,21 +258,32 @@ contains
       character(len=*), intent(in) :: path
       type(status_type), intent(inout) :: status
       character(len=:), allocatable, intent(out) :: notice
-      integer :: unit, ios, pid, attempt
+      character(len=:), allocatable :: mine
+      integer :: unit, ios, pid, attempt, cut
       character(len=256) :: holder_host
       notice = ""
       if (status%code /= 0) return
+      ! The line "PID HOST" is written under a name of this process's own, then linked to
+      ! `path` (link fails if `path` exists: an exclusive create), so that the lock
+      ! never exists without its line. Created first and filled after, a run killed in
+      ! between left an empty lock that every later run refused (the SIGKILL test caught it).
+      mine = path//"."//int_str(process_id())
+      call write_bytes(mine, int_str(process_id())//" "//host_name()//new_line("a"), status)
+      if (status%code /= 0) then
+         call remove_file(mine)
+         cut = index(status%message, ": writing failed")
+         if (cut > 0) then
+            status%message = path//": writing the lock file failed"//status%message(cut + 16:)//"; nothing was run"
+         else
+            status = status_type()
+            call set_error(status, STATUS_IO, path//": cannot write the lock file (directory missing or not "// &
+               "writable); nothing was run")
+         end if
+         return
+      end if
       do attempt = 1, 2
-         ! Created exclusively (status="new"), then its line written through write_bytes,
-         ! which, unlike Fortran's WRITE, reports a full disk.
-         open(newunit=unit, file=path, status="new", action="write", iostat=ios)
-         if (ios == 0) then
-            close(unit)
-            call write_bytes(path, int_str(process_id())//" "//host_name()//new_line("a"), status)
-            if (status%code /= 0) then
-               call remove_file(path)
-               status%message = status%message//"; nothing was run"
-            end if
+         if (c_link(mine//c_null_char, path//c_null_char) == 0) then
+            call remove_file(mine)
             return
          end if
          if (.not. path_exists(path)) exit
@@ -279,6 +296,7 @@ contains
             close(unit)
          end if
          if (ios /= 0) then
+            call remove_file(mine)
             call set_error(status, STATUS_IO, path//": a lock file that names no process (""PID HOST"" expected); "// &
                "remove it if no run writes these results")
             return
@@ -288,10 +306,12 @@ contains
             notice = path//": taken over from process "//int_str(pid)//", which no longer runs"
             cycle
          end if
+         call remove_file(mine)
          call set_error(status, STATUS_IO, path//": another run writes these results (process "//int_str(pid)// &
             " on "//trim(holder_host)//"); wait for it, or remove the lock if that run is gone")
          return
       end do
+      call remove_file(mine)
       call set_error(status, STATUS_IO, path//": cannot write the lock file (directory missing or not writable); "// &
          "nothing was run")
    end subroutine acquire_lock
