@@ -7,6 +7,7 @@ module test_deck
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, format_real, format_reals, int_str, parse_real
    use femcod_cli, only: run_femcod
+   use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens
    use test_support, only: write_text, scratch_path, contains_text, file_exists
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -31,6 +32,7 @@ contains
          new_unittest("format_real equals a brute-force search on 40000 values", test_format_real_search), &
          new_unittest("parse_real equals Fortran's READ on 60000 decimals and halfway cases", test_parse_real), &
          new_unittest("int_str equals Fortran's i0 edit descriptor", test_int_str), &
+         new_unittest("eight-byte scans equal byte-by-byte scans on 3000 random texts", test_word_scans), &
          new_unittest("the first bad height in file order is reported", test_first_bad_height), &
          new_unittest("bad deck: "//"missing value line 2", bad_01), &
          new_unittest("bad deck: "//"extra value line 3", bad_02), &
@@ -279,7 +281,9 @@ contains
       logical :: ok
       texts = [character(len=40) :: "9007199254740993", "9007199254740995", "-9007199254740993", &
          "18014398509481986", "0.5", "-0", "0.000", "1e-27", "999999999999999999e27", "123456789012345678e-27", &
-         "4.9406564584124654e-324", "1.7976931348623157e308", "2.2250738585072014D-308", ".5", "5.", "+3.25e+02"]
+         "4.9406564584124654e-324", "1.7976931348623157e308", "2.2250738585072014D-308", ".5", "5.", "+3.25e+02", &
+         "4503599627370496.5", "4503599627370497.5", "-4503599627370497.5", "9007199254740991.5", &
+         "9007199254740991.75", "2251799813685248.25", "2251799813685248.75"]
       call random_seed(size=nseed)
       allocate(seed(nseed))
       seed = 20261125
@@ -318,6 +322,91 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_parse_real
+
+   !> The deck reader's eight-byte scans (femcod_bytes) against the byte-by-byte
+   !> definitions written out here: the first control byte (below 32 but TAB, LF, FF, CR,
+   !> or DEL) of random texts of every byte value, and the tokens (separated by bytes
+   !> below 33 and commas), their first and last bytes and lines, and the line ends, of
+   !> random texts of separators and token bytes (also above 127), over random spans
+   !> whose lengths are not multiples of eight.
+   subroutine test_word_scans(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: alphabet(12) = [9, 10, 12, 13, 32, 44, 48, 49, 46, 101, 45, 200]
+      character(len=:), allocatable :: text
+      integer, allocatable :: first(:), last(:), line(:), ref_first(:), ref_last(:), ref_line(:)
+      real(dp) :: u
+      integer :: trial, n, i, i0, i1, expected, count, ends, nref, ln, k0, ln0
+      logical :: inside
+      if (.not. words_little_endian()) return
+      do trial = 1, 3000
+         call random_number(u)
+         n = 1 + int(u*70)
+         allocate(character(len=n) :: text)
+         do i = 1, n
+            call random_number(u)
+            if (trial <= 1000) then
+               ! Mostly ordinary text, a control byte now and then.
+               if (u < 0.97_dp) then
+                  text(i:i) = achar(alphabet(1 + int(u/0.97_dp*size(alphabet))))
+               else
+                  text(i:i) = achar(int((u - 0.97_dp)/0.03_dp*256))
+               end if
+            else
+               text(i:i) = achar(alphabet(1 + int(u*size(alphabet))))
+            end if
+         end do
+         if (trial <= 1000) then
+            expected = huge(expected)
+            do i = n, 1, -1
+               if ((iachar(text(i:i)) < 32 .and. all(iachar(text(i:i)) /= [9, 10, 12, 13])) .or. &
+                  iachar(text(i:i)) == 127) expected = i
+            end do
+            call check(error, first_control_byte(text), expected, "first control byte of a random text of "// &
+               int_str(n)//" bytes")
+            if (allocated(error)) return
+            deallocate(text)
+            cycle
+         end if
+         ! A span i0..i1 whose byte before is a separator (or the text's start).
+         call random_number(u)
+         i0 = 1 + int(u*n)
+         if (i0 > 1) text(i0 - 1:i0 - 1) = " "
+         call random_number(u)
+         i1 = i0 + int(u*(n - i0 + 1))
+         i1 = min(i1, n)
+         allocate(ref_first(n), ref_last(n), ref_line(n))
+         nref = 0
+         ln = 0
+         inside = .false.
+         do i = i0, i1
+            if (iachar(text(i:i)) < 33 .or. text(i:i) == ",") then
+               if (inside) ref_last(nref) = i - 1
+               inside = .false.
+               if (text(i:i) == new_line("a")) ln = ln + 1
+            else if (.not. inside) then
+               inside = .true.
+               nref = nref + 1
+               ref_first(nref) = i
+               ref_line(nref) = ln
+            end if
+         end do
+         if (inside) ref_last(nref) = i1
+         k0 = mod(trial, 5)
+         ln0 = mod(trial, 7)
+         call scan_tokens(text, i0, i1, k0, ln0, count, ends)
+         call check(error, count == nref .and. ends == ln, "tokens and line ends of a span of "// &
+            int_str(i1 - i0 + 1)//" bytes: "//int_str(count)//" and "//int_str(ends)//", expected "// &
+            int_str(nref)//" and "//int_str(ln))
+         if (allocated(error)) return
+         allocate(first(k0 + nref), last(k0 + nref), line(k0 + nref))
+         call scan_tokens(text, i0, i1, k0, ln0, count, ends, first, last, line)
+         call check(error, all(first(k0 + 1:) == ref_first(1:nref)) .and. all(last(k0 + 1:) == ref_last(1:nref)) &
+            .and. all(line(k0 + 1:) == ln0 + ref_line(1:nref)), "token bounds and lines of a span of "// &
+            int_str(i1 - i0 + 1)//" bytes")
+         if (allocated(error)) return
+         deallocate(text, first, last, line, ref_first, ref_last, ref_line)
+      end do
+   end subroutine test_word_scans
 
    !> int_str against the list-free i0 edit of Fortran's own formatted output, on the
    !> extremes of both kinds and on every power of ten and its neighbours.

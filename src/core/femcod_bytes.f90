@@ -1,0 +1,140 @@
+!> Scanning text eight bytes at a time, for the deck reader (femcod_deck): a 64-bit word
+!> holds text(i:i+7), byte k of the text in bits 8k..8k+7 (little-endian order, checked
+!> by `words_little_endian`; the reader scans byte by byte otherwise), and each test below
+!> answers for all eight bytes at once with the high bit of each byte (bit 8k+7) set
+!> where the byte passes. The tests are exact for every byte value: the low seven bits
+!> are added to a constant that cannot carry out of the byte, and the byte's own high
+!> bit is combined after, so no byte's answer leaks into its neighbour's (the common "has
+!> a zero byte" trick flags false bytes above a true one).
+!> The tests are private so that the compiler inlines them into the scans (a public
+!> procedure may be replaced at load time under -fPIC, so it is called, not inlined:
+!> 0.05 s instead of 0.005 s for the control bytes of a 21 MB deck).
+module femcod_bytes
+   use femcod_kinds, only: i8
+   implicit none
+   private
+   public :: words_little_endian, first_control_byte, scan_tokens
+
+   !> The low seven bits of every byte, and the high bit of every byte.
+   integer(i8), parameter :: LOW_BITS = int(z'7F7F7F7F7F7F7F7F', i8)
+   integer(i8), parameter :: HIGH_BITS = not(LOW_BITS)
+   !> One in every byte.
+   integer(i8), parameter :: ONES = int(z'0101010101010101', i8)
+
+contains
+
+   !> High bit of each byte of `word` whose value is below `limit` (1 to 128).
+   pure integer(i8) function bytes_below(word, limit) result(mask)
+      integer(i8), value :: word
+      integer, value :: limit
+      ! low + (128 - limit) reaches 128 exactly when low >= limit, and stays below 256.
+      mask = iand(not(ior(iand(word, LOW_BITS) + (128 - limit)*ONES, word)), HIGH_BITS)
+   end function bytes_below
+
+   !> High bit of each byte of `word` equal to `byte` (0 to 255).
+   pure integer(i8) function bytes_equal(word, byte) result(mask)
+      integer(i8), value :: word
+      integer, value :: byte
+      mask = bytes_below(ieor(word, int(byte, i8)*ONES), 1)
+   end function bytes_equal
+
+   !> The number of bytes of `mask` (high bits only, as the tests above give them) set.
+   pure integer function bytes_set(mask) result(n)
+      integer(i8), value :: mask
+      ! One in the low bit of each byte set; the product sums them into the top byte.
+      n = int(shiftr(shiftr(mask, 7)*ONES, 56))
+   end function bytes_set
+
+   !> Whether this machine stores text(i) in the lowest byte of a word (x86-64 and
+   !> AArch64 do).
+   pure logical function words_little_endian()
+      words_little_endian = transfer("a       ", 0_i8) == int(iachar("a"), i8) + int(z'2020202020202000', i8)
+   end function words_little_endian
+
+   !> text(i:i+7) as a word; past `last` (at most i+7) the bytes are blanks.
+   pure integer(i8) function word_at(text, i, last) result(word)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: i, last
+      character(len=8) :: chunk
+      if (last - i >= 7) then
+         word = transfer(text(i:i + 7), word)
+      else
+         chunk = " "
+         chunk(1:last - i + 1) = text(i:last)
+         word = transfer(chunk, word)
+      end if
+   end function word_at
+
+   !> The position of the first control byte of `text` (below 32 but TAB, LF, FF and CR,
+   !> or DEL), huge(0) if there is none; on all threads.
+   integer function first_control_byte(text) result(first)
+      character(len=*), intent(in) :: text
+      integer(i8) :: word, found
+      integer :: i
+      first = huge(first)
+      !$omp parallel do private(word, found) reduction(min: first) schedule(static)
+      do i = 1, len(text), 8
+         word = word_at(text, i, len(text))
+         found = iand(bytes_below(word, 32), not(ior(ior(bytes_equal(word, 9), bytes_equal(word, 10)), &
+            ior(bytes_equal(word, 12), bytes_equal(word, 13)))))
+         found = ior(found, bytes_equal(word, 127))
+         if (found /= 0) first = min(first, i + trailz(found)/8)
+      end do
+   end function first_control_byte
+
+   !> The tokens of text(i0:i1), separated by the bytes below 33 and commas (a text
+   !> without other control bytes: first_control_byte), and its line ends (LF): counted,
+   !> and when `first` is given recorded as tokens k0 + 1, ... (first and last byte, line
+   !> from ln0 on). The byte before i0 is taken as a separator. In each word, `starts`
+   !> has the high bit of every byte that begins a token (not a separator, after one) and
+   !> `stops` of every separator that ends one; tokens close in the order they open, so
+   !> the n-th stop ends the n-th token open. Blanks pad the last word.
+   pure subroutine scan_tokens(text, i0, i1, k0, ln0, count, ends, first, last, line)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: i0, i1, k0, ln0
+      integer, intent(out) :: count, ends
+      integer, intent(inout), optional :: first(:), last(:), line(:)
+      integer(i8) :: word, sep, other, starts, stops, newlines, after_sep, after_other
+      integer :: i, k, kstop, ln, b
+      logical :: record
+      record = present(first)
+      k = k0
+      kstop = k0
+      ln = ln0
+      ! The high bit of byte 0: whether the byte before the word was a separator, or not.
+      after_sep = 128
+      after_other = 0
+      do i = i0, i1, 8
+         word = word_at(text, i, i1)
+         sep = ior(bytes_below(word, 33), bytes_equal(word, 44))
+         other = iand(not(sep), HIGH_BITS)
+         starts = iand(other, ior(shiftl(sep, 8), after_sep))
+         stops = iand(sep, ior(shiftl(other, 8), after_other))
+         after_sep = shiftr(sep, 56)
+         after_other = shiftr(other, 56)
+         newlines = bytes_equal(word, 10)
+         if (record) then
+            do while (starts /= 0)
+               b = trailz(starts)
+               k = k + 1
+               first(k) = i + b/8
+               line(k) = ln + bytes_set(iand(newlines, maskr(b, i8)))
+               starts = iand(starts, starts - 1)
+            end do
+            do while (stops /= 0)
+               b = trailz(stops)
+               kstop = kstop + 1
+               last(kstop) = i + b/8 - 1
+               stops = iand(stops, stops - 1)
+            end do
+         else
+            k = k + bytes_set(starts)
+         end if
+         ln = ln + bytes_set(newlines)
+      end do
+      ends = ln - ln0
+      ! A token that runs to i1 at the end of a full word has no stop.
+      if (record .and. kstop < k) last(k) = i1
+      count = k - k0
+   end subroutine scan_tokens
+end module femcod_bytes
