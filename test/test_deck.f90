@@ -28,6 +28,7 @@ contains
          new_unittest("valid deck: values and layout", test_valid), &
          new_unittest("CRLF, tabs, commas, D exponents, wrapped values", test_formats), &
          new_unittest("write then read is exact", test_roundtrip), &
+         new_unittest("a 300 x 300 deck of mixed separators reads exactly; its bad values are named", test_large_deck), &
          new_unittest("shortest round-trip number format", test_format_real), &
          new_unittest("format_real equals a brute-force search on 40000 values", test_format_real_search), &
          new_unittest("parse_real equals Fortran's READ on 60000 decimals and halfway cases", test_parse_real), &
@@ -146,6 +147,70 @@ contains
          back%pixel == deck%pixel .and. all(back%young == deck%young) .and. all(back%poisson == deck%poisson), &
          "every value reads back bit for bit")
    end subroutine test_roundtrip
+
+   !> A deck of 2 x 300^2 random heights (about 4 MB, many of the reader's 256 KiB blocks),
+   !> each written with 17 significant digits (which name one double: READ of the
+   !> same text is the expected value) and separated at random by blanks, tabs, commas,
+   !> LF or CRLF: every value reads back bit for bit. Then the last value made "x", and
+   !> one value more: refused with the line the test counted while writing.
+   subroutine test_large_deck(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: np = 300
+      character(len=*), parameter :: separators(5) = [character(len=2) :: " ", achar(9), ",", nl, achar(13)//nl]
+      integer, parameter :: lengths(5) = [1, 1, 1, 1, 2]
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      character(len=:), allocatable :: path, text, body
+      character(len=25) :: t
+      real(dp), allocatable :: values(:)
+      real(dp) :: u
+      integer :: k, line, last_line, last_start, sep, n
+      allocate(values(2*np*np))
+      allocate(character(len=27*size(values)) :: body)
+      n = 0
+      line = 6
+      do k = 1, size(values)
+         call random_number(u)
+         write(t, "(es25.16e3)") (u - 0.5_dp)*10.0_dp**(mod(k, 9) - 4)
+         t = adjustl(t)
+         read(t, *) values(k)
+         if (k > 1) then
+            call random_number(u)
+            sep = 1 + int(u*size(separators))
+            if (sep >= 4) line = line + 1
+            body(n + 1:n + lengths(sep)) = separators(sep)(1:lengths(sep))
+            n = n + lengths(sep)
+         end if
+         last_start = n + 1
+         body(n + 1:n + len_trim(t)) = trim(t)
+         n = n + len_trim(t)
+      end do
+      body = body(1:n)
+      last_line = line
+      text = "large"//nl//int_str(np)//" 2.5 100"//nl//"200 0.25"//nl//"2e7 0.25"//nl//"2e7 0.3"//nl
+      path = scratch_path("large.deck")
+      call write_text(path, text//body//nl)
+      call read_deck(path, deck, status)
+      call check(error, status%code, 0, "a valid 300 x 300 deck is accepted: "//status%message)
+      if (allocated(error)) return
+      call check(error, all(transfer(reshape(transpose(deck%lower), [np*np]), 1_8, np*np) == &
+         transfer(values(1:np*np), 1_8, np*np)) .and. all(transfer(reshape(transpose(deck%upper), [np*np]), 1_8, &
+         np*np) == transfer(values(np*np + 1:), 1_8, np*np)), "every height reads back bit for bit, row by row")
+      if (allocated(error)) return
+      call write_text(path, text//body(1:last_start - 1)//"x"//nl)
+      status = status_type()
+      call read_deck(path, deck, status)
+      call check(error, status%code /= 0 .and. contains_text(status%message, "large.deck:"//int_str(last_line)// &
+         ": expected an upper-surface height in nm (row 300, column 300)"), "the bad last value is named "// &
+         "with its line: "//status%message)
+      if (allocated(error)) return
+      call write_text(path, text//body//" 1"//nl)
+      status = status_type()
+      call read_deck(path, deck, status)
+      call check(error, status%code /= 0 .and. contains_text(status%message, "large.deck:"//int_str(last_line)// &
+         ": expected the end of the deck after the 180000 heights, found '1'"), "one value more is refused "// &
+         "with its line: "//status%message)
+   end subroutine test_large_deck
 
    subroutine test_format_real(error)
       type(error_type), allocatable, intent(out) :: error

@@ -84,8 +84,8 @@ contains
 
    !> The tokens of text(i0:i1), separated by the bytes below 33 and commas (a text
    !> without other control bytes: first_control_byte), and its line ends (LF): counted,
-   !> and when `first` is given recorded as tokens k0 + 1, ... (first and last byte, line
-   !> from ln0 on). The byte before i0 is taken as a separator. In each word, `starts`
+   !> and when `first` is given recorded as tokens k0 + 1, ... (first and last byte; with
+   !> `line` their lines, from ln0 on). The byte before i0 is taken as a separator. In each word, `starts`
    !> has the high bit of every byte that begins a token (not a separator, after one) and
    !> `stops` of every separator that ends one; tokens close in the order they open, so
    !> the n-th stop ends the n-th token open. Blanks pad the last word.
@@ -93,7 +93,8 @@ contains
       character(len=*), intent(in) :: text
       integer, intent(in) :: i0, i1, k0, ln0
       integer, intent(out) :: count, ends
-      integer, intent(inout), optional :: first(:), last(:), line(:)
+      integer, intent(inout), optional :: first(:), last(:)
+      integer, intent(inout), optional :: line(:)
       integer(i8) :: word, sep, other, starts, stops, newlines, after_sep, after_other
       integer :: i, k, kstop, ln, b
       logical :: record
@@ -118,7 +119,7 @@ contains
                b = trailz(starts)
                k = k + 1
                first(k) = i + b/8
-               line(k) = ln + bytes_set(iand(newlines, maskr(b, i8)))
+               if (present(line)) line(k) = ln + bytes_set(iand(newlines, maskr(b, i8)))
                starts = iand(starts, starts - 1)
             end do
             do while (stops /= 0)

@@ -39,8 +39,9 @@ contains
       type(status_type), intent(inout) :: status
       character(len=:), allocatable :: text
       integer, allocatable :: tok_first(:), tok_last(:), tok_line(:)
-      integer :: ntok, k, first_line6, i, j, last_line
+      integer :: ntok, k, first_line6, i, j, last_line, header_end
       integer(i8) :: nvalues
+      logical :: ok
       character(len=24) :: count_text
       integer :: ln_first(2:5), ln_count(2:5)
 
@@ -52,7 +53,19 @@ contains
       end if
       call check_text(path, text, status)
       if (status%code /= 0) return
-      call tokenize(text, ntok, tok_first, tok_last, tok_line, last_line)
+      ! Lines 1 to 5 are tokenized here, the heights parsed straight from the text
+      ! (heights_from_text); only a deck whose heights are refused is tokenized whole,
+      ! for the message. A text of fewer than five lines is tokenized whole at once.
+      header_end = 0
+      do i = 1, 5
+         j = index(text(header_end + 1:), new_line("a"))
+         if (j == 0) then
+            header_end = len(text)
+            exit
+         end if
+         header_end = header_end + j
+      end do
+      call tokenize(text(1:header_end), ntok, tok_first, tok_last, tok_line, last_line)
       deck%label = label_of(text)
 
       ! Lines 2..5: exactly the named values.
@@ -107,6 +120,21 @@ contains
       end do
 
       ! Heights.
+      allocate(deck%lower(deck%np, deck%np), deck%upper(deck%np, deck%np))
+      if (header_end < len(text) .and. words_little_endian()) then
+         call heights_from_text(text, header_end + 1, deck%lower, deck%upper, ok)
+         if (ok) return
+      end if
+      if (header_end < len(text)) then
+         call tokenize(text, ntok, tok_first, tok_last, tok_line, last_line)
+         first_line6 = ntok + 1
+         do k = 1, ntok
+            if (tok_line(k) >= 6) then
+               first_line6 = k
+               exit
+            end if
+         end do
+      end if
       ! In 64 bits: 2 NP**2 overflows a default integer for NP > 32767.
       nvalues = 2*int(deck%np, i8)**2
       write(count_text, '(i0)') nvalues
@@ -121,7 +149,6 @@ contains
          call bad(tok_line(k), "the end of the deck after the "//trim(count_text)//" heights", tok(k))
          return
       end if
-      allocate(deck%lower(deck%np, deck%np), deck%upper(deck%np, deck%np))
       ! The message of a bad height is built only when there is one: a string per value
       ! made reading a 1024 x 1024 deck allocation-bound.
       k = first_line6
@@ -250,6 +277,84 @@ contains
          call add_text(b, new_line("a"))
       end subroutine add_row
    end subroutine write_deck
+
+   !> The NP x NP lower heights then the NP x NP upper ones (nm), row by row, from
+   !> text(start:) to its end, parsed where they stand: no token arrays (at 1024^2 three
+   !> of 2 million integers, written and read back). The text is cut at separators into
+   !> blocks of 256 KiB; the threads count each block's tokens (femcod_bytes), then, from
+   !> the counts before it, each block's tokens are found again into a small buffer and
+   !> converted. `ok` is false, and the caller tokenizes the whole deck for the message,
+   !> when the count is not 2 NP^2 or a value is not a number within MAX_HEIGHT.
+   subroutine heights_from_text(text, start, lower, upper, ok)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: start
+      real(dp), intent(out) :: lower(:, :), upper(:, :)
+      logical, intent(out) :: ok
+      integer, parameter :: BLOCK_BYTES = 262144
+      integer, allocatable :: bounds(:), counts(:), first(:), last(:)
+      integer(i8), allocatable :: before(:)
+      integer(i8) :: m, per_surface
+      integer :: nblocks, b, p, n, t, count, ends, np, i, j, bad
+      real(dp) :: v
+      logical :: good
+      n = len(text)
+      np = size(lower, 1)
+      per_surface = int(np, i8)**2
+      nblocks = max(1, (n - start + 1)/BLOCK_BYTES)
+      allocate(bounds(0:nblocks), counts(nblocks), before(nblocks))
+      bounds(0) = start - 1
+      do b = 1, nblocks - 1
+         p = max(bounds(b - 1), start - 1 + int(int(n - start + 1, i8)*b/nblocks))
+         do while (p < n)
+            if (iachar(text(p:p)) < 33 .or. text(p:p) == ",") exit
+            p = p + 1
+         end do
+         bounds(b) = p
+      end do
+      bounds(nblocks) = n
+      !$omp parallel do private(ends) schedule(static)
+      do b = 1, nblocks
+         call scan_tokens(text, bounds(b - 1) + 1, bounds(b), 0, 0, counts(b), ends)
+      end do
+      before(1) = 0
+      do b = 2, nblocks
+         before(b) = before(b - 1) + counts(b - 1)
+      end do
+      ok = before(nblocks) + counts(nblocks) == 2*per_surface
+      if (.not. ok) return
+      bad = 0
+      !$omp parallel private(first, last, count, ends, t, m, i, j, v, good) reduction(+: bad)
+      allocate(first(maxval(counts)), last(maxval(counts)))
+      !$omp do schedule(static)
+      do b = 1, nblocks
+         call scan_tokens(text, bounds(b - 1) + 1, bounds(b), 0, 0, count, ends, first, last)
+         ! Row i, column j of the height number before(b) + 1 of its surface.
+         m = mod(before(b), per_surface)
+         i = int(m/np) + 1
+         j = int(m - (i - 1)*int(np, i8)) + 1
+         m = before(b)
+         do t = 1, count
+            call parse_real(text(first(t):last(t)), v, good)
+            if (good) good = abs(v) <= MAX_HEIGHT
+            if (.not. good) bad = bad + 1
+            m = m + 1
+            if (m <= per_surface) then
+               lower(i, j) = v
+            else
+               upper(i, j) = v
+            end if
+            j = j + 1
+            if (j > np) then
+               j = 1
+               i = i + 1
+               if (i > np) i = 1
+            end if
+         end do
+      end do
+      !$omp end do
+      !$omp end parallel
+      ok = bad == 0
+   end subroutine heights_from_text
 
    !> Refuse what is not a text deck: UTF-16 (a byte order mark, or NUL bytes between
    !> the characters), and binary content (control bytes other than TAB, LF, CR and FF).
