@@ -1,10 +1,14 @@
 !> OpenBLAS 0.3.21 (Debian 12) does not recognise recent Xeons (Cooper Lake, Sapphire
 !> Rapids): it falls back to its generic "Prescott" kernels, and the BLAS-3 triangular
-!> solves of the incremental solver run 3 to 4 times slower (doc/performance.md). OpenBLAS
-!> reads OPENBLAS_CORETYPE once, when the library is loaded, so when the variable is
-!> unset femcod sets it from the CPU's flags (avx512f: SkylakeX, avx2: Haswell) and
-!> starts itself again, once. A user's own OPENBLAS_CORETYPE is never touched; with
-!> another BLAS the variable is ignored.
+!> solves of the incremental solver run 3 to 4 times slower (doc/performance.md). And its
+!> idle threads wait by calling sched_yield for 2^28 cycles (about 0.1 s) after the
+!> library is loaded and after each threaded call before they sleep: on 2 cores the
+!> waiting thread took a core from femcod's own threads reading a deck (1024^2: 0.14
+!> instead of 0.08 s) and cost 3.5 s of system time in a 5 s incremental run.
+!> OpenBLAS reads OPENBLAS_CORETYPE and OPENBLAS_THREAD_TIMEOUT once, when the library is
+!> loaded, so femcod sets those that are unset (the core from the CPU's flags, avx512f:
+!> SkylakeX, avx2: Haswell; the wait to 2^4 cycles) and starts itself again, once. A
+!> user's own values are never touched; with another BLAS the variables are ignored.
 module femcod_blas_core
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_ptr, c_null_char, c_null_ptr, c_loc
    implicit none
@@ -38,11 +42,18 @@ contains
       type(c_string), allocatable, target :: args(:)
       type(c_ptr), allocatable :: argv(:)
       integer :: status, n, k, length
+      logical :: changed
+      changed = .false.
       call get_environment_variable("OPENBLAS_CORETYPE", status=status)
-      if (status /= 1) return
-      core = core_from_cpu_flags()
-      if (core == "") return
-      if (c_setenv("OPENBLAS_CORETYPE"//c_null_char, core//c_null_char, 1_c_int) /= 0) return
+      if (status == 1) then
+         core = core_from_cpu_flags()
+         if (core /= "") changed = c_setenv("OPENBLAS_CORETYPE"//c_null_char, core//c_null_char, 1_c_int) == 0
+      end if
+      call get_environment_variable("OPENBLAS_THREAD_TIMEOUT", status=status)
+      if (status == 1) then
+         if (c_setenv("OPENBLAS_THREAD_TIMEOUT"//c_null_char, "4"//c_null_char, 1_c_int) == 0) changed = .true.
+      end if
+      if (.not. changed) return
       n = command_argument_count()
       allocate(args(0:n), argv(0:n + 1))
       do k = 0, n
