@@ -21,25 +21,27 @@ contains
       integer, intent(in) :: palette(:, :)
       logical, intent(out) :: ok
       character(len=:), allocatable :: png
-      character(len=:), allocatable :: raw, packed, plte
+      character(kind=c_char), allocatable :: raw(:)
+      character(len=:), allocatable :: packed, plte
       integer(c_long) :: packed_len
       integer :: rows, cols, i, j, k
       rows = size(image, 1)
       cols = size(image, 2)
       ! The scanlines: a filter byte (0, none), then one palette index per pixel.
-      allocate(character(len=rows*(cols + 1)) :: raw)
-      k = 0
+      ! Rows on all threads (into an array of bytes: gfortran 12 cannot share a
+      ! deferred-length string between threads).
+      allocate(raw(rows*(cols + 1)))
+      !$omp parallel do private(j, k)
       do i = 1, rows
-         k = k + 1
-         raw(k:k) = achar(0)
+         k = (i - 1)*(cols + 1) + 1
+         raw(k) = achar(0)
          do j = 1, cols
-            k = k + 1
-            raw(k:k) = achar(image(i, j))
+            raw(k + j) = achar(image(i, j))
          end do
       end do
-      packed_len = c_compress_bound(int(len(raw), c_long))
+      packed_len = c_compress_bound(int(size(raw), c_long))
       allocate(character(len=packed_len) :: packed)
-      ok = c_compress2(packed, packed_len, raw, int(len(raw), c_long), 6_c_int) == 0
+      ok = c_compress2(packed, packed_len, raw, int(size(raw), c_long), 6_c_int) == 0
       png = ""
       if (.not. ok) return
       allocate(character(len=3*size(palette, 2)) :: plte)

@@ -202,9 +202,9 @@ contains
       real(dp), intent(in) :: side
       character(len=:), allocatable :: svg
       integer, parameter :: levels = 64, max_image = 1024
-      integer :: np, i, j, k, f, m, palette(3, 0:levels)
-      real(dp) :: vmax, size_px, x0, y0
-      real(dp), allocatable :: ticks(:), block(:, :)
+      integer :: np, i, j, k, f, m, ii, jj, palette(3, 0:levels)
+      real(dp) :: vmax, size_px, x0, y0, largest
+      real(dp), allocatable :: ticks(:)
       integer, allocatable :: bin(:, :)
       character(len=:), allocatable :: png
       logical :: ok
@@ -215,16 +215,21 @@ contains
       y0 = mt
       f = (np + max_image - 1)/max_image
       m = (np + f - 1)/f
-      allocate(block(m, m), bin(m, m))
+      ! Each block's largest value and its colour, on all threads (no strings here).
+      allocate(bin(m, m))
+      !$omp parallel do private(i, ii, jj, largest)
       do j = 1, m
          do i = 1, m
-            block(i, j) = maxval(values((i - 1)*f + 1:min(np, i*f), (j - 1)*f + 1:min(np, j*f)))
+            largest = -huge(largest)
+            do jj = (j - 1)*f + 1, min(np, j*f)
+               do ii = (i - 1)*f + 1, min(np, i*f)
+                  largest = max(largest, values(ii, jj))
+               end do
+            end do
+            bin(i, j) = 0
+            if (vmax > 0 .and. largest > 0) bin(i, j) = 1 + min(levels - 1, int(largest/vmax*levels))
          end do
       end do
-      bin = 0
-      if (vmax > 0) then
-         where (block > 0) bin = 1 + min(levels - 1, int(block/vmax*levels))
-      end if
       palette(:, 0) = 255
       do k = 1, levels
          palette(:, k) = colour_rgb((k - 0.5_dp)/levels)
