@@ -27,11 +27,18 @@ contains
    pure integer(i8) function bytes_below(word, limit) result(mask)
       integer(i8), value :: word
       integer, value :: limit
-      ! low + (128 - limit) reaches 128 exactly when low >= limit, and stays below 256.
-      mask = iand(not(ior(iand(word, LOW_BITS) + (128 - limit)*ONES, word)), HIGH_BITS)
+      integer(i8), parameter :: LOW_HALF = int(z'7F7F7F7F', i8), ONES_HALF = int(z'01010101', i8)
+      integer(i8) :: step, low, high
+      ! low + (128 - limit) reaches 128 exactly when low >= limit, and stays below 256;
+      ! summed in halves of four bytes, so that no sum leaves 63 bits (Fortran's
+      ! integers do not wrap), then joined by a shift.
+      step = (128 - limit)*ONES_HALF
+      low = iand(word, LOW_HALF) + step
+      high = iand(shiftr(word, 32), LOW_HALF) + step
+      mask = iand(not(ior(ior(low, shiftl(high, 32)), word)), HIGH_BITS)
    end function bytes_below
 
-   !> High bit of each byte of `word` equal to `byte` (0 to 255).
+   !> High bit of each byte of `word` equal to `byte` (0 to 127).
    pure integer(i8) function bytes_equal(word, byte) result(mask)
       integer(i8), value :: word
       integer, value :: byte
@@ -41,8 +48,13 @@ contains
    !> The number of bytes of `mask` (high bits only, as the tests above give them) set.
    pure integer function bytes_set(mask) result(n)
       integer(i8), value :: mask
-      ! One in the low bit of each byte set; the product sums them into the top byte.
-      n = int(shiftr(shiftr(mask, 7)*ONES, 56))
+      integer(i8) :: ones
+      ! One in the low bit of each byte set, summed by halving shifts (at most 8).
+      ones = shiftr(mask, 7)
+      ones = ones + shiftr(ones, 32)
+      ones = ones + shiftr(ones, 16)
+      ones = ones + shiftr(ones, 8)
+      n = int(iand(ones, 255_i8))
    end function bytes_set
 
    !> Whether this machine stores text(i) in the lowest byte of a word (x86-64 and
@@ -120,13 +132,13 @@ contains
                k = k + 1
                first(k) = i + b/8
                if (present(line)) line(k) = ln + bytes_set(iand(newlines, maskr(b, i8)))
-               starts = iand(starts, starts - 1)
+               starts = ibclr(starts, b)
             end do
             do while (stops /= 0)
                b = trailz(stops)
                kstop = kstop + 1
                last(kstop) = i + b/8 - 1
-               stops = iand(stops, stops - 1)
+               stops = ibclr(stops, b)
             end do
          else
             k = k + bytes_set(starts)
