@@ -126,14 +126,10 @@ contains
          if (ok) return
       end if
       if (header_end < len(text)) then
-         call tokenize(text, ntok, tok_first, tok_last, tok_line, last_line)
+         ! The whole text: its first tokens are those of lines 1 to 5 found above (they
+         ! end at a line end), the heights follow.
          first_line6 = ntok + 1
-         do k = 1, ntok
-            if (tok_line(k) >= 6) then
-               first_line6 = k
-               exit
-            end if
-         end do
+         call tokenize(text, ntok, tok_first, tok_last, tok_line, last_line)
       end if
       ! In 64 bits: 2 NP**2 overflows a default integer for NP > 32767.
       nvalues = 2*int(deck%np, i8)**2
