@@ -7,7 +7,7 @@ module test_deck
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, format_real, format_reals, int_str, parse_real
    use femcod_cli, only: run_femcod
-   use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens
+   use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens, eight_digits
    use test_support, only: write_text, scratch_path, contains_text, file_exists
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -34,6 +34,7 @@ contains
          new_unittest("parse_real equals Fortran's READ on 60000 decimals and halfway cases", test_parse_real), &
          new_unittest("int_str equals Fortran's i0 edit descriptor", test_int_str), &
          new_unittest("eight-byte scans equal byte-by-byte scans on 3000 random texts", test_word_scans), &
+         new_unittest("eight digits at once: values as READ gives them, every neighbour byte refused", test_eight_digits), &
          new_unittest("the first bad height in file order is reported", test_first_bad_height), &
          new_unittest("bad deck: "//"missing value line 2", bad_01), &
          new_unittest("bad deck: "//"extra value line 3", bad_02), &
@@ -472,6 +473,46 @@ contains
          deallocate(text, first, last, line, ref_first, ref_last, ref_line)
       end do
    end subroutine test_word_scans
+
+   !> femcod_bytes' eight_digits against Fortran's READ of the same eight characters, on
+   !> 2000 random digit strings and the extremes; then each of the eight positions holding
+   !> '/' or ':' (the bytes next to the digits), a blank or a byte above 127: refused.
+   subroutine test_eight_digits(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=8) :: chunk
+      character(len=*), parameter :: others = "/: "//achar(200)
+      integer(8) :: value, expected
+      real(dp) :: u
+      integer :: trial, k, b
+      logical :: ok
+      if (.not. words_little_endian()) return
+      do trial = 1, 2002
+         if (trial == 1) then
+            chunk = "00000000"
+         else if (trial == 2) then
+            chunk = "99999999"
+         else
+            do k = 1, 8
+               call random_number(u)
+               chunk(k:k) = achar(iachar("0") + int(u*10))
+            end do
+         end if
+         read(chunk, "(i8)") expected
+         call eight_digits(chunk, value, ok)
+         call check(error, ok .and. value == expected, "eight_digits('"//chunk//"')")
+         if (allocated(error)) return
+         do k = 1, 8
+            do b = 1, len(others)
+               chunk = "12345678"
+               chunk(k:k) = others(b:b)
+               call eight_digits(chunk, value, ok)
+               call check(error, .not. ok, "eight_digits refuses byte "//int_str(iachar(others(b:b)))// &
+                  " at position "//int_str(k))
+               if (allocated(error)) return
+            end do
+         end do
+      end do
+   end subroutine test_eight_digits
 
    !> int_str against the list-free i0 edit of Fortran's own formatted output, on the
    !> extremes of both kinds and on every power of ten and its neighbours.

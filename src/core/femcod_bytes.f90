@@ -13,7 +13,7 @@ module femcod_bytes
    use femcod_kinds, only: i8
    implicit none
    private
-   public :: words_little_endian, first_control_byte, scan_tokens
+   public :: words_little_endian, first_control_byte, scan_tokens, eight_digits
 
    !> The low seven bits of every byte, and the high bit of every byte.
    integer(i8), parameter :: LOW_BITS = int(z'7F7F7F7F7F7F7F7F', i8)
@@ -62,6 +62,30 @@ contains
    pure logical function words_little_endian()
       words_little_endian = transfer("a       ", 0_i8) == int(iachar("a"), i8) + int(z'2020202020202000', i8)
    end function words_little_endian
+
+   !> Whether the eight characters of `chunk` are all decimal digits, and if so their
+   !> value (0 to 99999999), formed eight at a time: the digits' values in the bytes, then
+   !> pairs, fours and the eight joined by one multiply-and-shift each (every product
+   !> stays below 2^63). False on a machine that is not little-endian.
+   pure subroutine eight_digits(chunk, value, ok)
+      character(len=8), intent(in) :: chunk
+      integer(i8), intent(out) :: value
+      logical, intent(out) :: ok
+      integer(i8), parameter :: ZEROS = int(z'3030303030303030', i8), &
+         PAIRS = int(z'00FF00FF00FF00FF', i8), FOURS = int(z'0000FFFF0000FFFF', i8), &
+         EIGHT = int(z'00000000FFFFFFFF', i8)
+      integer(i8) :: word
+      value = 0
+      word = transfer(chunk, word)
+      ok = words_little_endian() .and. iand(word, HIGH_BITS) == 0
+      if (ok) ok = bytes_below(word, 58) == HIGH_BITS .and. bytes_below(word, 48) == 0
+      if (.not. ok) return
+      ! Byte k holds the k-th digit (the most significant first).
+      word = word - ZEROS
+      word = iand(word*10 + shiftr(word, 8), PAIRS)
+      word = iand(word*100 + shiftr(word, 16), FOURS)
+      value = iand(word*10000 + shiftr(word, 32), EIGHT)
+   end subroutine eight_digits
 
    !> text(i:i+7) as a word; past `last` (at most i+7) the bytes are blanks.
    pure integer(i8) function word_at(text, i, last) result(word)

@@ -5,6 +5,7 @@ module femcod_strings
    use, intrinsic :: ieee_exceptions, only: ieee_overflow, ieee_get_halting_mode, ieee_set_halting_mode, ieee_set_flag
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_double, c_null_char
    use femcod_kinds, only: dp, i8
+   use femcod_bytes, only: eight_digits
    implicit none
    private
    public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, add_lines, add_text, built_text
@@ -497,8 +498,8 @@ contains
       character(kind=c_char, len=64) :: short
       character(len=:), allocatable :: long
       integer :: i, n, ndig, mark, nsig, d, scale10, power, exp_sign
-      integer(i8) :: significand
-      logical :: halting, negative, fast, in_fraction
+      integer(i8) :: significand, chunk
+      logical :: halting, negative, fast, in_fraction, all_digits
       value = 0
       ok = .false.
       n = len(token)
@@ -516,6 +517,19 @@ contains
       fast = .true.
       in_fraction = .false.
       do while (i <= n)
+         ! Eight digits at a time after the first significant one (femcod_bytes), while
+         ! the significand stays within 18 digits.
+         if (nsig >= 1 .and. nsig <= 10 .and. n - i >= 7) then
+            call eight_digits(token(i:i + 7), chunk, all_digits)
+            if (all_digits) then
+               significand = significand*100000000_i8 + chunk
+               nsig = nsig + 8
+               ndig = ndig + 8
+               if (in_fraction) scale10 = scale10 - 8
+               i = i + 8
+               cycle
+            end if
+         end if
          if (token(i:i) == "." .and. .not. in_fraction) then
             in_fraction = .true.
          else if (is_digit(token(i:i))) then
