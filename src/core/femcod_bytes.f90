@@ -1,14 +1,14 @@
-!> Scanning text eight bytes at a time, for the deck reader (femcod_deck): a 64-bit word
-!> holds text(i:i+7), byte k of the text in bits 8k..8k+7 (little-endian order, checked
-!> by `words_little_endian`; the reader scans byte by byte otherwise), and each test below
-!> answers for all eight bytes at once with the high bit of each byte (bit 8k+7) set
-!> where the byte passes. The tests are exact for every byte value: the low seven bits
-!> are added to a constant that cannot carry out of the byte, and the byte's own high
-!> bit is combined after, so no byte's answer leaks into its neighbour's (the common "has
-!> a zero byte" trick flags false bytes above a true one).
+!> Scanning text eight bytes at a time, for the deck reader (femcod_deck) and the decimals
+!> of femcod_strings: a 64-bit word holds text(i:i+7), byte k of the text in bits 8k..8k+7
+!> (little-endian order, checked by `words_little_endian`; the readers go byte by byte
+!> otherwise), and each test below answers for all eight bytes at once with the high bit of
+!> each byte (bit 8k+7) set where the byte passes. The tests are exact for every byte value:
+!> the low seven bits are added to a constant that cannot carry out of the byte, and the
+!> byte's own high bit is combined after, so no byte's answer leaks into its neighbour's (the
+!> common "has a zero byte" trick flags false bytes above a true one).
 !> The tests are private so that the compiler inlines them into the scans (a public
 !> procedure may be replaced at load time under -fPIC, so it is called, not inlined:
-!> 0.05 s instead of 0.005 s for the control bytes of a 21 MB deck).
+!> 0.05 s instead of 0.005 to 0.010 s for the control bytes of a 21 MB deck).
 module femcod_bytes
    use femcod_kinds, only: i8
    implicit none
