@@ -59,6 +59,7 @@ contains
          new_unittest("bad deck: "//"binary content", bad_21), &
          new_unittest("bad deck: "//"header cut short", bad_22), &
          new_unittest("missing file, directory, empty file", test_bad_files), &
+         new_unittest("a deck above 2 GiB less 64 KiB is refused before it is read", test_huge_deck), &
          new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck), &
          new_unittest("a UTF-8 byte order mark is not part of the label", test_bom) &
          ]
@@ -817,6 +818,29 @@ contains
       call read_deck(scratch_path("empty.deck"), deck, status)
       call check(error, status%code == 3 .and. contains_text(status%message, ":1:"), "empty file: "//status%message)
    end subroutine test_bad_files
+
+   !> Text is indexed by default integers, so a deck of 2^31 - 2^16 + 2 bytes (a sparse
+   !> file: one byte written at that position) is refused with its size, before any of it
+   !> is read; the limit named is 2^31 - 2^16 bytes.
+   subroutine test_huge_deck(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      character(len=:), allocatable :: path
+      integer(8) :: size
+      integer :: unit
+      size = 2_8**31 - 2_8**16 + 2
+      path = scratch_path("huge.deck")
+      open(newunit=unit, file=path, access="stream", form="unformatted", status="replace", action="write")
+      write(unit, pos=size) "x"
+      close(unit)
+      call read_deck(path, deck, status)
+      open(newunit=unit, file=path, status="old")
+      close(unit, status="delete")
+      call check(error, status%code == 3 .and. contains_text(status%message, "found "//int_str(size)//" bytes") &
+         .and. contains_text(status%message, "at most "//int_str(2_8**31 - 2_8**16)//" bytes"), &
+         "a deck of "//int_str(size)//" bytes: "//status%message)
+   end subroutine test_huge_deck
 
    subroutine test_run_bad_deck(error)
       type(error_type), allocatable, intent(out) :: error

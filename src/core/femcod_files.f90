@@ -11,7 +11,11 @@ module femcod_files
    private
    public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, write_bytes, write_file
    public :: default_prefix, file_part, read_file, canonical_path, acquire_lock, release_lock, make_directories
-   public :: clear_write_error, write_error_cause
+   public :: clear_write_error, write_error_cause, MAX_TEXT_BYTES
+
+   !> The largest file read_file takes (bytes): 2 GiB less 64 KiB, so that positions in
+   !> the text, and positions a few words past them, stay default integers.
+   integer, parameter :: MAX_TEXT_BYTES = huge(0) - 65535
 
    interface
       function c_fopen(path, mode) bind(c, name="fopen") result(stream)
@@ -206,6 +210,15 @@ contains
       if (nbytes <= 0) then
          close(unit)
          call set_error(status, STATUS_BAD_INPUT, path//":1: expected "//what//", found an empty file")
+         return
+      end if
+      ! Text is held whole and indexed by default integers (gfortran's LEN is one too): a
+      ! larger file would be read wrongly, not refused.
+      if (nbytes > MAX_TEXT_BYTES) then
+         close(unit)
+         call set_error(status, STATUS_BAD_INPUT, path//": expected "//what//" of at most "// &
+            trim(i8_text(int(MAX_TEXT_BYTES, i8)))//" bytes (2 GiB less 64 KiB), found "//trim(i8_text(nbytes))// &
+            " bytes; give larger surfaces as an HDF5 dataset (--lower FILE.h5:/DATASET)")
          return
       end if
       allocate(character(len=nbytes) :: text, stat=ios)
