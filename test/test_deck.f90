@@ -60,6 +60,7 @@ contains
          new_unittest("bad deck: "//"header cut short", bad_22), &
          new_unittest("missing file, directory, empty file", test_bad_files), &
          new_unittest("a deck above 2 GiB less 64 KiB is refused before it is read", test_huge_deck), &
+         new_unittest("a deck beyond the writer's limit is refused and not written", test_deck_limit), &
          new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck), &
          new_unittest("a UTF-8 byte order mark is not part of the label", test_bom) &
          ]
@@ -841,6 +842,33 @@ contains
          .and. contains_text(status%message, "at most "//int_str(2_8**31 - 2_8**16)//" bytes"), &
          "a deck of "//int_str(size)//" bytes: "//status%message)
    end subroutine test_huge_deck
+
+   !> write_deck stops at its byte limit (MAX_TEXT_BYTES, 2 GiB less 64 KiB, in use; a
+   !> smaller one here): a limit of the deck's own size writes it, one byte less refuses
+   !> it with exit code 2 and leaves no file. The size is the file's, measured here.
+   subroutine test_deck_limit(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      character(len=:), allocatable :: path
+      integer(8) :: bytes
+      integer :: unit
+      path = scratch_path("limit.deck")
+      call write_text(path, header//heights)
+      call read_deck(path, deck, status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      call write_deck(path, deck, status)
+      inquire(file=path, size=bytes)
+      call write_deck(path, deck, status, max_bytes=int(bytes))
+      call check(error, status%code, 0, "a limit of the deck's size ("//int_str(bytes)//" bytes) writes it")
+      if (allocated(error)) return
+      open(newunit=unit, file=path, status="old")
+      close(unit, status="delete")
+      call write_deck(path, deck, status, max_bytes=int(bytes) - 1)
+      call check(error, status%code == 2 .and. contains_text(status%message, "more than "//int_str(bytes - 1)// &
+         " bytes") .and. .not. file_exists(path), "one byte less refuses it and writes nothing: "//status%message)
+   end subroutine test_deck_limit
 
    subroutine test_run_bad_deck(error)
       type(error_type), allocatable, intent(out) :: error

@@ -80,9 +80,11 @@ contains
       character(len=:), allocatable :: bigger
       integer :: need
       need = builder%length + len(text)
-      if (.not. allocated(builder%buffer)) allocate(character(len=max(4096, 2*need)) :: builder%buffer)
+      if (.not. allocated(builder%buffer)) allocate(character(len=max(4096_i8, 2*int(need, i8))) :: builder%buffer)
       if (need > len(builder%buffer)) then
-         allocate(character(len=2*need) :: bigger)
+         ! Doubled in 64 bits and capped: 2 * need leaves a default integer above 1 GiB
+         ! (the text itself stays below 2 GiB: write_deck refuses more).
+         allocate(character(len=min(2*int(need, i8), int(huge(need), i8))) :: bigger)
          bigger(1:builder%length) = builder%buffer(1:builder%length)
          call move_alloc(bigger, builder%buffer)
       end if

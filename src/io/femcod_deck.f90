@@ -15,8 +15,8 @@ module femcod_deck
    use femcod_kinds, only: dp, i8
    use femcod_problem, only: contact_problem, validate_problem, MAX_NP, MIN_PIXEL, MAX_PIXEL, MAX_HEIGHT, &
       MIN_YOUNG, MAX_YOUNG
-   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
-   use femcod_files, only: write_file, read_file
+   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO, STATUS_USAGE
+   use femcod_files, only: write_file, read_file, MAX_TEXT_BYTES
    use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens
    use femcod_strings, only: int_str, parse_real, parse_integer, format_real, format_reals, is_digit, text_builder, &
       add_line, add_text, built_text
@@ -238,12 +238,17 @@ contains
    !> Write a deck: validated first, written under a temporary name, then renamed, so
    !> that `path` is either untouched or complete. Each real is written with the fewest
    !> digits that read back to the same double, one image row per line.
-   subroutine write_deck(path, deck, status)
+   subroutine write_deck(path, deck, status, max_bytes)
       character(len=*), intent(in) :: path
       type(contact_problem), intent(in) :: deck
       type(status_type), intent(inout) :: status
+      !> The largest deck written (bytes; default and at most MAX_TEXT_BYTES, the most
+      !> read_deck reads): a larger one is refused and nothing is written.
+      integer, intent(in), optional :: max_bytes
       type(text_builder) :: b
-      integer :: i
+      integer :: i, limit
+      limit = MAX_TEXT_BYTES
+      if (present(max_bytes)) limit = min(max_bytes, MAX_TEXT_BYTES)
       call validate_problem(deck, status)
       if (status%code /= 0) return
       call add_line(b, deck%label)
@@ -257,15 +262,24 @@ contains
       do i = 1, deck%np
          call add_row(deck%upper(i, :))
       end do
+      if (status%code /= 0) return
       call write_file(path, built_text(b), status)
    contains
-      !> One image row on one line, the values separated by blanks.
+      !> One image row on one line, the values separated by blanks; refused (and nothing
+      !> written) when the deck would pass `limit`.
       subroutine add_row(row)
          real(dp), intent(in) :: row(:)
          character(len=24), allocatable :: texts(:)
          integer, allocatable :: lengths(:)
          integer :: j
+         if (status%code /= 0) return
          call format_reals(row, texts, lengths)
+         if (int(b%length, i8) + sum(int(lengths, i8)) + size(row) > limit) then
+            call set_error(status, STATUS_USAGE, path//": a deck of NP = "//int_str(deck%np)//" with these "// &
+               "heights is more than "//int_str(limit)//" bytes, the most a deck is written and read with; "// &
+               "give the surfaces as an HDF5 dataset (femcod run --lower FILE.h5:/DATASET)")
+            return
+         end if
          call add_text(b, texts(1)(1:lengths(1)))
          do j = 2, size(row)
             call add_text(b, " "//texts(j)(1:lengths(j)))
