@@ -828,19 +828,19 @@ contains
       type(contact_problem) :: deck
       type(status_type) :: status
       character(len=:), allocatable :: path
-      integer(8) :: size
+      integer(8) :: bytes
       integer :: unit
-      size = 2_8**31 - 2_8**16 + 2
+      bytes = 2_8**31 - 2_8**16 + 2
       path = scratch_path("huge.deck")
       open(newunit=unit, file=path, access="stream", form="unformatted", status="replace", action="write")
-      write(unit, pos=size) "x"
+      write(unit, pos=bytes) "x"
       close(unit)
       call read_deck(path, deck, status)
       open(newunit=unit, file=path, status="old")
       close(unit, status="delete")
-      call check(error, status%code == 3 .and. contains_text(status%message, "found "//int_str(size)//" bytes") &
+      call check(error, status%code == 3 .and. contains_text(status%message, "found "//int_str(bytes)//" bytes") &
          .and. contains_text(status%message, "at most "//int_str(2_8**31 - 2_8**16)//" bytes"), &
-         "a deck of "//int_str(size)//" bytes: "//status%message)
+         "a deck of "//int_str(bytes)//" bytes: "//status%message)
    end subroutine test_huge_deck
 
    !> write_deck stops at its byte limit (MAX_TEXT_BYTES, 2 GiB less 64 KiB, in use; a
