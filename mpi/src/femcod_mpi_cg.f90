@@ -731,8 +731,10 @@ contains
       end do
    end subroutine coarse_start
 
-   !> femcod_cg's constrained_cg on the distributed grid, step by step (a change there
-   !> belongs here too), with a fresh convolution whenever the projection changed a force.
+   !> femcod_cg's constrained_cg on the distributed grid, the same iteration (a change to
+   !> the method there belongs here too) with every step over all pixels of the rank's
+   !> slab (femcod_cg runs its contact-only steps over a list of the contacts), and a
+   !> fresh convolution whenever the projection changed a force.
    subroutine distributed_cg(grid, total_load, tol, max_iterations, how, p, state, status, observer)
       type(distributed_grid), intent(inout) :: grid
       real(dp), intent(in) :: total_load, tol
