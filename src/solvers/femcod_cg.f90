@@ -621,7 +621,7 @@ contains
       type(pixel_list), allocatable :: entering(:)
       integer, allocatable :: changed(:, :)
       real(dp), allocatable :: delta(:)
-      real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, residual, &
+      real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, psum_in, residual, &
          contact_gap, penetration, alpha, pn, lin, entry, zbar, cross, gij, threshold
       integer :: np, i, j, q, it, nc, nchanged, limit, slot, thread, threads
       logical :: restart, single, fresh, fresh_double, stalled, keep_old, kept_old
@@ -794,9 +794,11 @@ contains
          ! at zero. Where the projection changed a force, the displacements need a
          ! correction: the first `limit` changes are kept (in any order; sorted below).
          nchanged = 0
-         psum = 0
+         ! Each sum starts from zero in its own parallel region: how the threads' shares
+         ! are added is then the same in every run (on two threads).
+         psum_in = 0
          entering%n = 0
-         !$omp parallel private(thread, i, j, gij, pn, slot) reduction(+:psum)
+         !$omp parallel private(thread, i, j, gij, pn, slot) reduction(+:psum_in)
          thread = 0
          !$ thread = omp_get_thread_num()
          !$omp do schedule(static)
@@ -807,7 +809,7 @@ contains
                   if (gij < 0) then
                      pn = -tau*entry*gij
                      p(i, j) = pn
-                     psum = psum + pn
+                     psum_in = psum_in + pn
                      touching(i, j) = 1
                      ! Its gap now is its previous gap in the next iteration.
                      gm(i, j) = real(gij, sp)
@@ -828,6 +830,7 @@ contains
          end do
          !$omp end do
          !$omp end parallel
+         psum = 0
          !$omp parallel do private(i, j, lin, pn, slot) reduction(+:psum)
          do q = 1, nc
             i = contact(1, q)
@@ -858,6 +861,7 @@ contains
          call list_contacts_after_step()
          kept_old = .false.
          fresh_double = .false.
+         psum = psum + psum_in
          if (.not. psum > 0) then
             call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
             return
