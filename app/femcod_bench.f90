@@ -264,7 +264,9 @@ contains
          choice_option("--precondition", "on|off", "the inverse-Love stencil (default on)"), &
          choice_option("--polak-ribiere", "on|off", "PR+ beta (default on; off: Fletcher-Reeves)"), &
          real_option("--powell", "NU", "Powell's restart when |z.g_old| >= NU z.g (default 0.2; 0: never)", &
-            lower=0.0_dp)]
+            lower=0.0_dp), &
+         real_option("--entry", "F", "entering pixels' force, F times the preconditioned step's for a lone pixel "// &
+            "(default 0.25)", lower=0.0_dp, closed="()")]
    end function bench_cg_table
 
    !> The options of `femcod bench convolution`.
@@ -1356,6 +1358,7 @@ contains
          if (option_given(parsed, "--precondition")) method%precondition = switch("--precondition")
          if (option_given(parsed, "--polak-ribiere")) method%polak_ribiere = switch("--polak-ribiere")
          call get_option(parsed, "--powell", method%powell_restart)
+         call get_option(parsed, "--entry", method%entry_scale)
          call get_option(parsed, "--coarsest", method%coarsest)
          call get_option(parsed, "--coarse-tol", method%coarse_tol)
          call get_option(parsed, "--single-until", method%single_until)

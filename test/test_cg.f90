@@ -995,14 +995,15 @@ contains
    !> loads strictly inside steps (where contacts and approach are exact by linearity);
    !> the CG solver with each acceleration alone (nested grids down to 16, float32 early
    !> iterations, direct corrections, preconditioner, no restart on entry, Polak-Ribiere,
-   !> Powell's restart), with all of them and with none must find the same contact count
-   !> and the approach to 1e-8 relative (tolerance 1e-10 on the gap residual).
+   !> Powell's restart), with all of them, with all and the whole lone-pixel entering
+   !> force (entry_scale 1), and with none must find the same contact count and the
+   !> approach to 1e-8 relative (tolerance 1e-10 on the gap residual).
    subroutine test_accelerations(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, cg
-      type(cg_settings) :: plain, how(8)
+      type(cg_settings) :: plain, how(9)
       type(status_type) :: status
       real(dp), allocatable :: loads(:)
       integer :: v, k
@@ -1022,6 +1023,7 @@ contains
       how(6)%polak_ribiere = .true.
       how(7)%powell_restart = 0.2_dp
       how(8) = cg_settings(coarsest=16)
+      how(9) = cg_settings(coarsest=16, entry_scale=1.0_dp)
       do v = 0, size(how)
          if (v == 0) then
             options%solver = "cg"

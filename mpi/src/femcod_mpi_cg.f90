@@ -764,7 +764,7 @@ contains
          g_old = 0
       end if
       entry = 1
-      if (grid%preconditioned) entry = grid%taps(0, 0)
+      if (grid%preconditioned) entry = how%entry_scale*grid%taps(0, 0)
       psum = sum(p)
       call reduce_one(psum, MPI_SUM)
       alpha = total_load/psum

@@ -28,10 +28,12 @@
 !>   Every switch, and the final answer, starts from a fresh double convolution.
 !> - A preconditioner: the search direction is the contact gaps filtered by the 13-point
 !>   stencil of the inverse Love operator (inverse_kernel_taps, a discrete E*|q|/2).
-!>   Overlapping pixels enter with the force the preconditioned step gives a pixel alone,
-!>   -tau a00 g (a00 the stencil's centre), where Polonsky and Keer's unpreconditioned
-!>   step gives -tau g: without the factor the entering forces are out of scale with the
-!>   step and the contact set swings (at NP = 1024, 1 %: to three times its final size).
+!>   Overlapping pixels enter with a quarter of the force the preconditioned step gives a
+!>   pixel alone, -tau a00 g / 4 (a00 the stencil's centre), where Polonsky and Keer's
+!>   unpreconditioned step gives -tau g: without a00 the entering forces are out of scale
+!>   with the step and the contact set swings (at NP = 1024, 1 %: to three times its final
+!>   size); with all of it, pixels enter too strongly and many leave again (4096^2, 1 %:
+!>   52 iterations against 44 with the quarter; cg_settings%entry_scale).
 !> - beta by Polak-Ribiere clipped at zero (PR+) rather than Fletcher-Reeves: it restarts
 !>   by itself when the contact set has turned the gradient (2048^2: 45 -> 40 iterations
 !>   at 1 %, 77 -> 71 at 10 %).
@@ -642,9 +644,10 @@ contains
       ! The previous gradient, for Polak-Ribiere's beta and for Powell's restart test.
       keep_old = how%polak_ribiere .or. how%powell_restart > 0
       kept_old = .false.
-      ! Overlapping pixels enter with the preconditioned step's force for a lone pixel.
+      ! Overlapping pixels enter with a share (entry_scale) of the preconditioned step's
+      ! force for a lone pixel.
       entry = 1
-      if (grid%preconditioned) entry = grid%taps(0, 0)
+      if (grid%preconditioned) entry = how%entry_scale*grid%taps(0, 0)
       ! The start's contacts; the direction is zero off the contacts throughout.
       !$omp parallel do private(i)
       do j = 1, np
