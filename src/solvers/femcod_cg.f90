@@ -657,8 +657,8 @@ contains
          end do
       end do
       call list_contacts()
-      ! The load balance: p and w are `alpha` times what they stand for until the next
-      ! step writes them (and at the end).
+      ! The load balance: the forces and displacements are alpha times the stored p and w,
+      ! until the next step writes them scaled (and at the end).
       alpha = total_load/sum(p)
       single = how%single_until > 0
       fresh = .true.
