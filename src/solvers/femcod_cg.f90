@@ -625,7 +625,7 @@ contains
       real(dp), allocatable :: delta(:)
       real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, psum_in, residual, &
          contact_gap, penetration, alpha, pn, lin, entry, zbar, cross, gij, threshold
-      integer :: np, i, j, q, it, nc, nchanged, limit, slot, thread, threads
+      integer :: np, i, j, q, it, nc, nchanged, limit, thread, threads
       logical :: restart, single, fresh, fresh_double, stalled, keep_old, kept_old
       np = grid%np
       c = grid%c
@@ -801,7 +801,7 @@ contains
          ! are added is then the same in every run (on two threads).
          psum_in = 0
          entering%n = 0
-         !$omp parallel private(thread, i, j, gij, pn, slot) reduction(+:psum_in)
+         !$omp parallel private(thread, i, j, gij, pn) reduction(+:psum_in)
          thread = 0
          !$ thread = omp_get_thread_num()
          !$omp do schedule(static)
@@ -817,15 +817,7 @@ contains
                      ! Its gap now is its previous gap in the next iteration.
                      gm(i, j) = real(gij, sp)
                      call push_pixel(entering(thread), i, j)
-                     !$omp atomic capture
-                     nchanged = nchanged + 1
-                     slot = nchanged
-                     !$omp end atomic
-                     if (slot <= limit) then
-                        changed(1, slot) = i
-                        changed(2, slot) = j
-                        delta(slot) = pn
-                     end if
+                     call record_change(i, j, pn)
                   end if
                end if
                w(i, j) = alpha*w(i, j) - tau*r_at(i, j)
@@ -834,7 +826,7 @@ contains
          !$omp end do
          !$omp end parallel
          psum = 0
-         !$omp parallel do private(i, j, lin, pn, slot) reduction(+:psum)
+         !$omp parallel do private(i, j, lin, pn) reduction(+:psum)
          do q = 1, nc
             i = contact(1, q)
             j = contact(2, q)
@@ -848,17 +840,7 @@ contains
                t(i, j) = 0
                gm(i, j) = 0
             end if
-            if (pn /= lin) then
-               !$omp atomic capture
-               nchanged = nchanged + 1
-               slot = nchanged
-               !$omp end atomic
-               if (slot <= limit) then
-                  changed(1, slot) = i
-                  changed(2, slot) = j
-                  delta(slot) = pn - lin
-               end if
-            end if
+            if (pn /= lin) call record_change(i, j, pn - lin)
          end do
          restart = how%restart_on_entry .and. sum(entering%n) > 0
          call list_contacts_after_step()
@@ -977,6 +959,23 @@ contains
          end do
          call move_alloc(new, contact)
       end subroutine list_contacts_after_step
+
+      !> Count a change of the force at pixel (i, j) by the projection, d (nN), and keep it
+      !> among the first `limit` for a direct correction (called by the step's threads).
+      subroutine record_change(i, j, d)
+         integer, intent(in) :: i, j
+         real(dp), intent(in) :: d
+         integer :: slot
+         !$omp atomic capture
+         nchanged = nchanged + 1
+         slot = nchanged
+         !$omp end atomic
+         if (slot <= limit) then
+            changed(1, slot) = i
+            changed(2, slot) = j
+            delta(slot) = d
+         end if
+      end subroutine record_change
 
       !> The displacement (nm) of the search direction at pixel (i, j), from r32 or r.
       pure real(dp) function r_at(i, j)
