@@ -22,7 +22,8 @@
 !>   contacts' gaps, the preconditioner, the direction, the step length and the
 !>   projection run over a list of the contact pixels, and the load balance is applied
 !>   where the values are next written instead of by a pass of its own. At NP = 4096,
-!>   1 %: 0.44 -> 0.25 s an iteration, 38 -> 28 s the solve (doc/performance.md).
+!>   1 %: 0.44 -> 0.25 s an iteration, 38 -> 28 s the solve (doc/performance.md). This
+!>   one has no switch: it is the same iteration, with its sums taken in another order.
 !> - float32 transforms for the search directions, and for the forces' own displacements
 !>   while the residual is large (above `single_until`), then double.
 !>   Every switch, and the final answer, starts from a fresh double convolution.
