@@ -48,7 +48,7 @@ module femcod_adhesion
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
-   use femcod_scene, only: initial_gaps
+   use femcod_scene, only: initial_gap_map
    use femcod_love, only: offset_table, surface_compliance, love_influence
    use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
@@ -148,7 +148,7 @@ contains
       end if
       np = problem%np
       area = problem%pixel**2
-      g0 = transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np]))
+      g0 = initial_gap_map(problem%lower, problem%upper)
       call make_fourier_grid(grid, problem, options%boundary == "periodic", status)
       if (status%code /= 0) return
       allocate(res%states(m), x(grid%m, grid%m), g(np, np), force(np, np), plastic(np, np), cap(np, np))

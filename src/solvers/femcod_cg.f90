@@ -67,7 +67,7 @@ module femcod_cg
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
-   use femcod_scene, only: initial_gaps
+   use femcod_scene, only: initial_gap_map
    use femcod_love, only: offset_table, surface_compliance
    use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
@@ -173,7 +173,7 @@ contains
          call set_error(status, STATUS_NUMERICAL, "cg: --solver cg needs --loads or --approach")
          return
       end if
-      call make_grid(fine, transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np])), problem, &
+      call make_grid(fine, initial_gap_map(problem%lower, problem%upper), problem, &
          problem%pixel, how, options%boundary == "periodic")
       ! A periodic cell is in full contact when the approach (the fall of the mean gap)
       ! reaches the mean initial gap; there any load above the full-contact load gives

@@ -2,7 +2,7 @@
 module femcod_maps
    use femcod_kinds, only: dp
    use femcod_problem, only: contact_problem
-   use femcod_scene, only: initial_gaps
+   use femcod_scene, only: initial_gap_map
    use femcod_love, only: offset_table, surface_compliance
    use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
@@ -61,7 +61,7 @@ contains
          surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
       spring = 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
       ! g0 is numbered pixel by pixel along rows: p = (i - 1) np + j.
-      g0 = transpose(reshape(initial_gaps(problem%lower, problem%upper), [np, np]))
+      g0 = initial_gap_map(problem%lower, problem%upper)
       call convolution_setup(conv, table, periodic=cyclic)
       do s = 1, size(states)
          if (.not. states(s)%reached .or. handed(s)) cycle
