@@ -258,9 +258,16 @@ contains
          real_option("--coarse-tol", "T", "tolerance of the coarse grids (default 1e-4)", lower=0.0_dp, closed="()"), &
          real_option("--single-until", "R", "float32 transforms above this residual (default 1e-5; 0: never)", &
             lower=0.0_dp), &
-         integer_option("--direct", "N", "projection changes corrected directly (default 32; 0: two convolutions "// &
-            "per iteration)", lower=0), &
+         integer_option("--direct", "N", "projection changes corrected directly (default 32; 0 with --split 0: two "// &
+            "convolutions per iteration)", lower=0), &
          choice_option("--restart", "on|off", "restart the directions when pixels enter (default off)"), &
+         integer_option("--split", "R", "window (pixels) of the kernel split that corrects projection changes "// &
+            "beyond --direct (default 32; 0: a fresh convolution instead)", lower=0), &
+         integer_option("--split-cell", "K", "lattice spacing (pixels) of the split's far part (default 8)", lower=1), &
+         real_option("--split-budget", "B", "the split's near part at most B NP^2 multiply-adds (default 10)", &
+            lower=0.0_dp), &
+         real_option("--split-tolerance", "T", "split corrections while their error bound stays below T times the "// &
+            "residual (default 1)", lower=0.0_dp), &
          choice_option("--precondition", "on|off", "the inverse-Love stencil (default on)"), &
          choice_option("--polak-ribiere", "on|off", "PR+ beta (default on; off: Fletcher-Reeves)"), &
          real_option("--powell", "NU", "Powell's restart when |z.g_old| >= NU z.g (default 0.2; 0: never)", &
@@ -1363,6 +1370,10 @@ contains
          call get_option(parsed, "--coarse-tol", method%coarse_tol)
          call get_option(parsed, "--single-until", method%single_until)
          call get_option(parsed, "--direct", method%direct_corrections)
+         call get_option(parsed, "--split", method%split_radius)
+         call get_option(parsed, "--split-cell", method%split_cell)
+         call get_option(parsed, "--split-budget", method%split_budget)
+         call get_option(parsed, "--split-tolerance", method%split_tolerance)
          method%tol = tol
          method%max_iterations = 5000
          if (len(wisdom) > 0) then
@@ -1406,7 +1417,8 @@ contains
             write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | "// &
                fixed_str(res%wall_seconds, 2)//" | "//int_str(res%states(1)%iterations)//" (+"// &
                int_str(res%states(1)%coarse_iterations)//" coarse, "//int_str(res%states(1)%convolutions)// &
-               " fresh) | "//real_str(res%states(1)%residual, 2)//" | "// &
+               " fresh, "//int_str(res%states(1)%split_corrections)//" split) | "// &
+               real_str(res%states(1)%residual, 2)//" | "// &
                fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)//" | "//fixed_str(peak, 0)//" | converged |"
             flush(output_unit)
             if (len(python) == 0) cycle

@@ -14,6 +14,7 @@ module test_cg
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
    use femcod_love, only: offset_table, surface_compliance
+   use femcod_split_correction, only: split_correction, split_setup, split_apply, split_free
    use femcod_spring, only: spring_stiffness
    use femcod_scene, only: initial_gaps
    use femcod_random, only: random_stream, seed_stream, uniform
@@ -58,6 +59,8 @@ contains
          new_unittest("--plastic maps, both solvers: gap = -plastic displacement where capped, 0 on contact", &
             test_plastic_maps), &
          new_unittest("pruned padded FFT convolution equals the direct sum (NP 7, 8, 33)", test_convolution), &
+         new_unittest("kernel split: exact in its window, within its far bound beyond (direct sum)", &
+            test_split_correction), &
          new_unittest("preconditioner taps equal the inverse of a direct DFT (NP 4, 5, 9)", test_inverse_taps), &
          new_unittest("every acceleration, alone and together, keeps the event-exact answer", test_accelerations), &
          new_unittest("--fftw-wisdom writes both wisdom files and leaves the answer unchanged", test_wisdom), &
@@ -933,6 +936,95 @@ contains
       end do
    end subroutine test_convolution
 
+   !> The kernel split (femcod_split_correction) against the direct sum over the Love
+   !> table: 150 changes of either sign at random pixels of a 75 x 75 grid (not a
+   !> multiple of the lattice, so the last nodes lie beyond it), lattice 8, windows of 32
+   !> down to 12 pixels. What the solver relies on: within the window of each change the sum
+   !> is the exact one (to the float32 table, 1e-6 of I(0) per unit change); beyond it the
+   !> error of the whole sum is at most far_error(R) times the sum of |delta|, at every
+   !> pixel of the grid (far_error is recorded out to 2 R + 1 only; the test looks at all
+   !> offsets up to 74). One change alone: the same, pixel by pixel, inside and outside.
+   !> The bound is worth having: far_error(R) is below (k/R)^2 I(R) at R = 16 and 32, the
+   !> order of bilinear interpolation's error for a 1/r kernel.
+   subroutine test_split_correction(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: np = 75, n = 150, k = 8
+      type(split_correction) :: split
+      type(random_stream) :: stream
+      real(dp), allocatable :: table(:, :), exact(:, :), approx(:, :), delta(:)
+      integer, allocatable :: changed(:, :)
+      real(dp) :: u, bound, worst
+      integer :: q, i, j, v, radius, order(n), key(2)
+      call seed_stream(stream, 5)
+      allocate(table(0:np - 1, 0:np - 1), changed(2, n), delta(n), exact(np, np), approx(np, np))
+      table(:, :) = offset_table(np)
+      do q = 1, n
+         call uniform(stream, u)
+         changed(1, q) = 1 + min(int(u*np), np - 1)
+         call uniform(stream, u)
+         changed(2, q) = 1 + min(int(u*np), np - 1)
+         call uniform(stream, u)
+         delta(q) = 2*u - 1
+      end do
+      ! Sorted by column, then row (split_apply's contract), duplicates allowed.
+      order = [(q, q = 1, n)]
+      do q = 2, n
+         key = changed(:, order(q))
+         v = order(q)
+         i = q - 1
+         do while (i >= 1)
+            if (changed(2, order(i)) < key(2) .or. (changed(2, order(i)) == key(2) .and. &
+               changed(1, order(i)) <= key(1))) exit
+            order(i + 1) = order(i)
+            i = i - 1
+         end do
+         order(i + 1) = v
+      end do
+      changed = changed(:, order)
+      delta = delta(order)
+      exact = 0
+      do j = 1, np
+         do i = 1, np
+            do q = 1, n
+               exact(i, j) = exact(i, j) + delta(q)*table(abs(i - changed(1, q)), abs(j - changed(2, q)))
+            end do
+         end do
+      end do
+      call split_setup(split, np, k, 32)
+      do radius = 16, 32, 16
+         call check(error, split%far_error(radius) < (real(k, dp)/radius)**2*table(radius, 0), "far_error("// &
+            to_string(radius)//") = "//to_string(split%far_error(radius))//", I = "//to_string(table(radius, 0)))
+         if (allocated(error)) return
+      end do
+      do radius = 32, 12, -4
+         approx = 0
+         call split_apply(split, approx, 1.0_dp, changed, delta, n, radius)
+         bound = (split%far_error(radius) + 1.0e-6_dp*table(0, 0))*sum(abs(delta))
+         worst = maxval(abs(approx - exact))
+         call check(error, worst <= bound, "window "//to_string(radius)//": largest error "//to_string(worst)// &
+            ", bound "//to_string(bound))
+         if (allocated(error)) return
+         ! One change: exact in the window, within far_error beyond.
+         approx = 0
+         call split_apply(split, approx, 1.0_dp, changed(:, 1:1), delta(1:1), 1, radius)
+         do j = 1, np
+            do i = 1, np
+               u = abs(approx(i, j) - delta(1)*table(abs(i - changed(1, 1)), abs(j - changed(2, 1))))
+               if (max(abs(i - changed(1, 1)), abs(j - changed(2, 1))) <= radius) then
+                  bound = 1.0e-6_dp*table(0, 0)*abs(delta(1))
+               else
+                  ! far_error is attained: round-off allowed as in the window.
+                  bound = (split%far_error(radius) + 1.0e-6_dp*table(0, 0))*abs(delta(1))
+               end if
+               call check(error, u <= bound, "window "//to_string(radius)//", one change, pixel ("// &
+                  to_string(i)//", "//to_string(j)//"): error "//to_string(u)//", bound "//to_string(bound))
+               if (allocated(error)) return
+            end do
+         end do
+      end do
+      call split_free(split)
+   end subroutine test_split_correction
+
    !> The preconditioner's taps against an independent calculation: the Love kernel
    !> wrapped on the padded M x M periodic grid (M = 2 NP, zero on the middle lines),
    !> its spectrum by the O(M^4) direct cosine sum, and the inverse transform of one over
@@ -995,7 +1087,7 @@ contains
    !> loads strictly inside steps (where contacts and approach are exact by linearity);
    !> the CG solver with each acceleration alone (nested grids down to 16, float32 early
    !> iterations, direct corrections, preconditioner, no restart on entry, Polak-Ribiere,
-   !> Powell's restart), with all of them, with all and the whole lone-pixel entering
+   !> Powell's restart, the kernel split (which must have been used)), with all of them, with all and the whole lone-pixel entering
    !> force (entry_scale 1), and with none must find the same contact count and the
    !> approach to 1e-8 relative (tolerance 1e-10 on the gap residual).
    subroutine test_accelerations(error)
@@ -1003,7 +1095,7 @@ contains
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: inc, cg
-      type(cg_settings) :: plain, how(9)
+      type(cg_settings) :: plain, how(10)
       type(status_type) :: status
       real(dp), allocatable :: loads(:)
       integer :: v, k
@@ -1011,8 +1103,8 @@ contains
       call midstep_states(deck, options, inc, error)
       if (allocated(error)) return
       loads = options%loads
-      plain = cg_settings(nested=.false., single_until=0, direct_corrections=0, precondition=.false., &
-         restart_on_entry=.true., polak_ribiere=.false., powell_restart=0.0_dp)
+      plain = cg_settings(nested=.false., single_until=0, direct_corrections=0, split_radius=0, &
+         precondition=.false., restart_on_entry=.true., polak_ribiere=.false., powell_restart=0.0_dp)
       how = plain
       how(1)%nested = .true.
       how(1)%coarsest = 16
@@ -1024,6 +1116,9 @@ contains
       how(7)%powell_restart = 0.2_dp
       how(8) = cg_settings(coarsest=16)
       how(9) = cg_settings(coarsest=16, entry_scale=1.0_dp)
+      ! The kernel split alone: every projection change through it, as far as its bound
+      ! allows.
+      how(10)%split_radius = 32
       do v = 0, size(how)
          if (v == 0) then
             options%solver = "cg"
@@ -1040,6 +1135,10 @@ contains
          end if
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
+         if (v == 10) then
+            call check(error, sum(cg%states%split_corrections) > 0, "variant 10 made no split correction")
+            if (allocated(error)) return
+         end if
          do k = 1, size(loads)
             call check(error, cg%states(k)%residual < 1.0e-10_dp, "variant "//to_string(v)//": residual "// &
                to_string(cg%states(k)%residual))

@@ -39,9 +39,10 @@ module femcod_contact_result
       !> approach is within approach_bound (nm) of the exact answer of the discrete
       !> problem (femcod_cg's approach_error_bound); -1 where the solver has no bound.
       real(dp) :: approach_bound = -1
-      !> Fixed-load solver only: iterations on all coarser grids together, and fresh
-      !> convolutions of the forces on the finest grid.
-      integer :: coarse_iterations = 0, convolutions = 0
+      !> Fixed-load solver only: iterations on all coarser grids together, fresh
+      !> convolutions of the forces on the finest grid, and corrections there by the
+      !> kernel split instead of a fresh convolution.
+      integer :: coarse_iterations = 0, convolutions = 0, split_corrections = 0
       !> The contact pixels (row, column) and their forces (nN) at this load.
       integer, allocatable :: i(:), j(:)
       real(dp), allocatable :: force(:)
