@@ -105,7 +105,7 @@ contains
          flag_option("--force", "replace existing results as a whole set, and a checkpoint of an interrupted run "// &
             "(otherwise both are kept and the deck fails with exit code 5 before it is solved); an input file is "// &
             "never an output"), &
-         integer_option("--max-contacts", "N", "stop after N contacts (default: the deck's MAXCONT)", lower=1, &
+         integer_option("--max-contacts", "N", "stop after N contacts, in place of the deck's MAXCONT", lower=1, &
             mode="event"), &
          flag_option("--no-final-check", "skip the final check of every pixel for missed contacts", mode="event"), &
          choice_option("--event-search", "auto|bound|fft", "how the next contact is found: bound, a heap of lower "// &
@@ -558,7 +558,7 @@ contains
          if (st%code /= 0) return
          observer%quiet = settings%quiet
          observer%target_contacts = problem%maxcont
-         if (options%max_contacts > 0) observer%target_contacts = min(observer%target_contacts, options%max_contacts)
+         if (options%max_contacts > 0) observer%target_contacts = min(options%max_contacts, problem%np**2)
          if (size(options%loads) > 0) observer%target_load = maxval(options%loads)
          observer%growth = merge(4.0_dp, 3.0_dp, options%solver == "legacy")
          observer%checkpoint_path = prefix//".ckpt.h5"

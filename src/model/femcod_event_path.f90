@@ -47,8 +47,10 @@ contains
       type(contact_options), intent(in) :: options
       type(contact_result), intent(inout) :: res
       real(dp), allocatable :: loads(:)
+      ! --max-contacts replaces the deck's MAXCONT (either way, at most every pixel).
       path%max_contacts = problem%maxcont
-      if (options%max_contacts > 0) path%max_contacts = min(path%max_contacts, options%max_contacts)
+      if (options%max_contacts > 0) path%max_contacts = options%max_contacts
+      path%max_contacts = min(path%max_contacts, problem%np**2)
       if (allocated(options%loads)) then
          loads = options%loads
       else

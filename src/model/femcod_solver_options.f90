@@ -85,7 +85,8 @@ module femcod_solver_options
       character(len=11) :: solver = "incremental"
       !> One of BOUNDARY_NAMES: "free" (default) or "periodic" (femcod_love_periodic).
       character(len=8) :: boundary = "free"
-      !> Stop after this many contacts (0: the deck's MAXCONT; the event solvers only).
+      !> Stop after this many contacts, in place of the deck's MAXCONT (0: MAXCONT; the event
+      !> solvers only).
       integer :: max_contacts = 0
       !> Requested total loads (nN); empty: the event solvers run to MAXCONT.
       real(dp), allocatable :: loads(:)
