@@ -761,8 +761,9 @@ contains
             end if
             exit
          end if
-         ! The split corrections' error bound stays a fraction of the residual: once the
-         ! residual has fallen to it, the displacements afresh and new directions.
+         ! The split corrections' error bound stays below split_tolerance times the
+         ! residual: once the residual has fallen to it, the displacements afresh and new
+         ! directions.
          if (split_error > how%split_tolerance*residual*grid%scale) then
             fresh = .true.
             restart = .true.
@@ -1168,7 +1169,6 @@ contains
          end do
          fresh_double = .false.
       end subroutine add_direct
-
    end subroutine constrained_cg
 
    !> Append pixel (i, j) to `list`, growing it by doubling.
