@@ -532,11 +532,9 @@ contains
                cycle
             end if
          end if
-         if (token(i:i) == "." .and. .not. in_fraction) then
-            in_fraction = .true.
-         else if (is_digit(token(i:i))) then
+         d = iachar(token(i:i)) - iachar("0")
+         if (d >= 0 .and. d <= 9) then
             ndig = ndig + 1
-            d = iachar(token(i:i)) - iachar("0")
             if (nsig < 18) then
                if (nsig > 0 .or. d > 0) then
                   significand = 10*significand + d
@@ -546,6 +544,8 @@ contains
             else
                fast = .false.
             end if
+         else if (token(i:i) == "." .and. .not. in_fraction) then
+            in_fraction = .true.
          else
             exit
          end if
@@ -619,8 +619,7 @@ contains
       integer, intent(in) :: e
       real(dp), intent(out) :: x
       logical, intent(out) :: done
-      real(xp) :: wide, mid
-      real(dp) :: other
+      real(xp) :: wide, beyond
       x = 0
       done = digits(1.0_xp) >= 64 .and. abs(e) <= 27
       if (.not. done) return
@@ -631,9 +630,11 @@ contains
       end if
       x = real(wide, dp)
       if (real(x, xp) == wide) return
-      other = nearest(x, merge(1.0_dp, -1.0_dp, wide > real(x, xp)))
-      mid = (real(x, xp) + real(other, xp))/2
-      done = wide /= mid
+      ! wide lies strictly within half a unit of x; it is the midpoint of x and its
+      ! neighbour exactly when reflecting x about wide, 2 wide - x (exact in the wider
+      ! kind: x and wide share their binade up to a unit of x), gives a double.
+      beyond = 2*wide - real(x, xp)
+      done = real(real(beyond, dp), xp) /= beyond
    end subroutine exact_decimal
 
    !> Parse an integer token: [sign] digits, within the range of a default integer.
