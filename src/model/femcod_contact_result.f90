@@ -288,22 +288,37 @@ contains
       end select
    end function stop_reason_text
    !> The state's contacts from a map: the pixels (row, column) where `in_contact` holds,
-   !> row by row, with their forces (nN) from `force`; and their count.
+   !> row by row, with their forces (nN) from `force`; and their count. The maps are read
+   !> column by column, as they are stored: each row's contacts are counted first, so
+   !> that every contact goes straight to its place in row order.
    pure subroutine gather_contacts(state, in_contact, force)
       type(load_state), intent(inout) :: state
       logical, intent(in) :: in_contact(:, :)
       real(dp), intent(in) :: force(:, :)
+      integer, allocatable :: next(:)
       integer :: i, j, nc
-      state%contacts = count(in_contact)
-      allocate(state%i(state%contacts), state%j(state%contacts), state%force(state%contacts))
+      allocate(next(size(in_contact, 1)))
+      next = 0
+      do j = 1, size(in_contact, 2)
+         do i = 1, size(in_contact, 1)
+            if (in_contact(i, j)) next(i) = next(i) + 1
+         end do
+      end do
+      ! next(i): the place of row i's next contact.
       nc = 0
-      do i = 1, size(in_contact, 1)
-         do j = 1, size(in_contact, 2)
+      do i = 1, size(next)
+         nc = nc + next(i)
+         next(i) = nc - next(i) + 1
+      end do
+      state%contacts = nc
+      allocate(state%i(nc), state%j(nc), state%force(nc))
+      do j = 1, size(in_contact, 2)
+         do i = 1, size(in_contact, 1)
             if (in_contact(i, j)) then
-               nc = nc + 1
-               state%i(nc) = i
-               state%j(nc) = j
-               state%force(nc) = force(i, j)
+               state%i(next(i)) = i
+               state%j(next(i)) = j
+               state%force(next(i)) = force(i, j)
+               next(i) = next(i) + 1
             end if
          end do
       end do
