@@ -3,7 +3,7 @@ module test_sort
    use femcod_kinds, only: dp
    use femcod_sort, only: merge_sort_index
    use femcod_random, only: random_stream, seed_stream, uniform
-   use femcod_sha256, only: sha256_hex, file_sha256_hex
+   use femcod_sha256, only: sha256_hex, file_sha256_hex, file_digest, file_sha256_start, file_sha256_finish
    use testdrive, only: new_unittest, unittest_type, error_type, check
    implicit none
    private
@@ -18,7 +18,8 @@ contains
          new_unittest("sorted and reversed input", test_sorted_reversed), &
          new_unittest("random input against insertion sort", test_random), &
          new_unittest("SHA-256 of the FIPS 180-4 examples", test_sha256), &
-         new_unittest("SHA-256 of files read in blocks: FIPS 180-4's million a, 3 MiB + 5", test_sha256_file) &
+         new_unittest("SHA-256 of files read in blocks, also on a thread: FIPS 180-4's million a, 3 MiB + 5", &
+            test_sha256_file) &
          ]
    end subroutine collect_sort
 
@@ -92,11 +93,14 @@ contains
 
    !> The digest of a file read in 1 MiB blocks: a file of a million "a" has FIPS 180-4's
    !> digest; a file of 3 MiB + 5 bytes (four blocks, the last of 5 bytes) the digest of
-   !> the same bytes hashed whole; a missing file gives "".
+   !> the same bytes hashed whole; a missing file gives "". The same through a digest
+   !> taken on a thread of its own (file_sha256_start, as femcod run takes it while it
+   !> reads the deck), which is collected once: a second collection gives "".
    subroutine test_sha256_file(error)
       use test_support, only: scratch_path
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: path, bytes
+      type(file_digest) :: digest, missing
       integer :: unit, k
       path = scratch_path("sha256-million-a")
       open(newunit=unit, file=path, access="stream", form="unformatted", status="replace")
@@ -104,6 +108,12 @@ contains
       close(unit)
       call check(error, file_sha256_hex(path), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0", &
          "a million a")
+      if (allocated(error)) return
+      call file_sha256_start(path, digest)
+      call check(error, file_sha256_finish(digest), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0", &
+         "a million a, on a thread")
+      if (allocated(error)) return
+      call check(error, file_sha256_finish(digest), "", "a digest collected twice")
       if (allocated(error)) return
       allocate(character(len=3*1048576 + 5) :: bytes)
       do k = 1, len(bytes)
@@ -115,5 +125,11 @@ contains
       call check(error, file_sha256_hex(path), sha256_hex(bytes), "3 MiB + 5 bytes")
       if (allocated(error)) return
       call check(error, file_sha256_hex(path//".missing"), "", "a missing file")
+      if (allocated(error)) return
+      call file_sha256_start(path, digest)
+      call file_sha256_start(path//".missing", missing)
+      call check(error, file_sha256_finish(digest), sha256_hex(bytes), "3 MiB + 5 bytes, on a thread")
+      if (allocated(error)) return
+      call check(error, file_sha256_finish(missing), "", "a missing file, on a thread")
    end subroutine test_sha256_file
 end module test_sort

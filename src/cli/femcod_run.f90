@@ -15,7 +15,7 @@ module femcod_run
    use femcod_files, only: remove_file, path_exists, path_is_directory, default_prefix, file_part, canonical_path, &
       acquire_lock, release_lock, make_directories
    use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
-   use femcod_sha256, only: sha256_hex, file_sha256_hex
+   use femcod_sha256, only: sha256_hex, file_digest, file_sha256_start, file_sha256_finish
    use femcod_clock, only: wall_clock
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
@@ -438,7 +438,8 @@ contains
       type(contact_problem) :: problem
       type(status_type) :: st
       type(string_type), allocatable :: inputs(:), warnings(:), files(:)
-      character(len=:), allocatable :: notice
+      type(file_digest), allocatable :: pending(:)
+      character(len=:), allocatable :: notice, hex
       real(dp) :: t0, read_seconds
       integer :: k
       rc = 0
@@ -453,7 +454,14 @@ contains
             call append_string(files, height_file_path(settings%scene%matrix_file))
             if (settings%scene%second_file /= "") call append_string(files, height_file_path(settings%scene%second_file))
          end if
+         allocate(pending(size(files)))
+         do k = 1, size(files)
+            call file_sha256_start(files(k)%s, pending(k))
+         end do
       else
+         ! The deck's digest is taken while it is read.
+         allocate(pending(1))
+         call file_sha256_start(deck_path, pending(1))
          call read_deck(deck_path, problem, st)
          inputs = [string_type(deck_path//": femcod deck")]
          files = [string_type(deck_path)]
@@ -466,10 +474,14 @@ contains
          call acquire_lock(prefix//".lock", st, notice)
          if (notice /= "" .and. .not. settings%quiet) write(error_unit, '(a)') "femcod: "//notice
          if (st%code == 0) then
-            call run_locked(deck_path, prefix, settings, problem, inputs, files, read_seconds, st)
+            call run_locked(deck_path, prefix, settings, problem, inputs, files, pending, read_seconds, st)
             call release_lock(prefix//".lock")
          end if
       end if
+      ! Digests not collected (a run refused before it started) are waited for here.
+      do k = 1, size(pending)
+         hex = file_sha256_finish(pending(k))
+      end do
       if (st%code /= 0) then
          if (st%code == STATUS_INTERRUPTED) then
             write(error_unit, '(a)') "femcod: "//signal_name(stop_signal())//": "//st%message
@@ -503,11 +515,13 @@ contains
    end subroutine refuse_input_as_output
 
    !> A deck with its prefix locked: the checks of existing files, the solve, the results.
-   subroutine run_locked(deck_path, prefix, settings, problem, inputs, files, read_seconds, st)
+   subroutine run_locked(deck_path, prefix, settings, problem, inputs, files, pending, read_seconds, st)
       character(len=*), intent(in) :: deck_path, prefix
       type(run_settings), intent(in) :: settings
       type(contact_problem), intent(in) :: problem
       type(string_type), intent(in) :: inputs(:), files(:)
+      !> The input files' digests, started while they were read (file_sha256_start).
+      type(file_digest), intent(inout) :: pending(:)
       !> Wall seconds of reading the inputs.
       real(dp), intent(in) :: read_seconds
       type(status_type), intent(inout) :: st
@@ -524,7 +538,7 @@ contains
       associate(options => settings%solve)
          ! Every input file's SHA-256, once: for /run and for the fingerprint.
          call wall_clock(t0)
-         call input_digests(files, digests)
+         call input_digests(files, pending, digests)
          call wall_clock(t1)
          digest_seconds = t1 - t0
          fingerprint = run_fingerprint(problem, options, digests)
@@ -704,14 +718,15 @@ contains
    end function run_fingerprint
 
    !> "FILE sha256 HEX" for each input file.
-   subroutine input_digests(files, digests)
+   subroutine input_digests(files, pending, digests)
       type(string_type), intent(in) :: files(:)
+      type(file_digest), intent(inout) :: pending(:)
       type(string_type), allocatable, intent(out) :: digests(:)
       character(len=64) :: hex
       integer :: k
       allocate(digests(size(files)))
       do k = 1, size(files)
-         hex = file_sha256_hex(files(k)%s)
+         hex = file_sha256_finish(pending(k))
          if (len_trim(hex) == 64) then
             digests(k)%s = files(k)%s//" sha256 "//hex
          else
