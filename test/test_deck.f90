@@ -7,7 +7,7 @@ module test_deck
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, format_real, format_reals, int_str, parse_real
    use femcod_cli, only: run_femcod
-   use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens, eight_digits
+   use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens, count_tokens, eight_digits
    use test_support, only: write_text, scratch_path, contains_text, file_exists
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -402,22 +402,29 @@ contains
       integer, parameter :: alphabet(12) = [9, 10, 12, 13, 32, 44, 48, 49, 46, 101, 45, 200]
       character(len=:), allocatable :: text
       integer, allocatable :: first(:), last(:), line(:), ref_first(:), ref_last(:), ref_line(:)
-      real(dp) :: u
+      real(dp) :: u, rate
       integer :: trial, n, i, i0, i1, expected, count, ends, nref, ln, k0, ln0
       logical :: inside
       if (.not. words_little_endian()) return
       do trial = 1, 3000
          call random_number(u)
-         n = 1 + int(u*70)
+         ! Every tenth text is long: many of the scans' blocks of 4 KiB, or of 127 words.
+         if (mod(trial, 10) == 0) then
+            n = 1 + int(u*20000)
+         else
+            n = 1 + int(u*70)
+         end if
+         ! Control bytes: 3 % of a short text's bytes, about two in a long one.
+         rate = merge(0.03_dp, 2.0_dp/n, n <= 70)
          allocate(character(len=n) :: text)
          do i = 1, n
             call random_number(u)
             if (trial <= 1000) then
                ! Mostly ordinary text, a control byte now and then.
-               if (u < 0.97_dp) then
-                  text(i:i) = achar(alphabet(1 + int(u/0.97_dp*size(alphabet))))
+               if (u < 1 - rate) then
+                  text(i:i) = achar(alphabet(1 + int(u/(1 - rate)*size(alphabet))))
                else
-                  text(i:i) = achar(int((u - 0.97_dp)/0.03_dp*256))
+                  text(i:i) = achar(min(255, int((u - (1 - rate))/rate*256)))
                end if
             else
                text(i:i) = achar(alphabet(1 + int(u*size(alphabet))))
@@ -465,6 +472,8 @@ contains
          call check(error, count == nref .and. ends == ln, "tokens and line ends of a span of "// &
             int_str(i1 - i0 + 1)//" bytes: "//int_str(count)//" and "//int_str(ends)//", expected "// &
             int_str(nref)//" and "//int_str(ln))
+         if (allocated(error)) return
+         call check(error, count_tokens(text, i0, i1), nref, "count_tokens of a span of "//int_str(i1 - i0 + 1)//" bytes")
          if (allocated(error)) return
          allocate(first(k0 + nref), last(k0 + nref), line(k0 + nref))
          call scan_tokens(text, i0, i1, k0, ln0, count, ends, first, last, line)

@@ -13,7 +13,7 @@ module femcod_bytes
    use femcod_kinds, only: i8
    implicit none
    private
-   public :: words_little_endian, first_control_byte, scan_tokens, eight_digits
+   public :: words_little_endian, first_control_byte, scan_tokens, count_tokens, eight_digits
 
    !> The low seven bits of every byte, and the high bit of every byte.
    integer(i8), parameter :: LOW_BITS = int(z'7F7F7F7F7F7F7F7F', i8)
@@ -102,21 +102,100 @@ contains
    end function word_at
 
    !> The position of the first control byte of `text` (below 32 but TAB, LF, FF and CR,
-   !> or DEL), huge(0) if there is none; on all threads.
+   !> or DEL), huge(0) if there is none; on all threads. Each block of 4 KiB is first
+   !> tested as a whole for any byte below 32 or DEL, by one branch-free pass that the
+   !> compiler vectorises; only a block that has one (a line end, most often) is scanned
+   !> again word by word for the exact test. The last bytes past whole words are padded
+   !> with blanks.
    integer function first_control_byte(text) result(first)
       character(len=*), intent(in) :: text
-      integer(i8) :: word, found
-      integer :: i
+      integer, parameter :: BLOCK_BYTES = 4096
+      integer(i8) :: word, found, suspects
+      integer :: b, i, last_word
       first = huge(first)
-      !$omp parallel do private(word, found) reduction(min: first) schedule(static)
-      do i = 1, len(text), 8
-         word = word_at(text, i, len(text))
-         found = iand(bytes_below(word, 32), not(ior(ior(bytes_equal(word, 9), bytes_equal(word, 10)), &
-            ior(bytes_equal(word, 12), bytes_equal(word, 13)))))
-         found = ior(found, bytes_equal(word, 127))
-         if (found /= 0) first = min(first, i + trailz(found)/8)
+      ! The start of the last whole word.
+      last_word = len(text) - mod(len(text), 8) - 7
+      !$omp parallel do private(word, found, suspects, i) reduction(min: first) schedule(static)
+      do b = 1, last_word, BLOCK_BYTES
+         suspects = 0
+         do i = b, min(b + BLOCK_BYTES - 8, last_word), 8
+            word = transfer(text(i:i + 7), word)
+            suspects = ior(suspects, ior(bytes_below(word, 32), bytes_equal(word, 127)))
+         end do
+         if (suspects == 0) cycle
+         do i = b, min(b + BLOCK_BYTES - 8, last_word), 8
+            found = control_bytes(transfer(text(i:i + 7), word))
+            if (found /= 0) then
+               first = min(first, i + trailz(found)/8)
+               exit
+            end if
+         end do
       end do
+      if (first == huge(first) .and. mod(len(text), 8) /= 0) then
+         i = last_word + 8
+         found = control_bytes(word_at(text, i, len(text)))
+         if (found /= 0) first = i + trailz(found)/8
+      end if
    end function first_control_byte
+
+   !> High bit of each control byte of `word`: below 32 but TAB, LF, FF and CR, or DEL.
+   pure integer(i8) function control_bytes(word) result(found)
+      integer(i8), value :: word
+      found = iand(bytes_below(word, 32), not(ior(ior(bytes_equal(word, 9), bytes_equal(word, 10)), &
+         ior(bytes_equal(word, 12), bytes_equal(word, 13)))))
+      found = ior(found, bytes_equal(word, 127))
+   end function control_bytes
+
+   !> The number of tokens of text(i0:i1) as scan_tokens counts them (separated by the
+   !> bytes below 33 and commas; the byte before i0 taken as a separator), faster: a byte
+   !> starts a token where it is no separator and the byte before it is one, so each word
+   !> is tested against the word one byte before it, read as a word of its own, and the
+   !> starts are summed in the bytes of one word for up to 127 words at a time. No word
+   !> depends on the last one, and the compiler vectorises the pass.
+   pure integer function count_tokens(text, i0, i1) result(count)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: i0, i1
+      integer(i8), parameter :: EVEN_BYTES = int(z'00FF00FF00FF00FF', i8)
+      integer(i8) :: word, before, sums
+      integer :: i, k, words
+      logical :: after_separator
+      count = 0
+      if (i0 > i1) return
+      if (.not. separator(text(i0:i0))) count = 1
+      i = i0 + 1
+      do while (i1 - i >= 7)
+         words = min(127, (i1 - i + 1)/8)
+         sums = 0
+         do k = 0, words - 1
+            word = transfer(text(i + 8*k:i + 8*k + 7), word)
+            before = transfer(text(i + 8*k - 1:i + 8*k + 6), word)
+            sums = sums + shiftr(iand(not(separators(word)), separators(before)), 7)
+         end do
+         ! The bytes' sums (each at most 127) added in pairs, then across the word.
+         sums = iand(sums, EVEN_BYTES) + iand(shiftr(sums, 8), EVEN_BYTES)
+         sums = sums + shiftr(sums, 32)
+         sums = sums + shiftr(sums, 16)
+         count = count + int(iand(sums, 65535_i8))
+         i = i + 8*words
+      end do
+      after_separator = separator(text(i - 1:i - 1))
+      do i = i, i1
+         if (.not. separator(text(i:i)) .and. after_separator) count = count + 1
+         after_separator = separator(text(i:i))
+      end do
+   end function count_tokens
+
+   !> High bit of each byte of `word` that separates tokens: below 33, or a comma.
+   pure integer(i8) function separators(word) result(mask)
+      integer(i8), value :: word
+      mask = ior(bytes_below(word, 33), bytes_equal(word, 44))
+   end function separators
+
+   !> Whether the byte `c` separates tokens.
+   pure logical function separator(c)
+      character, intent(in) :: c
+      separator = iachar(c) < 33 .or. c == ","
+   end function separator
 
    !> The tokens of text(i0:i1), separated by the bytes below 33 and commas (a text
    !> without other control bytes: first_control_byte), and its line ends (LF): counted,

@@ -17,7 +17,7 @@ module femcod_deck
       MIN_YOUNG, MAX_YOUNG
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO, STATUS_USAGE
    use femcod_files, only: write_file, read_file, MAX_TEXT_BYTES
-   use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens
+   use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens, count_tokens
    use femcod_strings, only: int_str, parse_real, parse_integer, format_real, format_reals, is_digit, text_builder, &
       add_line, add_text, built_text
    !$ use omp_lib, only: omp_get_max_threads
@@ -322,9 +322,9 @@ contains
          bounds(b) = p
       end do
       bounds(nblocks) = n
-      !$omp parallel do private(ends) schedule(static)
+      !$omp parallel do schedule(static)
       do b = 1, nblocks
-         call scan_tokens(text, bounds(b - 1) + 1, bounds(b), 0, 0, counts(b), ends)
+         counts(b) = count_tokens(text, bounds(b - 1) + 1, bounds(b))
       end do
       before(1) = 0
       do b = 2, nblocks
