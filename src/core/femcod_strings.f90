@@ -389,14 +389,26 @@ contains
    end subroutine format_reals
 
    !> Whether `x` with `digits` significant digits reads back to `x`; `buf` holds that
-   !> decimal (decimal_e's form).
+   !> decimal (decimal_e's form) when it does. Where the wide kind forms the decimal
+   !> (nearest_decimal) and reads it back (exact_decimal, as parse_real would read its
+   !> text), no text is made for a decimal that does not read back; else decimal_e and
+   !> parse_real decide.
    logical function reads_back(x, digits, buf)
       real(dp), intent(in) :: x
       integer, intent(in) :: digits
       character(len=40), intent(out) :: buf
       real(dp) :: y
       logical :: ok
-      integer :: n
+      integer(i8) :: q
+      integer :: n, e10
+      call nearest_decimal(x, digits, q, e10, ok)
+      if (ok) call exact_decimal(q, e10 - digits + 1, y, ok)
+      if (ok) then
+         reads_back = y == abs(x)
+         buf = ""
+         if (reads_back) call decimal_text(x < 0, q, e10, digits, buf)
+         return
+      end if
       call decimal_e(x, digits, buf)
       reads_back = .false.
       n = len_trim(buf)
@@ -408,85 +420,111 @@ contains
    end function reads_back
 
    !> x (finite, not 0) with `ndigits` (1 to 17) significant digits in C's "%.*e" form
-   !> ("-d.ddde+XX", correctly rounded, ties to even) in buf; blank if C fails. Where
-   !> 10**k that scales x to `digits` digits is exact in a real kind of 64 significand
-   !> bits (|k| <= 27), x 10**k is formed there with one rounding (an error below 2**-64
-   !> of it) and rounded to an integer, unless its fraction lies within one unit of that
-   !> kind of a half, where the error could decide the rounding; otherwise, and then, C's
-   !> snprintf. glibc's printf forms every digit in multi-precision arithmetic: it was
-   !> most of writing a deck or PREFIX.contacts.csv.
+   !> ("-d.ddde+XX", correctly rounded, ties to even) in buf; blank if C fails. The digits
+   !> are nearest_decimal's where it decides them, else C's snprintf's. glibc's printf
+   !> forms every digit in multi-precision arithmetic: it was most of writing a deck or
+   !> PREFIX.contacts.csv.
    subroutine decimal_e(x, ndigits, buf)
       real(dp), intent(in) :: x
       integer, intent(in) :: ndigits
       character(len=40), intent(out) :: buf
       character(kind=c_char, len=40) :: cbuf
-      character(len=20) :: q_text
       integer(c_int) :: length
-      real(xp) :: scaled, fraction_part, low, high
       integer(i8) :: q
-      integer :: e10, k, tries, at, m, n
+      integer :: e10
       logical :: done
       buf = ""
-      done = .false.
-      if (digits(1.0_xp) >= 64 .and. ieee_is_finite(x) .and. x /= 0) then
-         e10 = floor(log10(abs(x)))
-         low = powers_of_ten(ndigits - 1)
-         high = powers_of_ten(ndigits)
-         do tries = 1, 2
-            k = ndigits - 1 - e10
-            if (abs(k) > 27) exit
-            if (k >= 0) then
-               scaled = abs(real(x, xp))*powers_of_ten(k)
-            else
-               scaled = abs(real(x, xp))/powers_of_ten(-k)
-            end if
-            ! log10 may be one off near a power of ten: then scale once more.
-            if (scaled < low) then
-               e10 = e10 - 1
-               cycle
-            else if (scaled >= high) then
-               e10 = e10 + 1
-               cycle
-            end if
-            q = int(scaled, i8)
-            fraction_part = scaled - real(q, xp)
-            ! (scaled epsilon is at least one unit of the kind at `scaled`.)
-            if (abs(fraction_part - 0.5_xp) <= scaled*epsilon(scaled)) exit
-            if (fraction_part > 0.5_xp) q = q + 1
-            if (real(q, xp) >= high) then
-               q = q/10
-               e10 = e10 + 1
-            end if
-            done = .true.
-            exit
-         end do
-      end if
+      call nearest_decimal(x, ndigits, q, e10, done)
       if (done) then
-         call integer_text(q, q_text, n)
-         at = 0
-         if (x < 0) call put("-")
-         call put(q_text(1:1))
-         if (ndigits > 1) then
-            call put(".")
-            call put(q_text(2:ndigits))
-         end if
-         call put(merge("e-", "e+", e10 < 0))
-         m = abs(e10)
-         if (m < 10) call put("0")
-         call integer_text(int(m, i8), q_text, n)
-         call put(q_text(1:n))
+         call decimal_text(x < 0, q, e10, ndigits, buf)
          return
       end if
       length = c_decimal_e(x, int(ndigits, c_int), cbuf, int(len(cbuf), c_int))
       if (length <= 0 .or. length >= len(cbuf)) return
       buf = cbuf(1:length)
-   contains
-      subroutine put(piece)
-         character(len=*), intent(in) :: piece
-         buf(at + 1:at + len(piece)) = piece
-         at = at + len(piece)
-      end subroutine put
    end subroutine decimal_e
+
+   !> |x| (finite, not 0) rounded to `ndigits` (1 to 17) significant digits, ties to
+   !> even: q (ndigits digits) times 10**(e10 - ndigits + 1). Where 10**k that scales x to
+   !> `ndigits` digits is exact in a real kind of 64 significand bits (|k| <= 27), x 10**k
+   !> is formed there with one rounding (an error below 2**-64 of it) and rounded to an
+   !> integer; `done` is false where it is not, and where the fraction lies within one
+   !> unit of that kind of a half, where the error could decide the rounding.
+   subroutine nearest_decimal(x, ndigits, q, e10, done)
+      real(dp), intent(in) :: x
+      integer, intent(in) :: ndigits
+      integer(i8), intent(out) :: q
+      integer, intent(out) :: e10
+      logical, intent(out) :: done
+      real(xp) :: scaled, fraction_part, low, high
+      integer :: k, tries
+      done = .false.
+      q = 0
+      e10 = 0
+      if (.not. (digits(1.0_xp) >= 64 .and. ieee_is_finite(x) .and. x /= 0)) return
+      e10 = floor(log10(abs(x)))
+      low = powers_of_ten(ndigits - 1)
+      high = powers_of_ten(ndigits)
+      do tries = 1, 2
+         k = ndigits - 1 - e10
+         if (abs(k) > 27) exit
+         if (k >= 0) then
+            scaled = abs(real(x, xp))*powers_of_ten(k)
+         else
+            scaled = abs(real(x, xp))/powers_of_ten(-k)
+         end if
+         ! log10 may be one off near a power of ten: then scale once more.
+         if (scaled < low) then
+            e10 = e10 - 1
+            cycle
+         else if (scaled >= high) then
+            e10 = e10 + 1
+            cycle
+         end if
+         q = int(scaled, i8)
+         fraction_part = scaled - real(q, xp)
+         ! (scaled epsilon is at least one unit of the kind at `scaled`.)
+         if (abs(fraction_part - 0.5_xp) <= scaled*epsilon(scaled)) exit
+         if (fraction_part > 0.5_xp) q = q + 1
+         if (real(q, xp) >= high) then
+            q = q/10
+            e10 = e10 + 1
+         end if
+         done = .true.
+         exit
+      end do
+   end subroutine nearest_decimal
+
+   !> "-d.ddde+XX": the digits of q (ndigits of them) with the point after the first,
+   !> the sign when `negative`, and the exponent e10 with at least two digits.
+   pure subroutine decimal_text(negative, q, e10, ndigits, buf)
+      logical, intent(in) :: negative
+      integer(i8), intent(in) :: q
+      integer, intent(in) :: e10, ndigits
+      character(len=40), intent(inout) :: buf
+      character(len=20) :: q_text, e_text
+      integer :: at, n, ne
+      call integer_text(q, q_text, n)
+      call integer_text(int(abs(e10), i8), e_text, ne)
+      at = 0
+      if (negative) then
+         buf(1:1) = "-"
+         at = 1
+      end if
+      buf(at + 1:at + 1) = q_text(1:1)
+      at = at + 1
+      if (ndigits > 1) then
+         buf(at + 1:at + ndigits) = "."//q_text(2:ndigits)
+         at = at + ndigits
+      end if
+      buf(at + 1:at + 2) = merge("e-", "e+", e10 < 0)
+      at = at + 2
+      if (ne < 2) then
+         buf(at + 1:at + 1) = "0"
+         at = at + 1
+      end if
+      buf(at + 1:at + ne) = e_text(1:ne)
+   end subroutine decimal_text
 
    !> Parse a real token: [sign] digits [. digits] [(e|E|d|D) [sign] digits], at least
    !> one mantissa digit. NaN, Inf, repeat counts and overflow are refused. The result is
