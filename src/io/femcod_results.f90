@@ -224,51 +224,47 @@ contains
       character(len=:), allocatable :: text
       character(len=*), parameter :: header = "i,j,step,force_nN,pressure_GPa"
       character(len=24), allocatable :: force(:), pressure(:)
-      character(len=112), allocatable :: rows(:)
-      integer, allocatable :: nf(:), np(:), lengths(:)
-      character(len=20) :: number
-      integer :: k, at, n, length
+      integer, allocatable :: nf(:), np(:)
+      integer(i8), allocatable :: ends(:)
+      character(len=20) :: ti, tj, ts
+      integer :: k, ni, nj, ns
+      integer(i8) :: at
       call format_reals(res%contact_force, force, nf)
       call format_reals(res%contact_force/deck%pixel**2, pressure, np)
-      ! The rows in parallel (fixed-length buffers only: see shortest_decimal), then
-      ! joined.
-      allocate(rows(size(res%contact_i)), lengths(size(res%contact_i)))
-      !$omp parallel do private(k, number, n, length) schedule(static)
+      ! Each row's end in the text from the lengths of its numbers, then every row
+      ! written at its place, in parallel (fixed-length buffers only: see
+      ! shortest_decimal).
+      allocate(ends(0:size(res%contact_i)))
+      ends(0) = len(header) + 1
       do k = 1, size(res%contact_i)
-         length = 0
-         call integer_text(int(res%contact_i(k), i8), number, n)
-         call append_piece(rows(k), length, number(1:n))
-         call append_piece(rows(k), length, ",")
-         call integer_text(int(res%contact_j(k), i8), number, n)
-         call append_piece(rows(k), length, number(1:n))
-         call append_piece(rows(k), length, ",")
-         call integer_text(int(res%contact_step(k), i8), number, n)
-         call append_piece(rows(k), length, number(1:n))
-         call append_piece(rows(k), length, ",")
-         call append_piece(rows(k), length, force(k)(1:nf(k)))
-         call append_piece(rows(k), length, ",")
-         call append_piece(rows(k), length, pressure(k)(1:np(k)))
-         call append_piece(rows(k), length, new_line("a"))
-         lengths(k) = length
+         ends(k) = ends(k - 1) + digits_of(res%contact_i(k)) + digits_of(res%contact_j(k)) + &
+            digits_of(res%contact_step(k)) + nf(k) + np(k) + 5
+      end do
+      allocate(character(len=ends(size(res%contact_i))) :: text)
+      text(1:len(header) + 1) = header//new_line("a")
+      !$omp parallel do private(k, ti, tj, ts, ni, nj, ns, at) schedule(static)
+      do k = 1, size(res%contact_i)
+         call integer_text(int(res%contact_i(k), i8), ti, ni)
+         call integer_text(int(res%contact_j(k), i8), tj, nj)
+         call integer_text(int(res%contact_step(k), i8), ts, ns)
+         at = ends(k - 1)
+         text(at + 1:ends(k)) = ti(1:ni)//","//tj(1:nj)//","//ts(1:ns)//","//force(k)(1:nf(k))//","// &
+            pressure(k)(1:np(k))//new_line("a")
       end do
       !$omp end parallel do
-      allocate(character(len=len(header) + 1 + sum(lengths)) :: text)
-      text(1:len(header) + 1) = header//new_line("a")
-      at = len(header) + 1
-      do k = 1, size(rows)
-         text(at + 1:at + lengths(k)) = rows(k)(1:lengths(k))
-         at = at + lengths(k)
-      end do
+   contains
+      !> The characters of the integer n in decimal.
+      pure integer function digits_of(n)
+         integer, intent(in) :: n
+         integer :: m
+         digits_of = merge(2, 1, n < 0)
+         m = abs(n)
+         do while (m >= 10)
+            m = m/10
+            digits_of = digits_of + 1
+         end do
+      end function digits_of
    end function contacts_csv
-
-   !> Put `piece` at row(length + 1:) and advance `length`.
-   pure subroutine append_piece(row, length, piece)
-      character(len=*), intent(inout) :: row
-      integer, intent(inout) :: length
-      character(len=*), intent(in) :: piece
-      row(length + 1:length + len(piece)) = piece
-      length = length + len(piece)
-   end subroutine append_piece
 
    !> PREFIX.loads.csv: the states at the requested loads that were reached.
    function loads_csv(deck, res) result(text)
