@@ -256,8 +256,10 @@ contains
    !> handed to HDF5 as stored) reads back exactly through HDF5's own shuffle and deflate
    !> filters, the independent decoder: 1000 x 300 doubles and integers, in chunks of 436
    !> rows (131072 values / 300), the last one partial; so does the same map written
-   !> plain (by blocks of 436 rows). The expected values are the formulas that made the
-   !> maps; h5dump (HDF5's tools) names both filters.
+   !> plain (by blocks of 436 rows). A table of 300000 rows and 3 columns (as the mesh's
+   !> nodes) is chunked by column, 131072 rows a chunk, the last partial, and reads back
+   !> exactly too. The expected values are the formulas that made the maps; h5dump
+   !> (HDF5's tools) names both filters.
    subroutine test_deflated(error)
       type(error_type), allocatable, intent(out) :: error
       type(h5_file) :: file
@@ -265,7 +267,8 @@ contains
       character(len=:), allocatable :: prefix, text
       real(dp) :: map(1000, 300)
       integer :: imap(1000, 300)
-      real(dp), allocatable :: back(:, :), iback(:, :), plain(:, :)
+      real(dp), allocatable :: back(:, :), iback(:, :), plain(:, :), table(:, :), tback(:, :), itback(:, :)
+      integer, allocatable :: itable(:, :)
       integer :: i, j, ios
       do j = 1, 300
          do i = 1, 1000
@@ -273,11 +276,20 @@ contains
             imap(i, j) = 1000*i + j
          end do
       end do
+      allocate(table(300000, 3), itable(300000, 3))
+      do j = 1, 3
+         do i = 1, 300000
+            table(i, j) = 0.5_dp*i - 7*j
+            itable(i, j) = 4*i + j
+         end do
+      end do
       prefix = scratch_path("h5-deflated")
       call h5_create(prefix//".h5", file, st)
       call h5_write(file, "/real", map, "nm", st, compress=.true.)
       call h5_write(file, "/int", imap, "1", st, compress=.true.)
       call h5_write(file, "/plain", map, "nm", st)
+      call h5_write(file, "/table", table, "nm", st, compress=.true.)
+      call h5_write(file, "/itable", itable, "1", st, compress=.true.)
       call h5_close(file, st)
       call check(error, st%code, 0, "writing")
       if (allocated(error)) return
@@ -285,6 +297,8 @@ contains
       call h5_read(file, "/real", back, st, STATUS_BAD_INPUT)
       call h5_read(file, "/int", iback, st, STATUS_BAD_INPUT)
       call h5_read(file, "/plain", plain, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/table", tback, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/itable", itback, st, STATUS_BAD_INPUT)
       call h5_close(file, st)
       call check(error, st%code, 0, "reading")
       if (allocated(error)) return
@@ -297,6 +311,12 @@ contains
       call check(error, all(shape(plain) == [1000, 300]), "the plain map's shape")
       if (allocated(error)) return
       call check(error, all(plain == map), "the plain map (written in blocks of 436 rows), exactly")
+      if (allocated(error)) return
+      call check(error, all(shape(tback) == [300000, 3]) .and. all(shape(itback) == [300000, 3]), &
+         "the tables' shapes")
+      if (allocated(error)) return
+      call check(error, all(tback == table) .and. all(itback == real(itable, dp)), &
+         "the tables chunked by column, exactly")
       if (allocated(error)) return
       call execute_command_line("h5dump -p -H -d /real "//prefix//".h5 > "//prefix//".dump 2>&1", exitstat=ios)
       call check(error, ios, 0, "h5dump (Debian hdf5-tools, installed by setup.sh)")

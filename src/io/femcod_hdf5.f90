@@ -194,6 +194,7 @@ contains
       if (present(compress)) then
          if (compress .and. size(dims) > 0 .and. product(dims) > 0) then
             chunk = dims
+            if (by_column(dims)) chunk(1) = 1
             chunk(size(dims)) = chunk_rows(dims)
             call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, error)
             call h5pset_chunk_f(dcpl, size(dims), chunk, error)
@@ -219,21 +220,37 @@ contains
    end subroutine create_dataset
 
    !> Rows of a compressed dataset's chunk (C order: its slowest dimension, Fortran's
-   !> last; `dims` in Fortran order): whole rows, about 2**17 values (1 MiB of doubles).
+   !> last; `dims` in Fortran order): about 2**17 values (1 MiB of doubles), of whole
+   !> rows, or of one column (by_column).
    pure integer(hsize_t) function chunk_rows(dims)
       integer(hsize_t), intent(in) :: dims(:)
-      chunk_rows = min(dims(size(dims)), max(1_hsize_t, 131072_hsize_t/max(1_hsize_t, product(dims(1:size(dims) - 1)))))
+      if (by_column(dims)) then
+         chunk_rows = min(dims(2), 131072_hsize_t)
+      else
+         chunk_rows = min(dims(size(dims)), max(1_hsize_t, 131072_hsize_t/max(1_hsize_t, &
+            product(dims(1:size(dims) - 1)))))
+      end if
    end function chunk_rows
+
+   !> Whether a compressed table of at most 8 columns (the mesh's nodes and
+   !> quadrilaterals) is chunked by column: one column's values alone are far more
+   !> regular than rows of interleaved columns. The 2048^2 mesh's nodes deflate in half
+   !> the time to a tenth of the size (0.6 instead of 5.8 MB).
+   pure logical function by_column(dims)
+      integer(hsize_t), intent(in) :: dims(:)
+      by_column = .false.
+      if (size(dims) == 2) by_column = dims(1) <= 8
+   end function by_column
 
    !> The whole of the open dataset `dset`, created with `compress` (chunked, shuffled,
    !> deflated), from `real_map` or `int_map` (one of them), stored transposed so that
    !> C-order readers see map(i, j) at [i - 1, j - 1]; `dims` as create_dataset had them.
-   !> Each chunk (whole rows of the map) is transposed into the thread's buffer, shuffled
-   !> (byte b of every value together: HDF5's shuffle filter) and deflated at level 1
-   !> (zlib's compress2: HDF5's deflate filter) on all threads, then handed to HDF5 as it
-   !> is stored, in order (H5Dwrite_chunk, filter mask 0: every filter applied). HDF5 runs
-   !> its filters on one thread: the 2048^2 mesh took 0.38 s that way. `error` /= 0 if
-   !> zlib or HDF5 failed.
+   !> Each chunk (whole rows of the map, or rows of one column: by_column) is copied into
+   !> the thread's buffer (rows transposed), shuffled (byte b of every value together:
+   !> HDF5's shuffle filter) and deflated at level 1 (zlib's compress2: HDF5's deflate
+   !> filter) on all threads, then handed to HDF5 as it is stored, in order
+   !> (H5Dwrite_chunk, filter mask 0: every filter applied). HDF5 runs its filters on one
+   !> thread: the 2048^2 mesh took 0.38 s that way. `error` /= 0 if zlib or HDF5 failed.
    subroutine write_deflated(dset, dims, error, real_map, int_map)
       integer(hid_t), intent(in) :: dset
       integer(hsize_t), intent(in) :: dims(2)
@@ -252,38 +269,50 @@ contains
       integer(hsize_t) :: per_chunk, offset(2)
       integer(int64) :: chunk_bytes, values
       integer(c_long) :: bound, zlen
-      integer :: nchunks, k, b, elem, r0, nr, j
+      integer :: nchunks, row_chunks, columns, k, b, elem, r0, nr, c, j
+      logical :: one_column
       per_chunk = chunk_rows(dims)
+      one_column = by_column(dims)
+      ! Columns in a chunk; chunk k holds rows r0 + 1.. of column c (all columns: c = 1).
+      columns = int(merge(1_hsize_t, dims(1), one_column))
       elem = 8
       if (present(int_map)) elem = storage_size(0)/8
-      values = dims(1)*per_chunk
+      values = columns*per_chunk
       chunk_bytes = elem*values
-      nchunks = int((dims(2) + per_chunk - 1)/per_chunk)
+      row_chunks = int((dims(2) + per_chunk - 1)/per_chunk)
+      nchunks = row_chunks*int(merge(dims(1), 1_hsize_t, one_column))
       bound = c_compress_bound(int(chunk_bytes, c_long))
       allocate(chunks(nchunks), failed(nchunks))
-      !$omp parallel private(real_rows, int_rows, raw, shuffled, z, k, b, zlen, r0, nr, j)
+      !$omp parallel private(real_rows, int_rows, raw, shuffled, z, k, b, zlen, r0, nr, c, j)
       if (present(int_map)) then
-         allocate(int_rows(dims(1), per_chunk))
+         allocate(int_rows(columns, per_chunk))
          call c_f_pointer(c_loc(int_rows), raw, [chunk_bytes])
       else
-         allocate(real_rows(dims(1), per_chunk))
+         allocate(real_rows(columns, per_chunk))
          call c_f_pointer(c_loc(real_rows), raw, [chunk_bytes])
       end if
       allocate(shuffled(chunk_bytes), z(bound))
       !$omp do schedule(dynamic)
       do k = 1, nchunks
-         r0 = int((k - 1)*per_chunk)
-         nr = int(min(per_chunk, dims(2) - r0))
+         call chunk_place(k, r0, nr, c)
          ! The last chunk is stored whole: its part beyond the rows is never read.
          if (present(int_map)) then
-            do j = 1, int(dims(1))
-               int_rows(j, 1:nr) = int_map(r0 + 1:r0 + nr, j)
-            end do
+            if (one_column) then
+               int_rows(1, 1:nr) = int_map(r0 + 1:r0 + nr, c)
+            else
+               do j = 1, columns
+                  int_rows(j, 1:nr) = int_map(r0 + 1:r0 + nr, j)
+               end do
+            end if
             int_rows(:, nr + 1:) = 0
          else
-            do j = 1, int(dims(1))
-               real_rows(j, 1:nr) = real_map(r0 + 1:r0 + nr, j)
-            end do
+            if (one_column) then
+               real_rows(1, 1:nr) = real_map(r0 + 1:r0 + nr, c)
+            else
+               do j = 1, columns
+                  real_rows(j, 1:nr) = real_map(r0 + 1:r0 + nr, j)
+               end do
+            end if
             real_rows(:, nr + 1:) = 0
          end if
          do b = 1, elem
@@ -298,10 +327,21 @@ contains
       error = merge(1, 0, any(failed))
       do k = 1, nchunks
          if (error /= 0) exit
-         offset = [(k - 1)*per_chunk, 0_hsize_t]
+         call chunk_place(k, r0, nr, c)
+         ! C order: [row, column].
+         offset = [int(r0, hsize_t), int(merge(c - 1, 0, one_column), hsize_t)]
          if (h5d_write_chunk(dset, H5P_DEFAULT_F, 0_c_int32_t, offset, size(chunks(k)%z, kind=c_size_t), &
             chunks(k)%z) < 0) error = 1
       end do
+   contains
+      !> Chunk k's first row r0 + 1, its rows nr within the map, and its column c.
+      pure subroutine chunk_place(k, r0, nr, c)
+         integer, intent(in) :: k
+         integer, intent(out) :: r0, nr, c
+         c = (k - 1)/row_chunks + 1
+         r0 = int(mod(k - 1, row_chunks)*per_chunk)
+         nr = int(min(per_chunk, dims(2) - r0))
+      end subroutine chunk_place
    end subroutine write_deflated
 
    !> Whether the optional `compress` is present and true.
