@@ -269,7 +269,7 @@ contains
       integer(hsize_t) :: per_chunk, offset(2)
       integer(int64) :: chunk_bytes, values
       integer(c_long) :: bound, zlen
-      integer :: nchunks, row_chunks, columns, k, b, elem, r0, nr, c, j
+      integer :: nchunks, row_chunks, columns, k, b, elem, r0, nr, c, c0, j
       logical :: one_column
       per_chunk = chunk_rows(dims)
       one_column = by_column(dims)
@@ -283,7 +283,7 @@ contains
       nchunks = row_chunks*int(merge(dims(1), 1_hsize_t, one_column))
       bound = c_compress_bound(int(chunk_bytes, c_long))
       allocate(chunks(nchunks), failed(nchunks))
-      !$omp parallel private(real_rows, int_rows, raw, shuffled, z, k, b, zlen, r0, nr, c, j)
+      !$omp parallel private(real_rows, int_rows, raw, shuffled, z, k, b, zlen, r0, nr, c, c0, j)
       if (present(int_map)) then
          allocate(int_rows(columns, per_chunk))
          call c_f_pointer(c_loc(int_rows), raw, [chunk_bytes])
@@ -295,24 +295,18 @@ contains
       !$omp do schedule(dynamic)
       do k = 1, nchunks
          call chunk_place(k, r0, nr, c)
-         ! The last chunk is stored whole: its part beyond the rows is never read.
+         ! Columns c0 + 1 .. c0 + columns of the rows, transposed. The last chunk is
+         ! stored whole: its part beyond the rows is never read.
+         c0 = merge(c, 1, one_column) - 1
          if (present(int_map)) then
-            if (one_column) then
-               int_rows(1, 1:nr) = int_map(r0 + 1:r0 + nr, c)
-            else
-               do j = 1, columns
-                  int_rows(j, 1:nr) = int_map(r0 + 1:r0 + nr, j)
-               end do
-            end if
+            do j = 1, columns
+               int_rows(j, 1:nr) = int_map(r0 + 1:r0 + nr, c0 + j)
+            end do
             int_rows(:, nr + 1:) = 0
          else
-            if (one_column) then
-               real_rows(1, 1:nr) = real_map(r0 + 1:r0 + nr, c)
-            else
-               do j = 1, columns
-                  real_rows(j, 1:nr) = real_map(r0 + 1:r0 + nr, j)
-               end do
-            end if
+            do j = 1, columns
+               real_rows(j, 1:nr) = real_map(r0 + 1:r0 + nr, c0 + j)
+            end do
             real_rows(:, nr + 1:) = 0
          end if
          do b = 1, elem
