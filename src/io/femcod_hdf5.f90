@@ -220,17 +220,23 @@ contains
    end subroutine create_dataset
 
    !> Rows of a compressed dataset's chunk (C order: its slowest dimension, Fortran's
-   !> last; `dims` in Fortran order): about 2**17 values (1 MiB of doubles), of whole
-   !> rows, or of one column (by_column).
+   !> last; `dims` in Fortran order): about 2**17 values (1 MiB of doubles), of one
+   !> column (by_column) or of whole rows (row_block).
    pure integer(hsize_t) function chunk_rows(dims)
       integer(hsize_t), intent(in) :: dims(:)
       if (by_column(dims)) then
          chunk_rows = min(dims(2), 131072_hsize_t)
       else
-         chunk_rows = min(dims(size(dims)), max(1_hsize_t, 131072_hsize_t/max(1_hsize_t, &
-            product(dims(1:size(dims) - 1)))))
+         chunk_rows = row_block(dims)
       end if
    end function chunk_rows
+
+   !> Whole rows of about 2**17 values: a compressed map's chunk, and the block in which a
+   !> plain map is transposed and written.
+   pure integer(hsize_t) function row_block(dims)
+      integer(hsize_t), intent(in) :: dims(:)
+      row_block = min(dims(size(dims)), max(1_hsize_t, 131072_hsize_t/max(1_hsize_t, product(dims(1:size(dims) - 1)))))
+   end function row_block
 
    !> Whether a compressed table of at most 8 columns (the mesh's nodes and
    !> quadrilaterals) is chunked by column: one column's values alone are far more
@@ -416,7 +422,7 @@ contains
       else
          ! In blocks of whole rows (about 1 MiB), each transposed into the same buffer:
          ! no second copy of the map in fresh memory.
-         rows = int(chunk_rows(dims))
+         rows = int(row_block(dims))
          allocate(stored(size(map, 2), rows))
          call h5dget_space_f(dset, filespace, error)
          if (error == 0) then
