@@ -239,8 +239,9 @@ contains
    !> written "1.5e-7" (no trailing zeros, no exponent when it is 0), or in plain
    !> positional form ("0.0025", "1200") when 1e-4 <= |x| < 1e15 and that is not longer.
    !>
-   !> The conversions are C's (snprintf "%.*e" and strtod, correctly rounded in glibc),
-   !> a few microseconds a value where formatted Fortran I/O took tens. Which n: if n
+   !> Each candidate is rounded and read back in extended precision (nearest_decimal,
+   !> exact_decimal), and made into text only when it reads back; near a rounding tie C's
+   !> snprintf "%.*e" and strtod decide (correctly rounded in glibc). Which n: if n
    !> digits read back, so do n + 1 (the (n+1)-digit rounding is at least as close to x),
    !> so the answer is found by trying 16, then 17 or 15, then bisection below 15.
    !> The smallest n never ends in 0 (n - 1 digits would read back as well), so the
