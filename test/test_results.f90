@@ -7,6 +7,7 @@ module test_results
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
+   use femcod_results, only: write_file_set
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_exists, h5_read_string_attribute, h5_create, &
       h5_write
    use femcod_generate, only: scene_spec, build_problem
@@ -569,34 +570,44 @@ contains
       call sphere_run("force-sphere", prefix, code)
       call check(error, code, 0, "first run")
       if (allocated(error)) return
-      call write_text(prefix//".history.csv", "kept"//new_line("a"))
+      ! An earlier femcod's table (a header of names): --force may replace it, and only it.
+      call write_text(prefix//".history.csv", "step,contacts"//new_line("a")//"kept,0"//new_line("a"))
       before = read_text(prefix//".h5")
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
          string_type(prefix), string_type("--quiet")], code)
       call check(error, code, 5, "existing results: exit 5")
       if (allocated(error)) return
-      call check(error, read_text(prefix//".history.csv") == "kept"//new_line("a") .and. &
-         read_text(prefix//".h5") == before, "results untouched")
+      call check(error, read_text(prefix//".history.csv") == "step,contacts"//new_line("a")//"kept,0"//new_line("a") &
+         .and. read_text(prefix//".h5") == before, "results untouched")
       if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
          string_type(prefix), string_type("--quiet"), string_type("--force")], code)
       call check(error, code, 0, "--force")
       if (allocated(error)) return
-      call check(error, read_text(prefix//".history.csv") /= "kept"//new_line("a"), "--force replaced the results")
+      call check(error, .not. contains_text(read_text(prefix//".history.csv"), "kept"), "--force replaced the results")
    end subroutine test_force
 
-   !> PREFIX.h5 is a directory, so the last rename fails: exit 5 and none of the files
-   !> renamed before it stays behind.
+   !> A set whose last rename fails (its name is a directory) leaves none of the files
+   !> renamed before it (commit_set, which the run's writer shares); and a run whose
+   !> PREFIX.h5 is a directory is refused before it solves (exit 2, nothing written).
    subroutine test_partial(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix
+      type(status_type) :: st
       integer :: code
       prefix = scratch_path("partial")
       call execute_command_line("rm -rf "//prefix//".* && mkdir -p "//prefix//".h5")
+      call write_file_set([string_type(prefix//".a.csv"), string_type(prefix//".b.csv"), string_type(prefix//".h5")], &
+         [string_type("a,b"//new_line("a")), string_type("c,d"//new_line("a")), string_type("x")], st)
+      call check(error, st%code, 5, "the last rename fails: exit 5")
+      if (allocated(error)) return
+      call check(error, .not. (file_exists(prefix//".a.csv") .or. file_exists(prefix//".b.csv") .or. &
+         file_exists(prefix//".a.csv.part") .or. file_exists(prefix//".h5.part")), "no partial set")
+      if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
          string_type(prefix), string_type("--loads"), string_type("100"), string_type("--quiet"), &
          string_type("--force")], code)
-      call check(error, code, 5, "exit code")
+      call check(error, code, 2, "PREFIX.h5 a directory: exit 2 before the solve")
       if (allocated(error)) return
       call check(error, .not. (file_exists(prefix//".history.csv") .or. file_exists(prefix//".contacts.csv") .or. &
          file_exists(prefix//".loads.csv") .or. file_exists(prefix//".xdmf") .or. &

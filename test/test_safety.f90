@@ -12,6 +12,7 @@ module test_safety
    use femcod_process, only: process_id, host_name
    use femcod_files, only: acquire_lock, release_lock
    use femcod_strings, only: int_str
+   use femcod_output_guard, only: written_by_femcod, OUTPUT_RESULT, OUTPUT_DECK, OUTPUT_WISDOM
    use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
    use test_results, only: self_command
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
@@ -32,7 +33,9 @@ contains
          new_unittest("--restart on finished results: nothing to do only for the same inputs", test_restart_finished), &
          new_unittest("--restart works for height-file runs", test_restart_heights), &
          new_unittest("batch: --outdir; decks that would write the same files are refused", test_batch_outputs), &
-         new_unittest("a full disk (the job's file-size limit): exit 5, the cause, no file left", test_full_disk) &
+         new_unittest("a full disk (the job's file-size limit): exit 5, the cause, no file left", test_full_disk), &
+         new_unittest("femcod's own files are told from a user's by their form (output guard)", test_own_files), &
+         new_unittest("--force replaces femcod's deck and results; --fftw-wisdom reuses its file", test_force_own) &
          ]
    end subroutine collect_safety
 
@@ -316,4 +319,73 @@ contains
       listing = read_text(dir//"/listing")
       call check(error, len(listing) == 0, "no file left: "//listing)
    end subroutine test_full_disk
+   !> Files whose origin the test knows: femcod wrote the result set, the deck and the
+   !> wisdom; the test wrote a user's notes, a height matrix, a header-less table and an
+   !> HDF5 height file (test/corpus). Each is recognised for what it is.
+   subroutine test_own_files(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir
+      character(len=*), parameter :: set(*) = [character(len=20) :: ".h5", ".xdmf", ".history.csv", ".contacts.csv", &
+         ".loads.csv", ".summary.json", ".load_approach.svg", ".area_load.svg", ".pressure_1.svg"]
+      integer :: k
+      dir = scratch_path("own_files")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call make_deck(dir//"/scene.deck", 20)
+      call check(error, femcod("run "//dir//"/scene.deck --solver cg --loads 100 --quiet -o "//dir//"/r "// &
+         "--fftw-wisdom "//dir//"/w"), 0, "the run")
+      if (allocated(error)) return
+      do k = 1, size(set)
+         call check(error, written_by_femcod(dir//"/r"//trim(set(k)), OUTPUT_RESULT), "femcod wrote r"//trim(set(k)))
+         if (allocated(error)) return
+      end do
+      call check(error, written_by_femcod(dir//"/scene.deck", OUTPUT_DECK), "femcod wrote the deck")
+      if (allocated(error)) return
+      call check(error, written_by_femcod(dir//"/w", OUTPUT_WISDOM) .and. &
+         written_by_femcod(dir//"/w.float32", OUTPUT_WISDOM), "femcod wrote the wisdom (double and float32)")
+      if (allocated(error)) return
+      call write_text(dir//"/notes.csv", "My notes on the scan"//new_line("a"))
+      call write_text(dir//"/numbers.csv", "1,2,3"//new_line("a")//"4,5,6"//new_line("a"))
+      call write_text(dir//"/empty.svg", "")
+      call execute_command_line("cp test/corpus/63_heights.h5 "//dir//"/heights.h5")
+      call check(error, .not. written_by_femcod(dir//"/notes.csv", OUTPUT_RESULT) .and. &
+         .not. written_by_femcod(dir//"/numbers.csv", OUTPUT_RESULT) .and. &
+         .not. written_by_femcod(dir//"/empty.svg", OUTPUT_RESULT) .and. &
+         .not. written_by_femcod(dir//"/heights.h5", OUTPUT_RESULT), "a user's table, figure and HDF5 file")
+      if (allocated(error)) return
+      call check(error, .not. written_by_femcod(dir//"/numbers.csv", OUTPUT_DECK) .and. &
+         .not. written_by_femcod(dir//"/r.h5", OUTPUT_DECK) .and. &
+         .not. written_by_femcod("test/corpus/40_square_matrix.txt", OUTPUT_DECK), "not decks")
+      if (allocated(error)) return
+      call check(error, .not. written_by_femcod(dir//"/scene.deck", OUTPUT_WISDOM) .and. &
+         .not. written_by_femcod(dir//"/r.h5", OUTPUT_WISDOM), "not wisdom")
+   end subroutine test_own_files
+
+   !> The other side of the corpus' refusals: what femcod wrote is replaced with --force,
+   !> and the wisdom file is read and brought up to date without it.
+   subroutine test_force_own(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, before
+      dir = scratch_path("force_own")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call check(error, femcod("mkdeck flat --np 4 --pixel 1 -o "//dir//"/a.deck"), 0, "mkdeck")
+      if (allocated(error)) return
+      before = read_text(dir//"/a.deck")
+      call check(error, femcod("mkdeck flat --np 4 --pixel 2 -o "//dir//"/a.deck"), 5, "mkdeck without --force")
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/a.deck") == before, "the deck is kept")
+      if (allocated(error)) return
+      call check(error, femcod("mkdeck flat --np 4 --pixel 2 -o "//dir//"/a.deck --force"), 0, "mkdeck --force")
+      if (allocated(error)) return
+      call check(error, contains_text(read_text(dir//"/a.deck"), "4 2 16"), "the deck is replaced: "// &
+         read_text(dir//"/a.deck"))
+      if (allocated(error)) return
+      call make_deck(dir//"/scene.deck", 20)
+      call check(error, femcod("run "//dir//"/scene.deck --solver cg --loads 100 --quiet -o "//dir//"/r "// &
+         "--fftw-wisdom "//dir//"/w"), 0, "a run that writes the wisdom")
+      if (allocated(error)) return
+      call check(error, femcod("run "//dir//"/scene.deck --solver cg --loads 100 --quiet -o "//dir//"/r --force "// &
+         "--fftw-wisdom "//dir//"/w"), 0, "a second run reads and updates it, and --force replaces its results")
+      if (allocated(error)) return
+      call check(error, contains_text(read_text(dir//"/w"), "(fftw-3"), "the wisdom is FFTW's")
+   end subroutine test_force_own
 end module test_safety

@@ -6,12 +6,13 @@ module femcod_cli
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE
-   use femcod_strings, only: string_type, int_str, parse_integer
+   use femcod_strings, only: string_type, int_str, parse_integer, append_string
    use femcod_problem, only: contact_problem
    use femcod_deck, only: write_deck
    use femcod_workspace, only: workspace_type, workspace_layout, workspace_table
    use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, KINDS
-   use femcod_heights, only: load_scene
+   use femcod_heights, only: load_scene, height_file_path
+   use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
    use femcod_run, only: run_command
    use femcod_studies, only: resolution_command, summits_command, multiscale_command
    use femcod_about, only: FEMCOD_VERSION
@@ -162,6 +163,7 @@ contains
       type(option_spec), allocatable :: table(:)
       table = [ &
          text_option("--output", "FILE", "output deck (written atomically)", alias="-o"), &
+         flag_option("--force", "replace an existing deck (only a deck; never the --file it is made from)"), &
          text_option("--verification", "NAME|all", "a verification deck of input/ by name, or all of them", &
             mode="verification"), &
          text_option("--dir", "DIR", "directory of the verification decks (default input/ for all, else .)", &
@@ -196,8 +198,8 @@ contains
 
    subroutine mkdeck_help()
       write(output_unit, '(a)') &
-         "usage: femcod mkdeck KIND -o FILE [options]", &
-         "       femcod mkdeck --verification NAME|all [-o FILE | --dir DIR]", &
+         "usage: femcod mkdeck KIND -o FILE [--force] [options]", &
+         "       femcod mkdeck --verification NAME|all [-o FILE | --dir DIR] [--force]", &
          "", &
          "Writes an input deck (doc/deck-format.md). The shape goes on one surface, the other is flat;", &
          "a rigid body gets E --rigid-factor times the elastic one (default 1e10), and so do the", &
@@ -232,11 +234,13 @@ contains
    end subroutine mkdeck_help
 
    !> The arguments of `femcod mkdeck` as a scene spec (or a verification request): no I/O.
-   subroutine parse_mkdeck_arguments(args, spec, output, verification, dir, status)
+   subroutine parse_mkdeck_arguments(args, spec, output, verification, dir, status, force)
       type(string_type), intent(in) :: args(:)
       type(scene_spec), intent(out) :: spec
       character(len=:), allocatable, intent(out) :: output, verification, dir
       type(status_type), intent(inout) :: status
+      !> --force: an existing deck may be replaced.
+      logical, intent(out), optional :: force
       type(parsed_options) :: parsed
       character(len=:), allocatable :: text
       output = ""
@@ -245,8 +249,10 @@ contains
       spec%kind = ""
       spec%label = ""
       spec%matrix_file = ""
+      if (present(force)) force = .false.
       call parse_options(mkdeck_table(), args, parsed, status)
       if (status%code /= 0) return
+      if (present(force)) call get_option(parsed, "--force", force)
       call get_option(parsed, "--output", output)
       call get_option(parsed, "--verification", verification)
       call get_option(parsed, "--dir", dir)
@@ -320,29 +326,49 @@ contains
       type(contact_problem) :: deck
       type(status_type) :: status
       character(len=:), allocatable :: output, verification, dir
+      type(string_type), allocatable :: outputs(:), inputs(:)
+      logical :: force
       integer :: k
       code = 0
       if (help_requested(args)) then
          call mkdeck_help()
          return
       end if
-      call parse_mkdeck_arguments(args, spec, output, verification, dir, status)
+      call parse_mkdeck_arguments(args, spec, output, verification, dir, status, force)
       if (status%code /= 0) then
          call command_usage("mkdeck", status, code)
          return
       end if
+      ! Every deck this command writes is checked before the first is made.
+      allocate(outputs(0), inputs(0))
+      if (verification == "all") then
+         if (dir == "") dir = "input"
+         do k = 1, size(VERIFICATION_DECKS)
+            call append_string(outputs, dir//"/"//trim(VERIFICATION_DECKS(k))//".deck")
+         end do
+      else if (verification /= "") then
+         if (output == "") then
+            if (dir == "") dir = "."
+            output = dir//"/"//verification//".deck"
+         end if
+         call append_string(outputs, output)
+      else
+         call append_string(outputs, output)
+         if (spec%matrix_file /= "") call append_string(inputs, height_file_path(spec%matrix_file))
+      end if
+      call guard_outputs(outputs, inputs, force, OUTPUT_DECK, status)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod mkdeck: "//status%message
+         code = status%code
+         return
+      end if
       if (verification /= "") then
          if (verification == "all") then
-            if (dir == "") dir = "input"
             do k = 1, size(VERIFICATION_DECKS)
                call one_verification(trim(VERIFICATION_DECKS(k)), dir//"/"//trim(VERIFICATION_DECKS(k))//".deck")
                if (code /= 0) return
             end do
          else
-            if (output == "") then
-               if (dir == "") dir = "."
-               output = dir//"/"//verification//".deck"
-            end if
             call one_verification(verification, output)
          end if
          return

@@ -30,6 +30,7 @@ module femcod_run
    use femcod_maps, only: load_maps, state_maps
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
    use femcod_wisdom, only: load_wisdom, save_wisdom
+   use femcod_output_guard, only: guard_outputs, OUTPUT_WISDOM, OUTPUT_RESULT
    use femcod_results, only: write_results, run_info, result_files, stored_fingerprint
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested, print_lines
@@ -393,6 +394,12 @@ contains
          code = status%code
          return
       end if
+      if (len(settings%wisdom) > 0) call check_wisdom_file(settings, status)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod run: "//status%message
+         code = status%code
+         return
+      end if
       if (settings%outdir /= "") then
          call make_directories(settings%outdir, status)
          if (status%code /= 0) then
@@ -493,6 +500,43 @@ contains
       end if
    end subroutine run_one
 
+   !> --fftw-wisdom FILE, before any deck is read: FILE and FILE.float32 are neither an
+   !> input nor a result file of this run, and each that exists is FFTW wisdom (it is
+   !> then read and brought up to date without --force: that is what the option is for);
+   !> a file that is not wisdom is refused and left as it is.
+   subroutine check_wisdom_file(settings, st)
+      type(run_settings), intent(in) :: settings
+      type(status_type), intent(inout) :: st
+      type(string_type), allocatable :: inputs(:), outputs(:)
+      type(string_type) :: wisdom(2)
+      integer :: d, m, w
+      allocate(inputs(0), outputs(0))
+      do d = 1, size(settings%decks)
+         if (settings%decks(d)%s /= "") then
+            call append_string(inputs, settings%decks(d)%s)
+         else
+            call append_string(inputs, height_file_path(settings%scene%matrix_file))
+            if (settings%scene%second_file /= "") &
+               call append_string(inputs, height_file_path(settings%scene%second_file))
+         end if
+         outputs = [outputs, result_files(settings%prefixes(d)%s, requested_states(settings%solve)), &
+            string_type(settings%prefixes(d)%s//".ckpt.h5"), string_type(settings%prefixes(d)%s//".lock")]
+      end do
+      wisdom(1)%s = settings%wisdom
+      wisdom(2)%s = settings%wisdom//".float32"
+      do w = 1, size(wisdom)
+         do m = 1, size(outputs)
+            if (canonical_path(wisdom(w)%s) == canonical_path(outputs(m)%s)) then
+               call set_error(st, STATUS_USAGE, "--fftw-wisdom: "//wisdom(w)%s//" is also a result file of this "// &
+                  "run; give the wisdom a name of its own")
+               return
+            end if
+         end do
+      end do
+      call guard_outputs(wisdom, inputs, .true., OUTPUT_WISDOM, st)
+      if (st%code /= 0) st%message = "--fftw-wisdom: "//st%message
+   end subroutine check_wisdom_file
+
    !> The result files of `prefix` (and its checkpoint and lock) may not be one of the
    !> input files, with or without --force.
    subroutine refuse_input_as_output(prefix, nloads, inputs, st)
@@ -569,6 +613,12 @@ contains
             if (.not. (settings%restart .and. (have_checkpoint .or. .not. path_exists(prefix//".h5")))) &
                call refuse_overwrite(prefix, requested_states(options), st)
          end if
+         ! What is replaced (with --force, or as a restart's leftovers) must be femcod's; a
+         ! checkpoint that --restart continues is checked whole by read_checkpoint.
+         if (st%code == 0) call guard_outputs(result_files(prefix, requested_states(options)), [string_type::], &
+            .true., OUTPUT_RESULT, st)
+         if (st%code == 0 .and. .not. settings%restart) call guard_outputs([string_type(prefix//".ckpt.h5")], &
+            [string_type::], .true., OUTPUT_RESULT, st)
          if (st%code /= 0) return
          observer%quiet = settings%quiet
          observer%target_contacts = problem%maxcont

@@ -11,9 +11,9 @@ module femcod_studies
    use femcod_strings, only: string_type, int_str, sig_str, split_list, text_builder, add_line, built_text, &
       parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
    use femcod_generate, only: scene_spec
-   use femcod_heights, only: load_scene, read_height_map, height_map, is_height_file
+   use femcod_heights, only: load_scene, read_height_map, height_map, is_height_file, height_file_path
    use femcod_files, only: default_prefix, file_part
-   use femcod_files, only: path_exists
+   use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_results, only: write_file_set
    use femcod_svg, only: svg_series, svg_multi_plot, add_series
    use femcod_clock, only: wall_clock
@@ -147,6 +147,18 @@ contains
       call get_option(parsed, "--hardness", hardness)
       call get_option(parsed, "--force", force)
       call get_option(parsed, "--quiet", quiet)
+      if (prefix == "") prefix = default_prefix(file_part(input))
+      names = [string_type(prefix//".resolution.csv"), string_type(prefix//".powerlaw.csv"), &
+         string_type(prefix//".estimates.csv"), string_type(prefix//".hardness.csv"), &
+         string_type(prefix//".load_displacement.svg"), string_type(prefix//".area_displacement.svg"), &
+         string_type(prefix//".area_pressure.svg"), string_type(prefix//".richardson.svg"), &
+         string_type(prefix//".hardness.svg"), string_type(prefix//".hardness_capped.csv")]
+      ! The outputs are checked before the input is read: an input is never an output.
+      call check_outputs(names, input, force, status)
+      if (status%code /= 0) then
+         call fail(status)
+         return
+      end if
       call surface_scene(parsed, input, spec)
       call study_deck(input, spec, deck, status)
       if (status%code /= 0) then
@@ -164,17 +176,6 @@ contains
             end if
          end do
          if (size(nps) == 0) nps = [deck%np]
-      end if
-      if (prefix == "") prefix = default_prefix(file_part(input))
-      names = [string_type(prefix//".resolution.csv"), string_type(prefix//".powerlaw.csv"), &
-         string_type(prefix//".estimates.csv"), string_type(prefix//".hardness.csv"), &
-         string_type(prefix//".load_displacement.svg"), string_type(prefix//".area_displacement.svg"), &
-         string_type(prefix//".area_pressure.svg"), string_type(prefix//".richardson.svg"), &
-         string_type(prefix//".hardness.svg"), string_type(prefix//".hardness_capped.csv")]
-      call check_outputs(names, force, status)
-      if (status%code /= 0) then
-         call fail(status)
-         return
       end if
       observer%quiet = quiet
       allocate(levels(size(nps)))
@@ -414,21 +415,17 @@ contains
       end if
    end subroutine study_deck
 
-   !> Refuse to overwrite (exit 5 before any work) unless --force; check that the
-   !> directory takes files.
-   subroutine check_outputs(names, force, status)
+   !> Before any work: no output names the input `input` (exit 2), an existing output is
+   !> replaced only with --force and only when femcod wrote it (exit 5; see
+   !> io/femcod_output_guard), and the directory takes files.
+   subroutine check_outputs(names, input, force, status)
       type(string_type), intent(in) :: names(:)
+      character(len=*), intent(in) :: input
       logical, intent(in) :: force
       type(status_type), intent(inout) :: status
-      integer :: k, unit, ios
-      if (.not. force) then
-         do k = 1, size(names)
-            if (path_exists(names(k)%s)) then
-               call set_error(status, STATUS_IO, names(k)%s//": exists; not overwritten (use --force to replace)")
-               return
-            end if
-         end do
-      end if
+      integer :: unit, ios
+      call guard_outputs(names, [string_type(height_file_path(input))], force, OUTPUT_RESULT, status)
+      if (status%code /= 0) return
       open(newunit=unit, file=names(1)%s//".part", status="replace", action="write", iostat=ios)
       if (ios /= 0) then
          call set_error(status, STATUS_IO, names(1)%s//": cannot write (directory missing or not writable); nothing was run")
@@ -613,18 +610,19 @@ contains
          return
       end if
       if (code /= 0) return
-      call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
-      if (status%code /= 0) then
-         call fail_with("summits", status, code)
-         return
-      end if
-      if (size(opts%sizes) == 0) opts%sizes = default_sizes(size(z, 1))
       names = [string_type(opts%prefix//".summits.csv"), string_type(opts%prefix//".summit_exponents.csv"), &
          string_type(opts%prefix//".psd.csv"), string_type(opts%prefix//".structure.csv"), &
          string_type(opts%prefix//".fractal.csv"), string_type(opts%prefix//".summit_density.svg"), &
          string_type(opts%prefix//".summit_height.svg"), string_type(opts%prefix//".summit_radius.svg"), &
          string_type(opts%prefix//".psd.svg"), string_type(opts%prefix//".structure.svg")]
-      call check_outputs(names, opts%force, status)
+      ! The outputs are checked before the input is read: an input is never an output.
+      call check_outputs(names, opts%input, opts%force, status)
+      if (status%code == 0) call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
+      if (status%code /= 0) then
+         call fail_with("summits", status, code)
+         return
+      end if
+      if (size(opts%sizes) == 0) opts%sizes = default_sizes(size(z, 1))
       if (status%code == 0) call summit_search(z, d, opts%sizes, stats, status)
       if (status%code /= 0) then
          call fail_with("summits", status, code)
@@ -765,15 +763,16 @@ contains
       call get_option(parsed, "--min-length", min_length)
       call get_option(parsed, "--scales", scales)
       call get_option(parsed, "--template-size", tsize)
-      call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
+      names = [string_type(opts%prefix//".multiscale.csv"), string_type(opts%prefix//".multiscale.svg")]
+      ! The outputs are checked before the input is read: an input is never an output.
+      call check_outputs(names, opts%input, opts%force, status)
+      if (status%code == 0) call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
       if (status%code /= 0) then
          call fail_with("multiscale", status, code)
          return
       end if
       if (size(opts%sizes) == 0) opts%sizes = default_sizes(size(z, 1))
       if (tsize > 0 .and. .not. any(opts%sizes == tsize)) opts%sizes = [opts%sizes, tsize]
-      names = [string_type(opts%prefix//".multiscale.csv"), string_type(opts%prefix//".multiscale.svg")]
-      call check_outputs(names, opts%force, status)
       if (status%code == 0) call summit_search(z, d, opts%sizes, stats, status)
       if (status%code /= 0) then
          call fail_with("multiscale", status, code)
