@@ -327,6 +327,17 @@ contains
             message="load at "//to_string(up(k)))
          if (allocated(error)) return
       end do
+      ! The cap is the law's bound: a capped pixel carries H d^2 exactly, none more (the
+      ! event path's reading; this path reported 11.000000000000028 GPa and pixels above
+      ! H before, issue 34).
+      do k = 1, size(path%states)
+         if (path%states(k)%n_plastic == 0) cycle
+         call check(error, path%states(k)%max_pressure == options%hardness .and. &
+            path%states(k)%n_above_hardness == 0, "state "//to_string(k)//": max pressure "// &
+            to_string(path%states(k)%max_pressure)//" GPa, "//to_string(path%states(k)%n_above_hardness)// &
+            " pixels above H = "//to_string(options%hardness))
+         if (allocated(error)) return
+      end do
       ! The surface deformed by the path's plastic displacement (shape on the lower body).
       plastic = path%states(6)%plastic
       deformed = deck

@@ -55,6 +55,8 @@ contains
          new_unittest("--plastic: contact area tends to load / H as H -> 0 (bearing area), both solvers", &
             test_plastic_bearing), &
          new_unittest("--plastic: 90 % plastic area converges, no pressure above H", test_plastic_90), &
+         new_unittest("--plastic --approach, cg (gap variables): the event path's loads; unloading keeps the "// &
+            "plastic displacement", test_plastic_approach), &
          new_unittest("--plastic: a square punch past full plasticity carries A H", test_plastic_punch), &
          new_unittest("--plastic maps, both solvers: gap = -plastic displacement where capped, 0 on contact", &
             test_plastic_maps), &
@@ -1220,6 +1222,7 @@ contains
             if (allocated(error)) return
          end do
       end do
+      options%loads = [real(dp) ::]
       options%approaches = [inc%states(1)%approach]
       call solve_contact(deck, options, cg, status)
       call check(error, status%code, 0, status%message)
@@ -1269,4 +1272,86 @@ contains
       read(unit, *, iostat=ios) load, loads_approach
       close(unit)
    end function loads_approach
+   !> cg with --plastic under displacement control, against the event path (the exact,
+   !> independent solver: yield events of a bordered Cholesky factor) on the thesis'
+   !> sphere (input/sphere_d2.deck, H = 11 GPa: 5 to 49 pixels plastic) and on a 32 x 32
+   !> rough surface (H = 2 GPa). At each approach the loads agree to 1e-7 (cg's tolerance
+   !> 1e-10, as test_approach_paths), and so do the plastic pixels' count and volume; no
+   !> pressure is above H and the largest is H itself (a capped pixel carries H d^2 by
+   !> the law). This combination used to stop with "Attempting to allocate already
+   !> allocated variable" (issue 34). Then unloading (approaches in decreasing order,
+   !> which the event path cannot follow): the plastic volume never decreases, the load
+   !> never rises (a small step back unloads elastically, a large one separates the
+   !> surfaces, whose plastic displacement keeps them apart), and no pressure exceeds H.
+   subroutine test_plastic_approach(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: event, cg
+      type(status_type) :: status
+      integer :: scene, k
+      real(dp) :: h
+      do scene = 1, 2
+         if (scene == 1) then
+            call read_deck("input/sphere_d2.deck", deck, status)
+            options%approaches = [0.5_dp, 1.0_dp, 2.0_dp, 3.0_dp]
+            h = 11
+         else
+            call rough_scene(32, 7, deck)
+            options%approaches = [0.5_dp, 1.5_dp, 3.0_dp]
+            h = 2
+         end if
+         options%loads = [real(dp) ::]
+         options%plastic = .true.
+         options%hardness = h
+         options%solver = "incremental"
+         call solve_contact(deck, options, event, status)
+         call check(error, status%code, 0, "event path: "//status%message)
+         if (allocated(error)) return
+         options%solver = "cg"
+         options%cg = cg_settings()
+         options%cg%tol = 1.0e-10_dp
+         options%cg%max_iterations = 5000
+         call solve_contact(deck, options, cg, status)
+         call check(error, status%code, 0, "cg: "//status%message)
+         if (allocated(error)) return
+         call check(error, any(event%states%n_plastic > 0), "scene "//to_string(scene)//": some pixel yields")
+         if (allocated(error)) return
+         do k = 1, size(options%approaches)
+            associate(e => event%states(k), c => cg%states(k))
+               call check(error, c%load, e%load, rel=.true., thr=1.0e-7_dp, message="scene "//to_string(scene)// &
+                  ", approach "//to_string(options%approaches(k))//": cg's load against the event path's")
+               if (allocated(error)) return
+               call check(error, c%n_plastic, e%n_plastic, "plastic pixels at "//to_string(options%approaches(k)))
+               if (allocated(error)) return
+               call check(error, c%plastic_volume, e%plastic_volume, rel=.true., thr=1.0e-6_dp, &
+                  message="plastic volume at "//to_string(options%approaches(k)))
+               if (allocated(error)) return
+               call check(error, c%n_above_hardness == 0 .and. c%max_pressure <= h .and. &
+                  (c%n_plastic == 0 .or. c%max_pressure == h), "no pressure above H = "//to_string(h)// &
+                  " (max "//to_string(c%max_pressure)//", "//to_string(c%n_above_hardness)//" above)")
+               if (allocated(error)) return
+            end associate
+         end do
+      end do
+      ! Unloading the rough surface from its deepest approach.
+      options%approaches = [3.0_dp, 2.98_dp, 2.9_dp, 0.5_dp]
+      call solve_contact(deck, options, cg, status)
+      call check(error, status%code, 0, "unloading: "//status%message)
+      if (allocated(error)) return
+      do k = 2, size(options%approaches)
+         call check(error, cg%states(k)%plastic_volume >= cg%states(k - 1)%plastic_volume .and. &
+            cg%states(k)%load <= cg%states(k - 1)%load .and. cg%states(k)%max_pressure <= h, &
+            "unloading to "//to_string(options%approaches(k))//": plastic volume kept ("// &
+            to_string(cg%states(k - 1)%plastic_volume)//" -> "//to_string(cg%states(k)%plastic_volume)// &
+            " nm^3), load falls ("//to_string(cg%states(k - 1)%load)//" -> "//to_string(cg%states(k)%load)// &
+            " nN), max pressure "//to_string(cg%states(k)%max_pressure)//" GPa")
+         if (allocated(error)) return
+      end do
+      call check(error, cg%states(2)%load < cg%states(1)%load .and. cg%states(2)%load > 0, &
+         "a small step back unloads elastically: "//to_string(cg%states(2)%load)//" nN")
+      if (allocated(error)) return
+      call check(error, cg%states(4)%load < event%states(1)%load, "unloading: below the loading branch at 0.5 nm (" &
+         //to_string(cg%states(4)%load)//" against "//to_string(event%states(1)%load)//" nN)")
+   end subroutine test_plastic_approach
 end module test_cg

@@ -22,7 +22,7 @@ module femcod_run
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, height_file_path
    use femcod_contact_result, only: contact_result, stop_reason_text
-   use femcod_solver_options, only: contact_options, requested_states
+   use femcod_solver_options, only: contact_options, requested_states, validate_options
    use femcod_observer, only: solver_observer
    use femcod_state_visitor, only: visitable
    use femcod_incremental_state, only: incremental_state
@@ -277,16 +277,13 @@ contains
          end associate
          settings%decks = [string_type("")]
       end if
+      ! Which options go together: one rule set for run, femcod-mpi and the benchmarks.
+      call validate_options(settings%solve, status)
+      if (status%code /= 0) return
       if (size(settings%decks) == 0) then
          call set_error(status, STATUS_USAGE, "run needs a DECK")
       else if (settings%restart .and. settings%solve%solver /= "incremental") then
          call set_error(status, STATUS_USAGE, "--restart: checkpoints are written by the incremental solver only")
-      else if (size(settings%solve%loads) > 0 .and. size(settings%solve%approaches) > 0) then
-         call set_error(status, STATUS_USAGE, "give --loads (load control) or --approach (displacement control), "// &
-            "not both")
-      else if (settings%solve%solver == "cg" .and. requested_states(settings%solve) == 0) then
-         call set_error(status, STATUS_USAGE, "--solver cg solves at given loads or approaches: add --loads F1,F2,... "// &
-            "or --approach D1,D2,...")
       else if (settings%solve%adhesion /= "none" .and. .not. (option_given(parsed, "--work") .and. &
          option_given(parsed, "--range"))) then
          call set_error(status, STATUS_USAGE, "--adhesion needs --work W (J/m^2) and --range R (nm)")
@@ -294,17 +291,6 @@ contains
          option_given(parsed, "--range"))) then
          call set_error(status, STATUS_USAGE, "--work and --range describe an adhesion law: add --adhesion "// &
             "dugdale|exponential")
-      else if (settings%solve%adhesion /= "none" .and. size(settings%solve%approaches) == 0) then
-         call set_error(status, STATUS_USAGE, "--adhesion needs --approach D1,D2,... (displacement control: under "// &
-            "load control the pull-off is an instability)")
-      else if (settings%solve%adhesion /= "none" .and. settings%solve%cg%kernel_radius > 0) then
-         call set_error(status, STATUS_USAGE, "--adhesion with --kernel-radius: the adhesive solver uses the whole "// &
-            "Love kernel")
-      else if (settings%solve%plastic .and. size(settings%solve%approaches) > 1 .and. &
-         settings%solve%adhesion == "none") then
-         if (any(settings%solve%approaches(2:) < settings%solve%approaches(:size(settings%solve%approaches) - 1))) &
-            call set_error(status, STATUS_USAGE, "--approach with --plastic: give the approaches in increasing order, "// &
-            "or unload along a path with --solver cg --adhesion dugdale --work 0 --range 1 (--work 0: no adhesion)")
       else if (size(settings%decks) > 1 .and. settings%prefix /= "" .and. .not. settings%from_files) then
          call set_error(status, STATUS_USAGE, "-o PREFIX names the outputs of one deck; with several decks each "// &
             "deck's outputs are named after it (--outdir DIR puts them in DIR)")

@@ -4,9 +4,11 @@
 !> dispatches on `solver`.
 module femcod_solver_options
    use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE
    implicit none
    private
-   public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, requested_states
+   public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, LAW_NAMES, requested_states
+   public :: validate_options, by_gap_variables
 
    !> The solvers by name: the event-exact incremental solver, the Appendix B program,
    !> and the fixed-load constrained conjugate gradients.
@@ -15,6 +17,10 @@ module femcod_solver_options
    !> The lateral boundary: the thesis' half-space with the grid alone on it (free), or
    !> the grid as one cell of a surface that repeats in both directions (periodic).
    character(len=*), parameter :: BOUNDARY_NAMES(2) = [character(len=8) :: "free", "periodic"]
+
+   !> The interface laws: the hard wall (no adhesion), Dugdale's and the exponential
+   !> adhesive laws (solvers/femcod_adhesion).
+   character(len=*), parameter :: LAW_NAMES(3) = [character(len=11) :: "none", "dugdale", "exponential"]
 
    !> The cg solver's own options (solvers/femcod_cg). The accelerations default to on;
    !> each can be switched off.
@@ -128,4 +134,69 @@ contains
       if (allocated(options%loads)) requested_states = size(options%loads)
       if (allocated(options%approaches)) requested_states = requested_states + size(options%approaches)
    end function requested_states
+   !> True when the run is solved in the gap variables under displacement control
+   !> (solvers/femcod_adhesion): --solver cg with --approach and an interface law other
+   !> than the elastic hard wall, i.e. --adhesion or --plastic. The plastic interface is
+   !> path-dependent and its load is not a function of the approach where the plastic
+   !> pixels carry it all (the load stays while the body sinks), so displacement control
+   !> solves it directly rather than by loads.
+   pure logical function by_gap_variables(options)
+      type(contact_options), intent(in) :: options
+      by_gap_variables = .false.
+      if (options%solver /= "cg" .or. .not. allocated(options%approaches)) return
+      by_gap_variables = size(options%approaches) > 0 .and. (options%adhesion /= "none" .or. options%plastic)
+   end function by_gap_variables
+
+   !> The one place where the combinations of options are checked: `femcod run` after
+   !> parsing, femcod-mpi, the benchmarks and solve_contact call it before any file is
+   !> read or any lock taken. A refused combination names both options (STATUS_USAGE,
+   !> exit 2). Checks that need the deck (a load above the fully plastic capacity) are
+   !> the solvers' own.
+   subroutine validate_options(options, status)
+      type(contact_options), intent(in) :: options
+      type(status_type), intent(inout) :: status
+      integer :: nloads, napproaches
+      if (status%code /= 0) return
+      nloads = 0
+      napproaches = 0
+      if (allocated(options%loads)) nloads = size(options%loads)
+      if (allocated(options%approaches)) napproaches = size(options%approaches)
+      if (.not. any(SOLVER_NAMES == options%solver)) then
+         call refuse("unknown solver '"//trim(options%solver)//"' (available: incremental, legacy, cg)")
+      else if (.not. any(BOUNDARY_NAMES == options%boundary)) then
+         call refuse("unknown boundary '"//trim(options%boundary)//"' (free or periodic)")
+      else if (.not. any(LAW_NAMES == options%adhesion)) then
+         call refuse("unknown adhesion law '"//trim(options%adhesion)//"' (dugdale or exponential)")
+      else if (nloads > 0 .and. napproaches > 0) then
+         call refuse("give --loads (load control) or --approach (displacement control), not both")
+      else if (options%solver == "cg" .and. nloads + napproaches == 0) then
+         call refuse("--solver cg solves at given loads or approaches: add --loads F1,F2,... or --approach D1,D2,...")
+      else if (options%plastic .and. options%solver == "legacy") then
+         call refuse("--plastic with --solver legacy: the legacy solver is the Appendix B program of the elastic "// &
+            "interface; use --solver incremental or cg")
+      else if (options%boundary == "periodic" .and. options%solver == "legacy") then
+         call refuse("--boundary periodic with --solver legacy: the legacy solver is the Appendix B program of the "// &
+            "free half-space; use --solver incremental or cg")
+      else if (options%adhesion /= "none" .and. options%solver /= "cg") then
+         call refuse("--adhesion with --solver "//trim(options%solver)//": the event solvers follow a path of "// &
+            "contact events without tension; use --solver cg")
+      else if (options%adhesion /= "none" .and. napproaches == 0) then
+         call refuse("--adhesion needs --approach D1,D2,... (displacement control: under load control the pull-off "// &
+            "is an instability)")
+      else if (options%adhesion /= "none" .and. .not. (options%work >= 0 .and. options%range > 0)) then
+         call refuse("--adhesion needs --work W >= 0 (J/m^2) and --range R > 0 (nm)")
+      else if (by_gap_variables(options) .and. options%cg%kernel_radius > 0) then
+         call refuse(trim(merge("--adhesion", "--plastic ", options%adhesion /= "none"))//" --approach with "// &
+            "--kernel-radius: displacement control in the gap variables uses the whole Love kernel")
+      else if (options%plastic .and. options%solver /= "cg" .and. napproaches > 1) then
+         if (any(options%approaches(2:) < options%approaches(:napproaches - 1))) call refuse("--approach with "// &
+            "--plastic and --solver "//trim(options%solver)//": the event path only loads; give the approaches in "// &
+            "increasing order, or unload with --solver cg")
+      end if
+   contains
+      subroutine refuse(message)
+         character(len=*), intent(in) :: message
+         call set_error(status, STATUS_USAGE, message)
+      end subroutine refuse
+   end subroutine validate_options
 end module femcod_solver_options

@@ -1,5 +1,8 @@
-!> Adhesive contact under displacement control (`--adhesion dugdale|exponential --work W
-!> --range R --approach D1,D2,...`, with `--solver cg`): at each prescribed approach A,
+!> Contact under displacement control in the gap variables, with an interface law and
+!> bounds as arguments: adhesive (`--adhesion dugdale|exponential --work W --range R
+!> --approach D1,D2,...`, with `--solver cg`) or the hard wall (law "none", phi = 0) with
+!> the plastic cap (`--solver cg --plastic --approach ...`); the cap H d^2 bounds every
+!> pixel's force with any law. At each prescribed approach A,
 !> in the order given, a local minimum of the total energy
 !>     Pi(u) = 1/2 u.K u + d^2 sum_i phi(g_i),   g = g0 - A + u >= 0,
 !> continued from the state at the previous approach, so that loading and unloading
@@ -142,7 +145,7 @@ contains
          call set_error(status, STATUS_USAGE, "--adhesion needs --approach (displacement control)")
          return
       end if
-      if (.not. (options%work >= 0 .and. options%range > 0)) then
+      if (law /= "none" .and. .not. (options%work >= 0 .and. options%range > 0)) then
          call set_error(status, STATUS_USAGE, "--adhesion needs --work W >= 0 (J/m^2) and --range R > 0 (nm)")
          return
       end if
@@ -171,7 +174,7 @@ contains
          ! the range, so that no step jumps over the law's reach (the first approach from
          ! the undeformed surfaces).
          nsub = 1
-         if (k > 1) nsub = min(MAX_SUBSTEPS, max(1, ceiling(abs(a - last)/(options%range/2))))
+         if (k > 1 .and. law /= "none") nsub = min(MAX_SUBSTEPS, max(1, ceiling(abs(a - last)/(options%range/2))))
          st%iterations = 0
          do sub = 1, nsub
             target = a
@@ -560,6 +563,9 @@ contains
       ! plus the mean force, the multiplier).
       call apply_operator(grid, grid%stiffness, x, kx)
       force = kx(1:np, 1:np) + mu
+      ! A capped pixel carries H d^2 by the law (its residual, kx + mu - fmax, is within
+      ! the tolerance): exactly, so that no pressure above H is reported.
+      if (capped) where (cap) force = fmax
    contains
       !> g >= 0 off the capped set; on a periodic cell the open gaps then shifted to the
       !> mean gap, and again, until no open gap went below 0.

@@ -178,7 +178,7 @@ contains
          res%states%load = targets
       end if
       if (m == 0) then
-         call set_error(status, STATUS_NUMERICAL, "cg: --solver cg needs --loads or --approach")
+         call set_error(status, STATUS_USAGE, "cg: --solver cg needs --loads or --approach")
          return
       end if
       call make_grid(fine, initial_gap_map(problem%lower, problem%upper), problem, &
@@ -407,6 +407,12 @@ contains
       real(dp) :: left
       integer :: round, ncap
       allocate(force(size(p, 1), size(p, 2)), w(size(p, 1), size(p, 2)))
+      ! A plastic set from a larger load (displacement control tries loads on both sides
+      ! of the answer) may carry this load alone or more: start elastic again.
+      if (count(capped)*fmax >= load) then
+         capped = .false.
+         p = 0
+      end if
       do round = 1, MAX_ROUNDS
          ncap = count(capped)
          if (ncap > 0) then
@@ -449,6 +455,8 @@ contains
          return
       end if
       p = merge(fmax, p, capped)
+      ! Displacement control solves one state at many trial loads: the last one's map.
+      if (allocated(state%plastic)) deallocate(state%plastic)
       allocate(state%plastic(size(p, 1), size(p, 2)))
       state%plastic = 0
       if (any(capped)) then

@@ -11,7 +11,7 @@ module femcod_solver
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, validate_options, by_gap_variables
    use femcod_observer, only: solver_observer
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental
@@ -40,15 +40,8 @@ contains
       type(incremental_state), intent(inout), optional :: resume
       type(solver_observer) :: nobody
       if (status%code /= 0) return
-      if (options%boundary /= "free" .and. options%boundary /= "periodic") then
-         call set_error(status, STATUS_USAGE, "unknown boundary '"//trim(options%boundary)//"' (free or periodic)")
-         return
-      end if
-      if (options%plastic .and. options%solver == "legacy") then
-         call set_error(status, STATUS_USAGE, "--plastic: the legacy solver is the Appendix B program of the "// &
-            "elastic interface; use --solver incremental or cg")
-         return
-      end if
+      call validate_options(options, status)
+      if (status%code /= 0) return
       ! The fixed-load solver cannot carry more than every pixel at H d^2; the event path
       ! stops where no pixel is left to touch, and says which loads it did not reach.
       if (options%plastic .and. options%solver == "cg" .and. allocated(options%loads)) then
@@ -61,21 +54,11 @@ contains
             end if
          end if
       end if
-      if (options%boundary == "periodic" .and. options%solver == "legacy") then
-         call set_error(status, STATUS_USAGE, "--boundary periodic: the legacy solver is the Appendix B program "// &
-            "of the free half-space; use --solver incremental or cg")
-         return
-      end if
-      if (options%adhesion /= "none") then
-         if (options%solver /= "cg") then
-            call set_error(status, STATUS_USAGE, "--adhesion: the event solvers follow a path of contact events "// &
-               "without tension; use --solver cg")
-         else if (.not. allocated(options%approaches)) then
-            call set_error(status, STATUS_USAGE, "--adhesion needs --approach: under load control the pull-off "// &
-               "is an instability")
-         else if (options%cg%kernel_radius > 0) then
-            call set_error(status, STATUS_USAGE, "--adhesion with --kernel-radius: the adhesive solver uses the "// &
-               "whole Love kernel")
+      ! Displacement control with an interface law (adhesion) or bounds (the plastic
+      ! cap): the constrained iteration in the gap variables.
+      if (by_gap_variables(options)) then
+         if (present(resume)) then
+            call set_error(status, STATUS_USAGE, "only the incremental solver continues from a stored state")
          else if (present(observer)) then
             call solve_adhesive(problem, options, res, status, observer)
          else
@@ -140,6 +123,11 @@ contains
                string_type("adhesion_convexity: one pixel's adhesive stiffness d^2 W/R^2 over its elastic "// &
                "stiffness = "//sig_str(ratio, 3)//verdict)]
          end if
+         if (options%plastic .and. options%adhesion == "none" .and. by_gap_variables(options)) lines = [lines, &
+            string_type("plastic cap H = "//sig_str(options%hardness, 4)//" GPa under displacement control: each "// &
+            "approach from the last in the gap variables (constrained CG, Rey, Anciaux and Molinari 2017), a "// &
+            "capped pixel's interpenetration kept as plastic displacement (give intermediate approaches to follow "// &
+            "a path finer than the one asked)")]
          if (.not. options%plastic) lines = [lines, string_type("no plastic cap: pressures are elastic, "// &
             "n_above_hardness counts the pixels above the hardness (--plastic caps them)")]
          if (options%boundary == "periodic") lines = [lines, periodic_note(problem%np, "cg")]
@@ -223,7 +211,7 @@ contains
                "every load one elastic solve, with no plastic bookkeeping")
          end if
          do k = 1, size(res%states)
-            if (options%adhesion /= "none") then
+            if (by_gap_variables(options)) then
                call add("cg", "approach "//sig_str(res%states(k)%approach, 6)//" nm: "// &
                   int_str(res%states(k)%iterations)//" iterations, residual "//sig_str(res%states(k)%residual, 2)// &
                   " (force balance, as a gap over the height range)")
