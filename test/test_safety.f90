@@ -13,6 +13,10 @@ module test_safety
    use femcod_files, only: acquire_lock, release_lock
    use femcod_strings, only: int_str
    use femcod_output_guard, only: written_by_femcod, OUTPUT_RESULT, OUTPUT_DECK, OUTPUT_WISDOM
+   use femcod_solver_options, only: contact_options
+   use femcod_incremental_state, only: incremental_state
+   use femcod_checkpoint, only: write_checkpoint, read_checkpoint
+   use femcod_deck, only: read_deck
    use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
    use test_results, only: self_command
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
@@ -35,7 +39,9 @@ contains
          new_unittest("batch: --outdir; decks that would write the same files are refused", test_batch_outputs), &
          new_unittest("a full disk (the job's file-size limit): exit 5, the cause, no file left", test_full_disk), &
          new_unittest("femcod's own files are told from a user's by their form (output guard)", test_own_files), &
-         new_unittest("--force replaces femcod's deck and results; --fftw-wisdom reuses its file", test_force_own) &
+         new_unittest("--force replaces femcod's deck and results; --fftw-wisdom reuses its file", test_force_own), &
+         new_unittest("a checkpoint continues only the physics it was written with (whole option set)", &
+            test_checkpoint_options) &
          ]
    end subroutine collect_safety
 
@@ -388,4 +394,64 @@ contains
       if (allocated(error)) return
       call check(error, contains_text(read_text(dir//"/w"), "(fftw-3"), "the wisdom is FFTW's")
    end subroutine test_force_own
+   !> A checkpoint of a plastic run (--plastic --hardness 4) used to be accepted by a run
+   !> without --plastic, which then continued it as an elastic history (issue 34). The
+   !> checkpoint stores the whole option set and --restart compares it whole: each option
+   !> that shapes the history, changed alone, is refused with the field named (exit 3);
+   !> the same options are accepted. The expected refusals follow from the options'
+   !> meaning, not from the code: each changes the answer.
+   subroutine test_checkpoint_options(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: problem
+      type(contact_options) :: written, other
+      type(incremental_state) :: state, again
+      type(status_type) :: st
+      character(len=:), allocatable :: dir
+      integer :: k
+      character(len=*), parameter :: fields(*) = [character(len=14) :: "plastic", "hardness", "boundary", &
+         "loads", "approaches", "max_contacts", "final_check"]
+      dir = scratch_path("checkpoint_options")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call make_deck(dir//"/scene.deck", 40)
+      call read_deck(dir//"/scene.deck", problem, st)
+      written%plastic = .true.
+      written%hardness = 4
+      written%loads = [real(dp) ::]
+      written%approaches = [real(dp) ::]
+      call state%init(problem, written)
+      call write_checkpoint(dir//"/run.ckpt.h5", problem, written, state, st)
+      call check(error, st%code, 0, "writing the checkpoint: "//st%message)
+      if (allocated(error)) return
+      call again%init(problem, written)
+      call read_checkpoint(dir//"/run.ckpt.h5", problem, written, again, st)
+      call check(error, st%code, 0, "the same options continue: "//st%message)
+      if (allocated(error)) return
+      do k = 1, size(fields)
+         other = written
+         select case (trim(fields(k)))
+         case ("plastic")
+            other%plastic = .false.
+         case ("hardness")
+            other%hardness = 5
+         case ("boundary")
+            other%boundary = "periodic"
+         case ("loads")
+            other%loads = [100.0_dp]
+         case ("approaches")
+            other%approaches = [1.0_dp]
+         case ("max_contacts")
+            other%max_contacts = 10
+         case ("final_check")
+            other%final_check = .false.
+         end select
+         st = status_type()
+         call again%init(problem, other)
+         call read_checkpoint(dir//"/run.ckpt.h5", problem, other, again, st)
+         call check(error, st%code, 3, trim(fields(k))//" changed: refused")
+         if (allocated(error)) return
+         call check(error, contains_text(st%message, trim(fields(k))//"="), trim(fields(k))// &
+            " changed: the message names it: "//st%message)
+         if (allocated(error)) return
+      end do
+   end subroutine test_checkpoint_options
 end module test_safety

@@ -22,7 +22,7 @@ module femcod_run
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, height_file_path
    use femcod_contact_result, only: contact_result, stop_reason_text
-   use femcod_solver_options, only: contact_options, requested_states, validate_options
+   use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options
    use femcod_observer, only: solver_observer
    use femcod_state_visitor, only: visitable
    use femcod_incremental_state, only: incremental_state
@@ -721,15 +721,7 @@ contains
       character(len=:), allocatable :: text
       integer :: k, at
       text = problem%label//"|"//int_str(problem%np)//"|"//format_real(problem%pixel)//"|"// &
-         int_str(problem%maxcont)//"|"//reals(problem%young)//reals(problem%poisson)//trim(options%solver)//"|"// &
-         reals(options%loads)//trim(merge("approach|", "         ", size(options%approaches) > 0))// &
-         reals(options%approaches)//int_str(options%max_contacts)//"|"//format_real(options%hardness)//"|"// &
-         trim(merge("plastic|", "        ", options%plastic))//trim(merge("periodic|", "         ", &
-         options%boundary == "periodic"))// &
-         format_real(options%tie_tolerance)//"|"//merge("T", "F", options%final_check)//"|"// &
-         trim(options%event_search)//"|"//format_real(options%cg%tol)//"|"//int_str(options%cg%max_iterations)//"|"// &
-         format_real(options%cg%kernel_radius)//"|"//trim(options%adhesion)//"|"//format_real(options%work)//"|"// &
-         format_real(options%range)//"|"
+         int_str(problem%maxcont)//"|"//reals(problem%young)//reals(problem%poisson)//history_options(options)//"|"
       do k = 1, size(digests)
          ! The digest without the file's path: a moved input is the same input.
          at = index(digests(k)%s, " sha256 ", back=.true.)

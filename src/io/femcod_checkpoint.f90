@@ -6,7 +6,8 @@
 !> writer and the reader here know no field of any state.
 !>
 !> Layout: /deck (label, NP, pixel, MAXCONT, young, poisson; lower, upper),
-!> /options (max_contacts, loads, tie_tolerance, hardness, final_check), then one group
+!> /options (attribute `history`: every option that shapes the history, one text,
+!> solvers' history_options), then one group
 !> per group the state visits (for the incremental solver /state, /history,
 !> /states/<k>, /counters), a dataset per field with its name.
 module femcod_checkpoint
@@ -15,7 +16,7 @@ module femcod_checkpoint
    use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, format_real
    use femcod_files, only: atomic_rename, remove_file, temporary_name
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, history_options, first_difference
    use femcod_state_visitor, only: state_visitor, visitable
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_read, h5_attribute, &
       h5_read_string_attribute, h5_exists
@@ -92,18 +93,9 @@ contains
          call h5_write(file, "/deck/lower", deck%lower, "nm", status)
          call h5_write(file, "/deck/upper", deck%upper, "nm", status)
          call h5_group(file, "/options", status)
-         call h5_write(file, "/options/max_contacts", options%max_contacts, "1", status)
-         call h5_write(file, "/options/loads", options%loads, "nN", status)
-         call h5_write(file, "/options/tie_tolerance", options%tie_tolerance, "1", status)
-         call h5_write(file, "/options/hardness", options%hardness, "GPa", status)
-         call h5_write(file, "/options/final_check", merge(1, 0, options%final_check), "1", status)
-         call h5_write(file, "/options/event_search", merge(1, 0, options%event_search == "fft") + &
-            2*merge(1, 0, options%event_search == "bound"), "1", status)
-         call h5_write(file, "/options/periodic", merge(1, 0, options%boundary == "periodic"), "1", status)
-         if (allocated(options%approaches)) then
-            if (size(options%approaches) > 0) call h5_write(file, "/options/approaches", options%approaches, "nm", &
-               status)
-         end if
+         ! The whole option set that shapes the history, as one text (history_options):
+         ! --restart compares it whole, so no checkpoint continues as another physics.
+         call h5_attribute(file, "/options", "history", history_options(options), status)
          if (status%code == 0) then
             call state%visit(writer)
             if (writer%status%code /= 0) call set_error(status, writer%status%code, writer%status%message)
@@ -128,10 +120,10 @@ contains
       class(visitable), intent(inout) :: state
       type(status_type), intent(inout) :: status
       type(h5_reader) :: reader
-      character(len=:), allocatable :: tag, label
+      character(len=:), allocatable :: tag, label, stored
       real(dp), allocatable :: r1(:), r2(:, :)
       real(dp) :: r
-      integer :: i, final_check
+      integer :: i
       integer, parameter :: bad = STATUS_BAD_INPUT
       if (status%code /= 0) return
       associate(file => reader%file)
@@ -139,8 +131,8 @@ contains
       call h5_read_string_attribute(file, "/", "format", len(FORMAT_TAG), tag, status, bad)
       if (status%code /= 0) then
          call h5_close(file, status)
-         status%message = path//": not a femcod checkpoint (truncated or corrupted; delete it, or run without "// &
-            "--restart)"
+         status%message = path//": not a femcod checkpoint (truncated or corrupted; delete it: femcod replaces "// &
+            "only files it can read as its own)"
          return
       end if
       if (tag /= FORMAT_TAG) then
@@ -189,54 +181,22 @@ contains
          call refuse("the upper surface's heights differ from the deck's")
          return
       end if
-      ! The options that shape the history.
-      call h5_read(file, "/options/max_contacts", i, status, bad)
-      if (status%code == 0 .and. i /= options%max_contacts) then
-         call refuse("--max-contacts "//int_str(i)//" there, "//int_str(options%max_contacts)//" here")
-         return
-      end if
-      call h5_read(file, "/options/loads", r1, status, bad)
-      if (status%code == 0 .and. .not. same(r1, options%loads)) then
-         call refuse("written with other --loads")
-         return
-      end if
-      call h5_read(file, "/options/tie_tolerance", r, status, bad)
-      if (status%code == 0 .and. r /= options%tie_tolerance) then
-         call refuse("written with another tie tolerance")
-         return
-      end if
-      call h5_read(file, "/options/hardness", r, status, bad)
-      if (status%code == 0 .and. r /= options%hardness) then
-         call refuse("written with --hardness "//format_real(r))
-         return
-      end if
-      call h5_read(file, "/options/final_check", final_check, status, bad)
-      if (status%code == 0 .and. (final_check == 1 .neqv. options%final_check)) then
-         call refuse("written with another --no-final-check setting")
-         return
-      end if
-      call h5_read(file, "/options/event_search", i, status, bad)
-      if (status%code == 0 .and. i /= merge(1, 0, options%event_search == "fft") + &
-         2*merge(1, 0, options%event_search == "bound")) then
-         call refuse("written with another --event-search")
-         return
-      end if
-      ! Checkpoints older than --boundary have no entry: they are of the free boundary.
-      i = 0
-      if (status%code == 0 .and. h5_exists(file, "/options/periodic")) call h5_read(file, "/options/periodic", i, &
-         status, bad)
-      if (status%code == 0 .and. (i == 1 .neqv. options%boundary == "periodic")) then
-         call refuse("written with another --boundary")
-         return
-      end if
-      ! Displacement control: the same approaches (none stored: load control).
-      if (allocated(r1)) deallocate(r1)
-      allocate(r1(0))
-      if (status%code == 0 .and. h5_exists(file, "/options/approaches")) call h5_read(file, "/options/approaches", &
-         r1, status, bad)
-      if (status%code == 0 .and. .not. same(r1, given_approaches(options))) then
-         call refuse("written with other --approach")
-         return
+      ! The options that shape the history, compared whole (history_options).
+      if (status%code == 0) then
+         if (.not. h5_exists(file, "/options")) then
+            call refuse("written by an earlier femcod that did not store its whole option set")
+            return
+         end if
+         call h5_read_string_attribute(file, "/options", "history", 65536, stored, status, bad)
+         if (status%code /= 0) then
+            status = status_type()
+            call refuse("written by an earlier femcod that did not store its whole option set")
+            return
+         end if
+         if (stored /= history_options(options)) then
+            call refuse("written with other options: "//first_difference(stored, history_options(options)))
+            return
+         end if
       end if
       if (status%code /= 0) then
          call h5_close(file, status)
@@ -256,7 +216,7 @@ contains
          type(status_type) :: ignore
          call h5_close(reader%file, ignore)
          call set_error(status, bad, path//": checkpoint refused: "//why// &
-            " (delete it, or run without --restart)")
+            " (start afresh with --force, which replaces it)")
       end subroutine refuse
       pure logical function same(a, b)
          real(dp), intent(in) :: a(:), b(:)
@@ -503,11 +463,4 @@ contains
       fits = .true.
    end function fits
 
-   !> The requested approaches, none when not given.
-   pure function given_approaches(options) result(values)
-      type(contact_options), intent(in) :: options
-      real(dp), allocatable :: values(:)
-      allocate(values(0))
-      if (allocated(options%approaches)) values = options%approaches
-   end function given_approaches
 end module femcod_checkpoint

@@ -5,10 +5,11 @@
 module femcod_solver_options
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE
+   use femcod_strings, only: format_real, int_str
    implicit none
    private
    public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, LAW_NAMES, requested_states
-   public :: validate_options, by_gap_variables
+   public :: validate_options, by_gap_variables, history_options, first_difference
 
    !> The solvers by name: the event-exact incremental solver, the Appendix B program,
    !> and the fixed-load constrained conjugate gradients.
@@ -199,4 +200,59 @@ contains
          call set_error(status, STATUS_USAGE, message)
       end subroutine refuse
    end subroutine validate_options
+   !> The options that shape a run's answer, as "name=value" fields joined by "; ", in
+   !> one fixed order: what a checkpoint stores and --restart compares whole, and what
+   !> the run's fingerprint digests (a finished run's --restart). An option that changes
+   !> the answer is one field here; progress, checkpoint and speed settings are not.
+   function history_options(options) result(text)
+      type(contact_options), intent(in) :: options
+      character(len=:), allocatable :: text
+      text = "solver="//trim(options%solver)//"; boundary="//trim(options%boundary)// &
+         "; loads="//reals(options%loads)//"; approaches="//reals(options%approaches)// &
+         "; max_contacts="//int_str(options%max_contacts)//"; plastic="//merge("T", "F", options%plastic)// &
+         "; hardness="//format_real(options%hardness)//"; adhesion="//trim(options%adhesion)// &
+         "; work="//format_real(options%work)//"; range="//format_real(options%range)// &
+         "; tie_tolerance="//format_real(options%tie_tolerance)//"; final_check="// &
+         merge("T", "F", options%final_check)//"; event_search="//trim(options%event_search)// &
+         "; tol="//format_real(options%cg%tol)//"; max_iterations="//int_str(options%cg%max_iterations)// &
+         "; kernel_radius="//format_real(options%cg%kernel_radius)
+   contains
+      function reals(v) result(t)
+         real(dp), allocatable, intent(in) :: v(:)
+         character(len=:), allocatable :: t
+         integer :: m
+         t = ""
+         if (.not. allocated(v)) return
+         do m = 1, size(v)
+            if (m > 1) t = t//","
+            t = t//format_real(v(m))
+         end do
+      end function reals
+   end function history_options
+
+   !> The first field in which two history_options texts differ, as "name=A there,
+   !> name=B here" ("" when they are equal).
+   function first_difference(there, here) result(text)
+      character(len=*), intent(in) :: there, here
+      character(len=:), allocatable :: text
+      integer :: a, b, ea, eb
+      text = ""
+      if (there == here) return
+      a = 1
+      b = 1
+      do
+         ea = index(there(a:), "; ")
+         eb = index(here(b:), "; ")
+         if (ea == 0) ea = len(there) - a + 2
+         if (eb == 0) eb = len(here) - b + 2
+         if (there(a:a + ea - 2) /= here(b:b + eb - 2)) then
+            text = there(a:a + ea - 2)//" there, "//here(b:b + eb - 2)//" here"
+            return
+         end if
+         a = a + ea + 1
+         b = b + eb + 1
+         if (a > len(there) .or. b > len(here)) exit
+      end do
+      text = "the option sets differ in length"
+   end function first_difference
 end module femcod_solver_options
