@@ -196,6 +196,8 @@ contains
             if (status%code /= 0) return
             call append_string(lines, describe(spec%second_file, other))
             warned = [warned, other%warnings]
+            call same_grid(spec%matrix_file, first, spec%second_file, other, status)
+            if (status%code /= 0) return
             call move_alloc(other%z, second)
          end if
       end if
@@ -232,6 +234,24 @@ contains
       if (map%scan_x > 0) text = text//", scan "//format_real(map%scan_x)//" x "//format_real(map%scan_y)//" nm"
       if (map%pixel_x > 0) text = text//", pixel "//format_real(map%pixel_x)//" nm"
    end function describe
+
+   !> Two surfaces pressed together share one grid: the same number of heights and, where
+   !> both files give it, the same pixel. femcod does not resample: two different grids
+   !> are refused, naming both (exit 3).
+   subroutine same_grid(path1, map1, path2, map2, status)
+      character(len=*), intent(in) :: path1, path2
+      type(height_map), intent(in) :: map1, map2
+      type(status_type), intent(inout) :: status
+      if (any(shape(map1%z) /= shape(map2%z))) then
+         call set_error(status, STATUS_BAD_INPUT, path1//" has "//int_str(size(map1%z, 1))//" x "// &
+            int_str(size(map1%z, 2))//" heights, "//path2//" has "//int_str(size(map2%z, 1))//" x "// &
+            int_str(size(map2%z, 2))//": the two surfaces must share one grid (femcod does not resample)")
+      else if (map1%pixel_x > 0 .and. map2%pixel_x > 0) then
+         if (abs(map1%pixel_x/map2%pixel_x - 1) > 1.0e-6_dp) call set_error(status, STATUS_BAD_INPUT, path1// &
+            " has pixels of "//format_real(map1%pixel_x)//" nm, "//path2//" of "//format_real(map2%pixel_x)// &
+            " nm: the two surfaces must share one pixel (femcod does not resample; bring them to one grid first)")
+      end if
+   end subroutine same_grid
 
    !> femcod's grids are square with square pixels.
    subroutine square_grid(path, map, status)
