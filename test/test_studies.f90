@@ -3,7 +3,7 @@
 module test_studies
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: read_deck
+   use femcod_deck, only: read_deck, write_deck
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
@@ -51,7 +51,10 @@ contains
          new_unittest("Appendix A: n asperities against one (eq. A.1)", test_appendix_a), &
          new_unittest("multiscale: area independent of s when one asperity per host", test_scale_independence), &
          new_unittest("multiscale: close-packed spots fit on their hosts", test_close_packed), &
-         new_unittest("femcod summits and multiscale write their files", test_surface_commands) &
+         new_unittest("femcod summits and multiscale write their files", test_surface_commands), &
+         new_unittest("multiscale takes E* from the deck's materials, --estar from a height file's user", &
+            test_multiscale_estar), &
+         new_unittest("summits: a fit range with fewer than two points determines no dimension", test_empty_fit) &
          ]
    end subroutine collect_studies
 
@@ -636,4 +639,89 @@ contains
       if (allocated(error)) return
       call check(error, .not. file_exists(prefix//"_bad.summits.csv"), "no file on failure")
    end subroutine test_surface_commands
+   !> `femcod multiscale` used the --estar default (200 GPa) whatever the deck said (issue
+   !> 35). Now a deck's E* is the Hertz composite 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
+   !> (Johnson, Contact Mechanics, eq. 4.22), computed here from the deck's numbers: the
+   !> deck's areas equal those of its heights given as a file with --estar set to that
+   !> value, bit for bit, and a deck with E1 = 70 instead of 200 GPa gives other areas.
+   subroutine test_multiscale_estar(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: st
+      character(len=:), allocatable :: dir, heights
+      character(len=32) :: estar_text
+      character(len=25) :: buf
+      real(dp) :: estar
+      integer :: code, i, j
+      dir = scratch_path("multiscale_estar")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call read_deck("input/rough_selfaffine_32.deck", deck, st)
+      call check(error, all(deck%upper == 0), "the deck's upper surface is flat (its heights are the lower's)")
+      if (allocated(error)) return
+      heights = ""
+      do i = 1, deck%np
+         do j = 1, deck%np
+            write(buf, '(es25.17)') deck%lower(i, j)
+            heights = heights//buf
+         end do
+         heights = heights//new_line("a")
+      end do
+      open(newunit=i, file=dir//"/lower.txt", status="replace", action="write")
+      write(i, '(a)', advance="no") heights
+      close(i)
+      estar = 1/((1 - deck%poisson(1)**2)/deck%young(1) + (1 - deck%poisson(2)**2)/deck%young(2))
+      write(estar_text, '(es25.17)') estar
+      call run_femcod([string_type("multiscale"), string_type("input/rough_selfaffine_32.deck"), &
+         string_type("--sizes"), string_type("1,2,3"), string_type("-o"), string_type(dir//"/deck"), &
+         string_type("--quiet")], code)
+      call check(error, code, 0, "the deck")
+      if (allocated(error)) return
+      call run_femcod([string_type("multiscale"), string_type(dir//"/lower.txt"), string_type("--pixel"), &
+         string_type("10"), string_type("--estar"), string_type(trim(adjustl(estar_text))), string_type("--sizes"), &
+         string_type("1,2,3"), string_type("-o"), string_type(dir//"/file"), string_type("--quiet")], code)
+      call check(error, code, 0, "the height file with --estar "//trim(adjustl(estar_text)))
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/deck.multiscale.csv") == read_text(dir//"/file.multiscale.csv"), &
+         "the deck's E* is "//trim(adjustl(estar_text))//" GPa: the same areas")
+      if (allocated(error)) return
+      deck%young(1) = 70
+      call write_deck(dir//"/soft.deck", deck, st)
+      call run_femcod([string_type("multiscale"), string_type(dir//"/soft.deck"), string_type("--sizes"), &
+         string_type("1,2,3"), string_type("-o"), string_type(dir//"/soft"), string_type("--quiet")], code)
+      call check(error, code, 0, "the soft deck")
+      if (allocated(error)) return
+      call check(error, read_text(dir//"/soft.multiscale.csv") /= read_text(dir//"/deck.multiscale.csv"), &
+         "E1 = 70 GPa gives other areas than 200 GPa")
+   end subroutine test_multiscale_estar
+   !> On a 16 x 16 grid the PSD's fit range 4/L to 1/(4d) holds one frequency (4/L = 1/(4d))
+   !> and the structure function's d to L/16 one lag, so no slope exists; femcod summits
+   !> reported a profile dimension of 2.5 there (issue 35). Now the dimension fields are
+   !> empty; on 64 x 64 (4/L to 1/(4d): frequencies 4..16 over L; lags 1..4 pixels) both
+   !> are numbers.
+   subroutine test_empty_fit(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, text
+      integer :: code
+      dir = scratch_path("empty_fit")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call run_femcod([string_type("mkdeck"), string_type("self-affine"), string_type("--np"), string_type("16"), &
+         string_type("--pixel"), string_type("1"), string_type("-o"), string_type(dir//"/a.deck")], code)
+      call run_femcod([string_type("summits"), string_type(dir//"/a.deck"), string_type("-o"), string_type(dir//"/a"), &
+         string_type("--quiet")], code)
+      call check(error, code, 0, "summits on 16 x 16")
+      if (allocated(error)) return
+      text = read_text(dir//"/a.fractal.csv")
+      call check(error, contains_text(text, "psd,,,") .and. contains_text(text, "structure,,,"), &
+         "no dimension on 16 x 16: "//text)
+      if (allocated(error)) return
+      call run_femcod([string_type("mkdeck"), string_type("self-affine"), string_type("--np"), string_type("64"), &
+         string_type("--pixel"), string_type("1"), string_type("-o"), string_type(dir//"/b.deck")], code)
+      call run_femcod([string_type("summits"), string_type(dir//"/b.deck"), string_type("-o"), string_type(dir//"/b"), &
+         string_type("--quiet")], code)
+      call check(error, code, 0, "summits on 64 x 64")
+      if (allocated(error)) return
+      text = read_text(dir//"/b.fractal.csv")
+      call check(error, .not. (contains_text(text, "psd,,") .or. contains_text(text, "structure,,")), &
+         "dimensions on 64 x 64: "//text)
+   end subroutine test_empty_fit
 end module test_studies

@@ -448,7 +448,7 @@ contains
 
    !> Heights for the surface studies: a height file (with --pixel) or a deck, whose
    !> composite roughness (lower surface plus the upper as it faces it) is analysed.
-   subroutine study_heights(input, pixel, plane, z, d, status, height_unit)
+   subroutine study_heights(input, pixel, plane, z, d, status, height_unit, estar)
       character(len=*), intent(in) :: input
       real(dp), intent(in) :: pixel
       logical, intent(in) :: plane
@@ -456,9 +456,13 @@ contains
       real(dp), intent(out) :: d
       type(status_type), intent(inout) :: status
       character(len=*), intent(in) :: height_unit
+      !> A deck's composite (Hertz) modulus E* (GPa), 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2;
+      !> 0 for a height file, which gives no material.
+      real(dp), intent(out), optional :: estar
       type(contact_problem) :: deck
       type(height_map) :: map
       integer :: k
+      if (present(estar)) estar = 0
       if (pixel > 0 .or. is_height_file(input)) then
          call read_height_map(input, map, status, height_unit)
          if (status%code /= 0) return
@@ -477,6 +481,7 @@ contains
          if (status%code /= 0) return
          z = deck%lower + flip_upper(deck%upper)
          d = deck%pixel
+         if (present(estar)) estar = 1/((1 - deck%poisson(1)**2)/deck%young(1) + (1 - deck%poisson(2)**2)/deck%young(2))
       end if
       if (status%code /= 0) return
       if (size(z, 1) /= size(z, 2)) then
@@ -540,7 +545,8 @@ contains
             "the elastic solution)", lower=0.0_dp, closed="()"), &
          integer_option("--scales", "K", "the number of scales instead of --min-length", lower=1, upper=60), &
          real_option("--load", "F", "total load in nN (default 1e6, 1 mN)", lower=0.0_dp, closed="()"), &
-         real_option("--estar", "E", "composite modulus in GPa (default 200)", lower=0.0_dp, closed="()"), &
+         real_option("--estar", "E", "composite modulus in GPa for a height file (default 200); a deck gives "// &
+            "its own: 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2", lower=0.0_dp, closed="()"), &
          real_list_option("--exponents", "eh,eR,eN", "override the power laws of the summit search", length=3)]
    end function surface_table
 
@@ -602,7 +608,7 @@ contains
       type(svg_series), allocatable :: series(:)
       character(len=14), parameter :: quantity(3) = [character(len=14) :: "density", "mean_height", "mean_radius"]
       real(dp) :: d, side, dpsd, slope, dsf, g
-      integer :: k, q
+      integer :: k, q, npsd, nsf
       call parse_surface_options("summits", args, opts, parsed, code)
       if (code == -1) then
          code = 0
@@ -630,9 +636,15 @@ contains
       end if
       side = size(z, 1)*d
       call profile_psd(z, d, freq, power)
-      call psd_dimension(freq, power, 4/side, 1/(4*d), dpsd, slope)
+      call psd_dimension(freq, power, 4/side, 1/(4*d), dpsd, slope, npsd)
       call structure_function(z, d, max(1, size(z, 1)/4), tau, sf)
-      call structure_dimension(tau, sf, d, side/16, dsf, g)
+      call structure_dimension(tau, sf, d, side/16, dsf, g, nsf)
+      ! A fit range with fewer than two points (grids below 32 pixels) determines nothing:
+      ! its CSV fields stay empty and the summary says so.
+      if (npsd < 2) write(error_unit, '(a)') "femcod summits: warning: the PSD's fit range 4/L to 1/(4d) holds "// &
+         int_str(npsd)//" frequencies on "//int_str(size(z, 1))//" pixels: its dimension is not determined"
+      if (nsf < 2) write(error_unit, '(a)') "femcod summits: warning: the structure function's fit range d to L/16 "// &
+         "holds "//int_str(nsf)//" lags on "//int_str(size(z, 1))//" pixels: its dimension is not determined"
       call add_line(b(1), "box_nm,n,density_per_um2,mean_height_nm,mean_radius_nm")
       do k = 1, size(stats)
          call add_line(b(1), format_real(stats(k)%box)//","//int_str(stats(k)%n)//","//format_real(stats(k)%density)// &
@@ -653,9 +665,9 @@ contains
          call add_line(b(4), format_real(tau(k))//","//format_real(sf(k)))
       end do
       call add_line(b(5), "method,profile_dimension,surface_dimension,fit_from,fit_to")
-      call add_line(b(5), "psd,"//format_real(dpsd)//","//format_real(dpsd + 1)//","//format_real(4/side)//","// &
+      call add_line(b(5), "psd,"//fitted(dpsd, npsd)//","//fitted(dpsd + 1, npsd)//","//format_real(4/side)//","// &
          format_real(1/(4*d)))
-      call add_line(b(5), "structure,"//format_real(dsf)//","//format_real(dsf + 1)//","//format_real(d)//","// &
+      call add_line(b(5), "structure,"//fitted(dsf, nsf)//","//fitted(dsf + 1, nsf)//","//format_real(d)//","// &
          format_real(side/16))
       allocate(texts(10))
       do k = 1, 5
@@ -672,12 +684,12 @@ contains
       if (allocated(series)) deallocate(series)
       allocate(series(0))
       call add_series(series, "profile PSD", freq, power, markers=.false.)
-      texts(9)%s = svg_multi_plot("power spectral density: D = "//sig_str(dpsd, 3)//" (eq. 3.1, slope "// &
-         sig_str(slope, 3)//")", "frequency (1/nm)", "power (nm^3)", series, .true., .true.)
+      texts(9)%s = svg_multi_plot("power spectral density: D = "//said(dpsd, npsd)//" (eq. 3.1, slope "// &
+         said(slope, npsd)//")", "frequency (1/nm)", "power (nm^3)", series, .true., .true.)
       if (allocated(series)) deallocate(series)
       allocate(series(0))
       call add_series(series, "structure function", tau, sf, markers=.false.)
-      texts(10)%s = svg_multi_plot("structure function: D = "//sig_str(dsf, 3)//" (eq. 2.15)", "tau (nm)", &
+      texts(10)%s = svg_multi_plot("structure function: D = "//said(dsf, nsf)//" (eq. 2.15)", "tau (nm)", &
          "S (nm^2)", series, .true., .true.)
       call write_file_set(names, texts, status)
       if (status%code /= 0) then
@@ -690,11 +702,28 @@ contains
             sig_str(stats(size(stats))%box, 4)//" nm"
          write(output_unit, '(a)') "  density ~ d^"//sig_str(e(1), 4)//", height ~ d^"//sig_str(e(2), 4)// &
             ", radius ~ d^"//sig_str(e(3), 4)
-         write(output_unit, '(a)') "  fractal dimension of a profile: "//sig_str(dpsd, 4)//" (PSD), "//sig_str(dsf, 4)// &
+         write(output_unit, '(a)') "  fractal dimension of a profile: "//said(dpsd, npsd)//" (PSD), "//said(dsf, nsf)// &
             " (structure function); surface: +1"
          write(output_unit, '(a)') "  wrote "//opts%prefix//".summits.csv, .summit_exponents.csv, .psd.csv, .structure.csv, "// &
             ".fractal.csv and 5 SVG figures"
       end if
+   contains
+      !> A fitted value for the CSV ("" when its range held fewer than two points).
+      function fitted(value, points) result(text)
+         real(dp), intent(in) :: value
+         integer, intent(in) :: points
+         character(len=:), allocatable :: text
+         text = ""
+         if (points >= 2) text = format_real(value)
+      end function fitted
+      !> A fitted value for the summary and figures ("not determined" likewise).
+      function said(value, points) result(text)
+         real(dp), intent(in) :: value
+         integer, intent(in) :: points
+         character(len=:), allocatable :: text
+         text = "not determined"
+         if (points >= 2) text = sig_str(value, 4)
+      end function said
    end subroutine summits_command
 
    subroutine fail_with(command, status, code)
@@ -739,7 +768,7 @@ contains
       real(dp), allocatable :: z(:, :), svals(:), heights(:), rx(:), ry(:), ex(:)
       integer, allocatable :: rows(:), cols(:)
       character(len=12), parameter :: constraints(2) = [character(len=12) :: "close-packed", "density"]
-      real(dp) :: d, load, estar, min_length, region, e3(3), p3(3)
+      real(dp) :: d, load, estar, deck_estar, min_length, region, e3(3), p3(3)
       integer :: k, scales, tsize, ks, kc, m, best
       logical :: ok
       call parse_surface_options("multiscale", args, opts, parsed, code)
@@ -764,9 +793,19 @@ contains
       call get_option(parsed, "--scales", scales)
       call get_option(parsed, "--template-size", tsize)
       names = [string_type(opts%prefix//".multiscale.csv"), string_type(opts%prefix//".multiscale.svg")]
+      ! A deck gives its materials: E* is the deck's, and --estar next to it would be a
+      ! second answer to one question.
+      if (option_given(parsed, "--estar") .and. .not. (opts%pixel > 0 .or. is_height_file(opts%input))) then
+         call set_error(status, STATUS_USAGE, "--estar: "//opts%input//" is a deck and gives its own materials "// &
+            "(E* from E1, nu1, E2, nu2); give --estar only with a height file")
+         call fail_with("multiscale", status, code)
+         return
+      end if
       ! The outputs are checked before the input is read: an input is never an output.
       call check_outputs(names, opts%input, opts%force, status)
-      if (status%code == 0) call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
+      if (status%code == 0) call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit, &
+         deck_estar)
+      if (deck_estar > 0) estar = deck_estar
       if (status%code /= 0) then
          call fail_with("multiscale", status, code)
          return
@@ -828,7 +867,8 @@ contains
          write(output_unit, '(a)') "femcod multiscale: template of "//int_str(size(template%heights))//" summits (n = "// &
             int_str(tsize)//", box "//sig_str(template%box, 4)//" nm, density "//sig_str(template%density*1.0e6_dp, 4)// &
             " per um^2); heights ~ d^"//sig_str(ex(1), 3)//", radii ~ d^"//sig_str(ex(2), 3)//", density ~ d^"// &
-            sig_str(ex(3), 3)
+            sig_str(ex(3), 3)//"; E* = "//sig_str(estar, 4)//" GPa ("// &
+            trim(merge("the deck's materials  ", "--estar or its default", deck_estar > 0))//")"
          write(output_unit, '(a)') "  wrote "//opts%prefix//".multiscale.csv and .multiscale.svg"
       end if
    end subroutine multiscale_command

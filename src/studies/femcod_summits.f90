@@ -313,12 +313,19 @@ contains
 
    !> Profile fractal dimension from the PSD slope over [fmin, fmax] (eq. 3.1:
    !> P ~ w^-(5 - 2D), so D = (5 + slope)/2; the surface's is Ds = D + 1).
-   pure subroutine psd_dimension(frequency, power, fmin, fmax, dimension, slope)
+   pure subroutine psd_dimension(frequency, power, fmin, fmax, dimension, slope, points)
       real(dp), intent(in) :: frequency(:), power(:), fmin, fmax
       real(dp), intent(out) :: dimension, slope
+      !> The frequencies in [fmin, fmax]: below 2 the dimension is not determined (0 and
+      !> slope 0 are returned; the grid is too small for the range).
+      integer, intent(out), optional :: points
       real(dp) :: pre
       logical :: keep(size(frequency))
       keep = frequency >= fmin .and. frequency <= fmax
+      if (present(points)) points = count(keep)
+      dimension = 0
+      slope = 0
+      if (count(keep) < 2) return
       call power_law_fit(pack(frequency, keep), pack(power, keep), slope, pre)
       dimension = (5 + slope)/2
    end subroutine psd_dimension
@@ -326,12 +333,18 @@ contains
    !> Profile fractal dimension and roughness G from the structure function over
    !> [tmin, tmax] (eq. 2.15: S = G^(2(D-1)) tau^(2(2-D)), so D = 2 - slope/2 and
    !> G = prefactor^(1/(2(D-1))), nm).
-   pure subroutine structure_dimension(tau, s, tmin, tmax, dimension, g)
+   pure subroutine structure_dimension(tau, s, tmin, tmax, dimension, g, points)
       real(dp), intent(in) :: tau(:), s(:), tmin, tmax
       real(dp), intent(out) :: dimension, g
+      !> The lags in [tmin, tmax]: below 2 the dimension is not determined (0 returned).
+      integer, intent(out), optional :: points
       real(dp) :: slope, pre
       logical :: keep(size(tau))
       keep = tau >= tmin .and. tau <= tmax
+      if (present(points)) points = count(keep)
+      dimension = 0
+      g = 0
+      if (count(keep) < 2) return
       call power_law_fit(pack(tau, keep), pack(s, keep), slope, pre)
       dimension = 2 - slope/2
       g = 0
