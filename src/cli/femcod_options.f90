@@ -11,6 +11,7 @@
 module femcod_options
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use femcod_kinds, only: dp
+   use femcod_problem, only: MIN_PIXEL, MAX_PIXEL
    use femcod_status, only: status_type, set_error, STATUS_USAGE
    use femcod_strings, only: string_type, int_str, format_real, parse_real, parse_integer, parse_real_list, &
       parse_integer_list, split_list
@@ -135,8 +136,8 @@ contains
       character(len=*), intent(in) :: mode
       type(option_spec), allocatable :: specs(:)
       specs = [ &
-         real_option("--pixel", "D", "pixel size in nm (height files that give theirs need none)", lower=0.0_dp, &
-            upper=1.0e6_dp, closed="(]", mode=mode), &
+         real_option("--pixel", "D", "pixel size in nm (height files that give theirs need none)", lower=MIN_PIXEL, &
+            upper=MAX_PIXEL, closed="[]", mode=mode), &
          real_option("--young", "E", "Young's modulus of the elastic body in GPa (default 200)", lower=0.0_dp, &
             closed="()", mode=mode), &
          real_option("--poisson", "NU", "Poisson's ratio of the elastic body (default 0.25)", lower=-1.0_dp, &
@@ -207,6 +208,14 @@ contains
             k = find(table, key)
             if (k == 0) then
                call set_error(status, STATUS_USAGE, "unknown option "//key)
+               return
+            end if
+            ! An option given twice is refused: keeping the last silently would ignore one
+            ! (FEMCOD_ARGS in the cluster scripts makes repeats likely).
+            if (parsed%given(k)) then
+               call set_error(status, STATUS_USAGE, "option "//key//" is given twice ("//table(k)%name// &
+                  trim(merge(" or "//table(k)%alias, repeat(" ", 4 + len(table(k)%alias)), len(table(k)%alias) > 0))// &
+                  "); give it once")
                return
             end if
             parsed%given(k) = .true.

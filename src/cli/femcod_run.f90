@@ -20,7 +20,7 @@ module femcod_run
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec
-   use femcod_heights, only: load_scene, height_file_path
+   use femcod_heights, only: load_scene, height_file_path, is_height_file
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options
    use femcod_observer, only: solver_observer
@@ -117,7 +117,8 @@ contains
             "(default 300; 0: after every step); removed at the end", lower=0.0_dp, mode="incremental"), &
          flag_option("--restart", "continue from PREFIX.ckpt.h5 if it exists (refused if it belongs to another deck "// &
             "or other options); the run ends exactly as an uninterrupted one. Complete results of the same inputs "// &
-            "and options: nothing to do; of others: refused", mode="incremental"), &
+            "and options: nothing to do; of others: refused. With a solver that keeps no checkpoint (cg, legacy) "// &
+            "the run starts afresh, so a resubmitted job array runs with every solver"), &
          real_option("--tol", "T", "stop when the gap violations over the height range are below T (default 1e-8; "// &
             "with --adhesion the force-balance violations times a pixel's compliance)", &
             lower=0.0_dp, closed="()", mode="cg"), &
@@ -244,6 +245,15 @@ contains
          "incremental=to the incremental solver only|cg=to --solver cg only", status)
       if (status%code /= 0) return
       settings%decks = parsed%positional
+      ! A scan given where a deck belongs (femcod run scan.spm): say how to run it.
+      do d = 1, size(settings%decks)
+         if (is_height_file(settings%decks(d)%s)) then
+            call set_error(status, STATUS_USAGE, settings%decks(d)%s//" is a height file (an instrument or HDF5 "// &
+               "scan), not a deck: run it with --lower "//settings%decks(d)%s//" (and --pixel D if it does not "// &
+               "give its pixel size)")
+            return
+         end if
+      end do
       if (settings%from_files) then
          if (size(settings%decks) > 0) then
             call set_error(status, STATUS_USAGE, "give either DECK files or --lower/--upper height files, not both")
@@ -273,7 +283,11 @@ contains
                spec%shape_on = "upper"
             end if
             if (spec%label == "") spec%label = "femcod run"//scene_arguments(args)
-            if (settings%prefix == "") settings%prefix = default_prefix(file_part(spec%matrix_file))
+            if (settings%prefix == "" .and. settings%outdir /= "") then
+               settings%prefix = settings%outdir//"/"//default_prefix(file_part(spec%matrix_file))
+            else if (settings%prefix == "") then
+               settings%prefix = default_prefix(file_part(spec%matrix_file))
+            end if
          end associate
          settings%decks = [string_type("")]
       end if
@@ -282,8 +296,6 @@ contains
       if (status%code /= 0) return
       if (size(settings%decks) == 0) then
          call set_error(status, STATUS_USAGE, "run needs a DECK")
-      else if (settings%restart .and. settings%solve%solver /= "incremental") then
-         call set_error(status, STATUS_USAGE, "--restart: checkpoints are written by the incremental solver only")
       else if (settings%solve%adhesion /= "none" .and. .not. (option_given(parsed, "--work") .and. &
          option_given(parsed, "--range"))) then
          call set_error(status, STATUS_USAGE, "--adhesion needs --work W (J/m^2) and --range R (nm)")
@@ -294,7 +306,7 @@ contains
       else if (size(settings%decks) > 1 .and. settings%prefix /= "" .and. .not. settings%from_files) then
          call set_error(status, STATUS_USAGE, "-o PREFIX names the outputs of one deck; with several decks each "// &
             "deck's outputs are named after it (--outdir DIR puts them in DIR)")
-      else if (settings%prefix /= "" .and. settings%outdir /= "") then
+      else if (option_given(parsed, "--output") .and. settings%outdir /= "") then
          call set_error(status, STATUS_USAGE, "give -o PREFIX or --outdir DIR, not both")
       else if (settings%prefix /= "") then
          if (settings%prefix(len(settings%prefix):) == "/" .or. path_is_directory(settings%prefix)) &
@@ -803,7 +815,12 @@ contains
       type(report_line), allocatable :: lines(:)
       integer :: k, last
       last = res%nsteps
-      write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//trim(options%solver)//")"
+      if (deck_path /= "") then
+         write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//trim(options%solver)//")"
+      else
+         ! Height files: the scene's label names them (femcod run --lower FILE ...).
+         write(output_unit, '(a)') problem%label//" (solver "//trim(options%solver)//")"
+      end if
       write(output_unit, '(a)') "  scene     : "//problem%label
       write(output_unit, '(a)') "              NP = "//int_str(problem%np)//", d = "//format_real(problem%pixel)// &
          " nm, E = "//sig_str(problem%young(1), 4)//" / "//sig_str(problem%young(2), 4)//" / "// &

@@ -217,6 +217,12 @@ contains
       end if
       if (used%pixel < 1.0e-3_dp) call append_string(warned, "a pixel of "//format_real(used%pixel)// &
          " nm: if that is metres, give the size in nm")
+      ! --maxcont is the user's: name it when the scan is too small for it.
+      if (used%maxcont > size(first%z, 1)**2) then
+         call set_error(status, STATUS_USAGE, "--maxcont "//int_str(used%maxcont)//" is above the "// &
+            int_str(size(first%z, 1)**2)//" pixels of "//spec%matrix_file//" (NP^2, the most contacts there are)")
+         return
+      end if
       call build_problem(used, problem, status, first%z, second)
       if (present(notes)) notes = lines
       if (present(warnings)) warnings = warned

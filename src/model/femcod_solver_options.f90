@@ -5,11 +5,11 @@
 module femcod_solver_options
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE
-   use femcod_strings, only: format_real, int_str
+   use femcod_strings, only: format_real, int_str, sig_str
    implicit none
    private
    public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, LAW_NAMES, requested_states
-   public :: validate_options, by_gap_variables, history_options, first_difference
+   public :: validate_options, by_gap_variables, history_options, first_difference, tolerance_floor
 
    !> The solvers by name: the event-exact incremental solver, the Appendix B program,
    !> and the fixed-load constrained conjugate gradients.
@@ -186,6 +186,11 @@ contains
             "is an instability)")
       else if (options%adhesion /= "none" .and. .not. (options%work >= 0 .and. options%range > 0)) then
          call refuse("--adhesion needs --work W >= 0 (J/m^2) and --range R > 0 (nm)")
+      else if (options%solver == "cg" .and. options%cg%tol < tolerance_floor()) then
+         call refuse("--tol "//sig_str(options%cg%tol, 3)//" is below what double precision resolves: the "// &
+            "gaps are sums of terms as large as the height range, each rounded to 1.1e-16 of it, so a relative "// &
+            "violation below 10 machine epsilons ("//sig_str(tolerance_floor(), 2)//") cannot be shown; give "// &
+            "--tol "//sig_str(tolerance_floor(), 2)//" or more")
       else if (by_gap_variables(options) .and. options%cg%kernel_radius > 0) then
          call refuse(trim(merge("--adhesion", "--plastic ", options%adhesion /= "none"))//" --approach with "// &
             "--kernel-radius: displacement control in the gap variables uses the whole Love kernel")
@@ -255,4 +260,10 @@ contains
       end do
       text = "the option sets differ in length"
    end function first_difference
+   !> The smallest --tol the cg solvers accept: 10 machine epsilons of double precision
+   !> (2.2e-16 each). Their residual is a gap violation over the height range; a gap is
+   !> g0 - A + u, terms as large as the range, each rounded to half an epsilon of it.
+   pure real(dp) function tolerance_floor()
+      tolerance_floor = 10*epsilon(1.0_dp)
+   end function tolerance_floor
 end module femcod_solver_options
