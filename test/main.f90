@@ -24,6 +24,7 @@ program tester
    use test_heights, only: collect_heights
    use test_safety, only: collect_safety
    use test_architecture, only: collect_architecture
+   use test_matrix, only: collect_matrix
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
    use femcod_strings, only: string_type, parse_integer
@@ -52,7 +53,8 @@ program tester
       new_testsuite("options", collect_options), &
       new_testsuite("heights", collect_heights), &
       new_testsuite("safety", collect_safety), &
-      new_testsuite("architecture", collect_architecture) &
+      new_testsuite("architecture", collect_architecture), &
+      new_testsuite("matrix", collect_matrix) &
       ]
    stat = 0
    total = 0
