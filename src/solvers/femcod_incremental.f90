@@ -13,8 +13,8 @@
 !> fmax = H d^2 (it leaves the elastic set, keeping fmax: femcod_incremental_state's
 !> cap_contact) or where a capped pixel's gap opens again (it rejoins).
 module femcod_incremental
-   use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_INTERRUPTED
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type, set_error, STATUS_INTERRUPTED, STATUS_NUMERICAL
    use femcod_strings, only: int_str, sig_str
    use femcod_problem, only: contact_problem
    use femcod_lapack, only: dtrsv
@@ -25,7 +25,8 @@ module femcod_incremental
    use femcod_solver_options, only: contact_options
    use femcod_observer, only: solver_observer
    use femcod_event_path, only: first_touch_limit, NO_EVENT
-   use femcod_incremental_state, only: incremental_state, REFILL_EVERY
+   use femcod_incremental_state, only: incremental_state, REFILL_EVERY, factor_peak_bytes
+   use femcod_memory, only: physical_memory, memory_text
    use femcod_event_search, only: event_search
    use femcod_clock, only: wall_clock
    implicit none
@@ -52,11 +53,32 @@ contains
       if (present(resume)) then
          call event_loop(resume, problem, options, res, status, observer, tstart)
       else
+         call check_memory(status)
+         if (status%code /= 0) return
          call fresh%init(problem, options)
          call first_contacts(fresh, options, status, observer, tstart)
          if (status%code /= 0) return
          call event_loop(fresh, problem, options, res, status, observer, tstart)
       end if
+   contains
+      !> MAXCONT (or --max-contacts) bounds the run: a path may go there, with loads too
+      !> (a flat scene's first touch alone may bring every pixel), so a factor of that many
+      !> contacts that cannot fit is refused before the run starts rather than after hours
+      !> of steps (the factor's growth checks each doubling too: add_contact).
+      subroutine check_memory(st)
+         type(status_type), intent(inout) :: st
+         integer(i8) :: need, may
+         integer :: target
+         target = problem%maxcont
+         if (options%max_contacts > 0) target = min(options%max_contacts, problem%np**2)
+         need = factor_peak_bytes(target, problem%np**2)
+         may = physical_memory()
+         if (may > 0 .and. need > may) call set_error(st, STATUS_NUMERICAL, "incremental: "//int_str(target)// &
+            " contacts (MAXCONT or --max-contacts) need "//memory_text(need)//" for the factor of their "// &
+            "compliance (8 bytes x "//int_str(target)//"^2, and the one it grows from), this run may use "// &
+            memory_text(may)//"; lower MAXCONT or --max-contacts (the run still stops at its loads), or use "// &
+            "--solver cg")
+      end subroutine check_memory
    end subroutine solve_incremental
 
    !> Steps from `state` until the path stops, then the final check and the result.

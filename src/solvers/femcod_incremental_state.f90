@@ -37,7 +37,7 @@ module femcod_incremental_state
    use femcod_event_path, only: load_path
    implicit none
    private
-   public :: incremental_state, CACHE_SIZE, REFILL_EVERY
+   public :: incremental_state, CACHE_SIZE, REFILL_EVERY, factor_peak_bytes
 
    !> Candidates whose bordering columns l = U^-T m and w = M^-1 m are kept up to date
    !> (O(n) each per new contact), and how many contacts join between refills of the
@@ -111,6 +111,21 @@ contains
 
    !> The state at zero load, before the first contact: tables, storage, every pixel in
    !> the heap keyed by its exact gap.
+   !> The most memory the contact storage takes at `maxc` contacts (bytes): the factor U
+   !> (8 maxc^2, square storage) and, while the last doubling copies it, the factor it
+   !> grew from (8 (maxc/2)^2 at least); the candidate cache's two column blocks of up to
+   !> CACHE_SIZE columns (twice, during that copy); ten per-contact vectors. Pixel arrays
+   !> (the gaps, the heap, the FFT buffers: O(NP^2)) are small beside it at any MAXCONT
+   !> where this matters and are left out.
+   pure function factor_peak_bytes(maxc, npix) result(bytes)
+      integer, intent(in) :: maxc, npix
+      integer(i8) :: bytes, m, kc, old
+      m = maxc
+      kc = min(CACHE_SIZE, npix)
+      old = (m + 1)/2
+      bytes = 8*m**2 + 8*old**2 + 2*(2*8*m*kc) + 10*8*m
+   end function factor_peak_bytes
+
    subroutine init(self, problem, options)
       class(incremental_state), intent(out) :: self
       type(contact_problem), intent(in) :: problem
