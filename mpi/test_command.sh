@@ -71,4 +71,47 @@ else
   echo "  FAILED   doc/cluster/mpi.sbatch"; sed 's/^/           /' "$work/out.txt" | head -5; failed=1
 fi
 expect 5 "existing results without --force" mpirun_2 "$femcod_mpi" "$deck" --loads 50 -o "$work/mpi"
+# The combination matrix on 2 ranks (issue 34): boundary x plastic cap x interface law x
+# question (loads, increasing, decreasing approaches) x --restart on the 2 nm sphere. Each
+# combination answers (exit 0, as serial `femcod run --solver cg` does, to 1e-6) or is
+# refused (exit 2) with no output and no lock; none ends in a runtime error.
+matrix_deck=../input/sphere_d2.deck
+combos=0; answered=0; refused=0; matrix_failed=0
+for boundary in free periodic; do for plastic in "" "--plastic --hardness 11"; do
+for law in none dugdale exponential; do for question in "--loads 300,800" "--approach 0.5,1" "--approach 1,0.5"; do
+for restart in "" "--restart"; do
+  combos=$((combos + 1))
+  args="--boundary $boundary $plastic $question --tol 1e-10 --max-iterations 20000 $restart --quiet"
+  [ "$law" = none ] || args="$args --adhesion $law --work 0.05 --range 1"
+  m="$work/m$combos"
+  got=0; mpirun_2 "$femcod_mpi" "$matrix_deck" $args -o "$m" >"$m.out" 2>&1 || got=$?
+  if grep -q -e Backtrace -e "runtime error" -e "Error termination" "$m.out" || [ -e "$m.lock" ] || \
+     { [ "$got" -ne 0 ] && [ "$got" -ne 2 ]; }; then
+    echo "  FAILED   femcod-mpi $args: exit $got"; sed 's/^/           /' "$m.out" | head -3; matrix_failed=1; continue
+  fi
+  if [ "$got" -eq 2 ]; then
+    refused=$((refused + 1))
+    if ls "$m".* 2>/dev/null | grep -qv '\.out$'; then echo "  FAILED   femcod-mpi $args: refused, left files"; matrix_failed=1; fi
+    continue
+  fi
+  answered=$((answered + 1))
+  "$femcod" run "$matrix_deck" --solver cg $args -o "$m.serial" >/dev/null 2>&1 || \
+    { echo "  FAILED   femcod-mpi $args answered, serial femcod did not"; matrix_failed=1; continue; }
+  if ! python3 - "$m.serial.loads.csv" "$m.loads.csv" <<'PY'
+import csv, sys
+a = list(csv.DictReader(open(sys.argv[1])))
+b = list(csv.DictReader(open(sys.argv[2])))
+assert len(a) == len(b) == 2, (len(a), len(b))
+for x, y in zip(a, b):
+    for key in ("load_nN", "approach_nm"):
+        u, v = float(x[key]), float(y[key])
+        assert abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
+PY
+  then echo "  FAILED   femcod-mpi $args: not the serial answer"; matrix_failed=1; fi
+done; done; done; done; done
+if [ "$matrix_failed" -eq 0 ]; then
+  echo "  passed   the combination matrix on 2 ranks: $combos combinations, $refused refused, $answered answered as serial"
+else
+  failed=1
+fi
 exit $failed
