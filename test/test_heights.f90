@@ -9,6 +9,7 @@ module test_heights
    use femcod_heights, only: height_map, read_height_map, is_height_file
    use femcod_cli, only: run_femcod
    use test_support, only: scratch_path, write_text, read_text, file_exists, contains_text
+   use test_results, only: self_command
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string, skip_test
    implicit none
    private
@@ -27,7 +28,8 @@ contains
          new_unittest("NanoScope written here: scaling, rows bottom to top, channels, truncation", test_nanoscope_made), &
          new_unittest("Gwyddion exports, English and German: metres to nm, width and height", test_gwyddion), &
          new_unittest("run with a Gwyddion export: pixel from the width, units from the header", test_gwyddion_run), &
-         new_unittest("--height-unit for plain matrices; refused against a file's own unit", test_height_unit) &
+         new_unittest("--height-unit for plain matrices; refused against a file's own unit", test_height_unit), &
+         new_unittest("a tilt far above the roughness is reported; --remove-plane silences it", test_tilt_warning) &
          ]
    end subroutine collect_heights
 
@@ -238,4 +240,45 @@ contains
       if (allocated(error)) return
       call check(error, contains_text(map%warnings(1)%s, "--height-unit m"), map%warnings(1)%s)
    end subroutine test_height_unit
+   !> A 16 x 16 scan: a plane rising 0.5 nm per pixel (7.5 nm across) plus a checkerboard
+   !> of +-0.05 nm (rms 0.05 nm about the plane, by construction). The rise is 150 times
+   !> the roughness: femcod warns, with both figures; with --remove-plane it does not, and
+   !> a scan of the checkerboard alone (no tilt) gives no warning either (issue 35).
+   subroutine test_tilt_warning(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, tilted, flat, err
+      character(len=16) :: buf
+      integer :: i, j, code
+      dir = scratch_path("tilt")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      tilted = ""
+      flat = ""
+      do i = 1, 16
+         do j = 1, 16
+            write(buf, '(f10.4)') 0.5_dp*(j - 1) + 0.05_dp*(-1)**(i + j)
+            tilted = tilted//" "//trim(adjustl(buf))
+            write(buf, '(f10.4)') 0.05_dp*(-1)**(i + j)
+            flat = flat//" "//trim(adjustl(buf))
+         end do
+         tilted = tilted//new_line("a")
+         flat = flat//new_line("a")
+      end do
+      call write_text(dir//"/tilted.txt", tilted)
+      call write_text(dir//"/flat.txt", flat)
+      call execute_command_line(self_command()//" run --lower "//dir//"/tilted.txt --pixel 1 --loads 1 -q -o "// &
+         dir//"/a 2> "//dir//"/a.err", exitstat=code)
+      err = read_text(dir//"/a.err")
+      call check(error, code == 0 .and. contains_text(err, "plane rises 7.5 nm across the scan, 150 times the "// &
+         "roughness about it (0.05 nm rms)"), "the tilt is reported: "//err)
+      if (allocated(error)) return
+      call execute_command_line(self_command()//" run --lower "//dir//"/tilted.txt --pixel 1 --loads 1 -q "// &
+         "--remove-plane -o "//dir//"/b 2> "//dir//"/b.err", exitstat=code)
+      call check(error, code == 0 .and. .not. contains_text(read_text(dir//"/b.err"), "plane rises"), &
+         "--remove-plane: no warning: "//read_text(dir//"/b.err"))
+      if (allocated(error)) return
+      call execute_command_line(self_command()//" run --lower "//dir//"/flat.txt --pixel 1 --loads 1 -q -o "// &
+         dir//"/c 2> "//dir//"/c.err", exitstat=code)
+      call check(error, code == 0 .and. .not. contains_text(read_text(dir//"/c.err"), "plane rises"), &
+         "no tilt: no warning: "//read_text(dir//"/c.err"))
+   end subroutine test_tilt_warning
 end module test_heights

@@ -14,6 +14,7 @@ module femcod_cli
    use femcod_heights, only: load_scene, height_file_path
    use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
    use femcod_run, only: run_command
+   use femcod_process, only: SIGINT, SIGTERM, SIGUSR1
    use femcod_studies, only: resolution_command, summits_command, multiscale_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
@@ -97,7 +98,10 @@ contains
          "  bench [--full]            speed against error, one table (use the release build)", &
          "  --help, --version", &
          "", &
-         "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O"
+         "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure or not enough memory, 5 I/O,", &
+         "  128 + N after signal N: "//int_str(128 + SIGTERM)//" SIGTERM, "//int_str(128 + SIGINT)//" SIGINT, "// &
+         int_str(128 + SIGUSR1)//" SIGUSR1 (a checkpoint is kept where the", &
+         "  solver writes one; continue with --restart)"
    end subroutine print_help
 
    subroutine usage_error(message)

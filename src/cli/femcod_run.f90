@@ -31,7 +31,8 @@ module femcod_run
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_output_guard, only: guard_outputs, OUTPUT_WISDOM, OUTPUT_RESULT
-   use femcod_results, only: write_results, run_info, result_files, stored_fingerprint
+   use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, HISTORY_HEADER, LOADS_HEADER, &
+      CONTACTS_HEADER
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
@@ -69,6 +70,10 @@ module femcod_run
       !> for the incremental solver, n^4 for the legacy one).
       integer :: target_contacts = 0
       real(dp) :: target_load = 0, growth = 3
+      !> What a progress step is: "event" (the event solvers), "load" or "approach" (cg's
+      !> states, of `states` asked).
+      character(len=:), allocatable :: step_word
+      integer :: states = 0
       !> Where checkpoints go; whether a failure to write one was reported already, and
       !> whether one was stored.
       character(len=:), allocatable :: checkpoint_path
@@ -168,11 +173,13 @@ contains
          "file's name; the elastic body carries the heights, the other is rigid):"
       call print_lines(option_help(run_table(), "heights"))
       write(output_unit, '(a)') "", &
-         "outputs: PREFIX.history.csv (step,contacts,load_nN,approach_nm,area_nm2,area_fraction,", &
-         "         n_above_hardness),", &
-         "         PREFIX.contacts.csv (i,j,step,force_nN,pressure_GPa) at the largest requested load", &
-         "         or the last step, PREFIX.loads.csv (load_nN,approach_nm,contacts,area_nm2,area_fraction,", &
-         "         max_pressure_GPa,n_above_hardness), PREFIX.h5 (everything, with the pressure and gap", &
+         "outputs: PREFIX.history.csv, one row per step:", &
+         "           "//HISTORY_HEADER, &
+         "         PREFIX.contacts.csv, at the largest requested load or the last step:", &
+         "           "//CONTACTS_HEADER, &
+         "         PREFIX.loads.csv, one row per requested load or approach:", &
+         "           "//LOADS_HEADER, &
+         "         PREFIX.h5 (everything, with the pressure and gap", &
          "         maps at each requested load; doc/results.md), PREFIX.xdmf (the maps on a mesh for", &
          "         ParaView and meshio), PREFIX.summary.json (the summary as numbers with units),", &
          "         PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg.", &
@@ -294,6 +301,11 @@ contains
       ! Which options go together: one rule set for run, femcod-mpi and the benchmarks.
       call validate_options(settings%solve, status)
       if (status%code /= 0) return
+      if (settings%solve%solver == "cg" .and. option_given(parsed, "--maxcont")) then
+         call set_error(status, STATUS_USAGE, "--maxcont with --solver cg: cg solves at the loads or approaches "// &
+            "asked and has no contact limit (MAXCONT bounds the event solvers)")
+         return
+      end if
       if (size(settings%decks) == 0) then
          call set_error(status, STATUS_USAGE, "run needs a DECK")
       else if (settings%solve%adhesion /= "none" .and. .not. (option_given(parsed, "--work") .and. &
@@ -421,7 +433,8 @@ contains
          if (stop_signal() /= 0 .and. d < size(settings%decks)) then
             code = 128 + stop_signal()
             write(error_unit, '(a)') "femcod: "//signal_name(stop_signal())// &
-               ": the batch stops; "//int_str(size(settings%decks) - d)//" decks not run"
+               ": the batch stops; "//int_str(size(settings%decks) - d)// &
+               trim(merge(" deck not run ", " decks not run", size(settings%decks) - d == 1))
             exit
          end if
       end do
@@ -623,6 +636,11 @@ contains
          if (options%max_contacts > 0) observer%target_contacts = min(options%max_contacts, problem%np**2)
          if (size(options%loads) > 0) observer%target_load = maxval(options%loads)
          observer%growth = merge(4.0_dp, 3.0_dp, options%solver == "legacy")
+         observer%step_word = "event"
+         if (options%solver == "cg") then
+            observer%step_word = trim(merge("approach", "load    ", size(options%approaches) > 0))
+            observer%states = requested_states(options)
+         end if
          observer%checkpoint_path = prefix//".ckpt.h5"
          resuming = .false.
          if (settings%restart) then
@@ -895,8 +913,15 @@ contains
          left = elapsed*(fraction**(-self%growth) - 1)
          estimate = ", about "//sig_str(left, 2)//" s left (cost ~ contacts^"//int_str(nint(self%growth))//")"
       end if
-      write(error_unit, '(a)') "femcod: event "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
-         sig_str(load, 5)//" nN, "//sig_str(elapsed, 3)//" s elapsed"//estimate
+      if (.not. allocated(self%step_word)) self%step_word = "event"
+      if (self%step_word == "event") then
+         write(error_unit, '(a)') "femcod: event "//int_str(step)//", "//int_str(contacts)//" contacts, load "// &
+            sig_str(load, 5)//" nN, "//sig_str(elapsed, 3)//" s elapsed"//estimate
+      else
+         write(error_unit, '(a)') "femcod: "//self%step_word//" "//int_str(step)//" of "//int_str(self%states)// &
+            " solved, "//int_str(contacts)//" contacts, load "//sig_str(load, 5)//" nN, "//sig_str(elapsed, 3)// &
+            " s elapsed"
+      end if
       flush(error_unit)
    end subroutine report_progress
 

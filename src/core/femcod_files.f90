@@ -11,7 +11,7 @@ module femcod_files
    private
    public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, write_bytes, write_file
    public :: default_prefix, file_part, read_file, canonical_path, acquire_lock, release_lock, make_directories
-   public :: clear_write_error, write_error_cause, MAX_TEXT_BYTES
+   public :: clear_write_error, write_error_cause, os_error_text, MAX_TEXT_BYTES
 
    !> The largest file read_file takes (bytes): 2 GiB less 64 KiB, so that positions in
    !> the text, and positions a few words past them, stay default integers.
@@ -201,9 +201,10 @@ contains
          call set_error(status, STATUS_BAD_INPUT, path//": expected "//what//", found no such file")
          return
       end if
+      call clear_write_error()
       open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
       if (ios /= 0) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected "//what//", cannot open it")
+         call set_error(status, STATUS_BAD_INPUT, path//": expected "//what//", cannot open it ("//os_error_text()//")")
          return
       end if
       inquire(unit=unit, size=nbytes)
@@ -346,15 +347,39 @@ contains
       type(status_type), intent(inout) :: status
       integer :: k
       integer(c_int) :: rc
+      character(len=:), allocatable :: cause
       if (status%code /= 0 .or. path_is_directory(path)) return
+      cause = ""
       do k = 2, len(path) + 1
          if (k <= len(path)) then
             if (path(k:k) /= "/") cycle
          end if
-         if (.not. path_is_directory(path(1:k - 1))) rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'777', c_int))
+         if (.not. path_is_directory(path(1:k - 1))) then
+            rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'777', c_int))
+            ! The system's own reason, at the first part it could not make.
+            if (rc /= 0 .and. cause == "") cause = " ("//path(1:k - 1)//": "//os_error_text()//")"
+         end if
       end do
-      if (.not. path_is_directory(path)) call set_error(status, STATUS_IO, path//": cannot make the directory")
+      if (.not. path_is_directory(path)) call set_error(status, STATUS_IO, path//": cannot make the directory"//cause)
    end subroutine make_directories
+
+   !> The C library's text for its last error (strerror(errno)), "unknown cause" when
+   !> errno is 0.
+   function os_error_text() result(message)
+      character(len=:), allocatable :: message
+      integer(c_int), pointer :: errno
+      character(kind=c_char), pointer :: text(:)
+      integer :: k
+      call c_f_pointer(c_errno_location(), errno)
+      message = "unknown cause"
+      if (errno == 0) return
+      call c_f_pointer(c_strerror(errno), text, [256])
+      message = ""
+      do k = 1, size(text)
+         if (text(k) == c_null_char) exit
+         message = message//text(k)
+      end do
+   end function os_error_text
 
    !> Forget the C library's last error (errno = 0) before a write whose cause
    !> write_error_cause may have to tell.

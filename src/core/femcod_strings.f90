@@ -829,6 +829,12 @@ contains
          s = "0"
          return
       end if
+      if (.not. ieee_is_finite(v)) then
+         ! Infinity or NaN as the processor writes it, never a failed read below.
+         write(buf, '(g0)') v
+         s = trim(adjustl(buf))
+         return
+      end if
       write(buf, '(es40.'//int_str(digits - 1)//'e3)') v
       ! The exponent after rounding to `digits` (9.9996 becomes 1.000E+001).
       mark = index(buf, "E")

@@ -140,7 +140,8 @@ contains
          return
       end if
       ! The deck: everything must match exactly.
-      call h5_read_string_attribute(file, "/deck", "label", max(len(deck%label), 1) + 1, label, status, bad)
+      ! Read the stored label whole, whatever its length, so that a refusal quotes it.
+      call h5_read_string_attribute(file, "/deck", "label", max(len(deck%label) + 1, 65536), label, status, bad)
       call h5_read(file, "/deck/NP", i, status, bad)
       if (status%code /= 0) return
       if (i /= deck%np) then

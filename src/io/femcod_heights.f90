@@ -15,7 +15,8 @@ module femcod_heights
    use, intrinsic :: iso_fortran_env, only: int16, int32
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_USAGE
-   use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real, append_string
+   use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real, append_string, sig_str
+   use femcod_surfaces, only: plane_tilt
    use femcod_files, only: path_exists, path_is_directory, read_file
    use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close, h5_rank_and_dims
    use femcod_memory, only: physical_memory, memory_text
@@ -172,6 +173,9 @@ contains
       type(string_type), allocatable, intent(out), optional :: notes(:), warnings(:)
       type(height_map) :: first, other
       type(scene_spec) :: used
+      !> A plane rising more than this many times the rms roughness about it is reported.
+      real(dp), parameter :: TILT_RATIO = 10
+      real(dp) :: rise, roughness
       type(string_type), allocatable :: lines(:), warned(:)
       real(dp), allocatable :: second(:, :)
       allocate(lines(0), warned(0))
@@ -217,6 +221,18 @@ contains
       end if
       if (used%pixel < 1.0e-3_dp) call append_string(warned, "a pixel of "//format_real(used%pixel)// &
          " nm: if that is metres, give the size in nm")
+      ! A tilt far above the roughness is most often the scan's mounting: say so.
+      if (.not. spec%plane) then
+         call plane_tilt(first%z, rise, roughness)
+         if (rise > TILT_RATIO*roughness .and. roughness > 0) then
+            call append_string(warned, spec%matrix_file//": its least-squares plane rises "//sig_str(rise, 3)// &
+               " nm across the scan, "//sig_str(rise/roughness, 3)//" times the roughness about it ("// &
+               sig_str(roughness, 3)//" nm rms): give --remove-plane if the tilt is the mounting, not the surface")
+         else if (rise > 0 .and. roughness == 0) then
+            call append_string(warned, spec%matrix_file//": its heights are a tilted plane (rising "// &
+               sig_str(rise, 3)//" nm across the scan) with no roughness about it")
+         end if
+      end if
       ! --maxcont is the user's: name it when the scan is too small for it.
       if (used%maxcont > size(first%z, 1)**2) then
          call set_error(status, STATUS_USAGE, "--maxcont "//int_str(used%maxcont)//" is above the "// &
@@ -435,8 +451,7 @@ contains
          first = n
          call split_reals(line, values, n, status)
          if (status%code /= 0) then
-            status%message = path//":"//int_str(lineno)//": expected a row of finite numbers (nm), found '"// &
-               line(1:min(len(line), 40))//"'"
+            status%message = path//":"//int_str(lineno)//": "//status%message
             return
          end if
          if (nrow == 0) then
@@ -498,10 +513,11 @@ contains
          real(dp), allocatable, intent(inout) :: vals(:)
          integer, intent(inout) :: n
          type(status_type), intent(inout) :: st
-         integer :: i, start
+         integer :: i, start, column
          real(dp) :: v
          logical :: ok
          i = 1
+         column = 0
          do while (i <= len(row))
             if (is_sep(row(i:i))) then
                i = i + 1
@@ -512,9 +528,12 @@ contains
                if (is_sep(row(i:i))) exit
                i = i + 1
             end do
+            column = column + 1
             call parse_real(row(start:i - 1), v, ok)
             if (.not. ok) then
-               call set_error(st, STATUS_BAD_INPUT, "")
+               ! Name the value itself: the line's head need not hold it.
+               call set_error(st, STATUS_BAD_INPUT, "column "//int_str(column)//": expected a finite height "// &
+                  "(nm), found '"//row(start:min(i - 1, start + 39))//"'")
                return
             end if
             if (n == size(vals)) then

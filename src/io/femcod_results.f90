@@ -24,6 +24,14 @@ module femcod_results
    implicit none
    private
    public :: write_results, run_info, result_files, write_file_set, stored_fingerprint, load_group
+   public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER
+
+   !> The CSV files' header lines (the help prints them from here).
+   character(len=*), parameter :: HISTORY_HEADER = &
+      "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness,n_plastic"
+   character(len=*), parameter :: LOADS_HEADER = "load_nN,approach_nm,contacts,area_nm2,area_fraction,"// &
+      "max_pressure_GPa,n_above_hardness,n_plastic,plastic_volume_nm3"
+   character(len=*), parameter :: CONTACTS_HEADER = "i,j,step,force_nN,pressure_GPa"
 
    !> What the run was, for /run in the HDF5 file.
    type :: run_info
@@ -197,7 +205,7 @@ contains
       real(dp) :: area_pixel, region
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      call add_line(b, "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness,n_plastic")
+      call add_line(b, HISTORY_HEADER)
       do k = 1, res%nsteps
          call add_line(b, int_str(k)//","//int_str(res%step_contacts(k))//","// &
             format_real(res%step_load(k))//","//format_real(res%step_approach(k))//","// &
@@ -222,7 +230,7 @@ contains
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       character(len=:), allocatable :: text
-      character(len=*), parameter :: header = "i,j,step,force_nN,pressure_GPa"
+      character(len=*), parameter :: header = CONTACTS_HEADER
       character(len=24), allocatable :: force(:), pressure(:)
       integer, allocatable :: nf(:), np(:)
       integer(i8), allocatable :: ends(:)
@@ -276,8 +284,7 @@ contains
       real(dp) :: area_pixel, region
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      call add_line(b, "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,"// &
-         "n_plastic,plastic_volume_nm3")
+      call add_line(b, LOADS_HEADER)
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          associate(s => res%states(k))

@@ -12,7 +12,7 @@ module femcod_surfaces
    implicit none
    private
    public :: circle_punch, square_punch, sphere_cap, sinusoid_surface, weierstrass_mandelbrot, wm_terms
-   public :: self_affine_surface, remove_plane, rms_height, downsample_subsample, downsample_average
+   public :: self_affine_surface, remove_plane, rms_height, downsample_subsample, downsample_average, plane_tilt
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -312,6 +312,42 @@ contains
          end do
       end do
    end subroutine remove_plane
+
+   !> The least-squares plane's rise across the grid (nm: its largest minus smallest value)
+   !> and the rms height about that plane (nm), without a copy of the heights: a tilt far
+   !> above the roughness is the sample's mounting more often than its shape.
+   pure subroutine plane_tilt(z, rise, roughness)
+      real(dp), intent(in) :: z(:, :)
+      real(dp), intent(out) :: rise, roughness
+      real(dp) :: mi, mj, mz, sii, sjj, szi, szj, b, c, r
+      integer :: i, j, n1, n2
+      n1 = size(z, 1)
+      n2 = size(z, 2)
+      mi = (n1 + 1)/2.0_dp
+      mj = (n2 + 1)/2.0_dp
+      mz = sum(z)/size(z)
+      sii = 0; sjj = 0; szi = 0; szj = 0
+      do j = 1, n2
+         do i = 1, n1
+            sii = sii + (i - mi)**2
+            sjj = sjj + (j - mj)**2
+            szi = szi + (z(i, j) - mz)*(i - mi)
+            szj = szj + (z(i, j) - mz)*(j - mj)
+         end do
+      end do
+      b = 0
+      c = 0
+      if (sii > 0) b = szi/sii
+      if (sjj > 0) c = szj/sjj
+      rise = abs(b)*(n1 - 1) + abs(c)*(n2 - 1)
+      r = 0
+      do j = 1, n2
+         do i = 1, n1
+            r = r + (z(i, j) - mz - b*(i - mi) - c*(j - mj))**2
+         end do
+      end do
+      roughness = sqrt(r/size(z))
+   end subroutine plane_tilt
 
    !> Keep the odd/odd pixels (1, 3, 5, ...): NP -> ceil(NP/2), pixel doubles (section 4.5).
    pure function downsample_subsample(z) result(w)
