@@ -67,6 +67,9 @@ fi
 fpm build --profile release >/dev/null 2>build.log || { cat build.log >&2; exit 1; }
 rm -f build.log
 fpm install --profile release --prefix "$prefix" >/dev/null 2>&1 || { echo "setup: fpm install into $prefix failed" >&2; exit 1; }
+# What the installed benchmarks need besides the program: the peers' script (--peers).
+mkdir -p "$prefix/share/femcod"
+cmp -s app/femcod_peers.py "$prefix/share/femcod/femcod_peers.py" || cp app/femcod_peers.py "$prefix/share/femcod/"
 case ":$(printenv PATH):" in
   *":$prefix/bin:"*) ;;
   *) echo "setup: femcod is installed in $prefix/bin; add it to PATH (export PATH=\"$prefix/bin:\$PATH\")" ;;

@@ -25,7 +25,7 @@ module femcod_bench
    use femcod_random, only: random_stream, seed_stream, uniform
    use femcod_clock, only: wall_clock
    use femcod_deck, only: write_deck
-   use femcod_files, only: write_file, file_part
+   use femcod_files, only: write_file, file_part, path_exists, canonical_path
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_create, h5_write
    use femcod_svg, only: svg_pressure_map, svg_series, add_series, svg_multi_plot
    use femcod_resolution_study, only: level_deck
@@ -779,6 +779,34 @@ contains
       call get_command_argument(0, path)
    end function self_path
 
+   !> The peers' script: app/femcod_peers.py of the source tree (run from its root), or
+   !> the copy `setup.sh` installs beside femcod (PREFIX/share/femcod/femcod_peers.py for
+   !> PREFIX/bin/femcod); "" when neither exists.
+   function peers_script() result(path)
+      character(len=:), allocatable :: path, exe
+      integer :: slash
+      path = "app/femcod_peers.py"
+      if (path_exists(path)) return
+      exe = canonical_path("/proc/self/exe")
+      slash = index(exe, "/", back=.true.)
+      path = ""
+      if (slash > 1) then
+         path = exe(1:slash - 1)//"/../share/femcod/femcod_peers.py"
+         if (.not. path_exists(path)) path = ""
+      end if
+   end function peers_script
+
+   !> With --peers PYTHON, the peers' script must be found before any work (exit 2).
+   subroutine require_peers(python, command, code)
+      character(len=*), intent(in) :: python, command
+      integer, intent(inout) :: code
+      if (len(python) == 0 .or. code /= 0) return
+      if (len(peers_script()) > 0) return
+      write(error_unit, '(a)') "femcod bench "//command//": --peers needs femcod_peers.py: app/femcod_peers.py "// &
+         "of the source tree (run from its root) or the copy setup.sh installs in PREFIX/share/femcod; found neither"
+      code = 2
+   end subroutine require_peers
+
    !> The number after `"key": ` in the JSON text (its first occurrence; 0 when absent).
    real(dp) function json_value(t, key)
       character(len=*), intent(in) :: t, key
@@ -870,6 +898,8 @@ contains
       call get_option(parsed, "--contact", fractions)
       call get_option(parsed, "--tol", tol)
       call get_option(parsed, "--peers", python)
+      call require_peers(python, "periodic", code)
+      if (code /= 0) return
       options%solver = "cg"
       options%boundary = "periodic"
       options%cg = cg_settings()
@@ -999,6 +1029,8 @@ contains
       integer :: np, k, f, m, factor, method
       real(dp), allocatable :: fractions(:), g0(:, :)
       character(len=:), allocatable :: svg_path, deck_path, case_label
+      type(contact_problem) :: thesis
+      type(scene_spec) :: builtin
       real(dp) :: deck_load
       type(contact_problem) :: deck, coarse
       type(status_type) :: status
@@ -1044,6 +1076,21 @@ contains
       call get_option(parsed, "--deck", deck_path)
       if (option_given(parsed, "--no-deck")) deck_path = ""
       call get_option(parsed, "--deck-load", deck_load)
+      ! The thesis deck first, so that a bad --deck fails before the table's work; the
+      ! default is input/sphere_d1.deck built in memory (the bench runs from anywhere).
+      if (len(deck_path) > 0) then
+         if (option_given(parsed, "--deck")) then
+            call read_deck(deck_path, thesis, status)
+         else
+            call verification_spec("sphere_d1", builtin, status)
+            if (status%code == 0) call build_problem(builtin, thesis, status)
+         end if
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod bench frontier: "//status%message
+            code = status%code
+            return
+         end if
+      end if
       call benchmark_surface(np, "bench frontier", deck, status)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod bench frontier: "//status%message
@@ -1063,12 +1110,7 @@ contains
       end do
       ! One thesis deck, with the Appendix B program among the methods.
       if (len(deck_path) > 0) then
-         call read_deck(deck_path, deck, status)
-         if (status%code /= 0) then
-            write(error_unit, '(a)') "femcod bench frontier: "//status%message
-            code = status%code
-            return
-         end if
+         deck = thesis
          np = deck%np
          g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
          case_label = file_part(deck_path)
@@ -1296,7 +1338,7 @@ contains
          real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,5)", lower=0.0_dp), &
          text_option("--svg", "FILE", "write the figure (log time against log area error, Pareto front)"), &
          text_option("--deck", "FILE", "a thesis deck solved the same ways, the Appendix B program too (default "// &
-            "input/sphere_d1.deck)"), &
+            "input/sphere_d1.deck, built in: the bench runs from any directory)"), &
          flag_option("--no-deck", "the benchmark surface only (no thesis deck, no Appendix B program)"), &
          real_option("--deck-load", "F", "the deck's load in nN (default 1000)", lower=0.0_dp, closed="()")]
    end function bench_frontier_table
@@ -1350,15 +1392,8 @@ contains
       call get_option(parsed, "--tol", tol)
       call get_option(parsed, "--peers", python)
       call get_option(parsed, "--fftw-wisdom", wisdom)
-      if (len(python) > 0) then
-         inquire(file="app/femcod_peers.py", exist=loaded)
-         if (.not. loaded) then
-            write(error_unit, '(a)') "femcod bench cg: --peers runs app/femcod_peers.py of the femcod source tree; "// &
-               "run it from the tree's root"
-            code = 2
-            return
-         end if
-      end if
+      call require_peers(python, "cg", code)
+      if (code /= 0) return
       associate(method => options%cg)
          if (option_given(parsed, "--nested")) method%nested = switch("--nested")
          if (option_given(parsed, "--restart")) method%restart_on_entry = switch("--restart")
@@ -1565,7 +1600,7 @@ contains
       integer :: unit, ios
       more = ""
       if (present(extra)) more = " "//extra
-      call execute_command_line(python//" app/femcod_peers.py "//peer//" "//path//" "//int_str(np)//" "// &
+      call execute_command_line(python//" "//peers_script()//" "//peer//" "//path//" "//int_str(np)//" "// &
          real_str(pixel, 16)//" "//real_str(estar, 16)//" "//real_str(pressure, 16)//" "//real_str(tol, 3)// &
          more//" > "//peer_out, exitstat=ios)
       line = peer//" - - - - - failed -"
@@ -1693,6 +1728,8 @@ contains
       call get_option(parsed, "--full", full)
       python = ""
       call get_option(parsed, "--peers", python)
+      call require_peers(python, "adhesion", code)
+      if (code /= 0) return
       options%solver = "cg"
       options%adhesion = "dugdale"
       options%work = work
