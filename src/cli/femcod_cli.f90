@@ -4,12 +4,13 @@
 !> parses its arguments against its option table (cli/femcod_options).
 module femcod_cli
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_USAGE
    use femcod_strings, only: string_type, int_str, parse_integer, append_string
    use femcod_problem, only: contact_problem
    use femcod_deck, only: write_deck
-   use femcod_workspace, only: workspace_type, workspace_layout, workspace_table
+   use femcod_workspace, only: workspace_type, workspace_layout, workspace_table, MAX_WORKSPACE_CONTACTS
+   use femcod_problem, only: MAX_NP
    use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, KINDS
    use femcod_heights, only: load_scene, height_file_path
    use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
@@ -144,7 +145,16 @@ contains
       if (status%code == 0) then
          call parse_integer(parsed%positional(1)%s, np, ok1)
          call parse_integer(parsed%positional(2)%s, maxcont, ok2)
-         if (.not. (ok1 .and. ok2)) call set_error(status, STATUS_USAGE, "NP and MAXCONT must be integers")
+         if (.not. (ok1 .and. ok2)) then
+            call set_error(status, STATUS_USAGE, "NP and MAXCONT must be integers")
+         else if (np < 1 .or. np > MAX_NP) then
+            call set_error(status, STATUS_USAGE, "NP "//int_str(np)//": expected 1 to "//int_str(MAX_NP)// &
+               " (the largest grid a deck may hold)")
+         else if (maxcont < 1 .or. int(maxcont, i8) > int(np, i8)**2 .or. maxcont > MAX_WORKSPACE_CONTACTS) then
+            call set_error(status, STATUS_USAGE, "MAXCONT "//int_str(maxcont)//": expected 1 to NP^2 = "// &
+               int_str(min(int(np, i8)**2, int(MAX_WORKSPACE_CONTACTS, i8)))//" (and at most "// &
+               int_str(MAX_WORKSPACE_CONTACTS)//", where MAXNODE = 4 MAXCONT + 2 still fits an integer word)")
+         end if
       end if
       if (status%code /= 0) then
          call command_usage("workspace", status, code)

@@ -15,11 +15,17 @@ module femcod_workspace
    use femcod_memory, only: physical_memory, memory_text
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_BAD_INPUT
+   use femcod_strings, only: int_str
    implicit none
    private
    public :: workspace_type, block_type, workspace_layout, allocate_workspace, skyline_words, workspace_table
+   public :: MAX_WORKSPACE_CONTACTS
    public :: MPSURF, MPGAPS, MPCORD, MPFEXT, MPDISP, MPDISP2, MPFORCE, MPWORK, MPSTIF, N_REAL_BLOCKS
    public :: IPSORT, IPKFIX, IPMAT, IPMAT2, IPMAT3, IPIADR, IPNOD1, IPNOD2, IPNOD3, IPCONT, IPSITU, N_INT_BLOCKS
+
+   !> The most contacts a map is drawn for: MAXNODE = 4 MAXCONT + 2 is an integer word
+   !> (Appendix B's node numbers), so MAXCONT <= (huge - 2)/4.
+   integer, parameter :: MAX_WORKSPACE_CONTACTS = (huge(1) - 2)/4
 
    !> Real blocks (Table B.1), in address order.
    integer, parameter :: MPSURF = 1, MPGAPS = 2, MPCORD = 3, MPFEXT = 4, MPDISP = 5, MPDISP2 = 6, &
@@ -76,6 +82,11 @@ contains
       integer :: k
       if (np <= 0 .or. maxcont <= 0) then
          call set_error(status, STATUS_BAD_INPUT, "workspace: NP and MAXCONT must be positive")
+         return
+      end if
+      if (maxcont > MAX_WORKSPACE_CONTACTS) then
+         call set_error(status, STATUS_BAD_INPUT, "workspace: MAXCONT above "//int_str(MAX_WORKSPACE_CONTACTS)// &
+            " makes MAXNODE = 4 MAXCONT + 2 overflow an integer word")
          return
       end if
       np2 = int(np, i8)**2
