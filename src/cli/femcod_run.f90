@@ -79,6 +79,7 @@ module femcod_run
       character(len=:), allocatable :: checkpoint_path
       logical :: warned = .false., stored = .false.
    contains
+      procedure :: configure => configure_observer
       procedure :: progress => report_progress
       procedure :: checkpoint => store_checkpoint
       procedure :: stop_requested => signal_arrived
@@ -326,55 +327,8 @@ contains
             "/name, not a directory (or use --outdir DIR)")
       end if
       if (status%code /= 0) return
-      ! Each deck's prefix; two decks may not write the same files.
-      allocate(settings%prefixes(size(settings%decks)))
-      do d = 1, size(settings%decks)
-         if (settings%prefix /= "") then
-            settings%prefixes(d)%s = settings%prefix
-         else if (settings%outdir /= "") then
-            settings%prefixes(d)%s = settings%outdir//"/"//default_prefix(settings%decks(d)%s)
-         else
-            settings%prefixes(d)%s = default_prefix(settings%decks(d)%s)
-         end if
-         do k = 1, d - 1
-            if (canonical_path(settings%decks(k)%s) == canonical_path(settings%decks(d)%s)) then
-               call set_error(status, STATUS_USAGE, "the deck '"//settings%decks(d)%s//"' is given twice (as '"// &
-                  settings%decks(k)%s//"'; its results would overwrite each other)")
-               return
-            end if
-            if (canonical_path(settings%prefixes(k)%s) == canonical_path(settings%prefixes(d)%s)) then
-               call set_error(status, STATUS_USAGE, settings%decks(k)%s//" and "//settings%decks(d)%s// &
-                  " would both write "//settings%prefixes(d)%s//".*: run them apart, each with its -o")
-               return
-            end if
-         end do
-      end do
+      call assign_prefixes(settings, status)
    contains
-      !> The arguments that define a height-file scene (the files and the scene options),
-      !> for its label: not -o, --restart, --force and the like, so that a restart with
-      !> other operational options finds its checkpoint.
-      function scene_arguments(list) result(text)
-         type(string_type), intent(in) :: list(:)
-         character(len=:), allocatable :: text
-         type(option_spec), allocatable :: scene(:)
-         integer :: i, j
-         scene = [scene_options("heights"), text_option("--lower", "FILE", ""), text_option("--upper", "FILE", "")]
-         text = ""
-         i = 1
-         do while (i <= size(list))
-            do j = 1, size(scene)
-               if (list(i)%s == scene(j)%name) then
-                  text = text//" "//list(i)%s
-                  if (scene(j)%value_name /= "" .and. i < size(list)) then
-                     i = i + 1
-                     text = text//" "//list(i)%s
-                  end if
-                  exit
-               end if
-            end do
-            i = i + 1
-         end do
-      end function scene_arguments
       function option_value(p, name) result(v)
          type(parsed_options), intent(in) :: p
          character(len=*), intent(in) :: name
@@ -511,6 +465,62 @@ contains
       end if
    end subroutine run_one
 
+   !> Each deck's output prefix (-o, --outdir DIR/NAME, or NAME beside the run); two
+   !> decks may not be one file nor write the same files.
+   subroutine assign_prefixes(settings, status)
+      type(run_settings), intent(inout) :: settings
+      type(status_type), intent(inout) :: status
+      integer :: d, k
+      allocate(settings%prefixes(size(settings%decks)))
+      do d = 1, size(settings%decks)
+         if (settings%prefix /= "") then
+            settings%prefixes(d)%s = settings%prefix
+         else if (settings%outdir /= "") then
+            settings%prefixes(d)%s = settings%outdir//"/"//default_prefix(settings%decks(d)%s)
+         else
+            settings%prefixes(d)%s = default_prefix(settings%decks(d)%s)
+         end if
+         do k = 1, d - 1
+            if (canonical_path(settings%decks(k)%s) == canonical_path(settings%decks(d)%s)) then
+               call set_error(status, STATUS_USAGE, "the deck '"//settings%decks(d)%s//"' is given twice (as '"// &
+                  settings%decks(k)%s//"'; its results would overwrite each other)")
+               return
+            end if
+            if (canonical_path(settings%prefixes(k)%s) == canonical_path(settings%prefixes(d)%s)) then
+               call set_error(status, STATUS_USAGE, settings%decks(k)%s//" and "//settings%decks(d)%s// &
+                  " would both write "//settings%prefixes(d)%s//".*: run them apart, each with its -o")
+               return
+            end if
+         end do
+      end do
+   end subroutine assign_prefixes
+
+   !> The arguments that define a height-file scene (the files and the scene options),
+   !> for its label: not -o, --restart, --force and the like, so that a restart with
+   !> other operational options finds its checkpoint.
+   function scene_arguments(list) result(text)
+      type(string_type), intent(in) :: list(:)
+      character(len=:), allocatable :: text
+      type(option_spec), allocatable :: scene(:)
+      integer :: i, j
+      scene = [scene_options("heights"), text_option("--lower", "FILE", ""), text_option("--upper", "FILE", "")]
+      text = ""
+      i = 1
+      do while (i <= size(list))
+         do j = 1, size(scene)
+            if (list(i)%s == scene(j)%name) then
+               text = text//" "//list(i)%s
+               if (scene(j)%value_name /= "" .and. i < size(list)) then
+                  i = i + 1
+                  text = text//" "//list(i)%s
+               end if
+               exit
+            end if
+         end do
+         i = i + 1
+      end do
+   end function scene_arguments
+
    !> --fftw-wisdom FILE, before any deck is read: FILE and FILE.float32 are neither an
    !> input nor a result file of this run, and each that exists is FFTW wisdom (it is
    !> then read and brought up to date without --force: that is what the option is for);
@@ -547,6 +557,74 @@ contains
       call guard_outputs(wisdom, inputs, .true., OUTPUT_WISDOM, st)
       if (st%code /= 0) st%message = "--fftw-wisdom: "//st%message
    end subroutine check_wisdom_file
+
+   !> What exists under `prefix` before a run: with --restart, a complete set of the same
+   !> inputs and options (`complete`: nothing to do) or of others (refused); a checkpoint
+   !> without --restart or --force (refused); existing results without --force (refused);
+   !> and with --force (or as a restart's leftovers) only files femcod wrote are replaced.
+   subroutine check_existing(deck_path, prefix, settings, fingerprint, have_checkpoint, complete, st)
+      character(len=*), intent(in) :: deck_path, prefix, fingerprint
+      type(run_settings), intent(in) :: settings
+      logical, intent(out) :: have_checkpoint, complete
+      type(status_type), intent(inout) :: st
+      character(len=:), allocatable :: stored
+      complete = .false.
+      have_checkpoint = path_exists(prefix//".ckpt.h5")
+      ! With --restart, result files are leftovers of the interrupted run while its
+      ! checkpoint exists, or while PREFIX.h5 (renamed last) does not. A complete set
+      ! without a checkpoint means the run had finished: nothing to do, if it is the
+      ! run of these inputs and options.
+      if (settings%restart .and. .not. settings%force .and. .not. have_checkpoint .and. &
+         path_exists(prefix//".h5")) then
+         stored = stored_fingerprint(prefix//".h5")
+         if (stored == fingerprint) then
+            if (.not. settings%quiet) write(error_unit, '(a)') "femcod: "//prefix//".h5: the run of "// &
+               deck_label(deck_path)//" is complete; nothing to restart"
+            complete = .true.
+            return
+         end if
+         call set_error(st, STATUS_IO, prefix//".h5 holds the results of other inputs or options; "// &
+            "--force replaces them, or give another -o")
+         return
+      end if
+      if (have_checkpoint .and. .not. settings%restart .and. .not. settings%force) then
+         call set_error(st, STATUS_IO, prefix//".ckpt.h5: the checkpoint of an interrupted run; continue it "// &
+            "with --restart, or start afresh with --force")
+         return
+      end if
+      call check_writable(prefix, st)
+      if (st%code == 0 .and. .not. settings%force) then
+         if (.not. (settings%restart .and. (have_checkpoint .or. .not. path_exists(prefix//".h5")))) &
+            call refuse_overwrite(prefix, requested_states(settings%solve), st)
+      end if
+      ! What is replaced (with --force, or as a restart's leftovers) must be femcod's; a
+      ! checkpoint that --restart continues is checked whole by read_checkpoint.
+      if (st%code == 0) call guard_outputs(result_files(prefix, requested_states(settings%solve)), [string_type::], &
+         .true., OUTPUT_RESULT, st)
+      if (st%code == 0 .and. .not. settings%restart) call guard_outputs([string_type(prefix//".ckpt.h5")], &
+         [string_type::], .true., OUTPUT_RESULT, st)
+   end subroutine check_existing
+
+   !> The progress and checkpoint observer of one run: what it aims at (contacts, the
+   !> largest load), how its cost grows, what a step is called, where checkpoints go.
+   subroutine configure_observer(self, prefix, problem, options, quiet)
+      class(run_observer), intent(inout) :: self
+      character(len=*), intent(in) :: prefix
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      logical, intent(in) :: quiet
+      self%quiet = quiet
+      self%target_contacts = problem%maxcont
+      if (options%max_contacts > 0) self%target_contacts = min(options%max_contacts, problem%np**2)
+      if (size(options%loads) > 0) self%target_load = maxval(options%loads)
+      self%growth = merge(4.0_dp, 3.0_dp, options%solver == "legacy")
+      self%step_word = "event"
+      if (options%solver == "cg") then
+         self%step_word = trim(merge("approach", "load    ", size(options%approaches) > 0))
+         self%states = requested_states(options)
+      end if
+      self%checkpoint_path = prefix//".ckpt.h5"
+   end subroutine configure_observer
 
    !> The result files of `prefix` (and its checkpoint and lock) may not be one of the
    !> input files, with or without --force.
@@ -585,9 +663,9 @@ contains
       type(incremental_state) :: resume
       type(state_maps), allocatable :: maps(:)
       type(run_info) :: info
-      character(len=:), allocatable :: fingerprint, stored, started
+      character(len=:), allocatable :: fingerprint, started
       type(string_type), allocatable :: digests(:)
-      logical :: resuming, ok, have_checkpoint
+      logical :: resuming, ok, have_checkpoint, complete
       real(dp) :: t0, t1, digest_seconds
       integer :: k
       associate(options => settings%solve)
@@ -597,51 +675,9 @@ contains
          call wall_clock(t1)
          digest_seconds = t1 - t0
          fingerprint = run_fingerprint(problem, options, digests)
-         have_checkpoint = path_exists(prefix//".ckpt.h5")
-         ! With --restart, result files are leftovers of the interrupted run while its
-         ! checkpoint exists, or while PREFIX.h5 (renamed last) does not. A complete set
-         ! without a checkpoint means the run had finished: nothing to do, if it is the
-         ! run of these inputs and options.
-         if (settings%restart .and. .not. settings%force .and. .not. have_checkpoint .and. &
-            path_exists(prefix//".h5")) then
-            stored = stored_fingerprint(prefix//".h5")
-            if (stored == fingerprint) then
-               if (.not. settings%quiet) write(error_unit, '(a)') "femcod: "//prefix//".h5: the run of "// &
-                  deck_label(deck_path)//" is complete; nothing to restart"
-               return
-            end if
-            call set_error(st, STATUS_IO, prefix//".h5 holds the results of other inputs or options; "// &
-               "--force replaces them, or give another -o")
-            return
-         end if
-         if (have_checkpoint .and. .not. settings%restart .and. .not. settings%force) then
-            call set_error(st, STATUS_IO, prefix//".ckpt.h5: the checkpoint of an interrupted run; continue it "// &
-               "with --restart, or start afresh with --force")
-            return
-         end if
-         call check_writable(prefix, st)
-         if (st%code == 0 .and. .not. settings%force) then
-            if (.not. (settings%restart .and. (have_checkpoint .or. .not. path_exists(prefix//".h5")))) &
-               call refuse_overwrite(prefix, requested_states(options), st)
-         end if
-         ! What is replaced (with --force, or as a restart's leftovers) must be femcod's; a
-         ! checkpoint that --restart continues is checked whole by read_checkpoint.
-         if (st%code == 0) call guard_outputs(result_files(prefix, requested_states(options)), [string_type::], &
-            .true., OUTPUT_RESULT, st)
-         if (st%code == 0 .and. .not. settings%restart) call guard_outputs([string_type(prefix//".ckpt.h5")], &
-            [string_type::], .true., OUTPUT_RESULT, st)
-         if (st%code /= 0) return
-         observer%quiet = settings%quiet
-         observer%target_contacts = problem%maxcont
-         if (options%max_contacts > 0) observer%target_contacts = min(options%max_contacts, problem%np**2)
-         if (size(options%loads) > 0) observer%target_load = maxval(options%loads)
-         observer%growth = merge(4.0_dp, 3.0_dp, options%solver == "legacy")
-         observer%step_word = "event"
-         if (options%solver == "cg") then
-            observer%step_word = trim(merge("approach", "load    ", size(options%approaches) > 0))
-            observer%states = requested_states(options)
-         end if
-         observer%checkpoint_path = prefix//".ckpt.h5"
+         call check_existing(deck_path, prefix, settings, fingerprint, have_checkpoint, complete, st)
+         if (st%code /= 0 .or. complete) return
+         call observer%configure(prefix, problem, options, settings%quiet)
          resuming = .false.
          if (settings%restart) then
             if (have_checkpoint) then
