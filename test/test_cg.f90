@@ -13,13 +13,13 @@ module test_cg
    use femcod_generate, only: VERIFICATION_DECKS, scene_spec, build_problem
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
-   use femcod_love, only: offset_table, surface_compliance
+   use femcod_love, only: surface_compliance
    use femcod_split_correction, only: split_correction, split_setup, split_apply, split_free
    use femcod_spring, only: spring_stiffness
    use femcod_scene, only: initial_gaps
    use femcod_random, only: random_stream, seed_stream, uniform
    use test_support, only: scratch_path, file_exists, remove_scratch, read_text
-   use oracles, only: grid_stiffness, love_quad
+   use oracles, only: grid_stiffness, love_quad, love_table
    use, intrinsic :: iso_fortran_env, only: real128
    use femcod_analytic, only: hertz_approach, segedin_sphere
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
@@ -160,7 +160,8 @@ contains
    !> The cg solver keeps the gap of its solution for the maps (no convolution of their
    !> own). Checked against the definition, gap = g0 - approach + c sum_kl L(|i-k|, |j-l|)
    !> F(k, l) off the contacts and 0 on them, summed directly over the Love table (no
-   !> transform), on the 1 nm sphere at two loads: agreement to 1e-10 of the largest gap.
+   !> transform; the oracles' quadruple-precision table, not the code's), on the 1 nm
+   !> sphere at two loads: agreement to 1e-10 of the largest gap.
    subroutine test_gap_maps(error)
       type(error_type), allocatable, intent(out) :: error
       type(contact_problem) :: deck
@@ -179,7 +180,7 @@ contains
       if (allocated(error)) return
       np = deck%np
       allocate(table(0:np - 1, 0:np - 1), force(np, np), direct(np, np))
-      table = offset_table(np)
+      table = love_table(np)
       c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
          surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
       g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
@@ -311,7 +312,8 @@ contains
 
    !> The bounded problem on an 8 x 8 rough surface solved independently of the cg code:
    !> the quadratic programme  min 1/2 F.C F + g0.F  subject to 0 <= F <= H d^2 and
-   !> sum F = P, with the dense compliance C = c L + s I (L the Love table by offsets), by
+   !> sum F = P, with the dense compliance C = c L + s I (L the Love table by offsets, in
+   !> quadruple precision from test/oracles), by
    !> projected gradients (the projection a shift found by bisection), then the active
    !> sets it found solved exactly (the KKT system of the free forces and the approach,
    !> Gaussian elimination) and checked. Forces agree to 1e-8 of H d^2, the approach to
@@ -331,7 +333,7 @@ contains
       logical :: capped(n), zero(n)
       real(dp), allocatable :: cg_force(:)
       call rough_scene(np, 7, deck)
-      table = offset_table(np)
+      table = love_table(np)
       c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
          surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
       s = 3/spring_stiffness(deck%young(3), deck%poisson(3), deck%pixel, deck%pixel)
@@ -838,7 +840,7 @@ contains
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       allocate(table(0:np - 1, 0:np - 1), direct(np, np))
-      table = offset_table(np)
+      table = love_table(np)
       do j = 0, np - 1
          do i = 0, np - 1
             if (i*i + j*j > 25) table(i, j) = 0
@@ -893,8 +895,8 @@ contains
          "no result file")
    end subroutine test_usage
    !> The convolution by pruned 1-D passes, the real kernel spectrum and the wrapped
-   !> kernel, against the O(NP^4) direct sum over the same Love table (independent of any
-   !> transform): agreement to round-off in double, and to float32's unit round-off
+   !> kernel, against the O(NP^4) direct sum over the Love table of test/oracles (quadruple
+   !> precision, independent of the code's table and of any transform): agreement to round-off in double, and to float32's unit round-off
    !> (6e-8) times a small growth factor in single precision (bound 1e-5 of the largest
    !> value). Odd, even and odd-prime sides.
    subroutine test_convolution(error)
@@ -908,7 +910,7 @@ contains
       do n = 1, size(sides)
          np = sides(n)
          allocate(table(0:np - 1, 0:np - 1), field(np, np), fast(np, np), single(np, np), direct(np, np))
-         table = offset_table(np)
+         table = love_table(np)
          do j = 1, np
             do i = 1, np
                call uniform(stream, field(i, j))
@@ -959,7 +961,7 @@ contains
       integer :: q, i, j, v, radius, order(n), key(2)
       call seed_stream(stream, 5)
       allocate(table(0:np - 1, 0:np - 1), changed(2, n), delta(n), exact(np, np), approx(np, np))
-      table(:, :) = offset_table(np)
+      table(:, :) = love_table(np)
       do q = 1, n
          call uniform(stream, u)
          changed(1, q) = 1 + min(int(u*np), np - 1)
@@ -1045,7 +1047,7 @@ contains
          np = sides(n)
          m = 2*np
          allocate(table(0:np - 1, 0:np - 1), wrapped(0:m - 1, 0:m - 1), spectrum(0:m - 1, 0:m - 1))
-         table = offset_table(np)
+         table = love_table(np)
          wrapped = 0
          do q = 0, m - 1
             do p = 0, m - 1
