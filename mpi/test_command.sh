@@ -71,6 +71,11 @@ else
   echo "  FAILED   doc/cluster/mpi.sbatch"; sed 's/^/           /' "$work/out.txt" | head -5; failed=1
 fi
 expect 5 "existing results without --force" mpirun_2 "$femcod_mpi" "$deck" --loads 50 -o "$work/mpi"
+# femcod's output rule on ranks too: an input is never an output, even with --force.
+printf '1 2 3 4\n2 3 4 1\n3 4 1 2\n4 1 2 3\n' >"$work/in.loads.csv"; cp "$work/in.loads.csv" "$work/in.copy"
+expect 2 "an input named as an output, with --force" mpirun_2 "$femcod_mpi" --lower "$work/in.loads.csv" --pixel 1 \
+  --loads 1 -o "$work/in" --force
+cmp -s "$work/in.loads.csv" "$work/in.copy" || { echo "  FAILED   the input was changed"; failed=1; }
 # The combination matrix on 2 ranks (issue 34): boundary x plastic cap x interface law x
 # question (loads, increasing, decreasing approaches) x --restart on the 2 nm sphere. Each
 # combination answers (exit 0, as serial `femcod run --solver cg` does, to 1e-6) or is

@@ -344,6 +344,10 @@ contains
          call check(error, written_by_femcod(dir//"/r"//trim(set(k)), OUTPUT_RESULT), "femcod wrote r"//trim(set(k)))
          if (allocated(error)) return
       end do
+      call check(error, written_by_femcod("doc/verification.md", OUTPUT_RESULT), "femcod verify wrote its report")
+      if (allocated(error)) return
+      call check(error, .not. written_by_femcod("README.md", OUTPUT_RESULT), "a page a person wrote")
+      if (allocated(error)) return
       call check(error, written_by_femcod(dir//"/scene.deck", OUTPUT_DECK), "femcod wrote the deck")
       if (allocated(error)) return
       call check(error, written_by_femcod(dir//"/w", OUTPUT_WISDOM) .and. &

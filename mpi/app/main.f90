@@ -21,7 +21,8 @@ program femcod_mpi
    use femcod_run, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
-   use femcod_heights, only: load_scene
+   use femcod_heights, only: load_scene, height_file_path
+   use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_files, only: path_exists, remove_file, atomic_rename, write_file, acquire_lock, release_lock, &
       default_prefix
    use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
@@ -93,11 +94,9 @@ program femcod_mpi
       else
          call read_deck(settings%decks(1)%s, problem, status)
       end if
-      if (status%code == 0 .and. .not. settings%force) then
-         if (path_exists(prefix//".h5") .or. path_exists(prefix//".summary.json") .or. &
-            path_exists(prefix//".loads.csv")) call set_error(status, STATUS_IO, &
-            prefix//".h5, .summary.json or .loads.csv exists; --force replaces them, or give another -o")
-      end if
+      ! femcod's rule for every file it writes: an input is never an output, and an
+      ! existing file is replaced only with --force and only if femcod wrote it.
+      if (status%code == 0) call guard_outputs(output_names(), input_names(), settings%force, OUTPUT_RESULT, status)
       if (status%code == 0) then
          call acquire_lock(prefix//".lock", status, notice)
          locked = status%code == 0
@@ -204,6 +203,27 @@ contains
          end if
       end associate
    end subroutine refuse_unsupported
+
+   !> The files this run writes: PREFIX.h5, .summary.json, .loads.csv, a figure per load.
+   function output_names() result(names)
+      type(string_type), allocatable :: names(:)
+      integer :: j
+      names = [string_type(prefix//".h5"), string_type(prefix//".summary.json"), string_type(prefix//".loads.csv")]
+      do j = 1, size(settings%solve%loads)
+         names = [names, string_type(prefix//".pressure_"//int_str(j)//".svg")]
+      end do
+   end function output_names
+
+   !> The files this run reads: the deck, or the height files.
+   function input_names() result(names)
+      type(string_type), allocatable :: names(:)
+      if (settings%decks(1)%s /= "") then
+         names = [string_type(settings%decks(1)%s)]
+      else
+         names = [string_type(height_file_path(settings%scene%matrix_file))]
+         if (settings%scene%second_file /= "") names = [names, string_type(height_file_path(settings%scene%second_file))]
+      end if
+   end function input_names
 
    !> Releases the lock, reports `message` (rank 0), ends MPI and exits with `code`.
    subroutine finish(code, message)

@@ -13,7 +13,7 @@ module femcod_cli
    use femcod_problem, only: MAX_NP
    use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, KINDS
    use femcod_heights, only: load_scene, height_file_path
-   use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
+   use femcod_output_guard, only: guard_outputs, OUTPUT_DECK, OUTPUT_RESULT
    use femcod_run, only: run_command
    use femcod_process, only: SIGINT, SIGTERM, SIGUSR1
    use femcod_studies, only: resolution_command, summits_command, multiscale_command
@@ -420,16 +420,17 @@ contains
       type(status_type) :: status
       type(parsed_options) :: parsed
       character(len=:), allocatable :: output
+      logical :: force
       code = 0
       if (help_requested(args)) then
-         write(output_unit, '(a)') "usage: femcod verify [-o FILE]", &
+         write(output_unit, '(a)') "usage: femcod verify [-o FILE] [--force]", &
             "Runs the legacy solver on the decks of input/ (run from the package root) and writes the", &
             "comparison with the thesis (Tables 4.1, 4.2, section 4.4.3, Fig. 5.2) to FILE", &
             "(default doc/verification.md). Takes about two minutes with the release build."
          return
       end if
-      call parse_options([text_option("--output", "FILE", "the report (default doc/verification.md)", alias="-o")], &
-         args, parsed, status)
+      call parse_options([text_option("--output", "FILE", "the report (default doc/verification.md)", alias="-o"), &
+         flag_option("--force", "replace an existing report (only one femcod generated)")], args, parsed, status)
       if (status%code == 0 .and. size(parsed%positional) > 0) &
          call set_error(status, STATUS_USAGE, "unknown argument "//parsed%positional(1)%s)
       if (status%code /= 0) then
@@ -437,7 +438,16 @@ contains
          return
       end if
       output = "doc/verification.md"
+      force = .false.
       call get_option(parsed, "--output", output)
+      call get_option(parsed, "--force", force)
+      ! Checked before the two minutes of solves: femcod's output rule (io/femcod_output_guard).
+      call guard_outputs([string_type(output)], [string_type ::], force, OUTPUT_RESULT, status)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod verify: "//status%message
+         code = status%code
+         return
+      end if
       call write_verification_report(output, status, .true.)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod: "//status%message

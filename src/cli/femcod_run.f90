@@ -20,7 +20,7 @@ module femcod_run
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec
-   use femcod_heights, only: load_scene, height_file_path, is_height_file
+   use femcod_heights, only: load_scene, height_file_path, is_height_file, looks_like_height_matrix
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options
    use femcod_observer, only: solver_observer
@@ -435,6 +435,11 @@ contains
          allocate(pending(1))
          call file_sha256_start(deck_path, pending(1))
          call read_deck(deck_path, problem, st)
+         if (st%code /= 0 .and. looks_like_height_matrix(deck_path)) then
+            st%code = STATUS_USAGE
+            st%message = deck_path//" reads as a matrix of heights, not as a deck: run it with --lower "// &
+               deck_path//" --pixel D ("//st%message//")"
+         end if
          inputs = [string_type(deck_path//": femcod deck")]
          files = [string_type(deck_path)]
       end if

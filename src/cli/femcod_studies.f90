@@ -11,7 +11,8 @@ module femcod_studies
    use femcod_strings, only: string_type, int_str, sig_str, split_list, text_builder, add_line, built_text, &
       parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
    use femcod_generate, only: scene_spec
-   use femcod_heights, only: load_scene, read_height_map, height_map, is_height_file, height_file_path
+   use femcod_heights, only: load_scene, read_height_map, height_map, is_height_file, height_file_path, &
+      looks_like_height_matrix
    use femcod_files, only: default_prefix, file_part
    use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_results, only: write_file_set
@@ -478,6 +479,11 @@ contains
          call move_alloc(map%z, z)
       else
          call read_deck(input, deck, status)
+         if (status%code /= 0 .and. looks_like_height_matrix(input)) then
+            status%code = STATUS_USAGE
+            status%message = input//" reads as a matrix of heights, not as a deck: give --pixel D (nm) to study "// &
+               "it as heights ("//status%message//")"
+         end if
          if (status%code /= 0) return
          z = deck%lower + flip_upper(deck%upper)
          d = deck%pixel

@@ -25,7 +25,7 @@ module femcod_heights
    implicit none
    private
    public :: height_map, read_height_map, read_heights, read_ascii_matrix, load_scene, is_height_file, unit_in_nm
-   public :: height_file_path
+   public :: height_file_path, looks_like_height_matrix
    public :: HEIGHT_UNITS
 
    !> The units --height-unit takes.
@@ -92,6 +92,57 @@ contains
       is_height_file = starts_with_file(file, "\*File list") .or. starts_with_file(file, "# Channel:") .or. &
          starts_with_file(file, "# Kanal:")
    end function is_height_file
+
+   !> Whether a file that failed to read as a deck reads as a plain matrix of heights: its
+   !> first two lines (past '#' comments) are rows of the same two or more numbers. For
+   !> the message that says --pixel is what it needs.
+   logical function looks_like_height_matrix(path) result(yes)
+      character(len=*), intent(in) :: path
+      character(len=4096) :: line
+      integer :: unit, ios, rows, counts(2)
+      yes = .false.
+      if (path_is_directory(path) .or. .not. path_exists(path)) return
+      open(newunit=unit, file=path, action="read", status="old", iostat=ios)
+      if (ios /= 0) return
+      rows = 0
+      do while (rows < 2)
+         read(unit, '(a)', iostat=ios) line
+         if (ios /= 0) exit
+         line = adjustl(line)
+         if (line == "" .or. line(1:1) == "#") cycle
+         rows = rows + 1
+         counts(rows) = number_count(trim(line))
+      end do
+      close(unit)
+      if (rows == 2) yes = counts(1) >= 2 .and. counts(1) == counts(2)
+   contains
+      !> The count of blank-separated numbers in `text` (0 when a token is not one).
+      integer function number_count(text) result(n)
+         character(len=*), intent(in) :: text
+         integer :: i, start
+         real(dp) :: v
+         logical :: ok
+         n = 0
+         i = 1
+         do while (i <= len(text))
+            if (text(i:i) == " " .or. text(i:i) == achar(9)) then
+               i = i + 1
+               cycle
+            end if
+            start = i
+            do while (i <= len(text))
+               if (text(i:i) == " " .or. text(i:i) == achar(9)) exit
+               i = i + 1
+            end do
+            call parse_real(text(start:i - 1), v, ok)
+            if (.not. ok) then
+               n = 0
+               return
+            end if
+            n = n + 1
+         end do
+      end function number_count
+   end function looks_like_height_matrix
 
    !> Read the heights `path` names (see the module's head). `height_unit` ("" for nm)
    !> is the unit of files that do not state theirs; a file that does, in another unit,

@@ -15,7 +15,7 @@
 !> Lengths nm, loads nN, E* GPa, areas nm^2. No I/O.
 module femcod_multiscale
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL, STATUS_BAD_INPUT
    use femcod_sort, only: merge_sort_index
    use femcod_strings, only: int_str
    implicit none
@@ -102,7 +102,8 @@ contains
       if (status%code /= 0) return
       nt = size(template%heights)
       if (nt == 0 .or. size(template%radii) /= nt) then
-         call set_error(status, STATUS_USAGE, "the roughness template has no summits")
+         call set_error(status, STATUS_BAD_INPUT, "the roughness template has no summits: the surface has none "// &
+            "at that neighbourhood size (--template-size or --sizes)")
          return
       end if
       if (.not. (s > 1) .or. scales < 1 .or. .not. (load > 0) .or. .not. (estar > 0) .or. any(template%radii <= 0)) then
