@@ -796,6 +796,23 @@ contains
       end if
    end function peers_script
 
+   !> The thesis deck of bench frontier: --deck FILE read, or by default
+   !> input/sphere_d1.deck built in memory from its verification spec (the bench runs
+   !> from any directory).
+   subroutine frontier_deck(path, given, deck, status)
+      character(len=*), intent(in) :: path
+      logical, intent(in) :: given
+      type(contact_problem), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      type(scene_spec) :: builtin
+      if (given) then
+         call read_deck(path, deck, status)
+      else
+         call verification_spec("sphere_d1", builtin, status)
+         if (status%code == 0) call build_problem(builtin, deck, status)
+      end if
+   end subroutine frontier_deck
+
    !> With --peers PYTHON, the peers' script must be found before any work (exit 2).
    subroutine require_peers(python, command, code)
       character(len=*), intent(in) :: python, command
@@ -1030,7 +1047,6 @@ contains
       real(dp), allocatable :: fractions(:), g0(:, :)
       character(len=:), allocatable :: svg_path, deck_path, case_label
       type(contact_problem) :: thesis
-      type(scene_spec) :: builtin
       real(dp) :: deck_load
       type(contact_problem) :: deck, coarse
       type(status_type) :: status
@@ -1076,15 +1092,9 @@ contains
       call get_option(parsed, "--deck", deck_path)
       if (option_given(parsed, "--no-deck")) deck_path = ""
       call get_option(parsed, "--deck-load", deck_load)
-      ! The thesis deck first, so that a bad --deck fails before the table's work; the
-      ! default is input/sphere_d1.deck built in memory (the bench runs from anywhere).
+      ! The thesis deck first, so that a bad --deck fails before the table's work.
       if (len(deck_path) > 0) then
-         if (option_given(parsed, "--deck")) then
-            call read_deck(deck_path, thesis, status)
-         else
-            call verification_spec("sphere_d1", builtin, status)
-            if (status%code == 0) call build_problem(builtin, thesis, status)
-         end if
+         call frontier_deck(deck_path, option_given(parsed, "--deck"), thesis, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod bench frontier: "//status%message
             code = status%code

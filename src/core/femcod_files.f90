@@ -396,19 +396,9 @@ contains
       character(len=:), allocatable :: cause
       integer(c_int), parameter :: EIO = 5, EFBIG = 27, ENOSPC = 28, EROFS = 30, EDQUOT = 122
       integer(c_int), pointer :: errno
-      character(kind=c_char), pointer :: text(:)
-      character(len=:), allocatable :: message
-      integer :: k
       cause = ""
       call c_f_pointer(c_errno_location(), errno)
       if (all(errno /= [EIO, EFBIG, ENOSPC, EROFS, EDQUOT])) return
-      ! Read up to the terminating NUL only: the text is short and static.
-      call c_f_pointer(c_strerror(errno), text, [256])
-      message = ""
-      do k = 1, size(text)
-         if (text(k) == c_null_char) exit
-         message = message//text(k)
-      end do
-      cause = " ("//message//")"
+      cause = " ("//os_error_text()//")"
    end function write_error_cause
 end module femcod_files

@@ -282,19 +282,19 @@ contains
       rms_height = sqrt(sum((z - mean)**2)/size(z))
    end function rms_height
 
-   !> Subtract the least-squares plane z = a + b i + c j (tilt and offset removal).
-   pure subroutine remove_plane(z)
-      real(dp), intent(inout) :: z(:, :)
-      real(dp) :: mi, mj, mz, sii, sjj, szi, szj, b, c
-      integer :: i, j, n1, n2
-      n1 = size(z, 1)
-      n2 = size(z, 2)
-      mi = (n1 + 1)/2.0_dp
-      mj = (n2 + 1)/2.0_dp
+   !> The least-squares plane z = mz + b (i - mi) + c (j - mj) of a grid of heights
+   !> (mi, mj the centre indices): its mean and slopes per pixel (nm, nm/pixel).
+   pure subroutine plane_fit(z, mz, b, c)
+      real(dp), intent(in) :: z(:, :)
+      real(dp), intent(out) :: mz, b, c
+      real(dp) :: mi, mj, sii, sjj, szi, szj
+      integer :: i, j
+      mi = (size(z, 1) + 1)/2.0_dp
+      mj = (size(z, 2) + 1)/2.0_dp
       mz = sum(z)/size(z)
       sii = 0; sjj = 0; szi = 0; szj = 0
-      do j = 1, n2
-         do i = 1, n1
+      do j = 1, size(z, 2)
+         do i = 1, size(z, 1)
             sii = sii + (i - mi)**2
             sjj = sjj + (j - mj)**2
             szi = szi + (z(i, j) - mz)*(i - mi)
@@ -306,8 +306,18 @@ contains
       c = 0
       if (sii > 0) b = szi/sii
       if (sjj > 0) c = szj/sjj
-      do j = 1, n2
-         do i = 1, n1
+   end subroutine plane_fit
+
+   !> Subtract the least-squares plane z = a + b i + c j (tilt and offset removal).
+   pure subroutine remove_plane(z)
+      real(dp), intent(inout) :: z(:, :)
+      real(dp) :: mi, mj, mz, b, c
+      integer :: i, j
+      call plane_fit(z, mz, b, c)
+      mi = (size(z, 1) + 1)/2.0_dp
+      mj = (size(z, 2) + 1)/2.0_dp
+      do j = 1, size(z, 2)
+         do i = 1, size(z, 1)
             z(i, j) = z(i, j) - mz - b*(i - mi) - c*(j - mj)
          end do
       end do
@@ -319,30 +329,15 @@ contains
    pure subroutine plane_tilt(z, rise, roughness)
       real(dp), intent(in) :: z(:, :)
       real(dp), intent(out) :: rise, roughness
-      real(dp) :: mi, mj, mz, sii, sjj, szi, szj, b, c, r
-      integer :: i, j, n1, n2
-      n1 = size(z, 1)
-      n2 = size(z, 2)
-      mi = (n1 + 1)/2.0_dp
-      mj = (n2 + 1)/2.0_dp
-      mz = sum(z)/size(z)
-      sii = 0; sjj = 0; szi = 0; szj = 0
-      do j = 1, n2
-         do i = 1, n1
-            sii = sii + (i - mi)**2
-            sjj = sjj + (j - mj)**2
-            szi = szi + (z(i, j) - mz)*(i - mi)
-            szj = szj + (z(i, j) - mz)*(j - mj)
-         end do
-      end do
-      b = 0
-      c = 0
-      if (sii > 0) b = szi/sii
-      if (sjj > 0) c = szj/sjj
-      rise = abs(b)*(n1 - 1) + abs(c)*(n2 - 1)
+      real(dp) :: mi, mj, mz, b, c, r
+      integer :: i, j
+      call plane_fit(z, mz, b, c)
+      mi = (size(z, 1) + 1)/2.0_dp
+      mj = (size(z, 2) + 1)/2.0_dp
+      rise = abs(b)*(size(z, 1) - 1) + abs(c)*(size(z, 2) - 1)
       r = 0
-      do j = 1, n2
-         do i = 1, n1
+      do j = 1, size(z, 2)
+         do i = 1, size(z, 1)
             r = r + (z(i, j) - mz - b*(i - mi) - c*(j - mj))**2
          end do
       end do
