@@ -2,7 +2,7 @@
 module test_surfaces
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
-   use femcod_deck, only: write_deck
+   use femcod_deck, only: write_deck, read_deck
    use femcod_problem, only: contact_problem
    use femcod_surfaces, only: circle_punch, square_punch, sphere_cap, wm_terms, self_affine_surface, remove_plane, &
       rms_height, sinusoid_surface, downsample_average, downsample_subsample
@@ -28,7 +28,8 @@ contains
          new_unittest("plane removal and down-sampling", test_transforms), &
          new_unittest("ASCII matrix: comments, errors", test_matrix), &
          new_unittest("flip and initial gaps (Fig. B.1)", test_gaps), &
-         new_unittest("input/ decks are what mkdeck generates", test_input_decks) &
+         new_unittest("input/ decks are what mkdeck generates", test_input_decks), &
+         new_unittest("input/ decks hold the thesis' scenes (closed forms, not the generator)", test_deck_scenes) &
          ]
    end subroutine collect_surfaces
 
@@ -195,4 +196,102 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_input_decks
+   !> The decks of input/ against the scenes the thesis describes, rebuilt here from their
+   !> definitions and not from femcod's generator (issue 34: the test above compares the
+   !> decks with the generator's own output, a golden file the code wrote):
+   !>  - Table 4.1: NP = 11 m, d = 1/m nm, the 21 m^2 pixels nearest the centre (21 nm^2,
+   !>    R = 2.5 nm) raised by R on the upper body (of a ring at the cut-off distance, any);
+   !>  - Table 4.2: NP = 3 m, d = 30/(3m) nm, the central m x m pixels (a 10 nm square in a
+   !>    30 nm region) raised by 10 nm;
+   !>  - Figs. 4.14-4.16: NP = ceil(30/d), z = sqrt(R^2 - r^2) for r < R = 15 nm from the
+   !>    grid centre, 0 beyond; MAXCONT the pixels within 10 nm;
+   !>  - the rough deck: NP = 32, d = 10 nm, rms 3 nm about its mean, a flat rigid upper;
+   !> every deck: E = 200 GPa, nu = 0.25, the rigid body and elements 1e5 times stiffer
+   !> (section 4.4), and a flat lower body under the punches and spheres.
+   subroutine test_deck_scenes(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      real(dp), allocatable :: want(:, :), r2(:, :)
+      real(dp) :: c, d, mean, rms
+      integer :: k, m, np, i, j, n
+      character(len=:), allocatable :: name
+      do k = 1, size(VERIFICATION_DECKS)
+         name = trim(VERIFICATION_DECKS(k))
+         call read_deck("input/"//name//".deck", deck, status)
+         call check(error, status%code, 0, name//": "//status%message)
+         if (allocated(error)) return
+         call check(error, all(deck%young == [200.0_dp, 2.0e7_dp, 2.0e7_dp]) .and. all(deck%poisson == 0.25_dp), &
+            name//": E = 200 GPa, nu = 0.25, rigid body and elements 1e5 times stiffer")
+         if (allocated(error)) return
+         np = deck%np
+         d = deck%pixel
+         c = (np + 1)/2.0_dp
+         if (allocated(r2)) deallocate(r2)
+         allocate(r2(np, np))
+         do j = 1, np
+            do i = 1, np
+               r2(i, j) = ((i - c)**2 + (j - c)**2)*d**2
+            end do
+         end do
+         want = 0*r2
+         if (index(name, "circle_punch_d") == 1) then
+            read(name(15:), *) m
+            call check(error, np == 11*m .and. abs(d - 1.0_dp/m) <= 1e-15_dp, name//": NP = 11 m, d = 1/m")
+            if (allocated(error)) return
+            ! The 21 m^2 nearest pixels: all nearer than the (21 m^2)-th distance, none
+            ! farther; a ring at exactly that distance may be cut (its choice is the
+            ! generator's), so there the deck's pixels are taken as they are if raised by R.
+            n = 21*m*m
+            where (r2 < nth_distance(r2, n)) want = 2.5_dp
+            where (r2 == nth_distance(r2, n) .and. (deck%upper == 0 .or. deck%upper == 2.5_dp)) want = deck%upper
+            call check(error, count(deck%upper > 0), n, name//": 21 m^2 pixels raised")
+            if (allocated(error)) return
+         else if (index(name, "square_punch_n") == 1) then
+            read(name(15:), *) m
+            call check(error, np == 3*m .and. abs(d - 10.0_dp/m) <= 1e-14_dp, name//": NP = 3 m, d = 30/(3 m)")
+            if (allocated(error)) return
+            want(m + 1:2*m, m + 1:2*m) = 10
+         else if (index(name, "sphere_d") == 1) then
+            call check(error, np == ceiling(30/d - 1e-9_dp), name//": NP d covers 30 nm")
+            if (allocated(error)) return
+            where (r2 < 15.0_dp**2) want = sqrt(15.0_dp**2 - r2)
+            call check(error, deck%maxcont, count(r2 < 10.0_dp**2), name//": MAXCONT = pixels within 10 nm")
+            if (allocated(error)) return
+         else
+            call check(error, np == 32 .and. d == 10 .and. all(deck%upper == 0), name//": 32 x 32, 10 nm, flat upper")
+            if (allocated(error)) return
+            mean = sum(deck%lower)/size(deck%lower)
+            rms = sqrt(sum((deck%lower - mean)**2)/size(deck%lower))
+            call check(error, rms, 3.0_dp, rel=.true., thr=1e-12_dp, message=name//": rms 3 nm")
+            cycle
+         end if
+         call check(error, all(deck%lower == 0), name//": a flat lower body")
+         if (allocated(error)) return
+         call check(error, maxval(abs(deck%upper - want)) <= 1e-12_dp*maxval(want), name//": the upper surface "// &
+            "differs from its definition by "//to_string(maxval(abs(deck%upper - want)))//" nm")
+         if (allocated(error)) return
+      end do
+   contains
+      !> The n-th smallest of the values (by a sort of a copy).
+      real(dp) function nth_distance(values, n) result(v)
+         real(dp), intent(in) :: values(:, :)
+         integer, intent(in) :: n
+         real(dp), allocatable :: flat(:)
+         integer :: a, b
+         real(dp) :: t
+         flat = reshape(values, [size(values)])
+         do a = 2, size(flat)
+            t = flat(a)
+            b = a - 1
+            do while (b >= 1)
+               if (flat(b) <= t) exit
+               flat(b + 1) = flat(b)
+               b = b - 1
+            end do
+            flat(b + 1) = t
+         end do
+         v = flat(n)
+      end function nth_distance
+   end subroutine test_deck_scenes
 end module test_surfaces
