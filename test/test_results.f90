@@ -32,6 +32,8 @@ contains
          new_unittest("pressure figure of a 2100^2 map: 3 x 3 blocks keep a one-pixel contact", test_png_blocks), &
          new_unittest("a plot of 200000 steps stays small and keeps its ends", test_long_plot), &
          new_unittest("summary.json: valid JSON, the CSV's numbers, timings within the command", test_summary_json), &
+         new_unittest("cg's memory estimate (checked before the solve) against the peak the system measured", &
+            test_memory_estimate), &
          new_unittest("existing results are kept without --force", test_force), &
          new_unittest("a result that cannot be put in place leaves no partial set", test_partial), &
          new_unittest("--lower/--upper: ASCII and HDF5 heights equal the deck", test_height_files), &
@@ -79,6 +81,60 @@ contains
       end do
       k = size(values)
    end function csv_column
+
+   !> The memory model the cg solvers check before they allocate (cg_storage_bytes and
+   !> gap_solver_storage_bytes, plus what the process holds when the solve begins), in
+   !> PREFIX.summary.json's memory_bytes, against the peak resident memory the system
+   !> measured over the whole run (VmHWM, read as the summary is written): within 0.75 to
+   !> 1.5 of it on 512^2 and 1024^2 self-affine surfaces (measured 0.9 to 1.2), free and
+   !> periodic at fixed loads and in the gap variables with the plastic cap. The model is
+   !> for the grids that can exhaust a machine; a small run is dominated by the libraries.
+   subroutine test_memory_estimate(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, text
+      character(len=*), parameter :: cases(4) = [character(len=60) :: &
+         "512 --solver cg --loads 1e5", "1024 --solver cg --loads 1e5", &
+         "512 --solver cg --loads 1e5 --boundary periodic", "512 --solver cg --approach 1,2 --plastic --hardness 5"]
+      integer :: k, code, np
+      real(dp) :: estimated, peak
+      character(len=60) :: item
+      dir = scratch_path("memory")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      do k = 1, size(cases)
+         item = cases(k)
+         read(item, *) np
+         if (.not. file_exists(dir//"/s"//to_string(np)//".deck")) then
+            call run_femcod([string_type("mkdeck"), string_type("self-affine"), string_type("--np"), &
+               string_type(to_string(np)), string_type("--pixel"), string_type("5"), string_type("--rms"), &
+               string_type("3"), string_type("--shape-on"), string_type("lower"), string_type("-o"), &
+               string_type(dir//"/s"//to_string(np)//".deck")], code)
+         end if
+         call execute_command_line(self_command()//" run "//dir//"/s"//to_string(np)//".deck "// &
+            trim(cases(k)(index(cases(k), " ") + 1:))//" -q -o "//dir//"/r"//to_string(k), exitstat=code)
+         call check(error, code, 0, trim(cases(k)))
+         if (allocated(error)) return
+         text = read_text(dir//"/r"//to_string(k)//".summary.json")
+         estimated = json_value(text, '"estimated_peak"')
+         peak = json_value(text, '"peak"')
+         call check(error, estimated >= 0.75_dp*peak .and. estimated <= 1.5_dp*peak, trim(cases(k))// &
+            ": estimated "//to_string(estimated)//" bytes, measured peak "//to_string(peak))
+         if (allocated(error)) return
+      end do
+   contains
+      !> The number after `key: ` in a JSON text (0 when absent).
+      real(dp) function json_value(t, key)
+         character(len=*), intent(in) :: t, key
+         integer :: at, ends, ios
+         json_value = 0
+         at = index(t, key//": ")
+         if (at == 0) return
+         at = at + len(key) + 2
+         ends = scan(t(at:), ",}")
+         if (ends == 0) return
+         read(t(at:at + ends - 2), *, iostat=ios) json_value
+         if (ios /= 0) json_value = 0
+      end function json_value
+   end subroutine test_memory_estimate
 
    !> A run of the 1 nm sphere deck at two loads, into a fresh prefix.
    subroutine sphere_run(name, prefix, code)

@@ -9,7 +9,7 @@ module femcod_memory
    use femcod_kinds, only: i8
    implicit none
    private
-   public :: physical_memory, memory_text
+   public :: physical_memory, memory_text, resident_bytes, peak_resident_bytes
 
    interface
       function c_sysconf(name) bind(c, name="sysconf") result(value)
@@ -77,6 +77,40 @@ contains
       close(unit)
       if (ios /= 0 .or. bytes >= 2_i8**60) bytes = 0
    end function read_limit
+
+   !> The memory this process holds now (VmRSS of /proc/self/status, bytes; 0 where the
+   !> system has no such file).
+   function resident_bytes() result(bytes)
+      integer(i8) :: bytes
+      bytes = status_field("VmRSS:")
+   end function resident_bytes
+
+   !> The most memory this process has held (VmHWM, bytes; 0 where unknown).
+   function peak_resident_bytes() result(bytes)
+      integer(i8) :: bytes
+      bytes = status_field("VmHWM:")
+   end function peak_resident_bytes
+
+   !> A "Key:   N kB" line of /proc/self/status, in bytes.
+   function status_field(key) result(bytes)
+      character(len=*), intent(in) :: key
+      integer(i8) :: bytes, kb
+      character(len=256) :: line
+      integer :: unit, ios
+      bytes = 0
+      open(newunit=unit, file="/proc/self/status", action="read", status="old", iostat=ios)
+      if (ios /= 0) return
+      do
+         read(unit, '(a)', iostat=ios) line
+         if (ios /= 0) exit
+         if (index(line, key) == 1) then
+            read(line(len(key) + 1:), *, iostat=ios) kb
+            if (ios == 0) bytes = 1024*kb
+            exit
+         end if
+      end do
+      close(unit)
+   end function status_field
 
    !> "N bytes (X GiB)".
    function memory_text(bytes) result(text)

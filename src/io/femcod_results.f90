@@ -10,6 +10,7 @@
 module femcod_results
    use femcod_kinds, only: dp, i8
    use femcod_clock, only: wall_clock
+   use femcod_memory, only: peak_resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real, xml_escape, sig_str, &
@@ -645,6 +646,8 @@ contains
          json_number(info%digest_seconds)//', "solve": '//json_number(res%wall_seconds)//', "maps": '// &
          json_number(info%maps_seconds)//', "write_hdf5": '//json_number(write_seconds(1))// &
          ', "write_text_and_figures": '//json_number(write_seconds(2))//'},'//nl// &
+         '  "memory_bytes": {"estimated_peak": '//int8_text(res%estimated_peak_bytes)//', "peak": '// &
+         int8_text(peak_resident_bytes())//'},'//nl// &
          '  "checks": {"penetrating_pixels_at_end": '//int_str(res%missed_final_check)// &
          ', "deepest_penetration_nm": '//json_number(res%max_penetration)//', "found_late": '// &
          int_str(res%missed_during_run)//', "releases": '//int_str(res%releases)// &
@@ -740,4 +743,12 @@ contains
          ', "work_of_adhesion_J_m2": '//json_number(info%work)//', "range_nm": '//json_number(info%range)//'},'// &
          new_line("a")
    end function adhesion_json
+   !> An 8-byte integer as JSON text.
+   pure function int8_text(v) result(text)
+      integer(i8), intent(in) :: v
+      character(len=:), allocatable :: text
+      character(len=24) :: buf
+      write(buf, '(i0)') v
+      text = trim(buf)
+   end function int8_text
 end module femcod_results

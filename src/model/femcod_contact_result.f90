@@ -100,6 +100,10 @@ module femcod_contact_result
       !> (TRFACT + LAPACK dlacn2); 0 for the incremental solver.
       real(dp) :: condition = 0
       real(dp) :: wall_seconds = 0
+      !> The memory the run was estimated to need at its largest (bytes: what the process
+      !> held when the solver began and the solver's storage model; 0 where the solver has
+      !> none), checked against the machine's before the solve.
+      integer(i8) :: estimated_peak_bytes = 0
    end type contact_result
 
 contains

@@ -48,7 +48,8 @@
 !> the summary reports both numbers (`adhesion_convexity`).
 module femcod_adhesion
    use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_double_complex, c_size_t, c_int, c_f_pointer
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, i8
+   use femcod_memory, only: physical_memory, memory_text, resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
@@ -66,7 +67,7 @@ module femcod_adhesion
    !$ use omp_lib, only: omp_get_max_threads
    implicit none
    private
-   public :: solve_adhesive, pixel_stiffness_ratio
+   public :: solve_adhesive, pixel_stiffness_ratio, gap_solver_storage_bytes
 
    !> Rounds of the capped set per solve at most.
    integer, parameter :: MAX_ROUNDS = 200
@@ -118,6 +119,23 @@ contains
          (c*love_influence(0, 0) + 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel))
    end function pixel_stiffness_ratio
 
+   !> The gap-variable solver's storage at its largest (bytes), from what it allocates on
+   !> the transform grid of M^2 points (M = 2 NP free, NP periodic): the field (8), the
+   !> spectrum (8: complex on half the points), the compliance and stiffness spectra (8),
+   !> the separations (8) and the iteration's K x, r, z, d, w, r_old (48) and free flags
+   !> (4); on the NP^2 pixels the gaps of the deck, the solution and the forces, the
+   !> plastic displacement, tension and curvature (48), the capped flags (4); each state's
+   !> gap map (8) and, with the plastic cap, its plastic map (8).
+   pure function gap_solver_storage_bytes(np, nstates, periodic, plastic) result(bytes)
+      integer, intent(in) :: np, nstates
+      logical, intent(in) :: periodic, plastic
+      integer(i8) :: bytes, m2, n2
+      n2 = int(np, i8)**2
+      m2 = merge(n2, 4*n2, periodic)
+      bytes = m2*(8 + 8 + 8 + 8 + 48 + 4) + n2*(48 + 4 + 8*nstates)
+      if (plastic) bytes = bytes + n2*8*nstates
+   end function gap_solver_storage_bytes
+
    !> The states at options%approaches (nm), in the order given, each from the last.
    subroutine solve_adhesive(problem, options, res, status, observer)
       type(contact_problem), intent(in) :: problem
@@ -151,6 +169,15 @@ contains
       end if
       np = problem%np
       area = problem%pixel**2
+      ! The storage, checked against the memory the run may use before it is allocated.
+      res%estimated_peak_bytes = resident_bytes() + gap_solver_storage_bytes(np, m, options%boundary == "periodic", &
+         options%plastic)
+      if (physical_memory() > 0 .and. res%estimated_peak_bytes > physical_memory()) then
+         call set_error(status, STATUS_NUMERICAL, "cg --approach (gap variables): NP = "//int_str(np)// &
+            " needs about "//memory_text(res%estimated_peak_bytes)//" (the solver's arrays and what the run holds "// &
+            "already), this run may use "//memory_text(physical_memory()))
+         return
+      end if
       g0 = initial_gap_map(problem%lower, problem%upper)
       call make_fourier_grid(grid, problem, options%boundary == "periodic", status)
       if (status%code /= 0) return

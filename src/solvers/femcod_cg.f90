@@ -69,7 +69,8 @@
 !> approach by exactly eps.
 module femcod_cg
    use, intrinsic :: iso_fortran_env, only: int8
-   use femcod_kinds, only: dp, sp
+   use femcod_kinds, only: dp, sp, i8
+   use femcod_memory, only: physical_memory, memory_text, resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
@@ -87,7 +88,7 @@ module femcod_cg
    !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
    implicit none
    private
-   public :: solve_cg, coarse_start_forces, approach_error_bound
+   public :: solve_cg, coarse_start_forces, approach_error_bound, cg_storage_bytes
 
    !> What the CG solver reached at one load.
    type :: cg_residuals
@@ -135,6 +136,25 @@ contains
    !> the approach (a relative load error e moves the approach by at most e times it while
    !> the load-approach curve is convex from first touch, the contact stiffness growing
    !> with the contact; e is round-off, 1e-16, by construction).
+   !> The cg solver's storage at its largest (bytes), from the arrays it allocates per
+   !> pixel of the NP x NP grid: the forces, the grid's gaps and Love table (8 bytes each);
+   !> the kernel's spectrum, complex on (M/2 + 1) x NP with M = 2 NP free or NP periodic
+   !> (16 or 8 bytes a pixel), and its half-plane of real coefficients (8 or 2); the
+   !> iteration's w, t, the stencil's padded copy, the residual and the last gradient (8
+   !> each), its contact flags (4) and list (8); each requested state's gap map (8). With
+   !> the plastic cap: the deck's gaps, the capped flags, the capped rounds' force, field
+   !> and gap maps (8 + 4 + 24), and each state's plastic map (8). The nested coarse grids
+   !> (a third of this) come and go before the fine grid's iteration.
+   pure function cg_storage_bytes(np, nstates, periodic, plastic) result(bytes)
+      integer, intent(in) :: np, nstates
+      logical, intent(in) :: periodic, plastic
+      integer(i8) :: bytes, n2, per_pixel
+      n2 = int(np, i8)**2
+      per_pixel = 3*8 + merge(8, 16, periodic) + merge(2, 8, periodic) + 5*8 + 4 + 8 + 8*nstates
+      if (plastic) per_pixel = per_pixel + 8 + 4 + 24 + 8*nstates
+      bytes = n2*per_pixel
+   end function cg_storage_bytes
+
    pure real(dp) function approach_error_bound(penetration, contact_gap, load_error, approach) result(bound)
       real(dp), intent(in) :: penetration, contact_gap, load_error, approach
       bound = max(penetration, contact_gap) + load_error*abs(approach)
@@ -179,6 +199,15 @@ contains
       end if
       if (m == 0) then
          call set_error(status, STATUS_USAGE, "cg: --solver cg needs --loads or --approach")
+         return
+      end if
+      ! The storage, checked against the memory the run may use before it is allocated.
+      res%estimated_peak_bytes = resident_bytes() + cg_storage_bytes(np, m, options%boundary == "periodic", &
+         options%plastic)
+      if (physical_memory() > 0 .and. res%estimated_peak_bytes > physical_memory()) then
+         call set_error(status, STATUS_NUMERICAL, "cg: NP = "//int_str(np)//" needs about "// &
+            memory_text(res%estimated_peak_bytes)//" (the solver's arrays and what the run holds already), "// &
+            "this run may use "//memory_text(physical_memory())//"; femcod-mpi splits the grid over nodes")
          return
       end if
       call make_grid(fine, initial_gap_map(problem%lower, problem%upper), problem, &
