@@ -76,6 +76,19 @@ printf '1 2 3 4\n2 3 4 1\n3 4 1 2\n4 1 2 3\n' >"$work/in.loads.csv"; cp "$work/i
 expect 2 "an input named as an output, with --force" mpirun_2 "$femcod_mpi" --lower "$work/in.loads.csv" --pixel 1 \
   --loads 1 -o "$work/in" --force
 cmp -s "$work/in.loads.csv" "$work/in.copy" || { echo "  FAILED   the input was changed"; failed=1; }
+# Each rank's memory estimate (checked, summed over the ranks of a node, before the grids
+# are made) against the peak the system measured on that rank: within 0.7 to 1.5 of it on
+# a 1024^2 surface (measured 0.85 to 0.9 on this machine).
+"$femcod" mkdeck self-affine --np 1024 --pixel 5 --rms 3 --shape-on lower -o "$work/s1024.deck" >/dev/null
+expect 0 "2 ranks on a 1024^2 surface" mpirun_2 "$femcod_mpi" "$work/s1024.deck" --loads 1e5 -o "$work/mem" --quiet
+if python3 - "$work/mem.summary.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+for est, peak in zip(d["estimated_peak_memory_MB_per_rank"], d["peak_memory_MB_per_rank"]):
+    assert 0.7 * peak <= est <= 1.5 * peak, (est, peak)
+PY
+then echo "  passed   each rank's memory estimate against its measured peak"
+else echo "  FAILED   each rank's memory estimate against its measured peak"; failed=1; fi
 # The combination matrix on 2 ranks (issue 34): boundary x plastic cap x interface law x
 # question (loads, increasing, decreasing approaches) x --restart on the 2 nm sphere. Each
 # combination answers (exit 0, as serial `femcod run --solver cg` does, to 1e-6) or is

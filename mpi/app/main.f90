@@ -14,7 +14,8 @@ program femcod_mpi
    use omp_lib, only: omp_get_max_threads
    use femcod_fftw_mpi, only: fftw_init_threads, fftw_plan_with_nthreads, fftw_mpi_init, fftwf_init_threads, &
       fftwf_plan_with_nthreads, fftwf_mpi_init, fftw_mpi_cleanup
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, i8
+   use femcod_memory, only: physical_memory, memory_text, resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED, STATUS_NUMERICAL
    use femcod_strings, only: string_type, int_str, sig_str, format_real, json_string, json_number
    use femcod_cli, only: command_arguments
@@ -36,7 +37,7 @@ program femcod_mpi
       agree
    use femcod_svg, only: svg_pressure_map
    use femcod_maps, only: state_maps
-   use femcod_cg, only: approach_error_bound
+   use femcod_cg, only: approach_error_bound, cg_storage_bytes
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -50,7 +51,9 @@ program femcod_mpi
    type(string_type), allocatable :: warnings(:)
    character(len=:), allocatable :: prefix, notice, started, blocks_note
    real(dp) :: t_start, t_read, t_solve, t_write, peak, read_peak, constants(4)
-   real(dp), allocatable :: local(:, :)
+   real(dp), allocatable :: local(:, :), estimated_mb(:)
+   type(string_type), allocatable :: outputs(:), inputs(:)
+   integer(i8) :: estimated_rank_bytes
    type(state_maps), allocatable :: figures(:)
    integer :: provided, rank, ranks, np, block, code, k, figure
    logical :: locked
@@ -96,7 +99,10 @@ program femcod_mpi
       end if
       ! femcod's rule for every file it writes: an input is never an output, and an
       ! existing file is replaced only with --force and only if femcod wrote it.
-      if (status%code == 0) call guard_outputs(output_names(), input_names(), settings%force, OUTPUT_RESULT, status)
+      if (status%code == 0) then
+         call output_and_input_names(outputs, inputs)
+         call guard_outputs(outputs, inputs, settings%force, OUTPUT_RESULT, status)
+      end if
       if (status%code == 0) then
          call acquire_lock(prefix//".lock", status, notice)
          locked = status%code == 0
@@ -114,6 +120,10 @@ program femcod_mpi
    read_peak = peak_memory_mb()
    if (allocated(problem%lower)) deallocate(problem%lower)
    if (allocated(problem%upper)) deallocate(problem%upper)
+   ! What each rank is about to allocate, summed over the ranks of a node, against that
+   ! node's memory: refused on every rank (exit 4) before the grids are made.
+   call check_node_memory(np, size(settings%solve%loads), status)
+   if (status%code /= 0) call finish(status%code, status%message)
    call grid_setup(grid, MPI_COMM_WORLD, np, block, local, constants(2), constants(3), constants(4), &
       settings%solve%cg, status)
    deallocate(local)
@@ -132,6 +142,9 @@ program femcod_mpi
    peak = peak_memory_mb()
    allocate(info%peak_mb(ranks))
    call MPI_Gather(peak, 1, MPI_DOUBLE_PRECISION, info%peak_mb, 1, MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD)
+   allocate(estimated_mb(ranks))
+   call MPI_Gather(real(estimated_rank_bytes, dp)/1024**2, 1, MPI_DOUBLE_PRECISION, estimated_mb, 1, &
+      MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD)
    info%version = FEMCOD_VERSION
    info%command_line = "femcod-mpi "//settings%command_line
    info%host = host_name()
@@ -204,26 +217,53 @@ contains
       end associate
    end subroutine refuse_unsupported
 
-   !> The files this run writes: PREFIX.h5, .summary.json, .loads.csv, a figure per load.
-   function output_names() result(names)
-      type(string_type), allocatable :: names(:)
-      integer :: j
-      names = [string_type(prefix//".h5"), string_type(prefix//".summary.json"), string_type(prefix//".loads.csv")]
-      do j = 1, size(settings%solve%loads)
-         names = [names, string_type(prefix//".pressure_"//int_str(j)//".svg")]
-      end do
-   end function output_names
+   !> Each rank's storage: what it holds now and its share of the cg solver's arrays
+   !> (cg_storage_bytes over the ranks: the grid is split in column slabs). The ranks that
+   !> share a node (MPI_COMM_TYPE_SHARED) share its memory, so their sum is compared with
+   !> it; the largest node's sum is reported.
+   subroutine check_node_memory(n, nstates, st)
+      integer, intent(in) :: n, nstates
+      type(status_type), intent(inout) :: st
+      type(MPI_Comm) :: node
+      integer(i8) :: on_node, worst, may
+      estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, .false., .false.) + ranks - 1)/ranks
+      call MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
+      call MPI_Allreduce(estimated_rank_bytes, on_node, 1, MPI_INTEGER8, MPI_SUM, node)
+      call MPI_Comm_free(node)
+      may = physical_memory()
+      worst = 0
+      if (may > 0 .and. on_node > may) worst = on_node
+      call MPI_Allreduce(MPI_IN_PLACE, worst, 1, MPI_INTEGER8, MPI_MAX, MPI_COMM_WORLD)
+      if (worst > 0) call set_error(st, STATUS_NUMERICAL, "NP = "//int_str(n)//" on "//int_str(ranks)// &
+         " ranks: the ranks of one node need about "//memory_text(worst)//" (their share of the solver's "// &
+         "arrays and what they hold already), a node may use "//memory_text(may)//"; give more nodes")
+   end subroutine check_node_memory
 
-   !> The files this run reads: the deck, or the height files.
-   function input_names() result(names)
-      type(string_type), allocatable :: names(:)
+   !> The files this run writes (PREFIX.h5, .summary.json, .loads.csv, a figure per load)
+   !> and the files it reads (the deck, or the height files); filled element by element.
+   subroutine output_and_input_names(outputs, inputs)
+      type(string_type), allocatable, intent(out) :: outputs(:), inputs(:)
+      integer :: j, nloads
+      nloads = size(settings%solve%loads)
+      allocate(outputs(3 + nloads))
+      outputs(1)%s = prefix//".h5"
+      outputs(2)%s = prefix//".summary.json"
+      outputs(3)%s = prefix//".loads.csv"
+      do j = 1, nloads
+         outputs(3 + j)%s = prefix//".pressure_"//int_str(j)//".svg"
+      end do
       if (settings%decks(1)%s /= "") then
-         names = [string_type(settings%decks(1)%s)]
+         allocate(inputs(1))
+         inputs(1)%s = settings%decks(1)%s
+      else if (settings%scene%second_file /= "") then
+         allocate(inputs(2))
+         inputs(1)%s = height_file_path(settings%scene%matrix_file)
+         inputs(2)%s = height_file_path(settings%scene%second_file)
       else
-         names = [string_type(height_file_path(settings%scene%matrix_file))]
-         if (settings%scene%second_file /= "") names = [names, string_type(height_file_path(settings%scene%second_file))]
+         allocate(inputs(1))
+         inputs(1)%s = height_file_path(settings%scene%matrix_file)
       end if
-   end function input_names
+   end subroutine output_and_input_names
 
    !> Releases the lock, reports `message` (rank 0), ends MPI and exits with `code`.
    subroutine finish(code, message)
@@ -285,6 +325,10 @@ contains
          ', "peak_memory_MB_per_rank": ['
       do s = 1, ranks
          text = text//json_number(info%peak_mb(s))//trim(merge(", ", "  ", s < ranks))
+      end do
+      text = trim(text)//'], "estimated_peak_memory_MB_per_rank": ['
+      do s = 1, ranks
+         text = text//json_number(estimated_mb(s))//trim(merge(", ", "  ", s < ranks))
       end do
       text = trim(text)//'], "read_peak_memory_MB": '//json_number(read_peak)//', "loads": ['
       do s = 1, size(states)

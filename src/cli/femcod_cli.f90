@@ -420,6 +420,7 @@ contains
       type(status_type) :: status
       type(parsed_options) :: parsed
       character(len=:), allocatable :: output
+      type(string_type), allocatable :: none(:), report(:)
       logical :: force
       code = 0
       if (help_requested(args)) then
@@ -442,7 +443,9 @@ contains
       call get_option(parsed, "--output", output)
       call get_option(parsed, "--force", force)
       ! Checked before the two minutes of solves: femcod's output rule (io/femcod_output_guard).
-      call guard_outputs([string_type(output)], [string_type ::], force, OUTPUT_RESULT, status)
+      allocate(none(0), report(1))
+      report(1)%s = output
+      call guard_outputs(report, none, force, OUTPUT_RESULT, status)
       if (status%code /= 0) then
          write(error_unit, '(a)') "femcod verify: "//status%message
          code = status%code

@@ -573,6 +573,7 @@ contains
       logical, intent(out) :: have_checkpoint, complete
       type(status_type), intent(inout) :: st
       character(len=:), allocatable :: stored
+      type(string_type), allocatable :: names(:), none(:), checkpoint(:)
       complete = .false.
       have_checkpoint = path_exists(prefix//".ckpt.h5")
       ! With --restart, result files are leftovers of the interrupted run while its
@@ -604,10 +605,13 @@ contains
       end if
       ! What is replaced (with --force, or as a restart's leftovers) must be femcod's; a
       ! checkpoint that --restart continues is checked whole by read_checkpoint.
-      if (st%code == 0) call guard_outputs(result_files(prefix, requested_states(settings%solve)), [string_type::], &
-         .true., OUTPUT_RESULT, st)
-      if (st%code == 0 .and. .not. settings%restart) call guard_outputs([string_type(prefix//".ckpt.h5")], &
-         [string_type::], .true., OUTPUT_RESULT, st)
+      ! (Named arrays, not constructors in the call: gfortran's temporaries of derived types
+      ! with allocatable components have corrupted the heap here, femcod-mpi 2026-11-26.)
+      allocate(none(0), checkpoint(1))
+      checkpoint(1)%s = prefix//".ckpt.h5"
+      names = result_files(prefix, requested_states(settings%solve))
+      if (st%code == 0) call guard_outputs(names, none, .true., OUTPUT_RESULT, st)
+      if (st%code == 0 .and. .not. settings%restart) call guard_outputs(checkpoint, none, .true., OUTPUT_RESULT, st)
    end subroutine check_existing
 
    !> The progress and checkpoint observer of one run: what it aims at (contacts, the

@@ -425,7 +425,9 @@ contains
       logical, intent(in) :: force
       type(status_type), intent(inout) :: status
       integer :: unit, ios
-      call guard_outputs(names, [string_type(height_file_path(input))], force, OUTPUT_RESULT, status)
+      type(string_type) :: inputs(1)
+      inputs(1)%s = height_file_path(input)
+      call guard_outputs(names, inputs, force, OUTPUT_RESULT, status)
       if (status%code /= 0) return
       open(newunit=unit, file=names(1)%s//".part", status="replace", action="write", iostat=ios)
       if (ios /= 0) then
