@@ -9,7 +9,8 @@
 !> io/femcod_results writes the set.
 module femcod_run
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, i8
+   use femcod_memory, only: available_memory, resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
    use femcod_strings, only: sig_str, string_type, int_str, format_real, append_string
    use femcod_files, only: remove_file, path_exists, path_is_directory, default_prefix, file_part, canonical_path, &
@@ -675,6 +676,8 @@ contains
       character(len=:), allocatable :: fingerprint, started
       type(string_type), allocatable :: digests(:)
       logical :: resuming, ok, have_checkpoint, complete
+      type(contact_options) :: solve_options
+      integer(i8) :: held
       real(dp) :: t0, t1, digest_seconds
       integer :: k
       associate(options => settings%solve)
@@ -710,11 +713,17 @@ contains
          end if
          if (options%solver == "cg" .and. len(settings%wisdom) > 0) call load_wisdom(settings%wisdom, ok)
          started = local_time_iso()
+         ! The solvers check their storage against what this run may still take; the
+         ! summary's estimate is what the run holds now plus that storage.
+         solve_options = options
+         held = resident_bytes()
+         solve_options%memory_available = available_memory()
          if (resuming) then
-            call solve_contact(problem, options, res, st, observer, resume)
+            call solve_contact(problem, solve_options, res, st, observer, resume)
          else
-            call solve_contact(problem, options, res, st, observer)
+            call solve_contact(problem, solve_options, res, st, observer)
          end if
+         if (res%estimated_peak_bytes > 0) res%estimated_peak_bytes = res%estimated_peak_bytes + held
          if (st%code == STATUS_INTERRUPTED) then
             if (path_exists(observer%checkpoint_path) .and. observer%stored) then
                st%message = st%message//"; the state is in "//observer%checkpoint_path//" (continue with --restart)"

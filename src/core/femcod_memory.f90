@@ -9,7 +9,7 @@ module femcod_memory
    use femcod_kinds, only: i8
    implicit none
    private
-   public :: physical_memory, memory_text, resident_bytes, peak_resident_bytes
+   public :: physical_memory, memory_text, resident_bytes, peak_resident_bytes, available_memory
 
    interface
       function c_sysconf(name) bind(c, name="sysconf") result(value)
@@ -84,6 +84,14 @@ contains
       integer(i8) :: bytes
       bytes = status_field("VmRSS:")
    end function resident_bytes
+
+   !> What a solve may still take (bytes): the memory this process may use less what it
+   !> holds now; 0 where the system does not say (then nothing is checked).
+   function available_memory() result(bytes)
+      integer(i8) :: bytes
+      bytes = physical_memory()
+      if (bytes > 0) bytes = max(bytes - resident_bytes(), 1_i8)
+   end function available_memory
 
    !> The most memory this process has held (VmHWM, bytes; 0 where unknown).
    function peak_resident_bytes() result(bytes)

@@ -3,13 +3,15 @@
 !> `femcod run` fills one `contact_options` from its command line; solvers/femcod_solver
 !> dispatches on `solver`.
 module femcod_solver_options
-   use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_USAGE
+   use femcod_kinds, only: dp, i8
+   use femcod_memory, only: memory_text
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL
    use femcod_strings, only: format_real, int_str, sig_str
    implicit none
    private
    public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, LAW_NAMES, requested_states
    public :: validate_options, by_gap_variables, history_options, first_difference, tolerance_floor
+   public :: refuse_beyond_memory
 
    !> The solvers by name: the event-exact incremental solver, the Appendix B program,
    !> and the fixed-load constrained conjugate gradients.
@@ -124,6 +126,10 @@ module femcod_solver_options
       character(len=5) :: event_search = "auto"
       !> The cg solver's own options.
       type(cg_settings) :: cg
+      !> The memory the solve may take (bytes): what the machine or the job allows less
+      !> what the run holds when it begins, measured by the caller (core/femcod_memory's
+      !> available_memory); 0: unknown, not checked. Not part of the answer.
+      integer(i8) :: memory_available = 0
    end type contact_options
 
 contains
@@ -148,9 +154,9 @@ contains
       by_gap_variables = size(options%approaches) > 0 .and. (options%adhesion /= "none" .or. options%plastic)
    end function by_gap_variables
 
-   !> The one place where the combinations of options are checked: `femcod run` after
-   !> parsing, femcod-mpi, the benchmarks and solve_contact call it before any file is
-   !> read or any lock taken. A refused combination names both options (STATUS_USAGE,
+   !> The one place where the combinations of options are checked: `femcod run` (and
+   !> femcod-mpi, which shares its parser) after parsing, before any file is read or any
+   !> lock taken, and solve_contact for every library caller, the benchmarks included. A refused combination names both options (STATUS_USAGE,
    !> exit 2). Checks that need the deck (a load above the fully plastic capacity) are
    !> the solvers' own.
    subroutine validate_options(options, status)
@@ -260,6 +266,18 @@ contains
       end do
       text = "the option sets differ in length"
    end function first_difference
+   !> A solver's storage `need` (bytes) against the memory the solve may take (0:
+   !> unknown, not checked): STATUS_NUMERICAL (exit 4) with both figures, before anything
+   !> is allocated. `what` names the solver and the grid.
+   subroutine refuse_beyond_memory(what, need, available, status)
+      character(len=*), intent(in) :: what
+      integer(i8), intent(in) :: need, available
+      type(status_type), intent(inout) :: status
+      if (available > 0 .and. need > available) call set_error(status, STATUS_NUMERICAL, what//" needs about "// &
+         memory_text(need)//" for the solver's arrays, this run may give it "//memory_text(available)// &
+         " (the memory it may use less what it holds); femcod-mpi splits a grid over nodes")
+   end subroutine refuse_beyond_memory
+
    !> The smallest --tol the cg solvers accept: 10 machine epsilons of double precision
    !> (2.2e-16 each). Their residual is a gap violation over the height range; a gap is
    !> g0 - A + u, terms as large as the range, each rounded to half an epsilon of it.

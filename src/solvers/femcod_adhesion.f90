@@ -49,7 +49,6 @@
 module femcod_adhesion
    use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_double_complex, c_size_t, c_int, c_f_pointer
    use femcod_kinds, only: dp, i8
-   use femcod_memory, only: physical_memory, memory_text, resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
@@ -60,7 +59,7 @@ module femcod_adhesion
       fftw_destroy_plan, fftw_alloc_real, fftw_alloc_complex, fftw_free, FFTW_ESTIMATE, fftw_init_threads, &
       fftw_plan_with_nthreads
    use femcod_contact_result, only: contact_result, append_step, STOP_LOADS, gather_contacts
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, refuse_beyond_memory
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
@@ -169,15 +168,10 @@ contains
       end if
       np = problem%np
       area = problem%pixel**2
-      ! The storage, checked against the memory the run may use before it is allocated.
-      res%estimated_peak_bytes = resident_bytes() + gap_solver_storage_bytes(np, m, options%boundary == "periodic", &
-         options%plastic)
-      if (physical_memory() > 0 .and. res%estimated_peak_bytes > physical_memory()) then
-         call set_error(status, STATUS_NUMERICAL, "cg --approach (gap variables): NP = "//int_str(np)// &
-            " needs about "//memory_text(res%estimated_peak_bytes)//" (the solver's arrays and what the run holds "// &
-            "already), this run may use "//memory_text(physical_memory()))
-         return
-      end if
+      res%estimated_peak_bytes = gap_solver_storage_bytes(np, m, options%boundary == "periodic", options%plastic)
+      call refuse_beyond_memory("cg --approach (gap variables): NP = "//int_str(np), res%estimated_peak_bytes, &
+         options%memory_available, status)
+      if (status%code /= 0) return
       g0 = initial_gap_map(problem%lower, problem%upper)
       call make_fourier_grid(grid, problem, options%boundary == "periodic", status)
       if (status%code /= 0) return
@@ -210,6 +204,9 @@ contains
                options%cg%tol, options%cg%max_iterations, x, g, force, cap, iterations, st%residual, status, observer)
             st%iterations = st%iterations + iterations
             if (status%code /= 0) exit
+            ! A capped pixel carries H d^2 by the law (its residual, K x + mu - fmax, is
+            ! within the tolerance): exactly, so that no pressure above H is reported.
+            if (options%plastic) where (cap) force = fmax
             ! Return mapping: a pixel that yielded keeps its interpenetration as plastic
             ! displacement, and its gap (of the deformed surfaces) is 0.
             if (options%plastic) then
@@ -590,9 +587,6 @@ contains
       ! plus the mean force, the multiplier).
       call apply_operator(grid, grid%stiffness, x, kx)
       force = kx(1:np, 1:np) + mu
-      ! A capped pixel carries H d^2 by the law (its residual, kx + mu - fmax, is within
-      ! the tolerance): exactly, so that no pressure above H is reported.
-      if (capped) where (cap) force = fmax
    contains
       !> g >= 0 off the capped set; on a periodic cell the open gaps then shifted to the
       !> mean gap, and again, until no open gap went below 0.

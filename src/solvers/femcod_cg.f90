@@ -70,7 +70,6 @@
 module femcod_cg
    use, intrinsic :: iso_fortran_env, only: int8
    use femcod_kinds, only: dp, sp, i8
-   use femcod_memory, only: physical_memory, memory_text, resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
@@ -81,7 +80,7 @@ module femcod_cg
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
       convolution_free, inverse_kernel_taps
    use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
@@ -130,12 +129,6 @@ module femcod_cg
 
 contains
 
-   !> The approach (nm) of a fixed-load answer lies within this many nm of the exact
-   !> answer of the discrete problem (module header): the largest gap violation eps =
-   !> max(penetration, contact_gap) (nm), plus the load error's share, load_error times
-   !> the approach (a relative load error e moves the approach by at most e times it while
-   !> the load-approach curve is convex from first touch, the contact stiffness growing
-   !> with the contact; e is round-off, 1e-16, by construction).
    !> The cg solver's storage at its largest (bytes), from the arrays it allocates per
    !> pixel of the NP x NP grid: the forces, the grid's gaps and Love table (8 bytes each);
    !> the kernel's spectrum, complex on (M/2 + 1) x NP with M = 2 NP free or NP periodic
@@ -155,6 +148,12 @@ contains
       bytes = n2*per_pixel
    end function cg_storage_bytes
 
+   !> The approach (nm) of a fixed-load answer lies within this many nm of the exact
+   !> answer of the discrete problem (module header): the largest gap violation eps =
+   !> max(penetration, contact_gap) (nm), plus the load error's share, load_error times
+   !> the approach (a relative load error e moves the approach by at most e times it while
+   !> the load-approach curve is convex from first touch, the contact stiffness growing
+   !> with the contact; e is round-off, 1e-16, by construction).
    pure real(dp) function approach_error_bound(penetration, contact_gap, load_error, approach) result(bound)
       real(dp), intent(in) :: penetration, contact_gap, load_error, approach
       bound = max(penetration, contact_gap) + load_error*abs(approach)
@@ -201,15 +200,9 @@ contains
          call set_error(status, STATUS_USAGE, "cg: --solver cg needs --loads or --approach")
          return
       end if
-      ! The storage, checked against the memory the run may use before it is allocated.
-      res%estimated_peak_bytes = resident_bytes() + cg_storage_bytes(np, m, options%boundary == "periodic", &
-         options%plastic)
-      if (physical_memory() > 0 .and. res%estimated_peak_bytes > physical_memory()) then
-         call set_error(status, STATUS_NUMERICAL, "cg: NP = "//int_str(np)//" needs about "// &
-            memory_text(res%estimated_peak_bytes)//" (the solver's arrays and what the run holds already), "// &
-            "this run may use "//memory_text(physical_memory())//"; femcod-mpi splits the grid over nodes")
-         return
-      end if
+      res%estimated_peak_bytes = cg_storage_bytes(np, m, options%boundary == "periodic", options%plastic)
+      call refuse_beyond_memory("cg: NP = "//int_str(np), res%estimated_peak_bytes, options%memory_available, status)
+      if (status%code /= 0) return
       call make_grid(fine, initial_gap_map(problem%lower, problem%upper), problem, &
          problem%pixel, how, options%boundary == "periodic")
       ! A periodic cell is in full contact when the approach (the fall of the mean gap)
@@ -436,12 +429,6 @@ contains
       real(dp) :: left
       integer :: round, ncap
       allocate(force(size(p, 1), size(p, 2)), w(size(p, 1), size(p, 2)))
-      ! A plastic set from a larger load (displacement control tries loads on both sides
-      ! of the answer) may carry this load alone or more: start elastic again.
-      if (count(capped)*fmax >= load) then
-         capped = .false.
-         p = 0
-      end if
       do round = 1, MAX_ROUNDS
          ncap = count(capped)
          if (ncap > 0) then
@@ -484,7 +471,6 @@ contains
          return
       end if
       p = merge(fmax, p, capped)
-      ! Displacement control solves one state at many trial loads: the last one's map.
       if (allocated(state%plastic)) deallocate(state%plastic)
       allocate(state%plastic(size(p, 1), size(p, 2)))
       state%plastic = 0

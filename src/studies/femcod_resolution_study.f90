@@ -12,6 +12,7 @@ module femcod_resolution_study
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options
+   use femcod_memory, only: available_memory
    use femcod_observer, only: solver_observer
    use femcod_solver, only: solve_contact
    use femcod_richardson, only: power_law_fit
@@ -120,6 +121,7 @@ contains
       level%pixel = d%pixel
       options%hardness = hardness
       allocate(options%loads(0))
+      options%memory_available = available_memory()
       call solve_contact(d, options, level%res, status, observer)
       if (status%code /= 0) return
       if (present(capped)) level%has_capped = capped
