@@ -9,7 +9,7 @@ module femcod_strings
    implicit none
    private
    public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, add_lines, add_text, built_text
-   public :: without_trailing_zeros, xml_escape, json_string, json_number, sig_str
+   public :: without_trailing_zeros, xml_escape, json_string, json_number, sig_str, next_line
    public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, format_reals, is_digit, &
       append_string, integer_text
 
@@ -855,4 +855,25 @@ contains
          end if
       end if
    end function sig_str
+
+   !> The next line of `text` from position `a` (CR LF or LF ends); false at the end.
+   logical function next_line(text, a, line)
+      character(len=*), intent(in) :: text
+      integer, intent(inout) :: a
+      character(len=:), allocatable, intent(out) :: line
+      integer :: b
+      next_line = a <= len(text)
+      if (.not. next_line) return
+      b = index(text(a:), achar(10))
+      if (b == 0) then
+         line = text(a:)
+         a = len(text) + 1
+      else
+         line = text(a:a + b - 2)
+         a = a + b
+      end if
+      if (len(line) > 0) then
+         if (line(len(line):len(line)) == achar(13)) line = line(1:len(line) - 1)
+      end if
+   end function next_line
 end module femcod_strings

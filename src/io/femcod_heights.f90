@@ -15,7 +15,8 @@ module femcod_heights
    use, intrinsic :: iso_fortran_env, only: int16, int32
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_USAGE
-   use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real, append_string, sig_str
+   use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real, append_string, sig_str, &
+      next_line
    use femcod_surfaces, only: plane_tilt
    use femcod_files, only: path_exists, path_is_directory, read_file
    use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close, h5_rank_and_dims
@@ -898,26 +899,6 @@ contains
       end subroutine number_and_unit
    end subroutine read_nanoscope
 
-   !> The next line of `text` from position `a` (CR LF or LF ends); false at the end.
-   logical function next_line(text, a, line)
-      character(len=*), intent(in) :: text
-      integer, intent(inout) :: a
-      character(len=:), allocatable, intent(out) :: line
-      integer :: b
-      next_line = a <= len(text)
-      if (.not. next_line) return
-      b = index(text(a:), achar(10))
-      if (b == 0) then
-         line = text(a:)
-         a = len(text) + 1
-      else
-         line = text(a:a + b - 2)
-         a = a + b
-      end if
-      if (len(line) > 0) then
-         if (line(len(line):len(line)) == achar(13)) line = line(1:len(line) - 1)
-      end if
-   end function next_line
 
    !> "\Key: value" -> key, value; false for other lines.
    logical function field(line, key, value)

@@ -19,7 +19,7 @@
 module femcod_output_guard
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_BAD_INPUT
-   use femcod_strings, only: string_type
+   use femcod_strings, only: string_type, next_line
    use femcod_files, only: canonical_path, path_exists, path_is_directory
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read_string_attribute, h5_exists
    implicit none
@@ -125,12 +125,12 @@ contains
       character(len=:), allocatable :: line
       ok = .false.
       start = 1
-      line = next_line(head, start)
-      line = next_line(head, start)
+      if (.not. next_line(head, start, line)) return
+      if (.not. next_line(head, start, line)) return
       read(line, *, iostat=ios) np, pixel, maxcont
       if (ios /= 0) return
       do k = 1, 3
-         line = next_line(head, start)
+         if (.not. next_line(head, start, line)) return
          read(line, *, iostat=ios) e, nu
          if (ios /= 0) return
       end do
@@ -203,36 +203,14 @@ contains
       close(unit)
    end function file_head
 
+   !> The first line of `text` (without its CR LF or LF).
    function first_line(text) result(line)
       character(len=*), intent(in) :: text
       character(len=:), allocatable :: line
       integer :: start
       start = 1
-      line = next_line(text, start)
+      if (.not. next_line(text, start, line)) line = ""
    end function first_line
-
-   !> The line of `text` from `start` (without its CR LF or LF); `start` moves past it.
-   function next_line(text, start) result(line)
-      character(len=*), intent(in) :: text
-      integer, intent(inout) :: start
-      character(len=:), allocatable :: line
-      integer :: stop_at
-      if (start > len(text)) then
-         line = ""
-         return
-      end if
-      stop_at = index(text(start:), new_line("a"))
-      if (stop_at == 0) then
-         line = text(start:)
-         start = len(text) + 1
-      else
-         line = text(start:start + stop_at - 2)
-         start = start + stop_at
-      end if
-      if (len(line) > 0) then
-         if (line(len(line):) == achar(13)) line = line(:len(line) - 1)
-      end if
-   end function next_line
 
    pure logical function ends_with(text, tail)
       character(len=*), intent(in) :: text, tail

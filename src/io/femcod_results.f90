@@ -646,8 +646,8 @@ contains
          json_number(info%digest_seconds)//', "solve": '//json_number(res%wall_seconds)//', "maps": '// &
          json_number(info%maps_seconds)//', "write_hdf5": '//json_number(write_seconds(1))// &
          ', "write_text_and_figures": '//json_number(write_seconds(2))//'},'//nl// &
-         '  "memory_bytes": {"estimated_peak": '//int8_text(res%estimated_peak_bytes)//', "peak": '// &
-         int8_text(peak_resident_bytes())//'},'//nl// &
+         '  "memory_bytes": {"estimated_peak": '//int_str(res%estimated_peak_bytes)//', "peak": '// &
+         int_str(peak_resident_bytes())//'},'//nl// &
          '  "checks": {"penetrating_pixels_at_end": '//int_str(res%missed_final_check)// &
          ', "deepest_penetration_nm": '//json_number(res%max_penetration)//', "found_late": '// &
          int_str(res%missed_during_run)//', "releases": '//int_str(res%releases)// &
@@ -743,12 +743,4 @@ contains
          ', "work_of_adhesion_J_m2": '//json_number(info%work)//', "range_nm": '//json_number(info%range)//'},'// &
          new_line("a")
    end function adhesion_json
-   !> An 8-byte integer as JSON text.
-   pure function int8_text(v) result(text)
-      integer(i8), intent(in) :: v
-      character(len=:), allocatable :: text
-      character(len=24) :: buf
-      write(buf, '(i0)') v
-      text = trim(buf)
-   end function int8_text
 end module femcod_results
