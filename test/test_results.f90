@@ -790,12 +790,13 @@ contains
          do k = 1, size(fractions)
             write(delay, '(f0.3)') fractions(k)*duration
             if (file_exists(dir//"/ck"//tag//".ckpt.h5")) resumed = resumed + 1
-            call execute_command_line("timeout -s KILL "//trim(delay)//" "//cmd//" 2>/dev/null", exitstat=code)
+            call execute_command_line("timeout -s KILL "//trim(delay)//" "//cmd//" 2>"//dir//"/killed.err", &
+               exitstat=code)
             if (code == 137) killed = killed + 1
             if (code /= 137 .and. code /= 0) exit
          end do
          call check(error, code == 0 .or. code == 137, tag//" killed runs exit by the signal only, got "// &
-            to_string(code))
+            to_string(code)//": "//read_text(dir//"/killed.err"))
          if (allocated(error)) return
          call execute_command_line(cmd, exitstat=code)
          call check(error, code, 0, tag//" the final --restart")
