@@ -51,8 +51,12 @@ if [ "$(head -1 "$work/mpi.loads.csv")" = "$(head -1 "$work/serial.loads.csv")" 
 else
   echo "  FAILED   loads.csv or the figures"; failed=1
 fi
-expect 2 "--approach refused" mpirun_2 "$femcod_mpi" "$deck" --approach 0.5 -o "$work/bad"
-expect 2 "--boundary periodic refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 --boundary periodic -o "$work/bad"
+expect 2 "--adhesion refused" mpirun_2 "$femcod_mpi" "$deck" --approach 0.5 --adhesion dugdale --work 0.05 \
+  --range 1 -o "$work/bad"
+expect 2 "--plastic with --approach refused" mpirun_2 "$femcod_mpi" "$deck" --approach 0.5 --plastic --hardness 11 \
+  -o "$work/bad"
+expect 2 "--kernel-radius on the periodic cell refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 \
+  --boundary periodic --kernel-radius 4 -o "$work/bad"
 expect 2 "two decks refused" mpirun_2 "$femcod_mpi" "$deck" ../input/sphere_d2.deck --loads 10
 expect 2 "the event solver refused" mpirun_2 "$femcod_mpi" "$deck" --solver incremental --loads 10 -o "$work/bad"
 printf 'a deck\n3 1 x\n' >"$work/broken.deck"
@@ -91,8 +95,9 @@ then echo "  passed   each rank's memory estimate against its measured peak"
 else echo "  FAILED   each rank's memory estimate against its measured peak"; failed=1; fi
 # The combination matrix on 2 ranks (issue 34): boundary x plastic cap x interface law x
 # question (loads, increasing, decreasing approaches) x --restart on the 2 nm sphere. Each
-# combination answers (exit 0, as serial `femcod run --solver cg` does, to 1e-6) or is
-# refused (exit 2) with no output and no lock; none ends in a runtime error.
+# combination answers (exit 0, as serial `femcod run --solver cg` does: loads, approaches
+# and plastic volumes to 1e-6, the same contact and plastic counts) or is refused (exit 2)
+# with no output and no lock; none ends in a runtime error. With --kernel-radius once more.
 matrix_deck=../input/sphere_d2.deck
 combos=0; answered=0; refused=0; matrix_failed=0
 for boundary in free periodic; do for plastic in "" "--plastic --hardness 11"; do
@@ -121,12 +126,23 @@ a = list(csv.DictReader(open(sys.argv[1])))
 b = list(csv.DictReader(open(sys.argv[2])))
 assert len(a) == len(b) == 2, (len(a), len(b))
 for x, y in zip(a, b):
-    for key in ("load_nN", "approach_nm"):
+    for key in ("load_nN", "approach_nm", "plastic_volume_nm3"):
         u, v = float(x[key]), float(y[key])
         assert abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
+    for key in ("contacts", "n_plastic"):
+        assert x[key] == y[key], (key, x[key], y[key])
 PY
   then echo "  FAILED   femcod-mpi $args: not the serial answer"; matrix_failed=1; fi
 done; done; done; done; done
+for args in "--loads 300,800 --kernel-radius 6" "--loads 300,800 --kernel-radius 6 --plastic --hardness 11"; do
+  combos=$((combos + 1)); m="$work/m$combos"
+  got=0; mpirun_2 "$femcod_mpi" "$matrix_deck" $args --tol 1e-10 --quiet -o "$m" >"$m.out" 2>&1 || got=$?
+  "$femcod" run "$matrix_deck" --solver cg $args --tol 1e-10 --quiet -o "$m.serial" >/dev/null 2>&1 || got=1
+  if [ "$got" -eq 0 ] && cmp -s <(cut -d, -f3,8 "$m.loads.csv") <(cut -d, -f3,8 "$m.serial.loads.csv") && \
+     python3 -c 'import csv,sys; a,b=[list(csv.DictReader(open(f))) for f in sys.argv[1:]]; assert len(a)==len(b)==2; assert all(abs(float(x["approach_nm"])-float(y["approach_nm"]))<=1e-6 for x,y in zip(a,b))' \
+     "$m.serial.loads.csv" "$m.loads.csv"; then answered=$((answered + 1))
+  else echo "  FAILED   femcod-mpi $args: not the serial answer (exit $got)"; matrix_failed=1; fi
+done
 if [ "$matrix_failed" -eq 0 ]; then
   echo "  passed   the combination matrix on 2 ranks: $combos combinations, $refused refused, $answered answered as serial"
 else

@@ -1,9 +1,11 @@
-!> femcod-mpi: the fixed-load solver (`femcod run --solver cg`) on MPI ranks, for grids
-!> beyond one node's memory or time. Run it under mpirun with the options of `femcod run`:
+!> femcod-mpi: the cg solver (`femcod run --solver cg`) on MPI ranks, for grids beyond one
+!> node's memory or time. Run it under mpirun with the options of `femcod run`:
 !>     mpirun -np 4 femcod-mpi DECK --loads F1,F2 [-o PREFIX] [--tol T] ...
 !>     mpirun -np 4 femcod-mpi --lower scan.h5:/heights --pixel 2 --loads F
+!>     mpirun -np 4 femcod-mpi DECK --boundary periodic --approach D1,D2 ...
 !> Rank 0 reads the deck or height files (one copy of the heights, on rank 0 only) and
-!> sends each rank its columns; all ranks solve (femcod_mpi_cg) and write PREFIX.h5 together
+!> sends each rank its columns; all ranks solve (femcod_cg's solve on the distributed
+!> elastic operator of femcod_mpi_cg) and write PREFIX.h5 together
 !> (femcod_mpi_results); rank 0 writes PREFIX.summary.json and prints the summary.
 !> Exit codes as femcod's: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O,
 !> 128 + the signal's number after SIGTERM, SIGINT or SIGUSR1 (no checkpoint: cg keeps none).
@@ -37,7 +39,7 @@ program femcod_mpi
       agree
    use femcod_svg, only: svg_pressure_map
    use femcod_maps, only: state_maps
-   use femcod_cg, only: approach_error_bound, cg_storage_bytes
+   use femcod_cg, only: cg_storage_bytes
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -122,14 +124,14 @@ program femcod_mpi
    if (allocated(problem%upper)) deallocate(problem%upper)
    ! What each rank is about to allocate, summed over the ranks of a node, against that
    ! node's memory: refused on every rank (exit 4) before the grids are made.
-   call check_node_memory(np, size(settings%solve%loads), status)
+   call check_node_memory(np, size(targets()), status)
    if (status%code /= 0) call finish(status%code, status%message)
    call grid_setup(grid, MPI_COMM_WORLD, np, block, local, constants(2), constants(3), constants(4), &
-      settings%solve%cg, status)
+      settings%solve%cg, status, settings%solve%boundary == "periodic")
    deallocate(local)
    call wall_clock(t_read)
-   if (status%code == 0) call solve_loads(grid, problem, settings%solve%loads, settings%solve%cg, block, states, &
-      status, observer, settings%solve%hardness)
+   if (status%code == 0) call solve_loads(grid, problem, targets(), settings%solve%cg, states, status, observer, &
+      settings%solve%hardness, settings%solve%plastic, by_approach())
    call wall_clock(t_solve)
    if (status%code /= 0) then
       if (status%code == STATUS_INTERRUPTED) call finish(128 + stop_signal(), signal_name(stop_signal())//": "// &
@@ -194,6 +196,9 @@ program femcod_mpi
 contains
 
    !> The options femcod run has and femcod-mpi does not (yet): refused, not ignored.
+   !> The ranks run femcod_cg's fixed-load and fixed-approach solve (with --plastic and
+   !> --kernel-radius) on the free surface or the periodic cell; the gap-variable solver
+   !> (adhesion, or the plastic cap under displacement control) runs on one node.
    subroutine refuse_unsupported(settings, status)
       type(run_settings), intent(in) :: settings
       type(status_type), intent(inout) :: status
@@ -204,18 +209,37 @@ contains
          else if (size(settings%decks) /= 1) then
             call set_error(status, STATUS_USAGE, "one deck per run: run several decks as a job array "// &
                "(doc/cluster.md)")
-         else if (size(o%loads) == 0) then
-            call set_error(status, STATUS_USAGE, "give the loads: --loads F1,F2,... "// &
-               "(--approach runs on one node: femcod run --solver cg)")
-         else if (o%boundary /= "free") then
-            call set_error(status, STATUS_USAGE, "--boundary periodic: the MPI solver has the free surface only; "// &
-               "a periodic cell runs on one node: femcod run --solver cg --boundary periodic")
-         else if (o%adhesion /= "none" .or. o%plastic .or. o%cg%kernel_radius > 0) then
-            call set_error(status, STATUS_USAGE, "--adhesion, --plastic and --kernel-radius are not in the MPI solver; "// &
-               "these run on one node: femcod run --solver cg")
+         else if (size(targets()) == 0) then
+            call set_error(status, STATUS_USAGE, "give the loads or the approaches: --loads F1,F2,... or "// &
+               "--approach D1,D2,...")
+         else if (o%boundary == "periodic" .and. o%cg%kernel_radius > 0) then
+            call set_error(status, STATUS_USAGE, "--kernel-radius with --boundary periodic: the ranks take the "// &
+               "periodic kernel's spectrum in closed form, untruncated; it runs on one node: femcod run --solver cg")
+         else if (o%adhesion /= "none") then
+            call set_error(status, STATUS_USAGE, "--adhesion is not in the MPI solver; it runs on one node: "// &
+               "femcod run --solver cg")
+         else if (o%plastic .and. by_approach()) then
+            call set_error(status, STATUS_USAGE, "--plastic with --approach (the gap-variable solver) is not in the "// &
+               "MPI solver; it runs on one node: femcod run --solver cg; on ranks give --plastic with --loads")
          end if
       end associate
    end subroutine refuse_unsupported
+
+   !> Displacement control: --approach given.
+   logical function by_approach()
+      by_approach = .false.
+      if (allocated(settings%solve%approaches)) by_approach = size(settings%solve%approaches) > 0
+   end function by_approach
+
+   !> The targets: the approaches (nm) with --approach, else the loads (nN).
+   function targets() result(values)
+      real(dp), allocatable :: values(:)
+      if (by_approach()) then
+         values = settings%solve%approaches
+      else
+         values = settings%solve%loads
+      end if
+   end function targets
 
    !> Each rank's storage: what it holds now and its share of the cg solver's arrays
    !> (cg_storage_bytes over the ranks: the grid is split in column slabs). The ranks that
@@ -226,7 +250,9 @@ contains
       type(status_type), intent(inout) :: st
       type(MPI_Comm) :: node
       integer(i8) :: on_node, worst, may
-      estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, .false., .false.) + ranks - 1)/ranks
+      estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, settings%solve%boundary == "periodic", &
+         settings%solve%plastic) + &
+         ranks - 1)/ranks
       call MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
       call MPI_Allreduce(estimated_rank_bytes, on_node, 1, MPI_INTEGER8, MPI_SUM, node)
       call MPI_Comm_free(node)
@@ -244,7 +270,7 @@ contains
    subroutine output_and_input_names(outputs, inputs)
       type(string_type), allocatable, intent(out) :: outputs(:), inputs(:)
       integer :: j, nloads
-      nloads = size(settings%solve%loads)
+      nloads = size(targets())
       allocate(outputs(3 + nloads))
       outputs(1)%s = prefix//".h5"
       outputs(2)%s = prefix//".summary.json"
@@ -297,8 +323,7 @@ contains
       close(unit)
    end function peak_memory_mb
 
-   !> PREFIX.loads.csv, the serial writer's columns (no plastic cap here: n_plastic and
-   !> plastic_volume_nm3 are 0).
+   !> PREFIX.loads.csv, the serial writer's columns.
    function loads_csv() result(text)
       character(len=:), allocatable :: text
       integer :: s
@@ -308,7 +333,8 @@ contains
          associate(st => states(s))
             text = text//format_real(st%load)//","//format_real(st%approach)//","//int_str(st%contacts)//","// &
                format_real(st%contacts*grid%pixel**2)//","//format_real(real(st%contacts, dp)/real(np, dp)**2)//","// &
-               format_real(st%max_pressure)//","//int_str(st%above_hardness)//",0,0"//new_line('a')
+               format_real(st%max_pressure)//","//int_str(st%above_hardness)//","//int_str(st%n_plastic)//","// &
+               format_real(st%plastic_volume)//new_line('a')
          end associate
       end do
    end function loads_csv
@@ -333,11 +359,13 @@ contains
       text = trim(text)//'], "read_peak_memory_MB": '//json_number(read_peak)//', "loads": ['
       do s = 1, size(states)
          associate(st => states(s))
-            text = text//'{"load_nN": '//json_number(st%load)//', "approach_nm": '//json_number(st%approach)// &
-               ', "approach_error_bound_nm": '//json_number(approach_error_bound(st%penetration, st%contact_gap, &
-               st%load_error, st%approach))//', "contacts": '//int_str(st%contacts)//', "area_fraction": '// &
+            text = text//'{"load_nN": '//json_number(st%load)//', "approach_nm": '//json_number(st%approach)
+            if (st%approach_bound >= 0) text = text//', "approach_error_bound_nm": '//json_number(st%approach_bound)
+            text = text//', "contacts": '//int_str(st%contacts)//', "area_fraction": '// &
                json_number(real(st%contacts, dp)/real(np, dp)**2)//', "max_pressure_GPa": '// &
-               json_number(st%max_pressure)//', "iterations": '//int_str(st%iterations)// &
+               json_number(st%max_pressure)//', "n_above_hardness": '//int_str(st%above_hardness)// &
+               ', "n_plastic": '//int_str(st%n_plastic)//', "plastic_volume_nm3": '// &
+               json_number(st%plastic_volume)//', "iterations": '//int_str(st%iterations)// &
                ', "coarse_iterations": '//int_str(st%coarse_iterations)//', "convolutions": '// &
                int_str(st%convolutions)//', "residual": '//json_number(st%residual)//', "time_s": '// &
                json_number(st%seconds)//', "transform_s": '//json_number(st%transform_seconds)// &
@@ -349,16 +377,22 @@ contains
    end function summary_json
 
    subroutine print_summary()
+      character(len=:), allocatable :: bound_note, plastic_note
       integer :: s
       write(output_unit, '(a)') "femcod-mpi: "//info%label
       write(output_unit, '(a)') "  grid "//int_str(np)//" x "//int_str(np)//", pixel "//format_real(grid%pixel)// &
-         " nm, free surface; "//int_str(ranks)//" MPI ranks x "//int_str(info%threads)//" threads"
+         " nm, "//trim(merge("periodic cell", "free surface ", settings%solve%boundary == "periodic"))//"; "// &
+         int_str(ranks)//" MPI ranks x "//int_str(info%threads)//" threads"
       do s = 1, size(states)
          associate(st => states(s))
+            bound_note = ""
+            if (st%approach_bound >= 0) bound_note = " (+- "//sig_str(st%approach_bound, 2)//" nm)"
+            plastic_note = ""
+            if (settings%solve%plastic) plastic_note = ", "//int_str(st%n_plastic)//" at the hardness"
             write(output_unit, '(a)') "  load "//format_real(st%load)//" nN: approach "//sig_str(st%approach, 10)// &
-               " nm (+- "//sig_str(approach_error_bound(st%penetration, st%contact_gap, st%load_error, st%approach), 2)// &
-               " nm), "//int_str(st%contacts)//" contacts ("//sig_str(100*real(st%contacts, dp)/real(np, dp)**2, 4)// &
-               " % of the area), max pressure "//sig_str(st%max_pressure, 4)//" GPa"
+               " nm"//bound_note//", "//int_str(st%contacts)//" contacts ("// &
+               sig_str(100*real(st%contacts, dp)/real(np, dp)**2, 4)//" % of the area), max pressure "// &
+               sig_str(st%max_pressure, 4)//" GPa"//plastic_note
             write(output_unit, '(a)') "    "//int_str(st%iterations)//" iterations (+ "//int_str(st%coarse_iterations)// &
                " on coarser grids), "//int_str(st%convolutions)//" fresh convolutions, residual "// &
                sig_str(st%residual, 2)//", "//sig_str(st%seconds, 3)//" s (rank 0: transforms "// &
@@ -379,12 +413,15 @@ contains
       write(output_unit, '(a)') ""
       write(output_unit, '(a)') "The fixed-load solver (femcod run --solver cg) with the grid split in column slabs"
       write(output_unit, '(a)') "across MPI ranks: FFTW-MPI transforms, parallel HDF5 output. The options are those"
-      write(output_unit, '(a)') "of femcod run (femcod run --help) for the cg solver on a free surface:"
-      write(output_unit, '(a)') "  --loads F1,F2,...  total loads (nN); --tol T (default 1e-8); --max-iterations N"
-      write(output_unit, '(a)') "  -o PREFIX, --outdir DIR, --force, --quiet; the height-file options (--lower,"
-      write(output_unit, '(a)') "  --upper, --pixel, --young, --poisson, --height-unit, ...)"
-      write(output_unit, '(a)') "Refused (they run on one node with femcod run): --approach, --boundary periodic,"
-      write(output_unit, '(a)') "--adhesion, --plastic, --kernel-radius, several decks, the event solvers."
+      write(output_unit, '(a)') "of femcod run (femcod run --help) for the cg solver, with the"
+      write(output_unit, '(a)') "same iteration (femcod_cg on the ranks' elastic operator):"
+      write(output_unit, '(a)') "  --loads F1,F2,...  total loads (nN), or --approach D1,D2,... approaches (nm)"
+      write(output_unit, '(a)') "  --boundary free|periodic, --plastic --hardness H (with --loads), --kernel-radius R"
+      write(output_unit, '(a)') "  (free surface), --tol T (default 1e-8),"
+      write(output_unit, '(a)') "  --max-iterations N, -o PREFIX, --outdir DIR, --force, --quiet; the height-file"
+      write(output_unit, '(a)') "  options (--lower, --upper, --pixel, --young, --poisson, --height-unit, ...)"
+      write(output_unit, '(a)') "Refused (they run on one node with femcod run): --adhesion, --plastic with"
+      write(output_unit, '(a)') "--approach, --kernel-radius on the periodic cell, several decks, the event solvers."
       write(output_unit, '(a)') "Writes PREFIX.h5 (/deck, /loads/<kkk> with pressure and gap maps, /run with the"
       write(output_unit, '(a)') "peak memory of every rank) and PREFIX.summary.json. Exit codes: 0 ok, 2 usage,"
       write(output_unit, '(a)') "3 bad input, 4 numerical failure, 5 I/O, 128 + signal after SIGTERM/SIGINT/SIGUSR1."

@@ -24,6 +24,11 @@
 !>   up to `direct_corrections` of them from the Love table, which would be NP^2 values on
 !>   every rank): more convolutions, the same answer (to the tolerance).
 !>
+!> The grid is an elastic operator (model/femcod_elastic_operator) whose reductions are
+!> MPI all-reduces: femcod_cg's one constrained iteration, its plastic rounds and its
+!> displacement control run on it unchanged (solve_loads), so every fixed-load and
+!> fixed-approach option of `femcod run --solver cg` on the free surface runs on ranks.
+!>
 !> No I/O and no stop: errors come back in a status, identical on every rank.
 module femcod_mpi_cg
    use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_float, c_float_complex, &
@@ -38,10 +43,13 @@ module femcod_mpi_cg
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
+   use femcod_love_periodic, only: periodic_love_spectrum_rows
    use femcod_spring, only: spring_stiffness
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: cg_settings
-   use femcod_cg, only: coarse_start_forces
+   use femcod_elastic_operator, only: elastic_operator, spread_load
+   use femcod_cg, only: coarse_start_forces, approach_error_bound, cg_session, cg_answer, session_start, solve_target, &
+      ascending_order, refuse_beyond_full_contact
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
@@ -50,20 +58,18 @@ module femcod_mpi_cg
    public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor
    public :: distribute_problem, scatter_problem, distributed_convolve
 
-   !> One rank's part of the problem and of the distributed convolution.
-   type :: distributed_grid
+   !> One rank's part of the problem and of the distributed convolution: an elastic
+   !> operator on this rank's columns (the parent type holds the grid side, the slab, the
+   !> pixel, c, s, the gaps and the preconditioner's taps).
+   type, extends(elastic_operator) :: distributed_grid
       type(MPI_Comm) :: comm
       integer :: ranks = 1, rank = 0
-      !> Grid side, this rank's first column (0-based) and number of columns.
-      integer :: np = 0, j0 = 0, nj = 0
       !> Every rank's first column (0-based) and number of columns, (0:ranks-1).
       integer, allocatable :: first(:), count(:)
-      !> Pixel (nm), compliance c and spring compliance s (nm/nN), height range (nm).
-      real(dp) :: pixel = 0, c = 0, s = 0, scale = 1
-      !> The initial gaps (nm) of this rank's columns, (np, nj).
-      real(dp), allocatable :: g0(:, :)
-      logical :: preconditioned = .false.
-      real(dp) :: taps(0:2, 0:2) = 0
+      !> The coarse start's averaging width (coarse_factor; 1: no coarse start), and on
+      !> rank 0 the deck's materials and pixel for it (no heights).
+      integer :: block = 1
+      type(contact_problem) :: materials
       !> Columns per rank (the last ranks may have fewer): FFTW-MPI's block size.
       integer :: block_columns = 0
       !> The padded side m = 2 np, its half spectrum mh = np + 1; this rank's frequencies
@@ -92,15 +98,32 @@ module femcod_mpi_cg
       !> transposes) and in the solver's other communication (sums, halos; waiting for
       !> slower ranks included).
       real(dp) :: transform_seconds = 0, communication_seconds = 0
+   contains
+      procedure :: displace => distributed_displace
+      procedure :: displace_single => distributed_displace_single
+      procedure :: sum_over_grid => sum_over_ranks
+      procedure :: max_over_grid => max_over_ranks
+      procedure :: min_over_grid => min_over_ranks
+      procedure :: any_over_grid => any_over_ranks
+      procedure :: exchange_halo => exchange_halo
+      procedure :: start_forces => coarse_start
    end type distributed_grid
 
    !> What the solver reached at one load (the same quantities as femcod_cg's residuals).
    type :: distributed_state
       real(dp) :: load = 0, approach = 0, residual = 0, penetration = 0, contact_gap = 0, load_error = 0
       real(dp) :: max_pressure = 0, seconds = 0
+      !> The approach's error bound (nm, femcod_cg's approach_error_bound) where the solver
+      !> has one (fixed loads, the full kernel, no cap); -1 elsewhere.
+      real(dp) :: approach_bound = -1
+      !> With --plastic: the capped pixels (all ranks), the plastic volume (nm^3), the
+      !> plastic rounds; this rank's columns of the plastic displacement (nm).
+      integer :: n_plastic = 0, plastic_rounds = 0
+      real(dp) :: plastic_volume = 0
+      real(dp), allocatable :: plastic(:, :)
       !> Of `seconds`: in the transforms and in communication (distributed_grid).
       real(dp) :: transform_seconds = 0, communication_seconds = 0
-      integer :: contacts = 0, iterations = 0, coarse_iterations = 0, convolutions = 0
+      integer :: contacts = 0, iterations = 0, coarse_iterations = 0, convolutions = 0, split_corrections = 0
       !> Pixels whose pressure is above the hardness given to solve_loads (all ranks).
       integer :: above_hardness = 0
       !> This rank's columns: contact forces (nN) and gaps (nm, 0 at the contacts).
@@ -142,7 +165,7 @@ contains
    !> and the global constants; makes the FFTW plans (the transposes FFTW-MPI's) and the
    !> kernel's spectrum.
    !> Collective over `comm`.
-   subroutine grid_setup(grid, comm, np, block, g0, pixel, c, s, how, status)
+   subroutine grid_setup(grid, comm, np, block, g0, pixel, c, s, how, status, periodic)
       type(distributed_grid), intent(inout) :: grid
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: np, block
@@ -150,16 +173,19 @@ contains
       real(dp), intent(in) :: pixel, c, s
       type(cg_settings), intent(in) :: how
       type(status_type), intent(inout) :: status
+      !> One cell of a periodic surface (cyclic convolution on the NP x NP grid, the
+      !> periodic Love kernel); default: the free surface.
+      logical, intent(in), optional :: periodic
       integer(c_intptr_t) :: alloc, dims(2), local_columns, column_start, local_freqs, freq_start
-      integer(c_int) :: flags
-      real(dp) :: lo, hi, kmin
-      real(dp), allocatable :: line(:)
-      integer :: jj, q, i, p
+      real(dp) :: lo, hi
       call grid_free(grid)
       grid%comm = comm
       call MPI_Comm_size(comm, grid%ranks)
       call MPI_Comm_rank(comm, grid%rank)
       grid%np = np
+      grid%block = block
+      grid%periodic = .false.
+      if (present(periodic)) grid%periodic = periodic
       call column_split(np, grid%ranks, block, grid%first, grid%count)
       grid%j0 = grid%first(grid%rank)
       grid%nj = grid%count(grid%rank)
@@ -189,8 +215,10 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, hi, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       grid%scale = max(hi - lo, tiny(1.0_dp))
       grid%block_columns = grid%count(0)
-      grid%m = 2*np
-      grid%mh = np + 1
+      ! The transform length down the columns and along the rows: 2 NP zero-padded (free
+      ! surface), NP (periodic cell); mh the half spectrum's length.
+      grid%m = merge(np, 2*np, grid%periodic)
+      grid%mh = grid%m/2 + 1
       ! The transpose of the half spectrum: [np][mh] complex by columns (blocks of
       ! block_columns) to [mh][np] by frequencies (FFTW's default block).
       dims = [integer(c_intptr_t) :: np, grid%mh]
@@ -205,45 +233,139 @@ contains
       grid%freq_start = int(freq_start)
       grid%column_memory = fftw_alloc_complex(int(max(alloc/2, int(grid%mh, c_intptr_t)*grid%nj, 1_c_intptr_t), c_size_t))
       grid%row_memory = fftw_alloc_complex(int(max(alloc/2, int(grid%m, c_intptr_t)*grid%freqs, 1_c_intptr_t), c_size_t))
+      call make_plans(grid, how, status)
+      if (status%code /= 0) return
+      call kernel_spectrum(grid, how)
+      grid%has_single = how%single_until > 0
+      if (grid%has_single) then
+         call make_single_plans(grid, how, status)
+         if (status%code /= 0) return
+         grid%kernel32 = real(grid%kernel, sp)
+      end if
+      call preconditioner(grid, how)
+   end subroutine grid_setup
+
+   !> FFTW flags: a measured plan when how%measure_plans.
+   pure integer(c_int) function plan_flags(how)
+      type(cg_settings), intent(in) :: how
+      plan_flags = FFTW_ESTIMATE
+      if (how%measure_plans) plan_flags = FFTW_MEASURE
+   end function plan_flags
+
+   !> The double-precision views of the transform memory and their plans: the columns'
+   !> r2c and c2r of length m, the rows' complex transforms of length m, FFTW-MPI's two
+   !> transposes.
+   subroutine make_plans(grid, how, status)
+      type(distributed_grid), intent(inout) :: grid
+      type(cg_settings), intent(in) :: how
+      type(status_type), intent(inout) :: status
+      integer(c_int) :: flags, m, mh, nj, freqs
+      flags = plan_flags(how)
+      m = int(grid%m, c_int)
+      mh = int(grid%mh, c_int)
+      nj = int(grid%nj, c_int)
+      freqs = int(grid%freqs, c_int)
       call c_f_pointer(grid%column_memory, grid%column_real, [2*grid%mh, grid%nj])
       call c_f_pointer(grid%column_memory, grid%column_flat, [2*grid%mh*grid%nj])
       call c_f_pointer(grid%column_memory, grid%columns, [grid%mh, grid%nj])
       call c_f_pointer(grid%row_memory, grid%rows, [grid%m, max(grid%freqs, 1)])
       call c_f_pointer(grid%row_memory, grid%row_values, [grid%m*max(grid%freqs, 1)])
       call c_f_pointer(grid%row_memory, grid%row_flat, [2*grid%m*max(grid%freqs, 1)])
-      flags = FFTW_ESTIMATE
-      if (how%measure_plans) flags = FFTW_MEASURE
-      grid%columns_forward = fftw_plan_many_dft_r2c(1_c_int, [int(grid%m, c_int)], int(grid%nj, c_int), &
-         grid%column_real, [int(2*grid%mh, c_int)], 1_c_int, int(2*grid%mh, c_int), grid%columns, &
-         [int(grid%mh, c_int)], 1_c_int, int(grid%mh, c_int), flags)
-      grid%columns_backward = fftw_plan_many_dft_c2r(1_c_int, [int(grid%m, c_int)], int(grid%nj, c_int), &
-         grid%columns, [int(grid%mh, c_int)], 1_c_int, int(grid%mh, c_int), grid%column_real, &
-         [int(2*grid%mh, c_int)], 1_c_int, int(2*grid%mh, c_int), flags)
+      grid%columns_forward = fftw_plan_many_dft_r2c(1_c_int, [m], nj, grid%column_real, [2*mh], 1_c_int, 2*mh, &
+         grid%columns, [mh], 1_c_int, mh, flags)
+      grid%columns_backward = fftw_plan_many_dft_c2r(1_c_int, [m], nj, grid%columns, [mh], 1_c_int, mh, &
+         grid%column_real, [2*mh], 1_c_int, 2*mh, flags)
       if (grid%freqs > 0) then
-         grid%rows_forward = fftw_plan_many_dft(1_c_int, [int(grid%m, c_int)], int(grid%freqs, c_int), grid%rows, &
-            [int(grid%m, c_int)], 1_c_int, int(grid%m, c_int), grid%rows, [int(grid%m, c_int)], 1_c_int, &
-            int(grid%m, c_int), FFTW_FORWARD, flags)
-         grid%rows_backward = fftw_plan_many_dft(1_c_int, [int(grid%m, c_int)], int(grid%freqs, c_int), grid%rows, &
-            [int(grid%m, c_int)], 1_c_int, int(grid%m, c_int), grid%rows, [int(grid%m, c_int)], 1_c_int, &
-            int(grid%m, c_int), FFTW_BACKWARD, flags)
+         grid%rows_forward = fftw_plan_many_dft(1_c_int, [m], freqs, grid%rows, [m], 1_c_int, m, grid%rows, [m], &
+            1_c_int, m, FFTW_FORWARD, flags)
+         grid%rows_backward = fftw_plan_many_dft(1_c_int, [m], freqs, grid%rows, [m], 1_c_int, m, grid%rows, [m], &
+            1_c_int, m, FFTW_BACKWARD, flags)
       end if
-      grid%to_rows = fftw_mpi_plan_many_transpose(int(np, c_intptr_t), int(grid%mh, c_intptr_t), 2_c_intptr_t, &
-         int(grid%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, grid%column_flat, grid%row_flat, comm%MPI_VAL, flags)
-      grid%to_columns = fftw_mpi_plan_many_transpose(int(grid%mh, c_intptr_t), int(np, c_intptr_t), 2_c_intptr_t, &
-         FFTW_MPI_DEFAULT_BLOCK, int(grid%block_columns, c_intptr_t), grid%row_flat, grid%column_flat, comm%MPI_VAL, flags)
+      grid%to_rows = fftw_mpi_plan_many_transpose(int(grid%np, c_intptr_t), int(grid%mh, c_intptr_t), 2_c_intptr_t, &
+         int(grid%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, grid%column_flat, grid%row_flat, &
+         grid%comm%MPI_VAL, flags)
+      grid%to_columns = fftw_mpi_plan_many_transpose(int(grid%mh, c_intptr_t), int(grid%np, c_intptr_t), &
+         2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(grid%block_columns, c_intptr_t), grid%row_flat, grid%column_flat, &
+         grid%comm%MPI_VAL, flags)
       if (.not. (c_associated(grid%columns_forward) .and. c_associated(grid%columns_backward) .and. &
          c_associated(grid%to_rows) .and. c_associated(grid%to_columns) .and. (grid%freqs == 0 .or. &
-         (c_associated(grid%rows_forward) .and. c_associated(grid%rows_backward))))) then
+         (c_associated(grid%rows_forward) .and. c_associated(grid%rows_backward))))) &
          call set_error(status, STATUS_NUMERICAL, "FFTW made no plan for the "//int_str(grid%m)//" x "// &
-            int_str(grid%m)//" grid")
+         int_str(grid%m)//" grid")
+   end subroutine make_plans
+
+   !> The float32 views of the same memory and their plans (fftwf, fftwf_mpi).
+   subroutine make_single_plans(grid, how, status)
+      type(distributed_grid), intent(inout) :: grid
+      type(cg_settings), intent(in) :: how
+      type(status_type), intent(inout) :: status
+      integer(c_int) :: flags, m, mh, nj, freqs
+      flags = plan_flags(how)
+      m = int(grid%m, c_int)
+      mh = int(grid%mh, c_int)
+      nj = int(grid%nj, c_int)
+      freqs = int(grid%freqs, c_int)
+      call c_f_pointer(grid%column_memory, grid%column32_real, [2*grid%mh, grid%nj])
+      call c_f_pointer(grid%column_memory, grid%column32_flat, [2*grid%mh*grid%nj])
+      call c_f_pointer(grid%column_memory, grid%columns32, [grid%mh, grid%nj])
+      call c_f_pointer(grid%row_memory, grid%rows32, [grid%m, max(grid%freqs, 1)])
+      call c_f_pointer(grid%row_memory, grid%row32_values, [grid%m*max(grid%freqs, 1)])
+      call c_f_pointer(grid%row_memory, grid%row32_flat, [2*grid%m*max(grid%freqs, 1)])
+      grid%columns_forward32 = fftwf_plan_many_dft_r2c(1_c_int, [m], nj, grid%column32_real, [2*mh], 1_c_int, &
+         2*mh, grid%columns32, [mh], 1_c_int, mh, flags)
+      grid%columns_backward32 = fftwf_plan_many_dft_c2r(1_c_int, [m], nj, grid%columns32, [mh], 1_c_int, mh, &
+         grid%column32_real, [2*mh], 1_c_int, 2*mh, flags)
+      if (grid%freqs > 0) then
+         grid%rows_forward32 = fftwf_plan_many_dft(1_c_int, [m], freqs, grid%rows32, [m], 1_c_int, m, grid%rows32, &
+            [m], 1_c_int, m, FFTW_FORWARD, flags)
+         grid%rows_backward32 = fftwf_plan_many_dft(1_c_int, [m], freqs, grid%rows32, [m], 1_c_int, m, grid%rows32, &
+            [m], 1_c_int, m, FFTW_BACKWARD, flags)
+      end if
+      grid%to_rows32 = fftwf_mpi_plan_many_transpose(int(grid%np, c_intptr_t), int(grid%mh, c_intptr_t), &
+         2_c_intptr_t, int(grid%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, grid%column32_flat, &
+         grid%row32_flat, grid%comm%MPI_VAL, flags)
+      grid%to_columns32 = fftwf_mpi_plan_many_transpose(int(grid%mh, c_intptr_t), int(grid%np, c_intptr_t), &
+         2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(grid%block_columns, c_intptr_t), grid%row32_flat, &
+         grid%column32_flat, grid%comm%MPI_VAL, flags)
+      if (.not. (c_associated(grid%columns_forward32) .and. c_associated(grid%columns_backward32) .and. &
+         c_associated(grid%to_rows32) .and. c_associated(grid%to_columns32) .and. (grid%freqs == 0 .or. &
+         (c_associated(grid%rows_forward32) .and. c_associated(grid%rows_backward32))))) &
+         call set_error(status, STATUS_NUMERICAL, "FFTW made no float32 plan for the "//int_str(grid%m)//" x "// &
+         int_str(grid%m)//" grid")
+   end subroutine make_single_plans
+
+   !> The kernel's spectrum on this rank's frequencies kx, over all ky (m values), divided
+   !> by m^2 (FFTW's transforms are not normalised). Free surface: the Love table's even
+   !> extension (offsets -(np-1)..np-1, offset +-np 0) through the same transforms, each
+   !> rank from its own columns, truncated beyond how%kernel_radius pixels as the serial
+   !> operator's table is. Periodic cell: femcod_love_periodic's spectrum, exact, for this
+   !> rank's kx only (0 at zero frequency: zero-mean displacements).
+   subroutine kernel_spectrum(grid, how)
+      type(distributed_grid), intent(inout) :: grid
+      type(cg_settings), intent(in) :: how
+      real(dp), allocatable :: line(:), quarter(:, :)
+      integer :: jj, q, i, p, np, l, ky
+      np = grid%np
+      grid%self = love_influence(0, 0)
+      allocate(grid%kernel(grid%m, grid%freqs))
+      if (grid%periodic) then
+         ! (An expression's bounds start at 1: quarter(l, k2 + 1) is S(freq_start + l - 1, k2).)
+         quarter = periodic_love_spectrum_rows(np, grid%freq_start, grid%freqs)
+         do l = 1, grid%freqs
+            do ky = 0, np - 1
+               grid%kernel(ky + 1, l) = quarter(l, min(ky, np - ky) + 1)/real(np, dp)**2
+            end do
+         end do
+         ! I(0, 0) of the periodic table: the mean of the spectrum over all frequencies.
+         grid%self = sum_of_spectrum(grid)
          return
       end if
-      ! The kernel: the Love table's even extension (offsets -(np-1)..np-1, offset +-np
-      ! 0) through the same transforms; its spectrum over m^2, real.
       allocate(line(0:np - 1))
       do jj = 1, grid%nj
          q = grid%j0 + jj - 1
          line = love_influence([(p, p = 0, np - 1)], q)
+         if (how%kernel_radius > 0) where ([(real(p, dp)**2, p = 0, np - 1)] + real(q, dp)**2 > how%kernel_radius**2) &
+            line = 0
          grid%column_real(1:np, jj) = line
          grid%column_real(np + 1, jj) = 0
          do i = np + 2, grid%m
@@ -253,65 +375,56 @@ contains
       call fftw_execute_dft_r2c(grid%columns_forward, grid%column_real, grid%columns)
       call fftw_mpi_execute_r2r(grid%to_rows, grid%column_flat, grid%row_flat)
       call expand_rows(grid, even=.true.)
-      allocate(grid%kernel(grid%m, grid%freqs))
       if (grid%freqs > 0) then
          call fftw_execute_dft(grid%rows_forward, grid%rows, grid%rows)
          grid%kernel = real(grid%rows(:, 1:grid%freqs), dp)/real(grid%m, dp)**2
       end if
-      grid%has_single = how%single_until > 0
-      if (grid%has_single) then
-         call c_f_pointer(grid%column_memory, grid%column32_real, [2*grid%mh, grid%nj])
-         call c_f_pointer(grid%column_memory, grid%column32_flat, [2*grid%mh*grid%nj])
-         call c_f_pointer(grid%column_memory, grid%columns32, [grid%mh, grid%nj])
-         call c_f_pointer(grid%row_memory, grid%rows32, [grid%m, max(grid%freqs, 1)])
-         call c_f_pointer(grid%row_memory, grid%row32_values, [grid%m*max(grid%freqs, 1)])
-         call c_f_pointer(grid%row_memory, grid%row32_flat, [2*grid%m*max(grid%freqs, 1)])
-         grid%columns_forward32 = fftwf_plan_many_dft_r2c(1_c_int, [int(grid%m, c_int)], int(grid%nj, c_int), &
-            grid%column32_real, [int(2*grid%mh, c_int)], 1_c_int, int(2*grid%mh, c_int), grid%columns32, &
-            [int(grid%mh, c_int)], 1_c_int, int(grid%mh, c_int), flags)
-         grid%columns_backward32 = fftwf_plan_many_dft_c2r(1_c_int, [int(grid%m, c_int)], int(grid%nj, c_int), &
-            grid%columns32, [int(grid%mh, c_int)], 1_c_int, int(grid%mh, c_int), grid%column32_real, &
-            [int(2*grid%mh, c_int)], 1_c_int, int(2*grid%mh, c_int), flags)
-         if (grid%freqs > 0) then
-            grid%rows_forward32 = fftwf_plan_many_dft(1_c_int, [int(grid%m, c_int)], int(grid%freqs, c_int), &
-               grid%rows32, [int(grid%m, c_int)], 1_c_int, int(grid%m, c_int), grid%rows32, [int(grid%m, c_int)], &
-               1_c_int, int(grid%m, c_int), FFTW_FORWARD, flags)
-            grid%rows_backward32 = fftwf_plan_many_dft(1_c_int, [int(grid%m, c_int)], int(grid%freqs, c_int), &
-               grid%rows32, [int(grid%m, c_int)], 1_c_int, int(grid%m, c_int), grid%rows32, [int(grid%m, c_int)], &
-               1_c_int, int(grid%m, c_int), FFTW_BACKWARD, flags)
-         end if
-         grid%to_rows32 = fftwf_mpi_plan_many_transpose(int(np, c_intptr_t), int(grid%mh, c_intptr_t), 2_c_intptr_t, &
-            int(grid%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, grid%column32_flat, grid%row32_flat, &
-            comm%MPI_VAL, flags)
-         grid%to_columns32 = fftwf_mpi_plan_many_transpose(int(grid%mh, c_intptr_t), int(np, c_intptr_t), &
-            2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(grid%block_columns, c_intptr_t), grid%row32_flat, &
-            grid%column32_flat, comm%MPI_VAL, flags)
-         if (.not. (c_associated(grid%columns_forward32) .and. c_associated(grid%columns_backward32) .and. &
-            c_associated(grid%to_rows32) .and. c_associated(grid%to_columns32) .and. (grid%freqs == 0 .or. &
-            (c_associated(grid%rows_forward32) .and. c_associated(grid%rows_backward32))))) then
-            call set_error(status, STATUS_NUMERICAL, "FFTW made no float32 plan for the "//int_str(grid%m)//" x "// &
-               int_str(grid%m)//" grid")
-            return
-         end if
-         grid%kernel32 = real(grid%kernel, sp)
-      end if
+   end subroutine kernel_spectrum
+
+   !> I(0, 0) of the periodic table from the spectrum: the sum over all m^2 frequencies of
+   !> the (normalised) kernel, the half spectrum's inner kx counted twice. Collective.
+   real(dp) function sum_of_spectrum(grid) result(total)
+      type(distributed_grid), intent(inout) :: grid
+      integer :: l, kx
+      total = 0
+      do l = 1, grid%freqs
+         kx = grid%freq_start + l - 1
+         total = total + merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%m)*sum(grid%kernel(:, l))
+      end do
+      call MPI_Allreduce(MPI_IN_PLACE, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
+   end function sum_of_spectrum
+
+   !> The preconditioner (how%precondition, NP >= 3) when the kernel's spectrum is
+   !> positive (at every frequency but zero, for the periodic cell).
+   subroutine preconditioner(grid, how)
+      type(distributed_grid), intent(inout) :: grid
+      type(cg_settings), intent(in) :: how
+      real(dp) :: kmin
       grid%preconditioned = .false.
       grid%taps = 0
-      if (how%precondition .and. np >= 3) then
-         kmin = huge(1.0_dp)
-         if (grid%freqs > 0) kmin = minval(grid%kernel)
-         call MPI_Allreduce(MPI_IN_PLACE, kmin, 1, MPI_DOUBLE_PRECISION, MPI_MIN, comm)
-         if (kmin > 0) then
-            call inverse_taps(grid)
-            grid%preconditioned = .true.
-         end if
+      if (.not. (how%precondition .and. grid%np >= 3)) return
+      kmin = huge(1.0_dp)
+      if (grid%freqs > 0) kmin = minval(grid%kernel, mask=.not. zero_frequency())
+      call MPI_Allreduce(MPI_IN_PLACE, kmin, 1, MPI_DOUBLE_PRECISION, MPI_MIN, grid%comm)
+      if (kmin > 0) then
+         call inverse_taps(grid)
+         grid%preconditioned = .true.
       end if
-   end subroutine grid_setup
+   contains
+      !> The periodic kernel's zero frequency, where it has no inverse (none for the free
+      !> surface).
+      function zero_frequency() result(mask)
+         logical :: mask(grid%m, grid%freqs)
+         mask = .false.
+         if (grid%periodic .and. grid%freq_start == 0) mask(1, 1) = .true.
+      end function zero_frequency
+   end subroutine preconditioner
 
    !> The preconditioner's taps (femcod_convolution's inverse_kernel_taps): the centre of
    !> the inverse of the padded convolution, taps(a, b) = sum over all frequencies of
    !> cos(2 pi a kx/m) cos(2 pi b ky/m) / kernel / m^4, each rank over its own kx (weight 2
-   !> for the half spectrum's inner ones), summed by MPI_Allreduce.
+   !> for the half spectrum's inner ones), summed by MPI_Allreduce; on the periodic cell
+   !> without the zero frequency (femcod_convolution's pseudo-inverse).
    subroutine inverse_taps(grid)
       type(distributed_grid), intent(inout) :: grid
       real(dp), parameter :: two_pi = 8*atan(1.0_dp)
@@ -320,9 +433,11 @@ contains
       partial = 0
       do l = 1, grid%freqs
          kx = grid%freq_start + l - 1
-         w = merge(1.0_dp, 2.0_dp, kx == 0 .or. kx == grid%m/2)
+         w = merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%m)
          cx = [(w*cos(two_pi*real(a*kx, dp)/real(grid%m, dp)), a = 0, 2)]
          do ky = 0, grid%m - 1
+            ! The periodic kernel's zero frequency has no inverse: the pseudo-inverse's 0.
+            if (grid%periodic .and. kx == 0 .and. ky == 0) cycle
             cy = [(cos(two_pi*real(b*ky, dp)/real(grid%m, dp)), b = 0, 2)]
             do b = 0, 2
                partial(:, b) = partial(:, b) + cx*cy(b)/grid%kernel(ky + 1, l)
@@ -336,18 +451,20 @@ contains
    !> The grid of `problem` (read on rank 0 only; the others' is not looked at) spread over
    !> the ranks of `comm` (scatter_problem), and the distributed grid made of it
    !> (grid_setup). `block` (out): the coarse start's width, coarse_factor. Collective.
-   subroutine distribute_problem(problem, comm, how, grid, block, status)
+   subroutine distribute_problem(problem, comm, how, grid, block, status, periodic)
       type(contact_problem), intent(in) :: problem
       type(MPI_Comm), intent(in) :: comm
       type(cg_settings), intent(in) :: how
       type(distributed_grid), intent(inout) :: grid
       integer, intent(out) :: block
       type(status_type), intent(inout) :: status
+      !> One periodic cell (grid_setup); default: the free surface.
+      logical, intent(in), optional :: periodic
       real(dp), allocatable :: local(:, :)
       real(dp) :: constants(4)
       call scatter_problem(problem, comm, how, local, constants, block)
       call grid_setup(grid, comm, nint(constants(1)), block, local, constants(2), constants(3), constants(4), how, &
-         status)
+         status, periodic)
    end subroutine distribute_problem
 
    !> Rank 0 forms the composite gaps (nm) of `problem` and sends each rank of `comm` its
@@ -436,7 +553,7 @@ contains
       real(dp) :: t0, t1, t2, t3
       if (present(single)) then
          if (single .and. grid%has_single) then
-            call convolve_single(grid, f, out, factor)
+            call convolve_single(grid, f, factor, out)
             return
          end if
       end if
@@ -478,11 +595,12 @@ contains
    end subroutine distributed_convolve
 
    !> distributed_convolve in float32.
-   subroutine convolve_single(grid, f, out, factor)
+   subroutine convolve_single(grid, f, factor, out, out32)
       type(distributed_grid), intent(inout) :: grid
       real(dp), intent(in) :: f(:, :)
-      real(dp), intent(out) :: out(:, :)
       real(dp), intent(in) :: factor
+      real(dp), intent(out), optional :: out(:, :)
+      real(sp), intent(out), optional :: out32(:, :)
       integer :: j, k, i, np, m
       real(dp) :: t0, t1, t2, t3
       np = grid%np
@@ -525,10 +643,17 @@ contains
       call fftwf_mpi_execute_r2r(grid%to_columns32, grid%row32_flat, grid%column32_flat)
       call wall_clock(t1)
       call fftwf_execute_dft_c2r(grid%columns_backward32, grid%columns32, grid%column32_real)
-      !$omp parallel do
-      do j = 1, grid%nj
-         out(:, j) = real(grid%column32_real(1:np, j), dp)
-      end do
+      if (present(out32)) then
+         !$omp parallel do
+         do j = 1, grid%nj
+            out32(:, j) = grid%column32_real(1:np, j)
+         end do
+      else
+         !$omp parallel do
+         do j = 1, grid%nj
+            out(:, j) = real(grid%column32_real(1:np, j), dp)
+         end do
+      end if
       call wall_clock(t2)
       grid%transform_seconds = grid%transform_seconds + (t2 - t1)
       grid%communication_seconds = grid%communication_seconds + (t1 - t0)
@@ -544,6 +669,8 @@ contains
       integer :: k, i, np, m
       np = grid%np
       m = grid%m
+      ! Rows of np are rows of m already on the periodic cell (m = np).
+      if (m == np) return
       do k = grid%freqs, 1, -1
          do i = np, 1, -1
             grid%row_values((k - 1)*m + i) = grid%row_values((k - 1)*np + i)
@@ -566,6 +693,7 @@ contains
       integer :: k, i, np, m
       np = grid%np
       m = grid%m
+      if (m == np) return
       do k = 1, grid%freqs
          do i = 1, np
             grid%row_values((k - 1)*np + i) = grid%row_values((k - 1)*m + i)
@@ -573,74 +701,76 @@ contains
       end do
    end subroutine compress_rows
 
-   !> Every load of `loads` (nN, solved in ascending order, each warm-started from the
-   !> last; states in the order given). `problem` is read on rank 0 only (the materials,
-   !> for the coarse start). Collective.
-   subroutine solve_loads(grid, problem, loads, how, block, states, status, observer, hardness)
+   !> Every target of `targets` (loads in nN, or with `by_approach` approaches in nm;
+   !> solved in ascending order, each warm-started from the last; states in the order
+   !> given) by femcod_cg's solve_target on this grid: the same constrained iteration,
+   !> plastic rounds (`plastic`: no pressure above `hardness`, GPa) and displacement
+   !> control as `femcod run --solver cg`. `problem` is read on rank 0 only (the
+   !> materials, for the coarse start). Collective.
+   subroutine solve_loads(grid, problem, targets, how, states, status, observer, hardness, plastic, by_approach)
       type(distributed_grid), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
-      real(dp), intent(in) :: loads(:)
-      !> GPa: the pressure above_hardness counts beyond (default: none counted).
-      real(dp), intent(in), optional :: hardness
+      real(dp), intent(in) :: targets(:)
       type(cg_settings), intent(in) :: how
-      !> The coarse start's averaging width (coarse_factor; 1: no coarse start).
-      integer, intent(in) :: block
       type(distributed_state), allocatable, intent(out) :: states(:)
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
-      real(dp), allocatable :: p(:, :)
+      !> GPa: the pressure above_hardness counts beyond (default: none counted), and the
+      !> cap with `plastic`.
+      real(dp), intent(in), optional :: hardness
+      logical, intent(in), optional :: plastic, by_approach
+      type(cg_session) :: session
+      type(cg_answer) :: answer
       integer, allocatable :: order(:)
-      real(dp) :: t0, t1, total(2), transform0, communication0
+      real(dp) :: t0, t1, transform0, communication0, cap
       integer :: k, kk, m
-      m = size(loads)
-      allocate(states(m), p(grid%np, grid%nj), order(m))
-      states%load = loads
-      order = [(k, k = 1, m)]
-      do k = 2, m
-         kk = k
-         do while (kk > 1)
-            if (loads(order(kk - 1)) <= loads(order(kk))) exit
-            order([kk - 1, kk]) = order([kk, kk - 1])
-            kk = kk - 1
-         end do
-      end do
-      if (any(.not. loads > 0)) then
-         call set_error(status, STATUS_USAGE, "every load must be positive (nN)")
+      logical :: capped, approaches
+      m = size(targets)
+      allocate(states(m))
+      capped = .false.
+      if (present(plastic)) capped = plastic
+      approaches = .false.
+      if (present(by_approach)) approaches = by_approach
+      cap = huge(1.0_dp)
+      if (present(hardness)) cap = hardness
+      if (approaches) then
+         states%approach = targets
+      else
+         states%load = targets
+         if (any(.not. targets > 0)) then
+            call set_error(status, STATUS_USAGE, "every load must be positive (nN)")
+            return
+         end if
+      end if
+      if (capped .and. .not. present(hardness)) then
+         call set_error(status, STATUS_USAGE, "the plastic cap needs a hardness (GPa)")
          return
       end if
-      p = 0
+      if (approaches .and. .not. capped) call refuse_beyond_full_contact(grid, targets, status)
+      if (status%code /= 0) return
+      if (grid%rank == 0) grid%materials = contact_problem(label="", np=problem%np, pixel=problem%pixel, &
+         young=problem%young, poisson=problem%poisson)
+      call session_start(grid, session, capped, merge(cap*grid%pixel**2, 0.0_dp, capped))
+      order = ascending_order(targets)
       do kk = 1, m
          k = order(kk)
          call wall_clock(t0)
          transform0 = grid%transform_seconds
          communication0 = grid%communication_seconds
+         call solve_target(grid, problem, session, targets(k), approaches, how, answer, status, observer)
+         if (status%code /= 0) return
+         call record_state(grid, session, answer, cap, states(k))
+         if (.not. (approaches .or. capped .or. grid%periodic .or. how%kernel_radius > 0)) states(k)%approach_bound = &
+            approach_error_bound(states(k)%penetration, states(k)%contact_gap, states(k)%load_error, states(k)%approach)
+         call wall_clock(t1)
          associate(st => states(k))
-            if (kk == 1) then
-               if (block > 1) then
-                  call coarse_start(grid, problem, st%load, how, block, p, st%coarse_iterations, status, observer)
-               else
-                  call first_guess(grid, st%load, p)
-               end if
-               if (status%code /= 0) return
-            end if
-            call distributed_cg(grid, st%load, how%tol, how%max_iterations, how, p, st, status, observer)
-            if (status%code /= 0) return
-            st%force = p
-            st%contacts = count(p > 0)
-            total = [real(st%contacts, dp), 0.0_dp]
-            if (present(hardness)) total(2) = count(p/grid%pixel**2 > hardness)
-            call MPI_Allreduce(MPI_IN_PLACE, total, 2, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
-            st%contacts = nint(total(1))
-            st%above_hardness = nint(total(2))
-            st%max_pressure = maxval(p)/grid%pixel**2
-            call MPI_Allreduce(MPI_IN_PLACE, st%max_pressure, 1, MPI_DOUBLE_PRECISION, MPI_MAX, grid%comm)
-            call wall_clock(t1)
             st%seconds = t1 - t0
             st%transform_seconds = grid%transform_seconds - transform0
             st%communication_seconds = grid%communication_seconds - communication0
             call observer%progress(kk, st%contacts, st%load, t1 - t0)
             if (st%residual > how%tol) then
-               call set_error(status, STATUS_NUMERICAL, "cg: load "//format_real(st%load)//" nN: residual "// &
+               call set_error(status, STATUS_NUMERICAL, "cg: "//trim(merge("approach", "load    ", approaches))// &
+                  " "//format_real(targets(k))//trim(merge(" nm", " nN", approaches))//": residual "// &
                   sig_str(st%residual, 2)//" after "//int_str(st%iterations)//" iterations, above --tol "// &
                   sig_str(how%tol, 2)//" (raise --max-iterations)")
                return
@@ -649,80 +779,112 @@ contains
       end do
    end subroutine solve_loads
 
-   !> Start: the load spread over the pixels within a tenth of the height range of the
-   !> first touch (femcod_cg's first_guess, distributed).
-   subroutine first_guess(grid, total_load, p)
-      type(distributed_grid), intent(in) :: grid
-      real(dp), intent(in) :: total_load
-      real(dp), intent(out) :: p(:, :)
-      real(dp) :: lo, n
-      lo = minval(grid%g0)
-      call MPI_Allreduce(MPI_IN_PLACE, lo, 1, MPI_DOUBLE_PRECISION, MPI_MIN, grid%comm)
-      where (grid%g0 <= lo + 0.1_dp*grid%scale)
-         p = 1
-      elsewhere
-         p = 0
-      end where
-      n = sum(p)
-      call MPI_Allreduce(MPI_IN_PLACE, n, 1, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
-      p = p*(total_load/n)
-   end subroutine first_guess
-
-   !> The coarse start: the gaps averaged over f x f blocks (in femcod_cg's order for
-   !> f = 2), gathered on rank 0, solved there by femcod_cg's nested start to
-   !> how%coarse_tol, and each coarse force split equally over its f^2 pixels.
-   subroutine coarse_start(grid, problem, total_load, how, f, p, iterations, status, observer)
+   !> One target's state from the answer and the session's forces: the residuals, this
+   !> rank's maps, and the counts over all ranks (contacts, pixels above `hardness` GPa,
+   !> capped pixels) with the largest pressure (GPa) and the plastic volume (nm^3).
+   subroutine record_state(grid, session, answer, hardness, st)
       type(distributed_grid), intent(inout) :: grid
-      type(contact_problem), intent(in) :: problem
+      type(cg_session), intent(in) :: session
+      type(cg_answer), intent(inout) :: answer
+      real(dp), intent(in) :: hardness
+      type(distributed_state), intent(inout) :: st
+      real(dp) :: total(4), top(1)
+      st%load = answer%load
+      st%approach = answer%approach
+      st%iterations = answer%rep%iterations
+      st%coarse_iterations = answer%rep%coarse_iterations
+      st%convolutions = answer%rep%convolutions
+      st%split_corrections = answer%rep%split_corrections
+      st%residual = answer%rep%residual
+      st%penetration = answer%rep%penetration
+      st%contact_gap = answer%rep%contact_gap
+      st%load_error = answer%rep%load_error
+      st%plastic_rounds = answer%plastic_rounds
+      st%force = session%p
+      if (allocated(answer%gap)) then
+         call move_alloc(answer%gap, st%gap)
+      else
+         ! No force (at or before first touch): the gaps at this approach.
+         st%gap = grid%g0 - session%approach
+      end if
+      total = 0
+      if (allocated(answer%plastic)) then
+         call move_alloc(answer%plastic, st%plastic)
+         total(3) = count(session%capped)
+         total(4) = sum(st%plastic)*grid%pixel**2
+      end if
+      total(1) = count(session%p > 0)
+      total(2) = count(session%p/grid%pixel**2 > hardness)
+      call grid%sum_over_grid(total)
+      st%contacts = nint(total(1))
+      st%above_hardness = nint(total(2))
+      st%n_plastic = nint(total(3))
+      st%plastic_volume = total(4)
+      top(1) = maxval(session%p)/grid%pixel**2
+      call grid%max_over_grid(top)
+      st%max_pressure = top(1)
+   end subroutine record_state
+
+   !> The coarse start (the elastic operator's start_forces): the gaps averaged over f x f
+   !> blocks (f = grid%block; in femcod_cg's order for f = 2), gathered on rank 0, solved
+   !> there by femcod_cg's nested start to how%coarse_tol, and each coarse force split
+   !> equally over its f^2 pixels. With f = 1, the load spread near the first touch.
+   subroutine coarse_start(op, total_load, how, p, coarse_iterations, status, observer)
+      class(distributed_grid), intent(inout) :: op
       real(dp), intent(in) :: total_load
       type(cg_settings), intent(in) :: how
-      integer, intent(in) :: f
       real(dp), intent(out) :: p(:, :)
-      integer, intent(out) :: iterations
+      integer, intent(inout) :: coarse_iterations
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
       real(dp), allocatable :: local(:, :), whole(:, :), forces(:, :)
       integer, allocatable :: counts(:), displs(:)
-      integer :: n, nl, i, j, di, dj, code
+      integer :: n, nl, i, j, di, dj, code, f, iterations
       character(len=512) :: message
-      n = grid%np/f
-      nl = grid%nj/f
-      allocate(local(n, nl), counts(0:grid%ranks - 1), displs(0:grid%ranks - 1))
+      f = op%block
+      if (f <= 1) then
+         call spread_load(op, total_load, p)
+         return
+      end if
+      n = op%np/f
+      nl = op%nj/f
+      allocate(local(n, nl), counts(0:op%ranks - 1), displs(0:op%ranks - 1))
       !$omp parallel do private(i, di, dj)
       do j = 1, nl
          do i = 1, n
             local(i, j) = 0
             do dj = 1, f
                do di = 1, f
-                  local(i, j) = local(i, j) + grid%g0(f*(i - 1) + di, f*(j - 1) + dj)
+                  local(i, j) = local(i, j) + op%g0(f*(i - 1) + di, f*(j - 1) + dj)
                end do
             end do
             local(i, j) = local(i, j)/f**2
          end do
       end do
-      counts = n*(grid%count/f)
-      displs = n*(grid%first/f)
-      if (grid%rank == 0) then
+      counts = n*(op%count/f)
+      displs = n*(op%first/f)
+      if (op%rank == 0) then
          allocate(whole(n, n), forces(n, n))
       else
          allocate(whole(1, 1), forces(1, 1))
       end if
-      call MPI_Gatherv(local, n*nl, MPI_DOUBLE_PRECISION, whole, counts, displs, MPI_DOUBLE_PRECISION, 0, grid%comm)
+      call MPI_Gatherv(local, n*nl, MPI_DOUBLE_PRECISION, whole, counts, displs, MPI_DOUBLE_PRECISION, 0, op%comm)
       iterations = 0
-      if (grid%rank == 0) call coarse_start_forces(whole, problem, f*grid%pixel, total_load, how, forces, &
+      if (op%rank == 0) call coarse_start_forces(whole, op%materials, f*op%pixel, total_load, how, op%periodic, forces, &
          iterations, status, observer)
       ! The coarse solve's outcome, the same on every rank.
       code = status%code
       message = ""
       if (code /= 0) message = status%message
-      call MPI_Bcast(code, 1, MPI_INTEGER, 0, grid%comm)
-      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, grid%comm)
-      call MPI_Bcast(iterations, 1, MPI_INTEGER, 0, grid%comm)
+      call MPI_Bcast(code, 1, MPI_INTEGER, 0, op%comm)
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, op%comm)
+      call MPI_Bcast(iterations, 1, MPI_INTEGER, 0, op%comm)
       if (code /= 0) then
          if (status%code == 0) call set_error(status, code, trim(message))
          return
       end if
-      call MPI_Scatterv(forces, counts, displs, MPI_DOUBLE_PRECISION, local, n*nl, MPI_DOUBLE_PRECISION, 0, grid%comm)
+      coarse_iterations = coarse_iterations + iterations
+      call MPI_Scatterv(forces, counts, displs, MPI_DOUBLE_PRECISION, local, n*nl, MPI_DOUBLE_PRECISION, 0, op%comm)
       !$omp parallel do private(i)
       do j = 1, nl
          do i = 1, n
@@ -731,320 +893,92 @@ contains
       end do
    end subroutine coarse_start
 
-   !> femcod_cg's constrained_cg on the distributed grid, the same iteration (a change to
-   !> the method there belongs here too) with every step over all pixels of the rank's
-   !> slab (femcod_cg runs its contact-only steps over a list of the contacts), and a
-   !> fresh convolution whenever the projection changed a force.
-   subroutine distributed_cg(grid, total_load, tol, max_iterations, how, p, state, status, observer)
-      type(distributed_grid), intent(inout) :: grid
-      real(dp), intent(in) :: total_load, tol
-      integer, intent(in) :: max_iterations
-      type(cg_settings), intent(in) :: how
-      real(dp), intent(inout) :: p(:, :)
-      type(distributed_state), intent(inout) :: state
-      type(status_type), intent(inout) :: status
-      class(solver_observer), intent(inout) :: observer
-      real(dp), allocatable :: w(:, :), g(:, :), t(:, :), r(:, :), gm(:, :), z(:, :), g_old(:, :)
-      real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, residual, &
-         contact_gap, penetration, alpha, pn, lin, entry, zbar, cross, nc, nchanged, entered, sums(4), maxima(2), t0, t1
-      integer :: np, nj, i, j, it
-      logical :: restart, fresh, fresh_double, stalled, keep_old, single
-      np = grid%np
-      nj = grid%nj
-      c = grid%c
-      s = grid%s
-      allocate(w(np, nj), g(np, nj), t(np, nj), r(np, nj))
-      if (grid%preconditioned) then
-         allocate(gm(-1:np + 2, -1:nj + 2), z(np, nj))
-         gm = 0
-      end if
-      keep_old = how%polak_ribiere .or. how%powell_restart > 0
-      if (keep_old) then
-         allocate(g_old(np, nj))
-         g_old = 0
-      end if
-      entry = 1
-      if (grid%preconditioned) entry = how%entry_scale*grid%taps(0, 0)
-      psum = sum(p)
-      call reduce_one(psum, MPI_SUM)
-      alpha = total_load/psum
-      single = how%single_until > 0 .and. grid%has_single
-      fresh = .true.
-      restart = .true.
-      big_g_old = 1
-      t = 0
-      it = 0
-      zbar = 0
-      fresh_double = .false.
-      stalled = .false.
-      do
-         if (fresh) then
-            call distributed_convolve(grid, p, w, c, single)
-            state%convolutions = state%convolutions + 1
-            fresh_double = .not. single
-            fresh = .false.
-            stalled = .false.
-         end if
-         nc = 0
-         gbar = 0
-         !$omp parallel do private(i) reduction(+:nc, gbar)
-         do j = 1, nj
-            do i = 1, np
-               p(i, j) = alpha*p(i, j)
-               w(i, j) = alpha*w(i, j)
-               g(i, j) = grid%g0(i, j) + w(i, j) + s*p(i, j)
-               if (p(i, j) > 0) then
-                  nc = nc + 1
-                  gbar = gbar + g(i, j)
-               end if
-            end do
-         end do
-         ! The stop request travels with the first sum, so that every rank stops together.
-         sums(1:3) = [nc, gbar, merge(1.0_dp, 0.0_dp, observer%stop_requested())]
-         call reduce(sums, 3, MPI_SUM)
-         nc = sums(1)
-         gbar = sums(2)
-         if (sums(3) > 0) then
-            call set_error(status, STATUS_INTERRUPTED, "stopped after "//int_str(it)//" iterations on the "// &
-               int_str(np)//" x "//int_str(np)//" grid; the cg solver keeps no checkpoint")
-            return
-         end if
-         alpha = 1
-         if (.not. nc > 0) then
-            call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
-            return
-         end if
-         gbar = gbar/nc
-         state%approach = gbar
-         big_g = 0
-         cross = 0
-         contact_gap = 0
-         penetration = 0
-         !$omp parallel do private(i) reduction(+:big_g, cross) reduction(max:contact_gap, penetration)
-         do j = 1, nj
-            do i = 1, np
-               g(i, j) = g(i, j) - gbar
-               if (p(i, j) > 0) then
-                  big_g = big_g + g(i, j)**2
-                  if (keep_old .and. .not. grid%preconditioned) cross = cross + g(i, j)*g_old(i, j)
-                  contact_gap = max(contact_gap, abs(g(i, j)))
-                  if (grid%preconditioned) gm(i, j) = g(i, j)
-               else
-                  penetration = max(penetration, -g(i, j))
-                  if (grid%preconditioned) gm(i, j) = 0
-               end if
-            end do
-         end do
-         maxima = [contact_gap, penetration]
-         call reduce(maxima, 2, MPI_MAX)
-         contact_gap = maxima(1)
-         penetration = maxima(2)
-         residual = max(contact_gap, penetration)/grid%scale
-         if (residual < tol .or. it >= max_iterations .or. stalled) then
-            ! Accept only on displacements from a fresh double-precision convolution.
-            if (.not. fresh_double) then
-               single = .false.
-               fresh = .true.
-               cycle
-            end if
-            exit
-         end if
-         if (single .and. residual < how%single_until) then
-            single = .false.
-            fresh = .true.
-            cycle
-         end if
-         if (grid%preconditioned) then
-            call wall_clock(t0)
-            call exchange_halo(grid, gm)
-            call wall_clock(t1)
-            grid%communication_seconds = grid%communication_seconds + (t1 - t0)
-            call precondition(big_g, zbar, cross)
-         else
-            sums(1:2) = [big_g, cross]
-            call reduce(sums, 2, MPI_SUM)
-            big_g = sums(1)
-            cross = sums(2)
-         end if
-         it = it + 1
-         if (how%powell_restart > 0 .and. abs(cross) >= how%powell_restart*big_g) restart = .true.
-         if (restart .or. .not. big_g_old > 0) then
-            beta = 0
-         else if (how%polak_ribiere) then
-            beta = max(0.0_dp, (big_g - cross)/big_g_old)
-         else
-            beta = big_g/big_g_old
-         end if
-         big_g_old = big_g
-         num = 0
-         !$omp parallel do private(i) reduction(+:num)
-         do j = 1, nj
-            do i = 1, np
-               if (keep_old) g_old(i, j) = g(i, j)
-               if (p(i, j) > 0) then
-                  if (grid%preconditioned) then
-                     t(i, j) = z(i, j) - zbar + beta*t(i, j)
-                  else
-                     t(i, j) = g(i, j) + beta*t(i, j)
-                  end if
-                  num = num + g(i, j)*t(i, j)
-               else
-                  t(i, j) = 0
-               end if
-            end do
-         end do
-         ! The search direction's displacements in float32 whenever float32 is on (as the
-         ! serial solver: their round-off scales with the step).
-         call distributed_convolve(grid, t, r, c, grid%has_single .and. how%single_until > 0)
-         fresh_double = .false.
-         rt = 0
-         rsum = 0
-         tsum = 0
-         !$omp parallel do private(i) reduction(+:rt, rsum, tsum)
-         do j = 1, nj
-            do i = 1, np
-               if (p(i, j) > 0) then
-                  rt = rt + (r(i, j) + s*t(i, j))*t(i, j)
-                  rsum = rsum + r(i, j) + s*t(i, j)
-                  tsum = tsum + t(i, j)
-               end if
-            end do
-         end do
-         sums = [num, rt, rsum, tsum]
-         call reduce(sums, 4, MPI_SUM)
-         num = sums(1)
-         rt = sums(2)
-         rsum = sums(3)
-         tsum = sums(4)
-         rbar = rsum/nc
-         den = rt - rbar*tsum
-         if (.not. abs(den) > 0) then
-            stalled = .true.
-            cycle
-         end if
-         tau = num/den
-         nchanged = 0
-         entered = 0
-         psum = 0
-         !$omp parallel do private(i, lin, pn) reduction(+:psum, nchanged, entered)
-         do j = 1, nj
-            do i = 1, np
-               if (p(i, j) > 0) then
-                  lin = p(i, j) - tau*t(i, j)
-                  pn = max(lin, 0.0_dp)
-               else
-                  lin = 0
-                  pn = 0
-                  if (g(i, j) < 0) then
-                     pn = -tau*entry*g(i, j)
-                     entered = 1
-                  end if
-               end if
-               p(i, j) = pn
-               w(i, j) = w(i, j) - tau*r(i, j)
-               psum = psum + pn
-               if (pn /= lin) nchanged = nchanged + 1
-            end do
-         end do
-         sums(1:3) = [psum, nchanged, entered]
-         call reduce(sums, 3, MPI_SUM)
-         psum = sums(1)
-         nchanged = sums(2)
-         entered = sums(3)
-         restart = entered > 0 .and. how%restart_on_entry
-         if (.not. psum > 0) then
-            call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
-            return
-         end if
-         if (nchanged > 0) fresh = .true.
-         alpha = total_load/psum
-      end do
-      psum = sum(p)
-      call reduce_one(psum, MPI_SUM)
-      state%iterations = state%iterations + it
-      state%residual = residual
-      state%contact_gap = contact_gap
-      state%penetration = penetration
-      state%load_error = abs(psum - total_load)/total_load
-      state%gap = merge(0.0_dp, g, p > 0)
-   contains
-      !> values(1:n) summed (op MPI_SUM) or maximised (MPI_MAX) over the ranks, in place;
-      !> the time it takes is communication.
-      subroutine reduce(values, n, op)
-         real(dp), intent(inout) :: values(*)
-         integer, intent(in) :: n
-         type(MPI_Op), intent(in) :: op
-         real(dp) :: start, done
-         call wall_clock(start)
-         call MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE_PRECISION, op, grid%comm)
-         call wall_clock(done)
-         grid%communication_seconds = grid%communication_seconds + (done - start)
-      end subroutine reduce
+   !> out = c (I * f) on this rank's columns, in double (the elastic operator's displace).
+   subroutine distributed_displace(op, f, out)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(in) :: f(:, :)
+      real(dp), intent(out) :: out(:, :)
+      call distributed_convolve(op, f, out, op%c)
+   end subroutine distributed_displace
 
-      !> One value, as `reduce`.
-      subroutine reduce_one(value, op)
-         real(dp), intent(inout) :: value
-         type(MPI_Op), intent(in) :: op
-         real(dp) :: values(1)
-         values(1) = value
-         call reduce(values, 1, op)
-         value = values(1)
-      end subroutine reduce_one
+   !> The same in float32 transforms (when the grid has them), into out or out32.
+   subroutine distributed_displace_single(op, f, out, out32)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(in) :: f(:, :)
+      real(dp), intent(out), optional :: out(:, :)
+      real(sp), intent(out), optional :: out32(:, :)
+      real(dp), allocatable :: double(:, :)
+      if (op%has_single) then
+         call convolve_single(op, f, op%c, out, out32)
+      else if (present(out32)) then
+         allocate(double(op%np, op%nj))
+         call distributed_convolve(op, f, double, op%c)
+         out32 = real(double, sp)
+      else
+         call distributed_convolve(op, f, out, op%c)
+      end if
+   end subroutine distributed_displace_single
 
-      !> femcod_cg's preconditioner on this rank's columns (the halo filled), its sums
-      !> over all ranks.
-      subroutine precondition(big_g, zbar, cross)
-         real(dp), intent(out) :: big_g, zbar, cross
-         real(dp) :: part(5)
-         real(dp) :: zsum, gz, gsum, zo, osum
-         integer :: ii, jj
-         zsum = 0
-         gz = 0
-         gsum = 0
-         zo = 0
-         osum = 0
-         associate(a => grid%taps)
-            !$omp parallel do private(ii) reduction(+:zsum, gz, gsum, zo, osum)
-            do jj = 1, nj
-               do ii = 1, np
-                  if (p(ii, jj) > 0) then
-                     z(ii, jj) = a(0, 0)*gm(ii, jj) + a(1, 0)*(gm(ii - 1, jj) + gm(ii + 1, jj)) + &
-                        a(0, 1)*(gm(ii, jj - 1) + gm(ii, jj + 1)) + &
-                        a(1, 1)*(gm(ii - 1, jj - 1) + gm(ii + 1, jj - 1) + gm(ii - 1, jj + 1) + gm(ii + 1, jj + 1)) + &
-                        a(2, 0)*(gm(ii - 2, jj) + gm(ii + 2, jj)) + a(0, 2)*(gm(ii, jj - 2) + gm(ii, jj + 2))
-                     zsum = zsum + z(ii, jj)
-                     gz = gz + g(ii, jj)*z(ii, jj)
-                     gsum = gsum + g(ii, jj)
-                     if (keep_old) then
-                        zo = zo + g_old(ii, jj)*z(ii, jj)
-                        osum = osum + g_old(ii, jj)
-                     end if
-                  end if
-               end do
-            end do
-         end associate
-         part = [zsum, gz, gsum, zo, osum]
-         call reduce(part, 5, MPI_SUM)
-         zbar = part(1)/nc
-         big_g = part(2) - zbar*part(3)
-         cross = part(4) - zbar*part(5)
-      end subroutine precondition
-   end subroutine distributed_cg
+   !> values(:) summed over the ranks, in place; the time it takes is communication.
+   subroutine sum_over_ranks(op, values)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(inout) :: values(:)
+      call reduce_over_ranks(op, values, MPI_SUM)
+   end subroutine sum_over_ranks
+
+   subroutine max_over_ranks(op, values)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(inout) :: values(:)
+      call reduce_over_ranks(op, values, MPI_MAX)
+   end subroutine max_over_ranks
+
+   subroutine min_over_ranks(op, values)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(inout) :: values(:)
+      call reduce_over_ranks(op, values, MPI_MIN)
+   end subroutine min_over_ranks
+
+   subroutine reduce_over_ranks(op, values, operation)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(inout) :: values(:)
+      type(MPI_Op), intent(in) :: operation
+      real(dp) :: start, done
+      call wall_clock(start)
+      call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, operation, op%comm)
+      call wall_clock(done)
+      op%communication_seconds = op%communication_seconds + (done - start)
+   end subroutine reduce_over_ranks
+
+   !> True on every rank when `flag` is on one.
+   logical function any_over_ranks(op, flag) result(any_flag)
+      class(distributed_grid), intent(inout) :: op
+      logical, intent(in) :: flag
+      real(dp) :: start, done
+      call wall_clock(start)
+      any_flag = flag
+      call MPI_Allreduce(MPI_IN_PLACE, any_flag, 1, MPI_LOGICAL, MPI_LOR, op%comm)
+      call wall_clock(done)
+      op%communication_seconds = op%communication_seconds + (done - start)
+   end function any_over_ranks
 
    !> The two columns each side of this rank's slab from its neighbours (zero beyond the
    !> grid's edges: MPI_PROC_NULL leaves them as they are).
-   subroutine exchange_halo(grid, gm)
-      type(distributed_grid), intent(in) :: grid
-      real(dp), intent(inout) :: gm(-1:, -1:)
+   subroutine exchange_halo(op, gm)
+      class(distributed_grid), intent(inout) :: op
+      real(sp), intent(inout) :: gm(-1:, -1:)
       integer :: left, right, n, nj
-      left = merge(grid%rank - 1, MPI_PROC_NULL, grid%rank > 0)
-      right = merge(grid%rank + 1, MPI_PROC_NULL, grid%rank < grid%ranks - 1)
+      real(dp) :: start, done
+      call wall_clock(start)
+      left = merge(op%rank - 1, MPI_PROC_NULL, op%rank > 0)
+      right = merge(op%rank + 1, MPI_PROC_NULL, op%rank < op%ranks - 1)
       n = 2*size(gm, 1)
-      nj = grid%nj
+      nj = op%nj
       ! Mine at the right edge to the right neighbour's left halo, and the reverse.
-      call MPI_Sendrecv(gm(:, nj - 1:nj), n, MPI_DOUBLE_PRECISION, right, 1, gm(:, -1:0), n, MPI_DOUBLE_PRECISION, &
-         left, 1, grid%comm, MPI_STATUS_IGNORE)
-      call MPI_Sendrecv(gm(:, 1:2), n, MPI_DOUBLE_PRECISION, left, 2, gm(:, nj + 1:nj + 2), n, MPI_DOUBLE_PRECISION, &
-         right, 2, grid%comm, MPI_STATUS_IGNORE)
+      call MPI_Sendrecv(gm(:, nj - 1:nj), n, MPI_REAL, right, 1, gm(:, -1:0), n, MPI_REAL, left, 1, op%comm, &
+         MPI_STATUS_IGNORE)
+      call MPI_Sendrecv(gm(:, 1:2), n, MPI_REAL, left, 2, gm(:, nj + 1:nj + 2), n, MPI_REAL, right, 2, op%comm, &
+         MPI_STATUS_IGNORE)
+      call wall_clock(done)
+      op%communication_seconds = op%communication_seconds + (done - start)
    end subroutine exchange_halo
 end module femcod_mpi_cg

@@ -12,7 +12,6 @@ module femcod_mpi_results
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_IO
    use femcod_strings, only: int_str
-   use femcod_cg, only: approach_error_bound
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_attribute
    use femcod_results, only: load_group
    use femcod_mpi_cg, only: distributed_grid, distributed_state
@@ -63,8 +62,10 @@ contains
                call h5_attribute(file, g, "cg_penetration_nm", s%penetration, status)
                call h5_attribute(file, g, "cg_contact_gap_nm", s%contact_gap, status)
                call h5_attribute(file, g, "cg_load_error", s%load_error, status)
-               call h5_attribute(file, g, "approach_error_bound_nm", approach_error_bound(s%penetration, &
-                  s%contact_gap, s%load_error, s%approach), status)
+               call h5_attribute(file, g, "approach_error_bound_nm", s%approach_bound, status)
+               call h5_attribute(file, g, "n_above_hardness", s%above_hardness, status)
+               call h5_attribute(file, g, "n_plastic", s%n_plastic, status)
+               call h5_attribute(file, g, "plastic_volume_nm3", s%plastic_volume, status)
             end associate
          end do
          call h5_group(file, "/run", status)
@@ -74,7 +75,7 @@ contains
          call h5_attribute(file, "/run", "started", info%started, status)
          call h5_attribute(file, "/run", "finished", info%finished, status)
          call h5_attribute(file, "/run", "solver", "cg (femcod-mpi)", status)
-         call h5_attribute(file, "/run", "boundary", "free", status)
+         call h5_attribute(file, "/run", "boundary", trim(merge("periodic", "free    ", grid%periodic)), status)
          call h5_attribute(file, "/run", "mpi_ranks", info%ranks, status)
          call h5_attribute(file, "/run", "threads_per_rank", info%threads, status)
          call h5_attribute(file, "/run", "wall_time_s", info%wall_seconds, status)
@@ -140,6 +141,7 @@ contains
          g = load_group(k, size(states))
          call write_map(g//"/pressure", states(k)%force/grid%pixel**2, "GPa")
          call write_map(g//"/gap", states(k)%gap, "nm")
+         if (allocated(states(k)%plastic)) call write_map(g//"/plastic_displacement", states(k)%plastic, "nm")
       end do
       call h5pclose_f(dxpl, error)
       call h5fclose_f(fid, error)

@@ -31,7 +31,14 @@ contains
          new_unittest("float32 convolution within float32's round-off of the double one", test_single), &
          new_unittest("too few columns for the ranks: refused on every rank", test_too_few_columns), &
          new_unittest("Hertz at 1000 nN on the 0.5 nm sphere deck", test_hertz), &
-         new_unittest("the serial cg solver's answer on 1, 2 and 4 ranks, rough surface", test_against_serial) &
+         new_unittest("the serial cg solver's answer on 1, 2 and 4 ranks, rough surface", test_against_serial), &
+         new_unittest("--plastic: the serial answer and plastic set on 1, 2 and 4 ranks", test_plastic_against_serial), &
+         new_unittest("--approach: the serial loads on 1, 2 and 4 ranks", test_approach_against_serial), &
+         new_unittest("--kernel-radius: the serial answer on 1, 2 and 4 ranks", test_truncated_against_serial), &
+         new_unittest("--boundary periodic --plastic: the serial answer on 1, 2 and 4 ranks", &
+         test_periodic_against_serial), &
+         new_unittest("--boundary periodic --approach: the serial loads on 1, 2 and 4 ranks", &
+         test_periodic_approach_against_serial) &
          ]
    end subroutine collect_distributed
 
@@ -187,7 +194,7 @@ contains
       if (allocated(error)) return
       how%tol = 1.0e-8_dp
       call distribute_problem(deck, MPI_COMM_WORLD, how, grid, block, status)
-      if (status%code == 0) call solve_loads(grid, deck, [1000.0_dp], how, block, states, status, observer)
+      if (status%code == 0) call solve_loads(grid, deck, [1000.0_dp], how, states, status, observer)
       call grid_free(grid)
       call check(error, status%code, 0)
       if (allocated(error)) return
@@ -202,10 +209,72 @@ contains
    !> and the same contact set, pixel by pixel (both at --tol 1e-12).
    subroutine test_against_serial(error)
       type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%loads = [3.0e3_dp, 2.0e4_dp]
+      call against_serial(error, options)
+   end subroutine test_against_serial
+
+   !> The same with the plastic cap at H = 10 GPa (below the elastic peak pressures of
+   !> these loads, so that pixels cap): the plastic set as serial's too, pixel count and
+   !> plastic volume (to 1e-9).
+   subroutine test_plastic_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%loads = [3.0e3_dp, 2.0e4_dp]
+      options%plastic = .true.
+      options%hardness = 10
+      call against_serial(error, options)
+   end subroutine test_plastic_against_serial
+
+   !> Displacement control: two approaches (2 and 6 % of the height range, in the order
+   !> 6, 2), the loads found within 1e-8 of the serial solver's.
+   subroutine test_approach_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%approaches = [0.06_dp, 0.02_dp]
+      call against_serial(error, options)
+   end subroutine test_approach_against_serial
+
+   !> The kernel truncated to 12 pixels (--kernel-radius; no preconditioner where the
+   !> truncated kernel's spectrum is not positive, on either side).
+   subroutine test_truncated_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%loads = [3.0e3_dp, 2.0e4_dp]
+      options%cg%kernel_radius = 12
+      call against_serial(error, options)
+   end subroutine test_truncated_against_serial
+
+   !> The periodic cell (the kernel's spectrum in closed form on each rank's frequencies,
+   !> femcod_love_periodic) at two loads with the plastic cap at 10 GPa.
+   subroutine test_periodic_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%loads = [3.0e3_dp, 2.0e4_dp]
+      options%boundary = "periodic"
+      options%plastic = .true.
+      options%hardness = 10
+      call against_serial(error, options)
+   end subroutine test_periodic_against_serial
+
+   !> The periodic cell under displacement control (the fall of the mean gap; 2 and 6 %
+   !> of the height range, below the mean gap).
+   subroutine test_periodic_approach_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%approaches = [0.02_dp, 0.06_dp]
+      options%boundary = "periodic"
+      call against_serial(error, options)
+   end subroutine test_periodic_approach_against_serial
+
+   !> femcod-mpi's solve_loads with `options` (approaches given as fractions of the height
+   !> range) against the serial solve_contact, on groups of 1, 2 and 4 ranks.
+   subroutine against_serial(error, options)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options), intent(inout) :: options
       integer, parameter :: np = 128
       type(scene_spec) :: spec
       type(contact_problem) :: deck
-      type(contact_options) :: options
       type(contact_result) :: res
       type(status_type) :: status, serial_status
       type(distributed_grid) :: grid
@@ -215,8 +284,9 @@ contains
       real(dp), allocatable :: forces(:, :)
       integer, allocatable :: firsts(:), counts(:)
       integer :: ranks, rank, group_size, group_rank, block, k, worst_code
-      real(dp) :: range, bad(3)
-      real(dp), parameter :: loads(2) = [3.0e3_dp, 2.0e4_dp]
+      real(dp) :: range, bad(5)
+      real(dp), allocatable :: targets(:)
+      logical :: by_approach
       call MPI_Comm_size(MPI_COMM_WORLD, ranks)
       call MPI_Comm_rank(MPI_COMM_WORLD, rank)
       spec%kind = "self-affine"
@@ -229,7 +299,14 @@ contains
       if (allocated(error)) return
       range = maxval(deck%upper) - minval(deck%upper)
       options%solver = "cg"
-      options%loads = loads
+      by_approach = .false.
+      if (allocated(options%approaches)) by_approach = size(options%approaches) > 0
+      if (by_approach) then
+         options%approaches = options%approaches*range
+         targets = options%approaches
+      else
+         targets = options%loads
+      end if
       options%cg%tol = 1.0e-12_dp
       options%cg%max_iterations = 5000
       group_size = 1
@@ -240,8 +317,9 @@ contains
          worst_code = 0
          if (group /= MPI_COMM_NULL) then
             call MPI_Comm_rank(group, group_rank)
-            call distribute_problem(deck, group, options%cg, grid, block, status)
-            if (status%code == 0) call solve_loads(grid, deck, loads, options%cg, block, states, status, observer)
+            call distribute_problem(deck, group, options%cg, grid, block, status, options%boundary == "periodic")
+            if (status%code == 0) call solve_loads(grid, deck, targets, options%cg, states, status, observer, &
+               options%hardness, options%plastic, by_approach)
             call grid_free(grid)
             worst_code = status%code
             if (group_rank == 0) call solve_contact(deck, options, res, serial_status)
@@ -256,13 +334,19 @@ contains
                      bad(1) = max(bad(1), abs(states(k)%approach - res%states(k)%approach)/range)
                      bad(2) = bad(2) + count_differences(forces, res%states(k)%i, res%states(k)%j)
                      bad(3) = bad(3) + abs(states(k)%contacts - res%states(k)%contacts)
+                     bad(4) = max(bad(4), abs(states(k)%load - res%states(k)%load)/res%states(k)%load)
+                     ! With the cap, the last load must cap pixels, or the test shows nothing.
+                     if (options%plastic .and. k == 2 .and. res%states(k)%n_plastic == 0) bad(5) = bad(5) + 1
+                     bad(5) = bad(5) + abs(states(k)%n_plastic - res%states(k)%n_plastic) + &
+                        abs(states(k)%plastic_volume - res%states(k)%plastic_volume)/ &
+                        max(res%states(k)%plastic_volume, 1.0e-300_dp)*1.0e9_dp
                   end if
                   deallocate(forces)
                end do
             end if
             call MPI_Comm_free(group)
          end if
-         call MPI_Allreduce(MPI_IN_PLACE, bad, 3, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+         call MPI_Allreduce(MPI_IN_PLACE, bad, 5, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
          call MPI_Allreduce(MPI_IN_PLACE, worst_code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
          call check(error, worst_code, 0, "solve on "//to_string(group_size)//" ranks")
          if (allocated(error)) return
@@ -271,6 +355,12 @@ contains
          if (allocated(error)) return
          call check(error, bad(2) == 0 .and. bad(3) == 0, "contact sets on "//to_string(group_size)//" ranks: "// &
             to_string(nint(bad(2)))//" pixels differ")
+         if (allocated(error)) return
+         call check(error, bad(4) <= 1.0e-8_dp, "load on "//to_string(group_size)//" ranks off by "// &
+            to_string(bad(4))//" of the serial load")
+         if (allocated(error)) return
+         call check(error, bad(5) < 1, "plastic set or volume on "//to_string(group_size)//" ranks differs (n "// &
+            "plastic differences + 1e9 x relative volume difference = "//to_string(bad(5))//")")
          if (allocated(error)) return
          group_size = 2*group_size
       end do
@@ -288,5 +378,5 @@ contains
          end do
          n = count(serial .neqv. forces > 0)
       end function count_differences
-   end subroutine test_against_serial
+   end subroutine against_serial
 end module test_distributed

@@ -4,7 +4,7 @@ module femcod_lapack
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv, dlacn2, dtrsm, dsyrk
+   public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv, dlacn2, dtrsm, dsyrk, dgemm
 
    interface
       pure subroutine dpotrf(uplo, n, a, lda, info)
@@ -48,6 +48,13 @@ module femcod_lapack
          real(dp), intent(in) :: alpha, beta, a(lda, *)
          real(dp), intent(inout) :: c(ldc, *)
       end subroutine dsyrk
+      pure subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+         import :: dp
+         character(len=1), intent(in) :: transa, transb
+         integer, intent(in) :: m, n, k, lda, ldb, ldc
+         real(dp), intent(in) :: alpha, beta, a(lda, *), b(ldb, *)
+         real(dp), intent(inout) :: c(ldc, *)
+      end subroutine dgemm
       pure subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
          import :: dp
          character(len=1), intent(in) :: trans

@@ -29,12 +29,12 @@
 module femcod_love_periodic
    use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_double_complex, c_size_t, c_int, c_f_pointer
    use femcod_kinds, only: dp
-   use femcod_lapack, only: dsyrk
+   use femcod_lapack, only: dsyrk, dgemm
    use femcod_fftw, only: fftw_plan_dft_c2r_2d, fftw_execute_dft_c2r, fftw_destroy_plan, fftw_alloc_real, &
       fftw_alloc_complex, fftw_free, FFTW_ESTIMATE
    implicit none
    private
-   public :: periodic_love_spectrum, periodic_offset_table
+   public :: periodic_love_spectrum, periodic_love_spectrum_rows, periodic_offset_table
 
    real(dp), parameter :: pi = 3.141592653589793238462643383279502884_dp
 
@@ -47,11 +47,42 @@ contains
    function periodic_love_spectrum(np) result(s)
       integer, intent(in) :: np
       real(dp) :: s(0:np/2, 0:np/2)
+      real(dp), allocatable :: a(:, :)
+      integer :: kh, k
+      kh = np/2
+      call sampled_factors(np, a)
+      s = 0
+      call dsyrk("U", "N", kh + 1, size(a, 2), 1.0_dp, a, kh + 1, 0.0_dp, s, kh + 1)
+      do k = 0, kh
+         s(k + 1:kh, k) = s(k, k + 1:kh)
+      end do
+      s(0, 0) = 0
+   end function periodic_love_spectrum
+
+   !> The rows k1 = first .. first + count - 1 of periodic_love_spectrum, S(k1, k2) for
+   !> k2 = 0 .. NP/2 (the same sums, one matrix product), so that a process holding some
+   !> frequencies (femcod-mpi's ranks) need not make the whole quarter spectrum.
+   function periodic_love_spectrum_rows(np, first, count) result(s)
+      integer, intent(in) :: np, first, count
+      real(dp) :: s(first:first + count - 1, 0:np/2)
+      real(dp), allocatable :: a(:, :)
+      integer :: kh
+      kh = np/2
+      if (count <= 0) return
+      call sampled_factors(np, a)
+      call dgemm("N", "T", count, kh + 1, size(a, 2), 1.0_dp, a(first, 1), kh + 1, a, kh + 1, 0.0_dp, s, count)
+      if (first == 0) s(0, 0) = 0
+   end function periodic_love_spectrum_rows
+
+   !> The factors of the spectrum's integral: a(k, j) = sqrt(trapezoidal weight at node
+   !> j) A(k/NP, t_j), k = 0 .. NP/2, so that S = a a^T (module header).
+   subroutine sampled_factors(np, a)
+      integer, intent(in) :: np
+      real(dp), allocatable, intent(out) :: a(:, :)
       !> Step in u = ln t, and the ends: below t = 1e-17 the integrand is 2/sqrt(pi)
       !> (A = 1 + O(t^2)), so the part left out is 1e-17; above t = 7 NP every factor
       !> exp(-t^2 |v|^2) with |v| >= 1/NP is below exp(-49).
       real(dp), parameter :: step = 0.125_dp
-      real(dp), allocatable :: a(:, :)
       real(dp) :: u_low, u_high, t, w
       integer :: kh, nodes, j, k
       kh = np/2
@@ -69,13 +100,7 @@ contains
          end do
       end do
       !$omp end parallel do
-      s = 0
-      call dsyrk("U", "N", kh + 1, nodes, 1.0_dp, a, kh + 1, 0.0_dp, s, kh + 1)
-      do k = 0, kh
-         s(k + 1:kh, k) = s(k, k + 1:kh)
-      end do
-      s(0, 0) = 0
-   end function periodic_love_spectrum
+   end subroutine sampled_factors
 
    !> A(a, t) = sum_m s(a + m) exp(-t^2 (a + m)^2), 0 <= a <= 1/2, t > 0: the samples
    !> at the pixel centres, shifted by a, of the pixel box smoothed by a Gaussian.

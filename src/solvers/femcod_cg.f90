@@ -73,12 +73,9 @@ module femcod_cg
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
-   use femcod_split_correction, only: split_correction, split_setup, split_apply, split_free, split_hand_over
-   use femcod_love, only: offset_table, surface_compliance
-   use femcod_love_periodic, only: periodic_offset_table
-   use femcod_spring, only: spring_stiffness
-   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
-      convolution_free, inverse_kernel_taps
+   use femcod_split_correction, only: split_hand_over
+   use femcod_elastic_operator, only: elastic_operator, grid_operator, grid_operator_setup, grid_operator_free, &
+      spread_load
    use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts
    use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings
    use femcod_observer, only: solver_observer
@@ -88,6 +85,8 @@ module femcod_cg
    implicit none
    private
    public :: solve_cg, coarse_start_forces, approach_error_bound, cg_storage_bytes
+   public :: cg_residuals, cg_session, cg_answer, session_start, solve_target, ascending_order, &
+      refuse_beyond_full_contact
 
    !> What the CG solver reached at one load.
    type :: cg_residuals
@@ -101,25 +100,29 @@ module femcod_cg
       real(dp) :: penetration = 0, contact_gap = 0, load_error = 0, residual = 0
    end type cg_residuals
 
-   !> One grid of the problem: gaps (nm), pixel (nm), compliance c (nm/nN) and spring
-   !> compliance s (nm/nN), the Love table and its convolution.
-   type :: cg_grid
-      integer :: np = 0
-      !> The grid is one cell of a periodic surface (periodic table, cyclic convolution).
-      logical :: periodic = .false.
-      real(dp) :: pixel = 0, c = 0, s = 0, scale = 1
+   !> What the solver carries from one target (load or approach) to the next, on this
+   !> process's columns of the operator's grid: the forces (nN; the next target's warm
+   !> start), the approach (nm) they give, and with --plastic the deck's gaps (nm), the
+   !> pixel force cap fmax = H d^2 (nN) and the capped (plastic) pixels.
+   type :: cg_session
+      real(dp), allocatable :: p(:, :)
+      real(dp) :: approach = 0
+      logical :: plastic = .false.
+      real(dp) :: fmax = 0
       real(dp), allocatable :: g0(:, :)
-      !> The Love table I(0:np-1, 0:np-1) for direct corrections, rounded to float32 (its
-      !> double is needed only to set up the convolution; at NP = 4096 the float32 table
-      !> is 67 MB); self = I(0, 0), one pixel's own coefficient, in double.
-      real(sp), allocatable :: table(:, :)
-      real(dp) :: self = 0
-      !> Preconditioner taps (inverse_kernel_taps); `preconditioned` false: none.
-      logical :: preconditioned = .false.
-      real(dp) :: taps(0:2, 0:2) = 0
-      type(love_convolution) :: conv
-      type(split_correction) :: split
-   end type cg_grid
+      logical, allocatable :: capped(:, :)
+   end type cg_session
+
+   !> One target's answer: the load (nN) and approach (nm), the residuals reached (over
+   !> every solve the target took), the plastic rounds, and on this process's columns the
+   !> gap map (nm; 0 on the elastic contacts, minus the plastic displacement on the capped
+   !> pixels) and the plastic displacement map (nm, with --plastic).
+   type :: cg_answer
+      real(dp) :: load = 0, approach = 0
+      type(cg_residuals) :: rep
+      integer :: plastic_rounds = 0
+      real(dp), allocatable :: gap(:, :), plastic(:, :)
+   end type cg_answer
 
    !> Pixels (i, j) in the order one thread found them (pixels entering the contacts).
    type :: pixel_list
@@ -128,6 +131,7 @@ module femcod_cg
    end type pixel_list
 
 contains
+
 
    !> The cg solver's storage at its largest (bytes), from the arrays it allocates per
    !> pixel of the NP x NP grid: the forces, the grid's gaps and Love table (8 bytes each);
@@ -170,15 +174,15 @@ contains
       !> Told of every load solved (progress).
       class(solver_observer), intent(inout) :: observer
       type(cg_residuals), allocatable :: report(:)
-      type(cg_grid) :: fine
-      real(dp), allocatable :: p(:, :), g0(:, :), targets(:)
-      logical, allocatable :: capped(:, :)
+      type(grid_operator) :: fine
+      type(cg_session) :: session
+      type(cg_answer) :: answer
+      real(dp), allocatable :: targets(:)
       integer, allocatable :: order(:)
-      real(dp) :: load, tstart, t0, t1, approach
-      integer :: np, k, kk, m, i, j
+      real(dp) :: tstart, t0, t1
+      integer :: np, k, kk, m, i
       logical :: by_approach
       call wall_clock(tstart)
-      associate(how => options%cg, tol => options%cg%tol, max_iterations => options%cg%max_iterations)
       np = problem%np
       ! Displacement control (--approach): the targets are approaches, the loads the answers.
       by_approach = .false.
@@ -203,31 +207,105 @@ contains
       res%estimated_peak_bytes = cg_storage_bytes(np, m, options%boundary == "periodic", options%plastic)
       call refuse_beyond_memory("cg: NP = "//int_str(np), res%estimated_peak_bytes, options%memory_available, status)
       if (status%code /= 0) return
-      call make_grid(fine, initial_gap_map(problem%lower, problem%upper), problem, &
-         problem%pixel, how, options%boundary == "periodic")
-      ! A periodic cell is in full contact when the approach (the fall of the mean gap)
-      ! reaches the mean initial gap; there any load above the full-contact load gives
-      ! that approach, and beyond it none does (the elastic displacements have no mean).
-      if (by_approach .and. fine%periodic .and. .not. options%plastic) then
-         if (maxval(targets) >= sum(fine%g0)/real(np, dp)**2) then
-            call set_error(status, STATUS_USAGE, "--approach "//format_real(maxval(targets))//" nm reaches the "// &
-               "periodic cell's mean gap ("//format_real(sum(fine%g0)/real(np, dp)**2)//" nm): full contact, "// &
-               "where the approach no longer determines the load; give --loads for loads beyond full contact")
-            call convolution_free(fine%conv)
-            call split_free(fine%split)
+      call grid_operator_setup(fine, initial_gap_map(problem%lower, problem%upper), problem, problem%pixel, &
+         options%cg, options%boundary == "periodic")
+      if (by_approach .and. .not. options%plastic) call refuse_beyond_full_contact(fine, targets, status)
+      if (status%code /= 0) then
+         call grid_operator_free(fine)
+         return
+      end if
+      if (options%plastic) allocate(res%step_plastic(0))
+      call session_start(fine, session, options%plastic, options%hardness*problem%pixel**2)
+      order = ascending_order(targets)
+      do kk = 1, m
+         k = order(kk)
+         call wall_clock(t0)
+         call solve_target(fine, problem, session, targets(k), by_approach, options%cg, answer, status, observer)
+         if (status%code /= 0) exit
+         call wall_clock(t1)
+         report(k) = answer%rep
+         ! The state at this load.
+         associate(st => res%states(k), p => session%p)
+            st%load = answer%load
+            st%reached = .true.
+            st%approach = answer%approach
+            st%iterations = answer%rep%iterations
+            st%residual = answer%rep%residual
+            st%penetration = answer%rep%penetration
+            st%contact_gap = answer%rep%contact_gap
+            st%load_error = answer%rep%load_error
+            if (.not. (by_approach .or. options%plastic .or. options%boundary == "periodic" .or. &
+               options%cg%kernel_radius > 0)) st%approach_bound = approach_error_bound(st%penetration, &
+               st%contact_gap, st%load_error, st%approach)
+            st%coarse_iterations = answer%rep%coarse_iterations
+            st%convolutions = answer%rep%convolutions
+            st%split_corrections = answer%rep%split_corrections
+            st%plastic_rounds = answer%plastic_rounds
+            if (allocated(answer%gap)) call move_alloc(answer%gap, st%gap)
+            if (allocated(answer%plastic)) call move_alloc(answer%plastic, st%plastic)
+            st%contacts = count(p > 0)
+            st%max_pressure = maxval(p)/problem%pixel**2
+            st%n_above_hardness = count(p/problem%pixel**2 > options%hardness)
+            if (options%plastic) then
+               st%n_plastic = count(session%capped)
+               st%plastic_volume = sum(st%plastic)*problem%pixel**2
+            end if
+            call gather_contacts(st, p > 0, p)
+            call append_step(res, st%contacts, st%n_above_hardness, st%load, st%approach, t1 - t0)
+            if (options%plastic) res%step_plastic = [res%step_plastic, st%n_plastic]
+            call observer%progress(kk, st%contacts, st%load, t1 - tstart)
+            if (targets(k) == maxval(targets)) then
+               res%contact_i = st%i
+               res%contact_j = st%j
+               res%contact_step = [(kk, i = 1, st%contacts)]
+               res%contact_force = st%force
+               res%reported_load = st%load
+            end if
+         end associate
+      end do
+      call grid_operator_free(fine)
+      res%stop_reason = STOP_LOADS
+      call wall_clock(t1)
+      res%wall_seconds = t1 - tstart
+      if (status%code /= 0) return
+      do k = 1, m
+         if (report(k)%residual > options%cg%tol) then
+            call set_error(status, STATUS_NUMERICAL, "cg: "//trim(merge("approach", "load    ", by_approach))//" "// &
+               format_real(targets(k))//trim(merge(" nm", " nN", by_approach))//": residual "// &
+               sig_str(report(k)%residual, 2)//" after "//int_str(report(k)%iterations)// &
+               " iterations, above --tol "//sig_str(options%cg%tol, 2)//" (raise --max-iterations)")
             return
          end if
-      end if
-      allocate(p(np, np))
-      if (options%plastic) then
-         g0 = fine%g0
-         allocate(res%step_plastic(0), capped(np, np))
-         capped = .false.
-      end if
-      ! Ascending loads, each warm-started from the last.
-      allocate(order(m))
-      order = [(k, k = 1, m)]
-      do k = 2, m
+      end do
+   end subroutine solve_cg
+
+   !> A periodic cell is in full contact when the approach (the fall of the mean gap)
+   !> reaches the mean initial gap; there any load above the full-contact load gives that
+   !> approach, and beyond it none does (the elastic displacements have no mean): such an
+   !> approach is refused.
+   subroutine refuse_beyond_full_contact(grid, approaches, status)
+      class(elastic_operator), intent(inout) :: grid
+      real(dp), intent(in) :: approaches(:)
+      type(status_type), intent(inout) :: status
+      real(dp) :: mean_gap(1)
+      if (.not. grid%periodic) return
+      mean_gap(1) = sum(grid%g0)
+      call grid%sum_over_grid(mean_gap)
+      mean_gap = mean_gap/real(grid%np, dp)**2
+      if (maxval(approaches) >= mean_gap(1)) call set_error(status, STATUS_USAGE, "--approach "// &
+         format_real(maxval(approaches))//" nm reaches the periodic cell's mean gap ("//format_real(mean_gap(1))// &
+         " nm): full contact, where the approach no longer determines the load; give --loads for loads beyond "// &
+         "full contact")
+   end subroutine refuse_beyond_full_contact
+
+   !> The order in which targets are solved: ascending, each warm-started from the last
+   !> (a stable insertion sort: equal targets in the order given).
+   pure function ascending_order(targets) result(order)
+      real(dp), intent(in) :: targets(:)
+      integer, allocatable :: order(:)
+      integer :: k, kk
+      order = [(k, k = 1, size(targets))]
+      do k = 2, size(targets)
          kk = k
          do while (kk > 1)
             if (targets(order(kk - 1)) <= targets(order(kk))) exit
@@ -235,163 +313,181 @@ contains
             kk = kk - 1
          end do
       end do
-      p = 0
-      approach = 0
-      do kk = 1, m
-         k = order(kk)
-         call wall_clock(t0)
-         if (by_approach) then
-            call find_load(targets(k), k)
-            load = res%states(k)%load
-         else
-            load = targets(k)
-            call solve_load(load, k)
-         end if
-         if (status%code /= 0) exit
-         call wall_clock(t1)
-         ! The state at this load.
-         associate(st => res%states(k))
-            st%reached = .true.
-            st%approach = approach
-            st%iterations = report(k)%iterations
-            st%residual = report(k)%residual
-            st%penetration = report(k)%penetration
-            st%contact_gap = report(k)%contact_gap
-            st%load_error = report(k)%load_error
-            if (.not. (by_approach .or. options%plastic .or. options%boundary == "periodic" .or. &
-               how%kernel_radius > 0)) st%approach_bound = approach_error_bound(st%penetration, &
-               st%contact_gap, st%load_error, st%approach)
-            st%coarse_iterations = report(k)%coarse_iterations
-            st%convolutions = report(k)%convolutions
-            st%split_corrections = report(k)%split_corrections
-            st%contacts = count(p > 0)
-            st%max_pressure = maxval(p)/problem%pixel**2
-            st%n_above_hardness = count(p/problem%pixel**2 > options%hardness)
-            if (options%plastic) then
-               st%n_plastic = count(capped)
-               st%plastic_volume = sum(st%plastic)*problem%pixel**2
-            end if
-            call gather_contacts(st, p > 0, p)
-            call append_step(res, st%contacts, st%n_above_hardness, load, st%approach, t1 - t0)
-            if (options%plastic) res%step_plastic = [res%step_plastic, st%n_plastic]
-            call observer%progress(kk, st%contacts, load, t1 - tstart)
-            if (targets(k) == maxval(targets)) then
-               res%contact_i = st%i
-               res%contact_j = st%j
-               res%contact_step = [(kk, i = 1, st%contacts)]
-               res%contact_force = st%force
-               res%reported_load = load
-            end if
-         end associate
-      end do
-      call convolution_free(fine%conv)
-      call split_free(fine%split)
-      res%stop_reason = STOP_LOADS
-      call wall_clock(t1)
-      res%wall_seconds = t1 - tstart
-      if (status%code /= 0) return
-      do k = 1, m
-         if (report(k)%residual > tol) then
-            call set_error(status, STATUS_NUMERICAL, "cg: "//trim(merge("approach", "load    ", by_approach))//" "// &
-               format_real(targets(k))//trim(merge(" nm", " nN", by_approach))//": residual "// &
-               sig_str(report(k)%residual, 2)//" after "//int_str(report(k)%iterations)// &
-               " iterations, above --tol "//sig_str(tol, 2)//" (raise --max-iterations)")
-            return
-         end if
-      end do
-      end associate
-   contains
-      !> The state at `load` (nN) into res%states(k): the forces p (warm start: the last
-      !> solution's, scaled by the solver to the load) and the approach.
-      subroutine solve_load(load, k)
-         real(dp), intent(in) :: load
-         integer, intent(in) :: k
-         associate(how => options%cg)
-         if (load <= 0) then
-            p = 0
-            approach = -minval(fine%g0)
-            if (options%plastic) capped = .false.
-         else if (options%plastic) then
-            call capped_solve(fine, problem, g0, load, options%hardness*problem%pixel**2, how, p, capped, approach, &
-               report(k), res%states(k), status, observer)
-         else
-            if (.not. sum(p) > 0) then
-               if (how%nested) then
-                  call nested_start(fine, problem, load, how, p, report(k), status, observer)
-               else
-                  call first_guess(fine, load, p)
-               end if
-               if (status%code /= 0) return
-            end if
-            call constrained_cg(fine, load, how%tol, how%max_iterations, how, p, approach, report(k), status, &
-               observer, res%states(k)%gap)
-         end if
-         end associate
-      end subroutine solve_load
+   end function ascending_order
 
-      !> Displacement control: the load at which the approach is `target` (nm), by the
-      !> Illinois variant of regula falsi on A(P) - target (A increases with P), each
-      !> A(P) a fixed-load solve warm-started from the last; to |A - target| <= tol times
-      !> the height range, the fixed-load solver's own accuracy. At or below first touch
-      !> (target <= 0) the state has no load and no contact. The load is the answer
-      !> (res%states(k)%load); report(k) counts the iterations of every solve.
-      subroutine find_load(target, k)
-         real(dp), intent(in) :: target
-         integer, intent(in) :: k
-         integer, parameter :: MAX_SOLVES = 100
-         real(dp) :: lo, alo, hi, ahi, trial, accuracy
-         integer :: solve, side
-         accuracy = options%cg%tol*fine%scale
-         if (target <= 0) then
-            res%states(k)%load = 0
-            call solve_load(0.0_dp, k)
-            approach = target
-            return
-         end if
-         lo = 0
-         alo = 0
-         hi = -1
-         ahi = 0
-         side = 0
-         ! First trial: the last solution's load scaled as Hertz (P ~ A^1.5), or one
-         ! pixel's stiffness.
-         if (sum(p) > 0 .and. approach > 0) then
-            trial = sum(p)*(target/approach)**1.5_dp
-         else
-            trial = target/(fine%c*fine%self + fine%s)
-         end if
-         do solve = 1, MAX_SOLVES
-            call solve_load(trial, k)
+   !> A session on `grid`: no forces yet; with `plastic`, the cap fmax (nN) per pixel and
+   !> the deck's gaps kept (the capped rounds move the operator's).
+   subroutine session_start(grid, session, plastic, fmax)
+      class(elastic_operator), intent(in) :: grid
+      type(cg_session), intent(out) :: session
+      logical, intent(in) :: plastic
+      real(dp), intent(in) :: fmax
+      allocate(session%p(grid%np, grid%nj))
+      session%p = 0
+      session%approach = 0
+      session%plastic = plastic
+      session%fmax = fmax
+      if (plastic) then
+         session%g0 = grid%g0
+         allocate(session%capped(grid%np, grid%nj))
+         session%capped = .false.
+      end if
+   end subroutine session_start
+
+   !> One target: the load `target` (nN), or with `by_approach` the approach `target`
+   !> (nm), solved from the session's forces; the answer, and the session moved on to it.
+   !> The same on one core and on ranks: everything over the grid goes through `grid`.
+   subroutine solve_target(grid, problem, session, target, by_approach, how, answer, status, observer)
+      class(elastic_operator), intent(inout) :: grid
+      type(contact_problem), intent(in) :: problem
+      type(cg_session), intent(inout) :: session
+      real(dp), intent(in) :: target
+      logical, intent(in) :: by_approach
+      type(cg_settings), intent(in) :: how
+      type(cg_answer), intent(out) :: answer
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      if (by_approach) then
+         call find_load(grid, problem, session, target, how, answer, status, observer)
+      else
+         answer%load = target
+         call solve_load(grid, problem, session, target, how, answer, status, observer)
+      end if
+      answer%approach = session%approach
+   end subroutine solve_target
+
+   !> The state at `load` (nN): the forces (warm start: the session's, scaled by the
+   !> solver to the load) and the approach, into the session; the maps into `answer`.
+   subroutine solve_load(grid, problem, session, load, how, answer, status, observer)
+      class(elastic_operator), intent(inout) :: grid
+      type(contact_problem), intent(in) :: problem
+      type(cg_session), intent(inout) :: session
+      real(dp), intent(in) :: load
+      type(cg_settings), intent(in) :: how
+      type(cg_answer), intent(inout) :: answer
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      real(dp) :: total(1)
+      if (load <= 0) then
+         session%p = 0
+         total(1) = minval(grid%g0)
+         call grid%min_over_grid(total)
+         session%approach = -total(1)
+         if (session%plastic) session%capped = .false.
+      else if (session%plastic) then
+         call capped_solve(grid, problem, session, load, how, answer, status, observer)
+      else
+         total(1) = sum(session%p)
+         call grid%sum_over_grid(total)
+         if (.not. total(1) > 0) then
+            call start_forces(grid, problem, load, how, .true., session%p, answer%rep, status, observer)
             if (status%code /= 0) return
-            if (abs(approach - target) <= accuracy) exit
-            ! Illinois: an end kept twice in a row has its residual halved.
-            if (approach < target) then
-               lo = trial
-               alo = approach
-               if (side == -1) ahi = target + (ahi - target)/2
-               side = -1
-            else
-               hi = trial
-               ahi = approach
-               if (side == 1) alo = target - (target - alo)/2
-               side = 1
-            end if
-            if (hi < 0) then
-               ! No bracket yet: the load grows as Hertz would have it, at least doubled.
-               trial = lo*max(2.0_dp, (target/max(alo, tiny(1.0_dp)))**1.5_dp)
-            else
-               trial = lo + (hi - lo)*(target - alo)/(ahi - alo)
-               if (.not. (trial > lo .and. trial < hi)) trial = (lo + hi)/2
-            end if
-         end do
-         if (solve > MAX_SOLVES) then
-            call set_error(status, STATUS_NUMERICAL, "cg --approach: no load found for the approach "// &
-               format_real(target)//" nm in "//int_str(MAX_SOLVES)//" solves")
-            return
          end if
-         res%states(k)%load = trial
-      end subroutine find_load
-   end subroutine solve_cg
+         call constrained_cg(grid, load, how%tol, how%max_iterations, how, session%p, session%approach, answer%rep, &
+            status, observer, answer%gap)
+      end if
+   end subroutine solve_load
+
+   !> Displacement control: the load at which the approach is `target` (nm), by the
+   !> Illinois variant of regula falsi on A(P) - target (A increases with P), each A(P) a
+   !> fixed-load solve warm-started from the last; to |A - target| <= tol times the
+   !> height range, the fixed-load solver's own accuracy. At or below first touch
+   !> (target <= 0) the state has no load and no contact. The load is the answer
+   !> (answer%load); answer%rep counts the iterations of every solve.
+   subroutine find_load(grid, problem, session, target, how, answer, status, observer)
+      class(elastic_operator), intent(inout) :: grid
+      type(contact_problem), intent(in) :: problem
+      type(cg_session), intent(inout) :: session
+      real(dp), intent(in) :: target
+      type(cg_settings), intent(in) :: how
+      type(cg_answer), intent(inout) :: answer
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      integer, parameter :: MAX_SOLVES = 100
+      real(dp) :: lo, alo, hi, ahi, trial, accuracy, total(1)
+      integer :: solve, side
+      accuracy = how%tol*grid%scale
+      if (target <= 0) then
+         answer%load = 0
+         call solve_load(grid, problem, session, 0.0_dp, how, answer, status, observer)
+         session%approach = target
+         return
+      end if
+      lo = 0
+      alo = 0
+      hi = -1
+      ahi = 0
+      side = 0
+      ! First trial: the last solution's load scaled as Hertz (P ~ A^1.5), or one pixel's
+      ! stiffness.
+      total(1) = sum(session%p)
+      call grid%sum_over_grid(total)
+      if (total(1) > 0 .and. session%approach > 0) then
+         trial = total(1)*(target/session%approach)**1.5_dp
+      else
+         trial = target/(grid%c*grid%self + grid%s)
+      end if
+      do solve = 1, MAX_SOLVES
+         call solve_load(grid, problem, session, trial, how, answer, status, observer)
+         if (status%code /= 0) return
+         if (abs(session%approach - target) <= accuracy) exit
+         ! Illinois: an end kept twice in a row has its residual halved.
+         if (session%approach < target) then
+            lo = trial
+            alo = session%approach
+            if (side == -1) ahi = target + (ahi - target)/2
+            side = -1
+         else
+            hi = trial
+            ahi = session%approach
+            if (side == 1) alo = target - (target - alo)/2
+            side = 1
+         end if
+         if (hi < 0) then
+            ! No bracket yet: the load grows as Hertz would have it, at least doubled.
+            trial = lo*max(2.0_dp, (target/max(alo, tiny(1.0_dp)))**1.5_dp)
+         else
+            trial = lo + (hi - lo)*(target - alo)/(ahi - alo)
+            if (.not. (trial > lo .and. trial < hi)) trial = (lo + hi)/2
+         end if
+      end do
+      if (solve > MAX_SOLVES) then
+         call set_error(status, STATUS_NUMERICAL, "cg --approach: no load found for the approach "// &
+            format_real(target)//" nm in "//int_str(MAX_SOLVES)//" solves")
+         return
+      end if
+      answer%load = trial
+   end subroutine find_load
+
+   !> The forces (nN) a solve at total load P starts from: on the whole grid in one
+   !> process, from nested coarser grids (when `coarse` and how%nested) or the load spread
+   !> near the first touch; another operator starts as it knows best (femcod-mpi's from a
+   !> coarse solve on rank 0).
+   subroutine start_forces(grid, problem, total_load, how, coarse, p, rep, status, observer)
+      class(elastic_operator), intent(inout) :: grid
+      type(contact_problem), intent(in) :: problem
+      real(dp), intent(in) :: total_load
+      type(cg_settings), intent(in) :: how
+      logical, intent(in) :: coarse
+      real(dp), intent(out) :: p(:, :)
+      type(cg_residuals), intent(inout) :: rep
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      select type (grid)
+      type is (grid_operator)
+         if (how%nested .and. coarse) then
+            call nested_start(grid, problem, total_load, how, p, rep, status, observer)
+         else
+            call spread_load(grid, total_load, p)
+         end if
+      class default
+         if (coarse) then
+            call grid%start_forces(total_load, how, p, rep%coarse_iterations, status, observer)
+         else
+            call spread_load(grid, total_load, p)
+         end if
+      end select
+   end subroutine start_forces
 
    !> The elastic-perfectly-plastic interface at one load: 0 <= F <= fmax = H d^2 per
    !> pixel, with
@@ -404,21 +500,16 @@ contains
    !> tol of the height range) leave it, until neither happens. A set only grows by
    !> pixels that carried more than fmax in a solution of the whole load, so the load left
    !> stays positive. Without a capped pixel this is the elastic solve, bit for bit.
-   !> Returned: the forces (fmax on the capped pixels), the approach, the plastic set,
-   !> and in `state` the gap map (0 on the elastic contacts, minus the plastic
+   !> Into the session: the forces (fmax on the capped pixels), the approach, the plastic
+   !> set; into `answer`: the gap map (0 on the elastic contacts, minus the plastic
    !> displacement on the capped ones) and the plastic displacement map.
-   subroutine capped_solve(grid, problem, g0, load, fmax, how, p, capped, approach, rep, state, status, observer)
-      type(cg_grid), intent(inout) :: grid
+   subroutine capped_solve(grid, problem, session, load, how, answer, status, observer)
+      class(elastic_operator), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
-      !> The deck's gaps (nm); grid%g0 is restored to them on return.
-      real(dp), intent(in) :: g0(:, :)
-      real(dp), intent(in) :: load, fmax
+      type(cg_session), intent(inout) :: session
+      real(dp), intent(in) :: load
       type(cg_settings), intent(in) :: how
-      real(dp), intent(inout) :: p(:, :)
-      logical, intent(inout) :: capped(:, :)
-      real(dp), intent(out) :: approach
-      type(cg_residuals), intent(inout) :: rep
-      type(load_state), intent(inout) :: state
+      type(cg_answer), intent(inout) :: answer
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
       !> The gap that takes a capped pixel out of the elastic problem (it never touches).
@@ -426,44 +517,45 @@ contains
       integer, parameter :: MAX_ROUNDS = 200
       real(dp), allocatable :: force(:, :), w(:, :), gap(:, :)
       logical, allocatable :: grow(:, :), release(:, :)
-      real(dp) :: left
+      real(dp) :: left, total(2)
       integer :: round, ncap
+      associate(p => session%p, capped => session%capped, g0 => session%g0, fmax => session%fmax)
       allocate(force(size(p, 1), size(p, 2)), w(size(p, 1), size(p, 2)))
       do round = 1, MAX_ROUNDS
-         ncap = count(capped)
+         total = [real(count(capped), dp), sum(p)]
+         call grid%sum_over_grid(total)
+         ncap = nint(total(1))
          if (ncap > 0) then
             force = merge(fmax, 0.0_dp, capped)
-            call convolution_apply(grid%conv, force, w, grid%c)
+            call grid%displace(force, w)
             grid%g0 = merge(EXCLUDED, g0 + w, capped)
             where (capped) p = 0
+            total(2) = sum(p)
+            call grid%sum_over_grid(total(2:2))
          else
             grid%g0 = g0
          end if
          left = load - ncap*fmax
-         if (.not. sum(p) > 0) then
-            if (how%nested .and. ncap == 0) then
-               call nested_start(grid, problem, left, how, p, rep, status, observer)
-            else
-               call first_guess(grid, left, p)
-            end if
+         if (.not. total(2) > 0) then
+            call start_forces(grid, problem, left, how, ncap == 0, p, answer%rep, status, observer)
             if (status%code /= 0) exit
          end if
-         call constrained_cg(grid, left, how%tol, how%max_iterations, how, p, approach, rep, status, observer, &
-            state%gap)
+         call constrained_cg(grid, left, how%tol, how%max_iterations, how, p, session%approach, answer%rep, status, &
+            observer, answer%gap)
          if (status%code /= 0) exit
          ! The gaps of all forces together, from one fresh double-precision convolution.
          force = merge(fmax, p, capped)
-         call convolution_apply(grid%conv, force, w, grid%c)
-         gap = g0 - approach + w + grid%s*force
+         call grid%displace(force, w)
+         gap = g0 - session%approach + w + grid%s*force
          grow = .not. capped .and. p > fmax
          release = capped .and. gap > how%tol*grid%scale
-         if (.not. (any(grow) .or. any(release))) exit
+         if (.not. grid%any_over_grid(any(grow) .or. any(release))) exit
          ! A released pixel starts from the force it had.
          where (release) p = fmax
          capped = (capped .or. grow) .and. .not. release
       end do
       grid%g0 = g0
-      state%plastic_rounds = min(round, MAX_ROUNDS)
+      answer%plastic_rounds = min(round, MAX_ROUNDS)
       if (status%code /= 0) return
       if (round > MAX_ROUNDS) then
          call set_error(status, STATUS_NUMERICAL, "cg --plastic: the plastic set did not settle in "// &
@@ -471,79 +563,21 @@ contains
          return
       end if
       p = merge(fmax, p, capped)
-      if (allocated(state%plastic)) deallocate(state%plastic)
-      allocate(state%plastic(size(p, 1), size(p, 2)))
-      state%plastic = 0
-      if (any(capped)) then
-         state%gap = merge(0.0_dp, gap, p > 0 .and. .not. capped)
-         where (capped) state%plastic = max(-gap, 0.0_dp)
+      if (allocated(answer%plastic)) deallocate(answer%plastic)
+      allocate(answer%plastic(size(p, 1), size(p, 2)))
+      answer%plastic = 0
+      if (grid%any_over_grid(any(capped))) then
+         answer%gap = merge(0.0_dp, gap, p > 0 .and. .not. capped)
+         where (capped) answer%plastic = max(-gap, 0.0_dp)
       end if
+      end associate
    end subroutine capped_solve
-
-   !> A grid for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's materials, one
-   !> cell of a periodic surface when `periodic`.
-   subroutine make_grid(grid, g0, problem, pixel, how, periodic)
-      type(cg_grid), intent(inout) :: grid
-      real(dp), intent(in) :: g0(:, :)
-      type(contact_problem), intent(in) :: problem
-      real(dp), intent(in) :: pixel
-      type(cg_settings), intent(in) :: how
-      logical, intent(in) :: periodic
-      real(dp), allocatable :: table(:, :)
-      grid%np = size(g0, 1)
-      grid%periodic = periodic
-      grid%pixel = pixel
-      grid%g0 = g0
-      grid%c = surface_compliance(problem%young(1), problem%poisson(1), pixel) + &
-         surface_compliance(problem%young(2), problem%poisson(2), pixel)
-      grid%s = 3/spring_stiffness(problem%young(3), problem%poisson(3), pixel, pixel)
-      grid%scale = max(maxval(g0) - minval(g0), tiny(1.0_dp))
-      allocate(table(0:grid%np - 1, 0:grid%np - 1))
-      if (periodic) then
-         table(:, :) = periodic_offset_table(grid%np)
-      else
-         table(:, :) = offset_table(grid%np)
-      end if
-      if (how%kernel_radius > 0) call truncate_table(table, how%kernel_radius*problem%pixel/pixel)
-      call convolution_setup(grid%conv, table, how%single_until > 0, how%measure_plans, periodic)
-      grid%self = table(0, 0)
-      allocate(grid%table(0:grid%np - 1, 0:grid%np - 1))
-      grid%table(:, :) = real(table, sp)
-      if (how%precondition) call inverse_kernel_taps(grid%conv, grid%taps, grid%preconditioned)
-   end subroutine make_grid
-
-   !> The kernel truncated: entries at offsets beyond `radius` pixels set to 0 (--kernel-
-   !> radius, in the finest grid's pixels; a coarser grid's radius is scaled to its pixel).
-   pure subroutine truncate_table(table, radius)
-      real(dp), intent(inout) :: table(0:, 0:)
-      real(dp), intent(in) :: radius
-      integer :: p, q
-      do q = 0, size(table, 2) - 1
-         do p = 0, size(table, 1) - 1
-            if (real(p, dp)**2 + real(q, dp)**2 > radius**2) table(p, q) = 0
-         end do
-      end do
-   end subroutine truncate_table
-
-   !> Start: the load spread over the pixels within a tenth of the height range of the
-   !> first touch.
-   subroutine first_guess(grid, total_load, p)
-      type(cg_grid), intent(in) :: grid
-      real(dp), intent(in) :: total_load
-      real(dp), intent(out) :: p(:, :)
-      where (grid%g0 <= minval(grid%g0) + 0.1_dp*grid%scale)
-         p = 1
-      elsewhere
-         p = 0
-      end where
-      p = p*(total_load/sum(p))
-   end subroutine first_guess
 
    !> The first load's start from nested grids: halve while the side stays even and at
    !> least 2 * coarsest; solve the coarsest from the first guess, then each finer grid
    !> from the coarser solution, to coarse_tol; return the forces on the finest grid.
    recursive subroutine nested_start(grid, problem, total_load, how, p, rep, status, observer)
-      type(cg_grid), intent(inout) :: grid
+      type(grid_operator), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: total_load
       type(cg_settings), intent(in) :: how
@@ -551,26 +585,25 @@ contains
       type(cg_residuals), intent(inout) :: rep
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
-      type(cg_grid) :: coarse
+      type(grid_operator) :: coarse
       type(cg_residuals) :: coarse_rep
       real(dp), allocatable :: pc(:, :)
       real(dp) :: approach
       integer :: n, i, j
       n = grid%np
       if (mod(n, 2) /= 0 .or. n < 2*how%coarsest) then
-         call first_guess(grid, total_load, p)
+         call spread_load(grid, total_load, p)
          return
       end if
       n = n/2
-      call make_grid(coarse, (grid%g0(1::2, 1::2) + grid%g0(2::2, 1::2) + grid%g0(1::2, 2::2) + &
+      call grid_operator_setup(coarse, (grid%g0(1::2, 1::2) + grid%g0(2::2, 1::2) + grid%g0(1::2, 2::2) + &
          grid%g0(2::2, 2::2))/4, problem, 2*grid%pixel, how, grid%periodic)
       allocate(pc(n, n))
       call nested_start(coarse, problem, total_load, how, pc, rep, status, observer)
       if (status%code == 0) call constrained_cg(coarse, total_load, how%coarse_tol, 10000, how, pc, approach, &
          coarse_rep, status, observer)
-      call convolution_free(coarse%conv)
       call split_hand_over(coarse%split, grid%split)
-      call split_free(coarse%split)
+      call grid_operator_free(coarse)
       if (status%code /= 0) return
       rep%coarse_iterations = rep%coarse_iterations + coarse_rep%iterations + coarse_rep%coarse_iterations
       do j = 1, n
@@ -581,38 +614,37 @@ contains
    end subroutine nested_start
 
    !> The forces (nN) at total load P (nN) on a grid of gaps g0 (nm) and pixel `pixel`
-   !> (nm), free surface, solved from its own nested start to how%coarse_tol: the start
-   !> that the distributed solver (femcod-mpi) hands down to its finer grid, as
-   !> nested_start does here. `iterations`: on this grid and all coarser ones.
-   subroutine coarse_start_forces(g0, problem, pixel, total_load, how, p, iterations, status, observer)
+   !> (nm), free surface or one periodic cell, solved from its own nested start to
+   !> how%coarse_tol: the start that the distributed solver (femcod-mpi) hands down to its
+   !> finer grid, as nested_start does here. `iterations`: on this grid and all coarser
+   !> ones.
+   subroutine coarse_start_forces(g0, problem, pixel, total_load, how, periodic, p, iterations, status, observer)
       real(dp), intent(in) :: g0(:, :)
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: pixel, total_load
       type(cg_settings), intent(in) :: how
+      logical, intent(in) :: periodic
       real(dp), intent(out) :: p(:, :)
       integer, intent(out) :: iterations
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
-      type(cg_grid) :: grid
+      type(grid_operator) :: grid
       type(cg_residuals) :: rep
       real(dp) :: approach
-      call make_grid(grid, g0, problem, pixel, how, .false.)
+      call grid_operator_setup(grid, g0, problem, pixel, how, periodic)
       if (how%nested) then
          call nested_start(grid, problem, total_load, how, p, rep, status, observer)
       else
-         call first_guess(grid, total_load, p)
+         call spread_load(grid, total_load, p)
       end if
       if (status%code == 0) call constrained_cg(grid, total_load, how%coarse_tol, 10000, how, p, approach, rep, &
          status, observer)
-      call convolution_free(grid%conv)
-      call split_free(grid%split)
+      call grid_operator_free(grid)
       iterations = rep%iterations + rep%coarse_iterations
    end subroutine coarse_start_forces
 
-   !> (femcod-mpi's distributed_cg, mpi/src/femcod_mpi_cg.f90, follows the same iteration
-   !> on all pixels of each rank's slab, with the sums over MPI ranks: a change to the
-   !> method here belongs there too.)
-   !> Polonsky-Keer constrained CG on `grid` at total load P from the forces p (nN, any
+
+   !> Polonsky-Keer constrained CG on the operator `grid` at total load P from the forces p (nN, any
    !> positive start; returned: the solution). `approach` (nm) is the mean gap of the
    !> contact pixels before the rigid shift, i.e. the approach from first touch.
    !>
@@ -626,8 +658,13 @@ contains
    !> test compares with (tol, single_until, or at the last iteration): above it the
    !> residual is above the threshold whatever the penetration, so every decision is the
    !> one the full residual would give.
+   !>
+   !> Written once against the elastic operator (model/femcod_elastic_operator): every
+   !> loop runs over this process's columns, every sum and maximum over the grid goes
+   !> through the operator's reductions, so femcod-mpi runs this same iteration on its
+   !> slabs (where the operator corrects no changed force directly: a fresh convolution).
    subroutine constrained_cg(grid, total_load, tol, max_iterations, how, p, approach, rep, status, observer, final_gap)
-      type(cg_grid), intent(inout) :: grid
+      class(elastic_operator), intent(inout) :: grid
       real(dp), intent(in) :: total_load, tol
       integer, intent(in) :: max_iterations
       type(cg_settings), intent(in) :: how
@@ -663,30 +700,27 @@ contains
       real(dp), allocatable :: delta(:)
       real(dp) :: c, s, gbar, big_g, big_g_old, beta, num, den, tau, rt, rsum, tsum, rbar, psum, psum_in, residual, &
          contact_gap, penetration, alpha, pn, lin, entry, zbar, cross, gij, threshold
-      integer :: np, i, j, q, it, nc, nchanged, limit, split_limit, capacity, reach, thread, threads
+      !> The sums and maxima handed to the operator's reductions; the contacts and the
+      !> changes on the whole grid.
+      real(dp) :: sums(5), nc_all
+      integer :: np, nj, i, j, q, it, nc, nchanged, nchanged_all, limit, split_limit, capacity, thread, threads
       !> The error bound (nm) of the split corrections since the last fresh convolution.
-      real(dp) :: split_error, bound
-      logical :: restart, single, fresh, fresh_double, stalled, keep_old, kept_old
+      real(dp) :: split_error
+      logical :: restart, single, fresh, fresh_double, stalled, keep_old, kept_old, applied
       np = grid%np
       c = grid%c
       s = grid%s
-      limit = max(how%direct_corrections, 0)
-      ! The kernel split takes up to split_limit changes: the budget with the smallest
-      ! window (one lattice cell); the full kernel only (not periodic, not truncated).
-      split_limit = 0
-      if (how%split_radius >= how%split_cell .and. how%split_cell >= 1 .and. .not. grid%periodic .and. &
-         .not. how%kernel_radius > 0) &
-         split_limit = int(min(how%split_budget*real(np, dp)**2/real(2*how%split_cell + 1, dp)**2, real(np, dp)**2, &
-         real(huge(1)/2, dp)))
+      nj = grid%nj
+      call grid%correction_limits(how, limit, split_limit)
       capacity = max(limit, split_limit)
       threads = 1
       !$ threads = omp_get_max_threads()
-      allocate(w(np, np), t(np, np), gm(-1:np + 2, -1:np + 2), changed(2, capacity), delta(capacity), touching(np, np), &
+      allocate(w(np, nj), t(np, nj), gm(-1:np + 2, -1:nj + 2), changed(2, capacity), delta(capacity), touching(np, nj), &
          entering(0:threads - 1))
       if (how%single_until > 0) then
-         allocate(r32(np, np))
+         allocate(r32(np, nj))
       else
-         allocate(r(np, np))
+         allocate(r(np, nj))
       end if
       gm = 0
       ! The previous gradient, for Polak-Ribiere's beta and for Powell's restart test.
@@ -698,7 +732,7 @@ contains
       if (grid%preconditioned) entry = how%entry_scale*grid%taps(0, 0)
       ! The start's contacts; the direction is zero off the contacts throughout.
       !$omp parallel do private(i)
-      do j = 1, np
+      do j = 1, nj
          do i = 1, np
             touching(i, j) = merge(1_int8, 0_int8, p(i, j) > 0)
             t(i, j) = 0
@@ -707,7 +741,9 @@ contains
       call list_contacts()
       ! The load balance: the forces and displacements are alpha times the stored p and w,
       ! until the next step writes them scaled (and at the end).
-      alpha = total_load/sum(p)
+      sums(1) = sum(p)
+      call grid%sum_over_grid(sums(1:1))
+      alpha = total_load/sums(1)
       single = how%single_until > 0
       fresh = .true.
       split_error = 0
@@ -719,7 +755,7 @@ contains
       stalled = .false.
       penetration = 0
       do
-         if (observer%stop_requested()) then
+         if (grid%any_over_grid(observer%stop_requested())) then
             call set_error(status, STATUS_INTERRUPTED, "stopped after "//int_str(it)//" iterations on the "// &
                int_str(np)//" x "//int_str(np)//" grid; the cg solver keeps no checkpoint")
             return
@@ -731,10 +767,6 @@ contains
             stalled = .false.
          end if
          nc = size(contact, 2)
-         if (nc == 0) then
-            call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
-            return
-         end if
          ! The contacts' mean gap.
          gbar = 0
          !$omp parallel do private(i, j) reduction(+:gbar)
@@ -743,7 +775,14 @@ contains
             j = contact(2, q)
             gbar = gbar + (grid%g0(i, j) + alpha*(w(i, j) + s*p(i, j)))
          end do
-         gbar = gbar/nc
+         sums(1:2) = [gbar, real(nc, dp)]
+         call grid%sum_over_grid(sums(1:2))
+         nc_all = sums(2)
+         if (.not. nc_all > 0) then
+            call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
+            return
+         end if
+         gbar = sums(1)/nc_all
          approach = gbar
          ! The contacts' residual, the search direction's norm, and their gaps for the
          ! preconditioner; the previous gaps taken from gm first, once an iteration.
@@ -766,11 +805,20 @@ contains
             gm(i, j) = real(gij, sp)
          end do
          kept_old = keep_old
+         sums(1:2) = [big_g, cross]
+         call grid%sum_over_grid(sums(1:2))
+         big_g = sums(1)
+         cross = sums(2)
+         sums(1) = contact_gap
+         call grid%max_over_grid(sums(1:1))
+         contact_gap = sums(1)
          ! The penetration off the contacts, where a decision depends on it.
          threshold = tol
          if (single) threshold = max(tol, how%single_until)
          if (contact_gap/grid%scale < threshold .or. it >= max_iterations .or. stalled) then
-            penetration = deepest_overlap()
+            sums(1) = deepest_overlap()
+            call grid%max_over_grid(sums(1:1))
+            penetration = sums(1)
          else
             penetration = 0
          end if
@@ -797,7 +845,10 @@ contains
             fresh = .true.
             cycle
          end if
-         if (grid%preconditioned) call precondition(big_g, zbar, cross)
+         if (grid%preconditioned) then
+            call grid%exchange_halo(gm)
+            call precondition(big_g, zbar, cross)
+         end if
          it = it + 1
          if (how%powell_restart > 0 .and. abs(cross) >= how%powell_restart*big_g) restart = .true.
          if (restart .or. .not. big_g_old > 0) then
@@ -825,7 +876,7 @@ contains
          ! steps shrink with the residual, so it never limits the accuracy; the forces'
          ! own displacements (fresh) switch to double below `single_until`.
          if (allocated(r32)) then
-            call convolution_apply_single(grid%conv, t, factor=c, result32=r32)
+            call grid%displace_single(t, out32=r32)
             fresh_double = .false.
          else
             call convolve(t, r, .false.)
@@ -841,7 +892,13 @@ contains
             rsum = rsum + r_at(i, j) + s*t(i, j)
             tsum = tsum + t(i, j)
          end do
-         rbar = rsum/nc
+         sums(1:4) = [num, rt, rsum, tsum]
+         call grid%sum_over_grid(sums(1:4))
+         num = sums(1)
+         rt = sums(2)
+         rsum = sums(3)
+         tsum = sums(4)
+         rbar = rsum/nc_all
          den = rt - rbar*tsum
          if (.not. abs(den) > 0) then
             ! Nothing left to move: the forces are the solution to round-off; accepted
@@ -863,7 +920,7 @@ contains
          thread = 0
          !$ thread = omp_get_thread_num()
          !$omp do schedule(static)
-         do j = 1, np
+         do j = 1, nj
             do i = 1, np
                if (touching(i, j) == 0) then
                   gij = grid%g0(i, j) + alpha*w(i, j) - gbar
@@ -900,36 +957,35 @@ contains
             end if
             if (pn /= lin) call record_change(i, j, pn - lin)
          end do
-         restart = how%restart_on_entry .and. sum(entering%n) > 0
+         sums(1:4) = [psum, psum_in, real(nchanged, dp), real(sum(entering%n), dp)]
+         call grid%sum_over_grid(sums(1:4))
+         nchanged_all = nint(sums(3))
+         restart = how%restart_on_entry .and. sums(4) > 0
          call list_contacts_after_step()
          kept_old = .false.
          fresh_double = .false.
-         psum = psum + psum_in
+         psum = sums(1) + sums(2)
          if (.not. psum > 0) then
             call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
             return
          end if
          if (nchanged > 0 .and. nchanged <= capacity) call sort_changes(nchanged)
-         if (nchanged > limit .and. nchanged <= split_limit) then
-            ! The kernel split, with the widest window the budget allows, while its error
-            ! bound (each change's far error, summed since the last fresh convolution)
+         if (nchanged_all > limit .and. nchanged_all <= split_limit) then
+            ! The kernel split, while its error bound since the last fresh convolution
             ! stays a fraction of the residual (nm).
-            if (grid%split%np /= np) call split_setup(grid%split, np, how%split_cell, how%split_radius)
-            reach = min(how%split_radius, int((sqrt(how%split_budget*real(np, dp)**2/nchanged) - 1)/2))
-            reach = max(reach, how%split_cell)
-            bound = split_error + c*grid%split%far_error(reach)*sum(abs(delta(1:nchanged)))
-            if (bound <= how%split_tolerance*residual*grid%scale) then
-               split_error = bound
-               call split_apply(grid%split, w, c, changed, delta, nchanged, reach)
+            call grid%split_correct(w, changed, delta, nchanged, how, how%split_tolerance*residual*grid%scale, &
+               split_error, applied)
+            if (applied) then
                rep%split_corrections = rep%split_corrections + 1
                fresh_double = .false.
             else
                fresh = .true.
             end if
-         else if (nchanged > limit) then
+         else if (nchanged_all > limit) then
             fresh = .true.
-         else if (nchanged > 0) then
-            call add_direct(nchanged)
+         else if (nchanged_all > 0) then
+            call grid%add_direct(w, changed, delta, nchanged)
+            fresh_double = .false.
          end if
          alpha = total_load/psum
       end do
@@ -944,13 +1000,15 @@ contains
       rep%residual = residual
       rep%contact_gap = contact_gap
       rep%penetration = penetration
-      rep%load_error = abs(sum(p) - total_load)/total_load
+      sums(1) = sum(p)
+      call grid%sum_over_grid(sums(1:1))
+      rep%load_error = abs(sums(1) - total_load)/total_load
       if (present(final_gap)) then
          ! Formed in t's storage and handed over: no further NP x NP array at the peak.
          if (allocated(r)) deallocate(r)
          if (allocated(r32)) deallocate(r32)
          !$omp parallel do private(i)
-         do j = 1, np
+         do j = 1, nj
             do i = 1, np
                if (touching(i, j) /= 0) then
                   t(i, j) = 0
@@ -962,12 +1020,12 @@ contains
          call move_alloc(t, final_gap)
       end if
    contains
-      !> The deepest overlap (nm) off the contacts, max(-gap, 0), over every pixel.
+      !> The deepest overlap (nm) off the contacts, max(-gap, 0), over this part's pixels.
       real(dp) function deepest_overlap() result(depth)
          integer :: ii, jj
          depth = 0
          !$omp parallel do private(ii) reduction(max:depth)
-         do jj = 1, np
+         do jj = 1, nj
             do ii = 1, np
                if (touching(ii, jj) == 0) depth = max(depth, -(grid%g0(ii, jj) + alpha*w(ii, jj) - gbar))
             end do
@@ -979,7 +1037,7 @@ contains
          integer :: ii, jj, n
          allocate(contact(2, count(touching /= 0)))
          n = 0
-         do jj = 1, np
+         do jj = 1, nj
             do ii = 1, np
                if (touching(ii, jj) /= 0) then
                   n = n + 1
@@ -1106,9 +1164,11 @@ contains
                osum = osum + real(g_old(k), dp)
             end if
          end do
-         zbar = zsum/nc
-         big_g = gz - zbar*gsum
-         cross = zo - zbar*osum
+         sums(1:5) = [zsum, gz, gsum, zo, osum]
+         call grid%sum_over_grid(sums(1:5))
+         zbar = sums(1)/nc_all
+         big_g = sums(2) - zbar*sums(3)
+         cross = sums(4) - zbar*sums(5)
       end subroutine precondition
 
       !> w = c (I * f) with fresh transforms (float32 while `single`).
@@ -1126,9 +1186,9 @@ contains
          real(dp), intent(out) :: out(:, :)
          logical, intent(in) :: in_single
          if (in_single) then
-            call convolution_apply_single(grid%conv, f, out, c)
+            call grid%displace_single(f, out)
          else
-            call convolution_apply(grid%conv, f, out, c)
+            call grid%displace(f, out)
          end if
          fresh_double = .false.
       end subroutine convolve
@@ -1142,13 +1202,13 @@ contains
          real(dp), allocatable :: by_delta(:)
          integer :: q, jj, slot, key(2)
          real(dp) :: d
-         allocate(start(np + 1), by_column(2, n), by_delta(n))
+         allocate(start(nj + 1), by_column(2, n), by_delta(n))
          start = 0
          do q = 1, n
             start(changed(2, q) + 1) = start(changed(2, q) + 1) + 1
          end do
          start(1) = 1
-         do jj = 2, np + 1
+         do jj = 2, nj + 1
             start(jj) = start(jj) + start(jj - 1)
          end do
          do q = 1, n
@@ -1174,25 +1234,8 @@ contains
          changed(:, 1:n) = by_column
          delta(1:n) = by_delta
       end subroutine sort_changes
-
-      !> w += c * I * (the changed forces' corrections), summed directly from the table
-      !> (the changes sorted).
-      subroutine add_direct(n)
-         integer, intent(in) :: n
-         integer :: jj, ii, q, iq, jq
-         !$omp parallel do private(ii, q, iq, jq)
-         do jj = 1, np
-            do q = 1, n
-               iq = changed(1, q)
-               jq = changed(2, q)
-               do ii = 1, np
-                  w(ii, jj) = w(ii, jj) + c*delta(q)*real(grid%table(abs(ii - iq), abs(jj - jq)), dp)
-               end do
-            end do
-         end do
-         fresh_double = .false.
-      end subroutine add_direct
    end subroutine constrained_cg
+
 
    !> Append pixel (i, j) to `list`, growing it by doubling.
    pure subroutine push_pixel(list, i, j)
