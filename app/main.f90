@@ -1,7 +1,7 @@
 !> The femcod command: `femcod <command> [options]`. Everything numerical lives in
 !> src/; this program parses the command line and turns a status into an exit code
 !> (0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O). `femcod bench` lives
-!> here (app/femcod_bench.f90) because it only measures.
+!> here (app/bench/, one module per benchmark) because it only measures.
 program femcod_main
    use femcod_cli, only: femcod_command, command_arguments
    use femcod_bench, only: bench_command
