@@ -1,8 +1,10 @@
 !> The shape of src/ (doc/architecture.md): the layers core < model < legacy < solvers <
 !> io < studies < cli, each a folder; a module uses only its own layer and those below.
-!> femcod-mpi's modules (mpi/src, built apart with MPI) are one more layer on top.
+!> femcod-mpi's modules (mpi/src, built apart with MPI) are one more layer on top, and the
+!> programs with their benchmarks (app/, mpi/app/) the last: nothing below uses them.
 !> The numerical core keeps no state between calls (no module-level save variables) and
-!> never stops the program.
+!> never stops the program. No routine is longer than a reader can hold (150 lines), but
+!> those listed as not yet split, a list that may only shrink.
 module test_architecture
    use femcod_strings, only: string_type
    use test_support, only: scratch_path, read_text
@@ -11,8 +13,24 @@ module test_architecture
    private
    public :: collect_architecture
 
-   character(len=*), parameter :: LAYERS(8) = [character(len=7) :: "core", "model", "legacy", "solvers", "io", &
-      "studies", "cli", "mpi"]
+   character(len=*), parameter :: LAYERS(9) = [character(len=7) :: "core", "model", "legacy", "solvers", "io", &
+      "studies", "cli", "mpi", "app"]
+
+   !> The longest a routine may be (lines, from its first line to its end statement, its
+   !> contained procedures included).
+   integer, parameter :: MAX_ROUTINE_LINES = 150
+   !> The routines longer than that today (issue 34), file and name: each is to be split,
+   !> and the test fails when one of them is no longer long, so the list only shrinks.
+   character(len=*), parameter :: LONG_ROUTINES(*) = [character(len=64) :: &
+      "src/io/femcod_heights.f90 read_nanoscope", &
+      "src/solvers/femcod_adhesion.f90 adhesive_cg", &
+      "src/io/femcod_deck.f90 read_deck", &
+      "src/legacy/femcod_legacy.f90 solve_legacy", &
+      "src/studies/femcod_verification.f90 write_verification_report", &
+      "src/io/femcod_heights.f90 read_ascii_matrix", &
+      "src/solvers/femcod_incremental.f90 event_loop", &
+      "app/bench/femcod_bench_frontier.f90 bench_frontier", &
+      "app/bench/femcod_bench_adhesion.f90 bench_adhesion"]
 
 contains
 
@@ -20,17 +38,24 @@ contains
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
       testsuite = [ &
          new_unittest("every use points to the same layer or one below", test_layers), &
-         new_unittest("no module-level save variables, no stop in src/", test_no_state) &
+         new_unittest("no module-level save variables, no stop in src/", test_no_state), &
+         new_unittest("no routine longer than 150 lines in src/, mpi/, app/ (but the listed)", test_routine_length) &
          ]
    end subroutine collect_architecture
 
-   !> The source files under src/ and mpi/src/ (one per line), from `find`.
-   function sources() result(files)
+   !> The source files under src/ and mpi/src/ (one per line), from `find`; with
+   !> `programs`, those of app/ and mpi/app/ too.
+   function sources(programs) result(files)
+      logical, intent(in), optional :: programs
       type(string_type), allocatable :: files(:)
-      character(len=:), allocatable :: list, text
+      character(len=:), allocatable :: list, text, folders
       integer :: start, k
       list = scratch_path("sources.txt")
-      call execute_command_line("find src mpi/src -name '*.[fF]90' | sort > "//list)
+      folders = "src mpi/src"
+      if (present(programs)) then
+         if (programs) folders = folders//" app mpi/app"
+      end if
+      call execute_command_line("find "//folders//" -name '*.[fF]90' | sort > "//list)
       text = read_text(list)
       allocate(files(0))
       start = 1
@@ -50,7 +75,8 @@ contains
       do k = 1, size(LAYERS)
          if (index(path, "src/"//trim(LAYERS(k))//"/") == 1) layer_of = k
       end do
-      if (index(path, "mpi/src/") == 1) layer_of = size(LAYERS)
+      if (index(path, "mpi/src/") == 1) layer_of = size(LAYERS) - 1
+      if (index(path, "app/") == 1 .or. index(path, "mpi/app/") == 1) layer_of = size(LAYERS)
    end function layer_of
 
    !> The lower-case words after "module" and "use" at the start of each code line.
@@ -90,7 +116,7 @@ contains
       integer, allocatable :: module_layer(:)
       character(len=:), allocatable :: text
       integer :: f, u, m, found
-      files = sources()
+      files = sources(programs=.true.)
       call check(error, size(files) > 40, "the sources are found")
       if (allocated(error)) return
       allocate(module_name(0), module_layer(0))
@@ -160,4 +186,108 @@ contains
          end do
       end do
    end subroutine test_no_state
+
+   !> Every routine of src/, mpi/ and app/ at most MAX_ROUTINE_LINES long, but those of
+   !> LONG_ROUTINES, each of which must still be longer (a stale entry fails too).
+   subroutine test_routine_length(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(string_type), allocatable :: files(:), names(:)
+      integer, allocatable :: lengths(:)
+      integer :: f, r, k
+      logical :: listed, seen(size(LONG_ROUTINES))
+      files = sources(programs=.true.)
+      seen = .false.
+      do f = 1, size(files)
+         call routine_lengths(read_text(files(f)%s), names, lengths)
+         do r = 1, size(names)
+            listed = .false.
+            do k = 1, size(LONG_ROUTINES)
+               if (trim(LONG_ROUTINES(k)) == files(f)%s//" "//names(r)%s) then
+                  listed = .true.
+                  seen(k) = .true.
+                  call check(error, lengths(r) > MAX_ROUTINE_LINES, files(f)%s//" "//names(r)%s//" is "// &
+                     int_text(lengths(r))//" lines now: take it off LONG_ROUTINES")
+                  if (allocated(error)) return
+               end if
+            end do
+            if (.not. listed) call check(error, lengths(r) <= MAX_ROUTINE_LINES, files(f)%s//" "//names(r)%s//": "// &
+               int_text(lengths(r))//" lines, above "//int_text(MAX_ROUTINE_LINES))
+            if (allocated(error)) return
+         end do
+      end do
+      do k = 1, size(LONG_ROUTINES)
+         call check(error, seen(k), trim(LONG_ROUTINES(k))//": no such routine (take it off LONG_ROUTINES)")
+         if (allocated(error)) return
+      end do
+   end subroutine test_routine_length
+
+   !> The subroutines and functions of a source text, each with its length in lines from
+   !> its first statement to its end statement (contained procedures counted in their
+   !> host too). Comment lines are skipped; a procedure starts on a line whose first words
+   !> are prefixes or a type followed by "subroutine NAME" or "function NAME".
+   subroutine routine_lengths(text, names, lengths)
+      character(len=*), intent(in) :: text
+      type(string_type), allocatable, intent(out) :: names(:)
+      integer, allocatable, intent(out) :: lengths(:)
+      type(string_type) :: open_names(32)
+      integer :: open_lines(32), depth, start, k, line_no
+      character(len=:), allocatable :: line, word
+      allocate(names(0), lengths(0))
+      depth = 0
+      start = 1
+      line_no = 0
+      do k = 1, len(text)
+         if (text(k:k) /= new_line("a")) cycle
+         line = lower(adjustl(text(start:k - 1)))
+         start = k + 1
+         line_no = line_no + 1
+         if (index(line, "!") == 1) cycle
+         if (index(line, "end subroutine") == 1 .or. index(line, "end function") == 1) then
+            if (depth > 0) then
+               names = [names, open_names(depth)]
+               lengths = [lengths, line_no - open_lines(depth) + 1]
+               depth = depth - 1
+            end if
+            cycle
+         end if
+         word = procedure_name(line)
+         if (len(word) == 0 .or. depth == size(open_lines)) cycle
+         depth = depth + 1
+         open_names(depth)%s = word
+         open_lines(depth) = line_no
+      end do
+   end subroutine routine_lengths
+
+   !> NAME when `line` opens a procedure ("[prefixes] [type] subroutine|function NAME"),
+   !> else "".
+   function procedure_name(line) result(name)
+      character(len=*), intent(in) :: line
+      character(len=:), allocatable :: name
+      character(len=:), allocatable :: rest
+      integer :: at, e
+      name = ""
+      if (index(line, "end ") == 1 .or. index(line, "module procedure") == 1 .or. index(line, "procedure") == 1) &
+         return
+      at = index(line, "subroutine ")
+      if (at == 0) at = index(line, "function ")
+      if (at == 0) return
+      ! Only prefixes, a type and a kind may come before the keyword.
+      if (at > 1) then
+         if (verify(line(1:at - 1), "abcdefghijklmnopqrstuvwxyz0123456789_(),:= *") /= 0) return
+         if (index(line(1:at - 1), "=") > 0 .or. index(line(1:at - 1), "::") > 0 .or. &
+            index(line(1:at - 1), "call") > 0) return
+      end if
+      rest = adjustl(line(at + index(line(at:), " "):))
+      e = scan(rest, " (!")
+      if (e > 0) rest = rest(1:e - 1)
+      name = rest
+   end function procedure_name
+
+   pure function int_text(v) result(s)
+      integer, intent(in) :: v
+      character(len=:), allocatable :: s
+      character(len=16) :: buf
+      write(buf, '(i0)') v
+      s = trim(buf)
+   end function int_text
 end module test_architecture
