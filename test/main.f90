@@ -7,6 +7,7 @@ program tester
    use testdrive, only: run_testsuite, run_selected, new_testsuite, testsuite_type, select_suite, count_tests, &
       tests_skipped
    use test_deck, only: collect_deck
+   use test_deck_h5, only: collect_deck_h5
    use test_workspace, only: collect_workspace
    use test_sort, only: collect_sort
    use test_surfaces, only: collect_surfaces
@@ -37,6 +38,7 @@ program tester
 
    suites = [ &
       new_testsuite("deck", collect_deck), &
+      new_testsuite("deck_h5", collect_deck_h5), &
       new_testsuite("workspace", collect_workspace), &
       new_testsuite("sort", collect_sort), &
       new_testsuite("surfaces", collect_surfaces), &

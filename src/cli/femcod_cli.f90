@@ -8,7 +8,7 @@ module femcod_cli
    use femcod_status, only: status_type, set_error, STATUS_USAGE
    use femcod_strings, only: string_type, int_str, parse_integer, append_string
    use femcod_problem, only: contact_problem
-   use femcod_deck, only: write_deck
+   use femcod_deck, only: write_deck, read_deck
    use femcod_workspace, only: workspace_type, workspace_layout, workspace_table, MAX_WORKSPACE_CONTACTS
    use femcod_problem, only: MAX_NP
    use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, KINDS
@@ -176,7 +176,7 @@ contains
    function mkdeck_table() result(table)
       type(option_spec), allocatable :: table(:)
       table = [ &
-         text_option("--output", "FILE", "output deck (written atomically)", alias="-o"), &
+         text_option("--output", "FILE", "output deck (written atomically; FILE.h5: an HDF5 deck)", alias="-o"), &
          flag_option("--force", "replace an existing deck (only a deck; never the --file it is made from)"), &
          text_option("--verification", "NAME|all", "a verification deck of input/ by name, or all of them", &
             mode="verification"), &
@@ -214,8 +214,11 @@ contains
       write(output_unit, '(a)') &
          "usage: femcod mkdeck KIND -o FILE [--force] [options]", &
          "       femcod mkdeck --verification NAME|all [-o FILE | --dir DIR] [--force]", &
+         "       femcod mkdeck convert IN OUT [--force]", &
          "", &
-         "Writes an input deck (doc/deck-format.md). The shape goes on one surface, the other is flat;", &
+         "Writes an input deck (doc/deck-format.md): a text deck, or an HDF5 deck when FILE ends in .h5", &
+         "(the same content as datasets, read at disk speed; `convert` turns one form into the other).", &
+         "The shape goes on one surface, the other is flat;", &
          "a rigid body gets E --rigid-factor times the elastic one (default 1e10), and so do the", &
          "contact/interface elements (thesis section 4.4 uses 1e5, as the decks of input/ do).", &
          "", &
@@ -348,6 +351,12 @@ contains
          call mkdeck_help()
          return
       end if
+      if (size(args) > 0) then
+         if (args(1)%s == "convert") then
+            call convert_deck_command(args(2:), code)
+            return
+         end if
+      end if
       call parse_mkdeck_arguments(args, spec, output, verification, dir, status, force)
       if (status%code /= 0) then
          call command_usage("mkdeck", status, code)
@@ -412,6 +421,43 @@ contains
             int_str(deck%maxcont)//")"
       end subroutine one_verification
    end subroutine mkdeck_command
+
+   !> `femcod mkdeck convert IN OUT [--force]`: the deck IN (text or HDF5, by its
+   !> signature) written as OUT, an HDF5 deck when OUT ends in .h5, else a text deck. The
+   !> output rule as for every deck: IN is never OUT, an existing OUT replaced only with
+   !> --force and only when it is a deck.
+   subroutine convert_deck_command(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      type(parsed_options) :: parsed
+      type(status_type) :: status
+      type(contact_problem) :: deck
+      type(string_type), allocatable :: outputs(:), inputs(:)
+      logical :: force
+      code = 0
+      call parse_options([flag_option("--force", "replace an existing deck (only a deck)")], args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) /= 2) call set_error(status, STATUS_USAGE, &
+         "mkdeck convert takes two files, IN and OUT (found "//int_str(size(parsed%positional))//")")
+      if (status%code /= 0) then
+         call command_usage("mkdeck", status, code)
+         return
+      end if
+      force = .false.
+      call get_option(parsed, "--force", force)
+      allocate(outputs(1), inputs(1))
+      outputs(1)%s = parsed%positional(2)%s
+      inputs(1)%s = parsed%positional(1)%s
+      call guard_outputs(outputs, inputs, force, OUTPUT_DECK, status)
+      if (status%code == 0) call read_deck(inputs(1)%s, deck, status)
+      if (status%code == 0) call write_deck(outputs(1)%s, deck, status)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod mkdeck: "//status%message
+         code = status%code
+         return
+      end if
+      write(output_unit, '(a)') "wrote "//outputs(1)%s//" (NP = "//int_str(deck%np)//", MAXCONT = "// &
+         int_str(deck%maxcont)//") from "//inputs(1)%s
+   end subroutine convert_deck_command
 
    !> `femcod verify [-o FILE]`.
    subroutine verify_command(args, code)

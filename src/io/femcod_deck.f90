@@ -10,13 +10,16 @@
 !> Lines 2 to 5 hold exactly the values named; the heights are free format from
 !> line 6 on (any number per line, separated by blanks, tabs or commas). CRLF line
 !> ends and Fortran `D` exponents are accepted. Every error names the file, the line
-!> and what was expected and found (doc/deck-format.md).
+!> and what was expected and found (doc/deck-format.md). An HDF5 file (by its
+!> signature) is read, and a name ending in .h5 written, as the HDF5 deck of the same
+!> content (femcod_deck_h5).
 module femcod_deck
    use femcod_kinds, only: dp, i8
    use femcod_problem, only: contact_problem, validate_problem, MAX_NP, MIN_PIXEL, MAX_PIXEL, MAX_HEIGHT, &
       MIN_YOUNG, MAX_YOUNG
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO, STATUS_USAGE
    use femcod_files, only: write_file, read_file, MAX_TEXT_BYTES
+   use femcod_deck_h5, only: read_deck_h5, write_deck_h5, is_hdf5_file
    use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens, count_tokens
    use femcod_strings, only: int_str, parse_real, parse_integer, format_real, format_reals, is_digit, text_builder, &
       add_line, add_text, built_text
@@ -45,6 +48,11 @@ contains
       character(len=24) :: count_text
       integer :: ln_first(2:5), ln_count(2:5)
 
+      ! An HDF5 deck (femcod_deck_h5) by its signature, whatever its name.
+      if (is_hdf5_file(path)) then
+         call read_deck_h5(path, deck, status)
+         return
+      end if
       call read_file(path, "a deck file", text, status)
       if (status%code /= 0) then
          if (index(status%message, "empty file") > 0) status%message = path//":1: expected a label line, found an "// &
@@ -247,6 +255,13 @@ contains
       integer, intent(in), optional :: max_bytes
       type(text_builder) :: b
       integer :: i, limit
+      ! A name ending in .h5: the HDF5 deck (femcod_deck_h5), any size.
+      if (len(path) >= 3) then
+         if (path(len(path) - 2:) == ".h5") then
+            call write_deck_h5(path, deck, status)
+            return
+         end if
+      end if
       limit = MAX_TEXT_BYTES
       if (present(max_bytes)) limit = min(max_bytes, MAX_TEXT_BYTES)
       call validate_problem(deck, status)
