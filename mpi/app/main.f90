@@ -3,8 +3,9 @@
 !>     mpirun -np 4 femcod-mpi DECK --loads F1,F2 [-o PREFIX] [--tol T] ...
 !>     mpirun -np 4 femcod-mpi --lower scan.h5:/heights --pixel 2 --loads F
 !>     mpirun -np 4 femcod-mpi DECK --boundary periodic --approach D1,D2 ...
-!> Rank 0 reads the deck or height files (one copy of the heights, on rank 0 only) and
-!> sends each rank its columns; all ranks solve (femcod_cg's solve on the distributed
+!> Rank 0 reads a text deck or the height files (one copy of the heights, on rank 0 only)
+!> and sends each rank its columns; of an HDF5 deck every rank reads its own columns
+!> (femcod_mpi_input); all ranks solve (femcod_cg's solve on the distributed
 !> elastic operator of femcod_mpi_cg) and write PREFIX.h5 together
 !> (femcod_mpi_results); rank 0 writes PREFIX.summary.json and prints the summary.
 !> Exit codes as femcod's: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O,
@@ -24,6 +25,8 @@ program femcod_mpi
    use femcod_run, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
+   use femcod_deck_h5, only: is_hdf5_file, read_deck_h5_header
+   use femcod_mpi_input, only: read_deck_columns
    use femcod_heights, only: load_scene, height_file_path
    use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_files, only: path_exists, remove_file, atomic_rename, write_file, acquire_lock, release_lock, &
@@ -45,7 +48,7 @@ program femcod_mpi
    type(string_type), allocatable :: args(:)
    type(run_settings) :: settings
    type(status_type) :: status
-   type(contact_problem) :: problem
+   type(contact_problem) :: problem, header
    type(distributed_grid) :: grid
    type(distributed_state), allocatable :: states(:)
    type(distributed_run_info) :: info
@@ -58,7 +61,7 @@ program femcod_mpi
    integer(i8) :: estimated_rank_bytes
    type(state_maps), allocatable :: figures(:)
    integer :: provided, rank, ranks, np, block, code, k, figure
-   logical :: locked
+   logical :: locked, slab_input
 
    call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
@@ -96,6 +99,9 @@ program femcod_mpi
                write(error_unit, '(a)') "femcod-mpi: warning: "//warnings(k)%s
             end do
          end if
+      else if (is_hdf5_file(settings%decks(1)%s)) then
+         ! An HDF5 deck: its header here, its heights by every rank below.
+         call read_deck_h5_header(settings%decks(1)%s, problem, status)
       else
          call read_deck(settings%decks(1)%s, problem, status)
       end if
@@ -115,7 +121,17 @@ program femcod_mpi
    call agree(status, MPI_COMM_WORLD)
    if (status%code /= 0) call finish(status%code, status%message)
 
-   call scatter_problem(problem, MPI_COMM_WORLD, settings%solve%cg, local, constants, block)
+   slab_input = .false.
+   if (settings%decks(1)%s /= "") slab_input = is_hdf5_file(settings%decks(1)%s)
+   if (slab_input) then
+      ! Each rank reads its own columns of the HDF5 deck (parallel HDF5, collective).
+      call read_deck_columns(settings%decks(1)%s, MPI_COMM_WORLD, settings%solve%cg, header, local, constants, &
+         block, status)
+      if (rank == 0) problem = header
+      if (status%code /= 0) call finish(status%code, status%message)
+   else
+      call scatter_problem(problem, MPI_COMM_WORLD, settings%solve%cg, local, constants, block)
+   end if
    np = nint(constants(1))
    ! Every rank has its columns now: rank 0 keeps the materials only. Its peak so far is
    ! what reading the inputs took.
@@ -348,7 +364,8 @@ contains
          ', "mpi_ranks": '//int_str(ranks)//', "threads_per_rank": '//int_str(info%threads)// &
          ', "wall_time_s": '//json_number(t_write - t_start)//', "read_time_s": '//json_number(t_read - t_start)// &
          ', "solve_time_s": '//json_number(t_solve - t_read)//', "write_time_s": '//json_number(t_write - t_solve)// &
-         ', "peak_memory_MB_per_rank": ['
+         ', "input": '//json_string(trim(merge("HDF5 deck, each rank its own columns", &
+         "rank 0 reads, sends columns         ", slab_input)))//', "peak_memory_MB_per_rank": ['
       do s = 1, ranks
          text = text//json_number(info%peak_mb(s))//trim(merge(", ", "  ", s < ranks))
       end do

@@ -24,7 +24,7 @@ module femcod_deck_h5
    use femcod_about, only: FEMCOD_VERSION
    implicit none
    private
-   public :: write_deck_h5, read_deck_h5, is_hdf5_file, is_deck_h5, DECK_H5_FORMAT
+   public :: write_deck_h5, read_deck_h5, read_deck_h5_header, is_hdf5_file, is_deck_h5, DECK_H5_FORMAT
 
    !> The format tag on / that makes an HDF5 file a femcod deck.
    character(len=*), parameter :: DECK_H5_FORMAT = "femcod deck 1"
@@ -102,6 +102,51 @@ contains
       type(contact_problem), intent(out) :: deck
       type(status_type), intent(inout) :: status
       type(h5_file) :: file
+      call open_header(path, file, deck, status)
+      if (status%code /= 0) return
+      call check_memory(path, deck%np, status)
+      if (status%code == 0) call h5_read(file, "/lower", deck%lower, status, STATUS_BAD_INPUT)
+      if (status%code == 0) call h5_read(file, "/upper", deck%upper, status, STATUS_BAD_INPUT)
+      call h5_close(file, status)
+      if (status%code /= 0) return
+      call first_non_finite(path//":/lower", deck%lower, status)
+      call first_non_finite(path//":/upper", deck%upper, status)
+      if (status%code /= 0) return
+      call validate_problem(deck, status)
+      if (status%code /= 0) status%message = path//": "//status%message
+   end subroutine read_deck_h5
+
+   !> The HDF5 deck `path` without its heights: label, NP, pixel, MAXCONT and the
+   !> materials, checked, and /lower and /upper checked to be NP x NP (for a reader that
+   !> takes the heights in parts, femcod-mpi's ranks).
+   subroutine read_deck_h5_header(path, deck, status)
+      character(len=*), intent(in) :: path
+      type(contact_problem), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      type(h5_file) :: file
+      type(contact_problem) :: probe
+      call open_header(path, file, deck, status)
+      if (status%code /= 0) return
+      call h5_close(file, status)
+      if (status%code /= 0) return
+      ! The scalars' limits, checked on a copy with flat surfaces of one pixel's worth.
+      probe = deck
+      probe%np = 1
+      probe%maxcont = 1
+      allocate(probe%lower(1, 1), probe%upper(1, 1))
+      probe%lower = 0
+      probe%upper = 0
+      call validate_problem(probe, status)
+      if (status%code /= 0) status%message = path//": "//status%message
+   end subroutine read_deck_h5_header
+
+   !> Open `path` and read everything of the deck but the heights, the maps' shapes
+   !> checked; `file` is left open (closed on an error).
+   subroutine open_header(path, file, deck, status)
+      character(len=*), intent(in) :: path
+      type(h5_file), intent(out) :: file
+      type(contact_problem), intent(inout) :: deck
+      type(status_type), intent(inout) :: status
       character(len=:), allocatable :: format
       real(dp), allocatable :: values(:)
       integer :: k
@@ -131,21 +176,11 @@ contains
          if (k == 2) deck%poisson = values
       end do
       if (status%code == 0) call check_maps(file, path, deck%np, status)
-      if (status%code == 0) call h5_read(file, "/lower", deck%lower, status, STATUS_BAD_INPUT)
-      if (status%code == 0) call h5_read(file, "/upper", deck%upper, status, STATUS_BAD_INPUT)
-      call h5_close(file, status)
-      if (status%code /= 0) return
-      if (deck%maxcont < 1 .or. deck%maxcont > deck%np**2) then
+      if (status%code == 0 .and. (deck%maxcont < 1 .or. deck%maxcont > deck%np**2)) &
          call set_error(status, STATUS_BAD_INPUT, path//":/MAXCONT: expected an integer from 1 to NP**2 = "// &
-            int_str(deck%np**2)//", found "//int_str(deck%maxcont))
-         return
-      end if
-      call first_non_finite(path//":/lower", deck%lower, status)
-      call first_non_finite(path//":/upper", deck%upper, status)
-      if (status%code /= 0) return
-      call validate_problem(deck, status)
-      if (status%code /= 0) status%message = path//": "//status%message
-   end subroutine read_deck_h5
+         int_str(deck%np**2)//", found "//int_str(deck%maxcont))
+      if (status%code /= 0) call h5_close(file, status)
+   end subroutine open_header
 
    !> The first height of `map` (row by row) that is not a finite number, named with its
    !> row and column.
@@ -168,15 +203,28 @@ contains
       end do
    end subroutine first_non_finite
 
-   !> /lower and /upper: two-dimensional, NP x NP (NP within the deck's range), and room
-   !> for them: each map once, and once more in the reader's transposition buffer.
+   !> Room for the heights: each map once, and once more in the reader's transposition
+   !> buffer (exit 4 when the machine has less available).
+   subroutine check_memory(path, np, status)
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: np
+      type(status_type), intent(inout) :: status
+      integer(i8) :: need, may
+      need = 3*8*int(np, i8)**2
+      may = available_memory()
+      if (may > 0 .and. need > may) call set_error(status, STATUS_NUMERICAL, path//": NP = "//int_str(np)// &
+         ": the two height maps need about "//memory_text(need)//" to read, this machine has "//memory_text(may)// &
+         " available")
+   end subroutine check_memory
+
+   !> /lower and /upper: two-dimensional, NP x NP (NP within the deck's range).
    subroutine check_maps(file, path, np, status)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: path
       integer, intent(in) :: np
       type(status_type), intent(inout) :: status
       integer :: rank, k
-      integer(i8) :: dims(7), need, may
+      integer(i8) :: dims(7)
       character(len=*), parameter :: MAPS(2) = ["/lower", "/upper"]
       if (np <= 0 .or. np > 46340) then
          call set_error(status, STATUS_BAD_INPUT, path//":/NP: expected NP from 1 to 46340, found "//int_str(np))
@@ -196,11 +244,6 @@ contains
             return
          end if
       end do
-      need = 3*8*int(np, i8)**2
-      may = available_memory()
-      if (may > 0 .and. need > may) call set_error(status, STATUS_NUMERICAL, path//": NP = "//int_str(np)// &
-         ": the two height maps need about "//memory_text(need)//" to read, this machine has "//memory_text(may)// &
-         " available")
    contains
       function shape_text(r, d) result(text)
          integer, intent(in) :: r
