@@ -28,7 +28,6 @@ module test_architecture
       "src/legacy/femcod_legacy.f90 solve_legacy", &
       "src/studies/femcod_verification.f90 write_verification_report", &
       "src/io/femcod_heights.f90 read_ascii_matrix", &
-      "src/solvers/femcod_incremental.f90 event_loop", &
       "app/bench/femcod_bench_frontier.f90 bench_frontier", &
       "app/bench/femcod_bench_adhesion.f90 bench_adhesion"]
 

@@ -190,22 +190,7 @@ contains
       end do
 
       call search%free()
-      if (options%final_check) call final_check(state, options)
-      associate(n => state%n, npl => state%nplastic)
-         if (npl == 0) then
-            call finish_contacts(state%res, state%ic(1:n), state%jc(1:n), state%cstep(1:n), state%ftot(1:n), &
-               state%path%total)
-         else
-            call finish_contacts(state%res, [state%ic(1:n), (state%plastic_pix(1:npl) - 1)/state%np + 1], &
-               [state%jc(1:n), state%plastic_pix(1:npl) - ((state%plastic_pix(1:npl) - 1)/state%np)*state%np], &
-               [state%cstep(1:n), state%plastic_step(1:npl)], [state%ftot(1:n), spread(state%fmax, 1, npl)], &
-               state%path%total)
-         end if
-      end associate
-      if (state%fmax > 0) call plastic_displacements(state)
-      res = state%res
-      call wall_clock(t1)
-      res%wall_seconds = t1 - tstart
+      call finish_events(state, options, res, tstart)
 
    contains
 
@@ -234,6 +219,33 @@ contains
          end do
       end subroutine return_joiners
    end subroutine event_loop
+
+   !> The end of the event loop: the final check (options%final_check), the contact list
+   !> (the capped pixels after the elastic contacts, at the cap's force), the plastic
+   !> displacements, and the result with its wall time since `tstart`.
+   subroutine finish_events(state, options, res, tstart)
+      type(incremental_state), intent(inout) :: state
+      type(contact_options), intent(in) :: options
+      type(contact_result), intent(out) :: res
+      real(dp), intent(in) :: tstart
+      real(dp) :: t1
+      if (options%final_check) call final_check(state, options)
+      associate(n => state%n, npl => state%nplastic)
+         if (npl == 0) then
+            call finish_contacts(state%res, state%ic(1:n), state%jc(1:n), state%cstep(1:n), state%ftot(1:n), &
+               state%path%total)
+         else
+            call finish_contacts(state%res, [state%ic(1:n), (state%plastic_pix(1:npl) - 1)/state%np + 1], &
+               [state%jc(1:n), state%plastic_pix(1:npl) - ((state%plastic_pix(1:npl) - 1)/state%np)*state%np], &
+               [state%cstep(1:n), state%plastic_step(1:npl)], [state%ftot(1:n), spread(state%fmax, 1, npl)], &
+               state%path%total)
+         end if
+      end associate
+      if (state%fmax > 0) call plastic_displacements(state)
+      res = state%res
+      call wall_clock(t1)
+      res%wall_seconds = t1 - tstart
+   end subroutine finish_events
 
    !> The first step's contacts: the smallest gap and every pixel tied with it (within
    !> the tie tolerance of the gaps' range; the load scale is still zero), in pixel order.
