@@ -38,7 +38,8 @@ contains
       testsuite = [ &
          new_unittest("every use points to the same layer or one below", test_layers), &
          new_unittest("no module-level save variables, no stop in src/", test_no_state), &
-         new_unittest("no routine longer than 150 lines in src/, mpi/, app/ (but the listed)", test_routine_length) &
+         new_unittest("no routine longer than 150 lines in src/, mpi/, app/ (but the listed)", test_routine_length), &
+         new_unittest("the numerical layers (model, legacy, solvers) do no I/O", test_numerical_no_io) &
          ]
    end subroutine collect_architecture
 
@@ -185,6 +186,58 @@ contains
          end do
       end do
    end subroutine test_no_state
+
+   !> The numerical layers (src/model, src/legacy, src/solvers) open, inquire, print and
+   !> run nothing: no open, inquire(file=...), execute_command_line, no write or read on
+   !> an external unit (internal writes into a character variable are text formatting);
+   !> from core they use no file, process or /proc reader (femcod_files, femcod_process;
+   !> of femcod_memory only memory_text, which formats a number). What the system says (the
+   !> memory a run may use) comes in through the options.
+   subroutine test_numerical_no_io(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(string_type), allocatable :: files(:)
+      character(len=:), allocatable :: text, line
+      character(len=*), parameter :: FORBIDDEN(10) = [character(len=24) :: "open(", "open (", "inquire(file", &
+         "execute_command_line", "write(output_unit", "write(error_unit", "write(*", "print *", "read(*", &
+         "use femcod_files"]
+      integer :: f, start, k, q
+      files = sources()
+      do f = 1, size(files)
+         if (.not. (index(files(f)%s, "src/model/") == 1 .or. index(files(f)%s, "src/legacy/") == 1 .or. &
+            index(files(f)%s, "src/solvers/") == 1)) cycle
+         text = read_text(files(f)%s)
+         start = 1
+         do k = 1, len(text)
+            if (text(k:k) /= new_line("a")) cycle
+            line = lower(adjustl(text(start:k - 1)))
+            start = k + 1
+            if (index(line, "!") == 1) cycle
+            do q = 1, size(FORBIDDEN)
+               call check(error, .not. statement_starts(line, trim(FORBIDDEN(q))), files(f)%s// &
+                  ": I/O in a numerical layer: "//line)
+               if (allocated(error)) return
+            end do
+            call check(error, index(line, "use femcod_process") == 0, files(f)%s//": uses femcod_process")
+            if (allocated(error)) return
+            if (index(line, "use femcod_memory") == 1) then
+               call check(error, trim(line) == "use femcod_memory, only: memory_text", files(f)%s// &
+                  ": reads the system's memory (pass it in the options): "//line)
+               if (allocated(error)) return
+            end if
+         end do
+      end do
+   end subroutine test_numerical_no_io
+
+   !> Whether `word` begins a statement of `line`: at its start, after a one-line if's
+   !> condition (") "), or after "call " (a variable may be named like a keyword).
+   pure logical function statement_starts(line, word)
+      character(len=*), intent(in) :: line, word
+      integer :: at
+      at = index(line, word)
+      statement_starts = at == 1
+      if (at > 2) statement_starts = line(at - 2:at - 1) == ") "
+      if (at > 5) statement_starts = statement_starts .or. line(at - 5:at - 1) == "call "
+   end function statement_starts
 
    !> Every routine of src/, mpi/ and app/ at most MAX_ROUTINE_LINES long, but those of
    !> LONG_ROUTINES, each of which must still be longer (a stale entry fails too).

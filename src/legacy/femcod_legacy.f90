@@ -86,7 +86,7 @@ contains
       call path%start(problem, options, res)
       call workspace_layout(np, path%max_contacts, ws, status)
       if (status%code /= 0) return
-      call allocate_workspace(ws, status)
+      call allocate_workspace(ws, status, options%memory_available)
       if (status%code /= 0) return
       isurf = ws%rfirst(MPSURF)
       igaps = ws%rfirst(MPGAPS)

@@ -12,7 +12,7 @@
 !>  - MPSTIF is the skyline size of femcod's equation numbering at MAXCONT
 !>    contacts, (7*MAXCONT + 2)*(MAXCONT + 1)/2 words (see `skyline_words`).
 module femcod_workspace
-   use femcod_memory, only: physical_memory, memory_text
+   use femcod_memory, only: memory_text
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_BAD_INPUT
    use femcod_strings, only: int_str
@@ -172,9 +172,13 @@ contains
 
    !> Allocate both arrays (zeroed). A failed allocation is reported with the bytes
    !> needed, never a crash.
-   subroutine allocate_workspace(ws, status)
+   subroutine allocate_workspace(ws, status, memory_available)
       type(workspace_type), intent(inout) :: ws
       type(status_type), intent(inout) :: status
+      !> The bytes this run may use (the caller asks the system: the numerical layers do
+      !> no I/O); absent or 0: not checked.
+      integer(i8), intent(in), optional :: memory_available
+      integer(i8) :: budget
       integer :: stat
       character(len=40) :: buf
       if (ws%mpend > huge(1) .or. ws%ipend > huge(1)) then
@@ -183,9 +187,11 @@ contains
             " bytes, more words than one array can address")
          return
       end if
-      if (physical_memory() > 0 .and. 8*ws%mpend + 4*ws%ipend > physical_memory()) then
+      budget = 0
+      if (present(memory_available)) budget = memory_available
+      if (budget > 0 .and. 8*ws%mpend + 4*ws%ipend > budget) then
          call set_error(status, STATUS_NUMERICAL, "workspace: needs "//memory_text(8*ws%mpend + 4*ws%ipend)// &
-            ", this run may use "//memory_text(physical_memory()))
+            ", this run may use "//memory_text(budget))
          return
       end if
       allocate(ws%ra(ws%mpend), ws%ia(ws%ipend), stat=stat)

@@ -51,6 +51,8 @@ contains
       real(dp) :: tstart
       call wall_clock(tstart)
       if (present(resume)) then
+         ! The budget is this run's, not the stored run's.
+         resume%memory_available = options%memory_available
          call event_loop(resume, problem, options, res, status, observer, tstart)
       else
          call check_memory(status)

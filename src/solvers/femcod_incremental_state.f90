@@ -30,7 +30,7 @@ module femcod_incremental_state
    use femcod_condensed, only: gap_and_rate
    use femcod_heap, only: min_heap, heap_build, heap_push
    use femcod_sort, only: merge_sort_index
-   use femcod_memory, only: physical_memory, memory_text
+   use femcod_memory, only: memory_text
    use femcod_state_visitor, only: state_visitor, visitable
    use femcod_solver_options, only: contact_options
    use femcod_contact_result, only: contact_result, visit_result
@@ -56,6 +56,9 @@ module femcod_incremental_state
       !> entry of the table if negative, else 0 (for the gap bound of unit_load).
       logical :: periodic = .false.
       real(dp) :: table_min = 0
+      !> The bytes this run may use (options%memory_available; 0: not checked): the
+      !> factor grows within it.
+      integer(i8) :: memory_available = 0
       !> The plastic cap (--plastic): the force H d^2 (nN) a capped pixel carries (0: no
       !> cap). Capped pixels are out of the elastic set and the heap (slot -1); their
       !> forces are folded into g0 (c fmax I at every pixel), so the elastic problem is
@@ -138,6 +141,7 @@ contains
       self%maxc = self%path%max_contacts
       allocate(self%table(0:self%np - 1, 0:self%np - 1))
       self%periodic = options%boundary == "periodic"
+      self%memory_available = options%memory_available
       if (self%periodic) then
          self%table(:, :) = periodic_offset_table(self%np)
       else
@@ -322,10 +326,10 @@ contains
          ! Grow the factor's storage by doubling (amortised O(n^2) copies), within the
          ! machine's memory (Linux would over-commit and kill the run later).
          grown = min(2*self%ld, self%maxc)
-         if (physical_memory() > 0 .and. 8*grown**2 > physical_memory()) then
+         if (self%memory_available > 0 .and. 8*grown**2 > self%memory_available) then
             call set_error(status, STATUS_NUMERICAL, "incremental: the factor for "// &
                int_str(int(grown))//" contacts needs "//memory_text(8*grown**2)//", this run may use "// &
-               memory_text(physical_memory())//"; lower MAXCONT or --max-contacts")
+               memory_text(self%memory_available)//"; lower MAXCONT or --max-contacts")
             return
          end if
          call resize_factor(self, int(grown), .true., status)
