@@ -27,9 +27,7 @@ module test_architecture
       "src/io/femcod_deck.f90 read_deck", &
       "src/legacy/femcod_legacy.f90 solve_legacy", &
       "src/studies/femcod_verification.f90 write_verification_report", &
-      "src/io/femcod_heights.f90 read_ascii_matrix", &
-      "app/bench/femcod_bench_frontier.f90 bench_frontier", &
-      "app/bench/femcod_bench_adhesion.f90 bench_adhesion"]
+      "src/io/femcod_heights.f90 read_ascii_matrix"]
 
 contains
 

@@ -33,16 +33,16 @@ contains
       type(status_type), intent(inout) :: status
       logical, intent(in) :: progress
       type(text_builder) :: b
-      integer :: k, i0
+      integer :: k
       real(dp) :: a(4), p(4), ratio(4), t(4), wall(4), acirc(3), pcirc(3), wcirc(3)
       real(dp) :: p13, p24, ext, extr, delta0, rc, pc_known, pc_three, pc_thesis_three
-      real(dp) :: estar, hertz, segedin, aseg, expo, pref, c
+      real(dp) :: estar, hertz, segedin, aseg, expo, pref
       type(contact_result) :: res
       ! The thesis' values (femcod_thesis), approaches in units of 1e-3 nm as it prints them.
       character(len=*), parameter :: circle(3) = TABLE_4_1_DECKS, square(4) = TABLE_4_2_DECKS
       real(dp), parameter :: th_circ_a(3) = TABLE_4_1_APPROACH*1e3_dp, th_circ_p(3) = TABLE_4_1_CENTRE_PRESSURE
       real(dp), parameter :: th_sq_a(4) = TABLE_4_2_APPROACH*1e3_dp, th_sq_r(4) = TABLE_4_2_CENTRE_OVER_MEAN
-      integer, parameter :: circle_pixels(3) = TABLE_4_1_PIXELS, offsets(5) = [5, 10, 20, 40, FIG_5_2_PERMILLE]
+      integer, parameter :: circle_pixels(3) = TABLE_4_1_PIXELS
       character(len=*), parameter :: circle_d(3) = TABLE_4_1_MESH
       real(dp), allocatable :: area(:), load(:)
       real(dp) :: worst
@@ -50,19 +50,19 @@ contains
       worst = 0
       do k = 1, 3
          if (progress) write(*, '(a)') "verify: "//trim(circle(k))
-         call at_load(trim(circle(k)), [1.0_dp], acirc(k), pcirc(k), res)
+         call at_load(trim(circle(k)), [1.0_dp], acirc(k), pcirc(k), res, status)
          if (status%code /= 0) return
          wcirc(k) = res%wall_seconds
       end do
       do k = 1, 4
          if (progress) write(*, '(a)') "verify: "//trim(square(k))
-         call at_load(trim(square(k)), [1.0_dp], a(k), p(k), res)
+         call at_load(trim(square(k)), [1.0_dp], a(k), p(k), res, status)
          if (status%code /= 0) return
          ratio(k) = p(k)/0.01_dp
          wall(k) = res%wall_seconds
       end do
       if (progress) write(*, '(a)') "verify: sphere_d05 to 18000 nN"
-      call at_load("sphere_d05", [1000.0_dp, 18000.0_dp], t(1), t(2), res)
+      call at_load("sphere_d05", [1000.0_dp, 18000.0_dp], t(1), t(2), res, status)
       if (status%code /= 0) return
 
       call add_lines(b, "# Verification against the thesis", "", &
@@ -141,8 +141,24 @@ contains
          fmt(SPHERE_FIT_EXPONENT, 2)//" is not reproduced", &
          "to its digits; Hertz gives 2/3 and the exact rigid sphere bends the curve upward at large loads.", "")
 
+      call add_boussinesq_section(b)
+      call add_lines(b, "", "## Summary", "", &
+         "Largest relative difference from the 14 values of Tables 4.1 and 4.2: "//pct(1 + worst, 1.0_dp)//".", &
+         "Wall time of the legacy solver: circle "//secs(wcirc(1))//", "//secs(wcirc(2))//", "// &
+         secs(wcirc(3))//"; square "//secs(wall(1))//", "//secs(wall(2))//", "//secs(wall(3))//", "// &
+         secs(wall(4))//".")
+      call write_file(path, built_text(b), status)
+   end subroutine write_verification_report
+
+   !> The report's section on the Boussinesq element: the single-pixel compliance, the
+   !> reach of one pixel's influence (Fig. 5.2), and the far-field expansion against the
+   !> exact four-corner sum.
+   subroutine add_boussinesq_section(b)
+      type(text_builder), intent(inout) :: b
+      integer, parameter :: offsets(5) = [5, 10, 20, 40, FIG_5_2_PERMILLE]
+      real(dp) :: c
+      integer :: k
       c = surface_compliance(200.0_dp, 0.25_dp, 5000.0_dp/512)*love_influence(0, 0)
-      i0 = 0
       call add_lines(b, "## Boussinesq element (section 4.2.1, section 4.5, Fig. 5.2)", "", &
          "| check | thesis | femcod |", "|---|---|---|", &
          "| single-pixel compliance, E = 200 GPa, nu = 0.25, d = 5000/512 nm (nm/nN) | "// &
@@ -161,51 +177,50 @@ contains
                fmt(abs(love_influence_far(real(q, dp), 0.0_dp)/love_influence_exact(real(q, dp), 0.0_dp) - 1), 2)//" |")
          end associate
       end do
-      call add_lines(b, "", "## Summary", "", &
-         "Largest relative difference from the 14 values of Tables 4.1 and 4.2: "//pct(1 + worst, 1.0_dp)//".", &
-         "Wall time of the legacy solver: circle "//secs(wcirc(1))//", "//secs(wcirc(2))//", "// &
-         secs(wcirc(3))//"; square "//secs(wall(1))//", "//secs(wall(2))//", "//secs(wall(3))//", "// &
-         secs(wall(4))//".")
-      call write_file(path, built_text(b), status)
-   contains
-      subroutine at_load(name, loads, first, second, res)
-         character(len=*), intent(in) :: name
-         real(dp), intent(in) :: loads(:)
-         real(dp), intent(out) :: first, second
-         type(contact_result), intent(out) :: res
-         type(contact_problem) :: deck
-         type(contact_options) :: options
-         integer :: m, cc
-         type(scene_spec) :: spec
-         ! The deck of input/ built in memory (the same bytes, a test checks): verify runs
-         ! from any directory.
-         call verification_spec(name, spec, status)
-         call build_problem(spec, deck, status)
-         if (status%code /= 0) return
-         options%loads = loads
-         options%solver = "legacy"
-         call solve_contact(deck, options, res, status)
-         if (status%code /= 0) return
-         first = res%states(1)%approach
-         second = -1
-         if (size(loads) > 1) then
-            second = res%states(2)%approach
-            return
-         end if
-         cc = (deck%np + 1)/2
-         do m = 1, size(res%contact_i)
-            if (res%contact_i(m) == cc .and. res%contact_j(m) == cc) second = res%contact_force(m)/deck%pixel**2
-         end do
-      end subroutine at_load
+   end subroutine add_boussinesq_section
 
-      integer function crossing(fraction)
-         real(dp), intent(in) :: fraction
-         crossing = 0
-         do while (love_influence(crossing, 0) >= love_influence(0, 0)/fraction)
-            crossing = crossing + 1
-         end do
-      end function crossing
-   end subroutine write_verification_report
+   !> The verification deck `name` (built in memory) by the legacy solver at `loads`
+   !> (nN): the first load's approach (nm), and the second's, or with one load the
+   !> centre pixel's pressure (GPa).
+   subroutine at_load(name, loads, first, second, res, status)
+      character(len=*), intent(in) :: name
+      real(dp), intent(in) :: loads(:)
+      real(dp), intent(out) :: first, second
+      type(contact_result), intent(out) :: res
+      type(status_type), intent(inout) :: status
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      integer :: m, cc
+      type(scene_spec) :: spec
+      ! The deck of input/ built in memory (the same bytes, a test checks): verify runs
+      ! from any directory.
+      call verification_spec(name, spec, status)
+      call build_problem(spec, deck, status)
+      if (status%code /= 0) return
+      options%loads = loads
+      options%solver = "legacy"
+      call solve_contact(deck, options, res, status)
+      if (status%code /= 0) return
+      first = res%states(1)%approach
+      second = -1
+      if (size(loads) > 1) then
+         second = res%states(2)%approach
+         return
+      end if
+      cc = (deck%np + 1)/2
+      do m = 1, size(res%contact_i)
+         if (res%contact_i(m) == cc .and. res%contact_j(m) == cc) second = res%contact_force(m)/deck%pixel**2
+      end do
+   end subroutine at_load
+
+   !> The first pixel offset n where u(n d, 0)/u(0, 0) falls below 1/fraction.
+   integer function crossing(fraction)
+      real(dp), intent(in) :: fraction
+      crossing = 0
+      do while (love_influence(crossing, 0) >= love_influence(0, 0)/fraction)
+         crossing = crossing + 1
+      end do
+   end function crossing
 
    !> A number with `digits` significant digits.
    function fmt(x, digits) result(s)
