@@ -126,6 +126,9 @@ contains
       case ("ulimit")
          ! ulimit:N limits every file written to N blocks (512 bytes under dash, 1 KiB under bash).
          limit = "ulimit -f "//value//" && "
+      case ("memory")
+         ! memory:VALUE runs the case with FEMCOD_MEMORY=VALUE (the memory femcod may use).
+         limit = "export FEMCOD_MEMORY="//value//" && "
       end select
       call write_text(dir//".before", file_listing(dir))
    end subroutine set_up

@@ -18,7 +18,7 @@ program femcod_mpi
    use femcod_fftw_mpi, only: fftw_init_threads, fftw_plan_with_nthreads, fftw_mpi_init, fftwf_init_threads, &
       fftwf_plan_with_nthreads, fftwf_mpi_init, fftw_mpi_cleanup
    use femcod_kinds, only: dp, i8
-   use femcod_memory, only: physical_memory, memory_text, resident_bytes
+   use femcod_memory, only: physical_memory, memory_text, resident_bytes, memory_setting, MEMORY_VARIABLE
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED, STATUS_NUMERICAL
    use femcod_strings, only: string_type, int_str, sig_str, format_real, json_string, json_number
    use femcod_cli, only: command_arguments
@@ -78,6 +78,10 @@ program femcod_mpi
    locked = .false.
 
    args = command_arguments()
+   ! A memory cap (FEMCOD_MEMORY) that does not read is refused, not ignored.
+   call memory_setting(estimated_rank_bytes)
+   if (estimated_rank_bytes < 0) call finish(STATUS_USAGE, MEMORY_VARIABLE//": expected a number of bytes, "// &
+      "optionally with K, M, G or T (KiB to TiB), for example 8G")
    if (help_requested(args)) then
       if (rank == 0) call print_help()
       call finish(0, "")

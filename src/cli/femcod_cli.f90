@@ -5,6 +5,7 @@
 module femcod_cli
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp, i8
+   use femcod_memory, only: memory_setting, MEMORY_VARIABLE
    use femcod_status, only: status_type, set_error, STATUS_USAGE
    use femcod_strings, only: string_type, int_str, parse_integer, append_string
    use femcod_problem, only: contact_problem
@@ -51,9 +52,20 @@ contains
    subroutine run_femcod(args, code)
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
+      integer(i8) :: cap
+      character(len=64) :: setting
       code = 0
       if (size(args) == 0) then
          call usage_error("no command given")
+         code = STATUS_USAGE
+         return
+      end if
+      ! A memory cap that does not read is refused before any work, not ignored.
+      call memory_setting(cap)
+      if (cap < 0) then
+         call get_environment_variable(MEMORY_VARIABLE, setting)
+         call usage_error(MEMORY_VARIABLE//": expected a number of bytes, optionally with K, M, G or T "// &
+            "(KiB to TiB), for example 8G, found '"//trim(setting)//"'")
          code = STATUS_USAGE
          return
       end if
@@ -102,7 +114,11 @@ contains
          "exit codes: 0 ok, 2 usage, 3 bad input, 4 numerical failure or not enough memory, 5 I/O,", &
          "  128 + N after signal N: "//int_str(128 + SIGTERM)//" SIGTERM, "//int_str(128 + SIGINT)//" SIGINT, "// &
          int_str(128 + SIGUSR1)//" SIGUSR1 (a checkpoint is kept where the", &
-         "  solver writes one; continue with --restart)"
+         "  solver writes one; continue with --restart)", &
+         "", &
+         "environment: FEMCOD_MEMORY=8G caps the memory femcod may use (bytes, or K, M, G, T), below the", &
+         "  machine's and the job's (cgroup) limits; every solver and study checks its estimate against", &
+         "  it before the work (exit 4)"
    end subroutine print_help
 
    subroutine usage_error(message)

@@ -4,8 +4,8 @@
 !> and SVG files as one set (temporaries renamed into place; nothing on failure).
 module femcod_studies
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO, STATUS_NUMERICAL
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, sig_str, split_list, text_builder, add_line, built_text, &
@@ -20,7 +20,8 @@ module femcod_studies
    use femcod_clock, only: wall_clock
    use femcod_resolution_study, only: resolution_level, solve_level, extrapolate_levels
    use femcod_summits, only: summit_statistics, summit_search, summits_of_size, default_sizes, profile_psd, summit_power_laws, &
-      structure_function, psd_dimension, structure_dimension
+      structure_function, psd_dimension, structure_dimension, summits_storage_bytes
+   use femcod_memory, only: available_memory, memory_text
    use femcod_multiscale, only: roughness_template, multiscale_result, multiscale_hertz
    use femcod_scene, only: flip_upper
    use femcod_surfaces, only: remove_plane
@@ -616,6 +617,7 @@ contains
       type(svg_series), allocatable :: series(:)
       character(len=14), parameter :: quantity(3) = [character(len=14) :: "density", "mean_height", "mean_radius"]
       real(dp) :: d, side, dpsd, slope, dsf, g
+      integer(i8) :: need, may
       integer :: k, q, npsd, nsf
       call parse_surface_options("summits", args, opts, parsed, code)
       if (code == -1) then
@@ -632,6 +634,15 @@ contains
       ! The outputs are checked before the input is read: an input is never an output.
       call check_outputs(names, opts%input, opts%force, status)
       if (status%code == 0) call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
+      ! The analysis' memory, checked before it starts (the heights are read).
+      if (status%code == 0) then
+         need = summits_storage_bytes(size(z, 1), size(z, 2))
+         may = available_memory()
+         if (may > 0 .and. need > may) call set_error(status, STATUS_NUMERICAL, opts%input//": the analysis of "// &
+            int_str(size(z, 1))//" x "//int_str(size(z, 2))//" heights needs about "//memory_text(need)// &
+            " besides them (box maxima, summit lists, the structure function's differences), this run may use "// &
+            memory_text(may))
+      end if
       if (status%code /= 0) then
          call fail_with("summits", status, code)
          return

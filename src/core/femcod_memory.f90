@@ -3,13 +3,19 @@
 !> process be killed later when the pages are touched). On a cluster that is the job's
 !> limit, not the machine's: the smaller of the physical memory and the memory limit of
 !> the process's control group (cgroup v2 memory.max, v1 memory.limit_in_bytes), which
-!> is where Slurm and container runtimes put a job's --mem.
+!> is where Slurm and container runtimes put a job's --mem. The environment variable
+!> FEMCOD_MEMORY (bytes, or a number with K, M, G or T: KiB to TiB) lowers it further, for
+!> a run that shares a machine or a node without a memory limit of its own.
 module femcod_memory
    use, intrinsic :: iso_c_binding, only: c_int, c_long
    use femcod_kinds, only: i8
    implicit none
    private
    public :: physical_memory, memory_text, resident_bytes, peak_resident_bytes, available_memory
+   public :: memory_setting, MEMORY_VARIABLE
+
+   !> The environment variable that caps the memory femcod may use.
+   character(len=*), parameter :: MEMORY_VARIABLE = "FEMCOD_MEMORY"
 
    interface
       function c_sysconf(name) bind(c, name="sysconf") result(value)
@@ -35,7 +41,42 @@ contains
       if (pages > 0 .and. page > 0) bytes = int(pages, i8)*int(page, i8)
       limit = cgroup_limit()
       if (limit > 0 .and. (bytes == 0 .or. limit < bytes)) bytes = limit
+      call memory_setting(limit)
+      if (limit > 0 .and. (bytes == 0 .or. limit < bytes)) bytes = limit
    end function physical_memory
+
+   !> FEMCOD_MEMORY in bytes: 0 when it is not set, -1 when it is set but is not a
+   !> positive number of bytes with an optional K, M, G or T (powers of 1024).
+   subroutine memory_setting(bytes)
+      integer(i8), intent(out) :: bytes
+      character(len=64) :: text
+      integer :: length, status, ios, last
+      real(kind(1.0d0)) :: value, factor
+      bytes = 0
+      call get_environment_variable(MEMORY_VARIABLE, text, length, status)
+      if (status == 1) return
+      bytes = -1
+      if (status /= 0 .or. length == 0) return
+      text = adjustl(text)
+      last = len_trim(text)
+      factor = 1
+      select case (text(last:last))
+      case ("K", "k")
+         factor = 1024.0d0
+      case ("M", "m")
+         factor = 1024.0d0**2
+      case ("G", "g")
+         factor = 1024.0d0**3
+      case ("T", "t")
+         factor = 1024.0d0**4
+      end select
+      if (factor > 1) last = last - 1
+      if (last < 1) return
+      if (verify(text(1:last), "0123456789.") /= 0) return
+      read(text(1:last), *, iostat=ios) value
+      if (ios /= 0 .or. .not. value*factor >= 1 .or. value*factor > 2.0d0**62) return
+      bytes = int(value*factor, i8)
+   end subroutine memory_setting
 
    !> The memory limit of this process's cgroup in bytes (0: none found, or unlimited).
    function cgroup_limit() result(bytes)
@@ -120,12 +161,22 @@ contains
       close(unit)
    end function status_field
 
-   !> "N bytes (X GiB)".
+   !> "N bytes (X.Y UNIT)", UNIT the largest of KiB, MiB, GiB and TiB that X is at least
+   !> 1 of (bytes alone below 1 KiB).
    function memory_text(bytes) result(text)
       integer(i8), intent(in) :: bytes
       character(len=:), allocatable :: text
+      character(len=*), parameter :: UNITS(4) = ["KiB", "MiB", "GiB", "TiB"]
       character(len=48) :: buf
-      write(buf, '(i0," bytes (",f0.1," GiB)")') bytes, real(bytes)/1024.0**3
+      integer :: k
+      write(buf, '(i0," bytes")') bytes
       text = trim(buf)
+      do k = size(UNITS), 1, -1
+         if (real(bytes, kind(1.0d0)) >= 1024.0d0**k) then
+            write(buf, '(f0.1)') real(bytes, kind(1.0d0))/1024.0d0**k
+            text = text//" ("//trim(buf)//" "//UNITS(k)//")"
+            exit
+         end if
+      end do
    end function memory_text
 end module femcod_memory

@@ -5,14 +5,14 @@
 !> No I/O.
 module femcod_summits
    use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_double_complex
-   use femcod_kinds, only: dp
+   use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT
    use femcod_richardson, only: power_law_fit
    use femcod_strings, only: int_str
    implicit none
    private
    public :: summit_statistics, summit_search, summits_of_size, paraboloid_fit, default_sizes, summit_power_laws
-   public :: profile_psd, structure_function, psd_dimension, structure_dimension
+   public :: profile_psd, structure_function, psd_dimension, structure_dimension, summits_storage_bytes
 
    !> The summits found with neighbourhood size n (box d_n = (2n+1) L/N, eq. 3.2) in
    !> the central region common to all sizes.
@@ -31,6 +31,16 @@ contains
 
    !> Neighbourhood sizes 1, 2, 3, 4, 6, 8, 11, 16, 23, 32, ... (steps of about sqrt 2)
    !> up to N/8, so that the common central region keeps three quarters of the side.
+   !> The analysis' storage at its largest besides the heights (bytes), per pixel of an
+   !> n1 x n2 surface: the summit search's two maps of box maxima (8 each) and its lists
+   !> (row, column, height, two radii: 32 bytes a summit, at most one summit in four
+   !> pixels), or the structure function's two difference maps (8 each): 24 bytes.
+   pure function summits_storage_bytes(n1, n2) result(bytes)
+      integer, intent(in) :: n1, n2
+      integer(i8) :: bytes
+      bytes = 24*int(n1, i8)*int(n2, i8)
+   end function summits_storage_bytes
+
    pure function default_sizes(np) result(sizes)
       integer, intent(in) :: np
       integer, allocatable :: sizes(:)
