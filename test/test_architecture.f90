@@ -26,7 +26,6 @@ module test_architecture
       "src/solvers/femcod_adhesion.f90 adhesive_cg", &
       "src/io/femcod_deck.f90 read_deck", &
       "src/legacy/femcod_legacy.f90 solve_legacy", &
-      "src/studies/femcod_verification.f90 write_verification_report", &
       "src/io/femcod_heights.f90 read_ascii_matrix"]
 
 contains
