@@ -12,7 +12,7 @@ module oracles
    implicit none
    private
    public :: love_quad, love_table, composite_compliance, spring_compliance, reference_gaps, exact_state, &
-      gaps_at_state, appendix_b_condition, first_touch_gaps, grid_stiffness
+      gaps_at_state, appendix_b_condition, first_touch_gaps, grid_stiffness, event_path
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -160,6 +160,82 @@ contains
          end do
       end do
    end function gaps_at_state
+
+   !> The event path of the elastic contact by brute force, independent of femcod's
+   !> solvers: from the pixels that touch first (initial gap within `tie` nm of the
+   !> smallest), the contact set's state is linear in the load between events, so two
+   !> dense solves (exact_state at loads 0 and 1) give every gap as g(P) = g_0 + P g_1;
+   !> the next event is the smallest load above the last at which a pixel off the set
+   !> closes (with every pixel that closes within `tie` relative of it), and it joins.
+   !> Returned per event: the load (nN) and the contacts carrying it until then; at most
+   !> `max_events`, none past `max_load` (nN), the last with MAXCONT contacts. `tie` is
+   !> the first touch's tolerance (nm) and a tie's between closing loads (relative). `released` is true when a contact's
+   !> force turned tensile before the last event (the path then needs releases, which
+   !> this oracle does not follow; the caller compares the events before it only).
+   subroutine event_path(problem, table, tie, max_events, max_load, loads, counts, nevents, released)
+      type(contact_problem), intent(in) :: problem
+      real(dp), intent(in) :: table(0:, 0:), tie, max_load
+      integer, intent(in) :: max_events
+      real(dp), intent(out) :: loads(:)
+      integer, intent(out) :: counts(:), nevents
+      logical, intent(out) :: released
+      integer, allocatable :: i(:), j(:)
+      real(dp), allocatable :: f0(:), f1(:), g0(:, :), g1(:, :)
+      real(dp) :: a0, a1, last, next, rate
+      logical :: in_set(problem%np, problem%np)
+      integer :: p, q, info, np
+      np = problem%np
+      g0 = reference_gaps(problem)
+      in_set = g0 <= minval(g0) + tie
+      nevents = 0
+      released = .false.
+      last = 0
+      do while (nevents < max_events)
+         i = [integer :: ]
+         j = [integer :: ]
+         do q = 1, np
+            do p = 1, np
+               if (in_set(p, q)) then
+                  i = [i, p]
+                  j = [j, q]
+               end if
+            end do
+         end do
+         if (size(i) > problem%maxcont .or. size(i) == np*np) exit
+         allocate(f0(size(i)), f1(size(i)))
+         call exact_state(problem, table, i, j, 0.0_dp, f0, a0, info)
+         if (info /= 0) exit
+         call exact_state(problem, table, i, j, 1.0_dp, f1, a1, info)
+         if (info /= 0) exit
+         g0 = gaps_at_state(problem, table, i, j, f0, a0)
+         g1 = gaps_at_state(problem, table, i, j, f1, a1) - g0
+         f1 = f1 - f0
+         ! The next closing load: g0 + P g1 = 0 for a pixel off the set whose gap falls.
+         next = huge(1.0_dp)
+         do q = 1, np
+            do p = 1, np
+               rate = g1(p, q)
+               if (.not. in_set(p, q) .and. rate < 0) next = min(next, max(-g0(p, q)/rate, last))
+            end do
+         end do
+         if (next > max_load) exit
+         if (any(f0 + next*f1 < -tie*abs(next))) released = .true.
+         nevents = nevents + 1
+         loads(nevents) = next
+         counts(nevents) = size(i)
+         last = next
+         do q = 1, np
+            do p = 1, np
+               if (.not. in_set(p, q) .and. g1(p, q) < 0) then
+                  if (g0(p, q) + next*g1(p, q) <= tie*max(abs(g0(p, q)), abs(next*g1(p, q)))) in_set(p, q) = .true.
+               end if
+            end do
+         end do
+         deallocate(f0, f1)
+         ! MAXCONT contacts carry up to the load where one more would close: the last event.
+         if (released .or. size(i) == problem%maxcont) exit
+      end do
+   end subroutine event_path
 
    !> The exact 1-norm condition number ||K||_1 ||K^-1||_1 of the Appendix B stiffness
    !> for the contacts (i, j): per contact a lower substrate, a lower and an upper surface

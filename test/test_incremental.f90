@@ -12,7 +12,7 @@ module test_incremental
    use femcod_love, only: offset_table
    use femcod_event_search, only: fft_search_pays
    use femcod_thesis, only: TABLE_4_1_APPROACH, TABLE_4_2_APPROACH
-   use oracles, only: love_table, exact_state, gaps_at_state, reference_gaps
+   use oracles, only: love_table, exact_state, gaps_at_state, reference_gaps, event_path
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
    implicit none
@@ -25,6 +25,8 @@ contains
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
       testsuite = [ &
          new_unittest("same events as legacy on every input/ deck", test_same_events), &
+         new_unittest("the events of a brute-force dense event path (oracle), spheres and the rough deck", &
+            test_oracle_events), &
          new_unittest("rigid springs: equals a fixed-load active-set solution", test_active_set), &
          new_unittest("Tables 4.1, 4.2; the state against an exact solve and every gap", test_tables), &
          new_unittest("--max-contacts above MAXCONT: the factor grows; the end state against an exact solve", &
@@ -104,6 +106,67 @@ contains
          deallocate(li, ci, ll, cl)
       end do
    end subroutine test_same_events
+
+   !> Independent reference for the event path itself (issue 34, section 6: the test above
+   !> compares two of femcod's solvers): test/oracles' event_path, a brute-force stepping
+   !> with two dense LU solves per event and direct-sum gaps from the quadruple-precision
+   !> Love table, on the 2 nm and 1 nm spheres of input/ (to 18000 nN) and the rough 32^2
+   !> deck (to MAXCONT). The incremental solver's distinct event loads and contact counts
+   !> equal the oracle's, the loads within 1e-9 relative (the condensed factor's
+   !> round-off, doc/stability.md, is 1e-10).
+   subroutine test_oracle_events(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: decks(3) = [character(len=20) :: "sphere_d2", "sphere_d1", "rough_selfaffine_32"]
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: inc
+      type(status_type) :: status
+      real(dp), allocatable :: table(:, :), oracle_loads(:), li(:)
+      integer, allocatable :: oracle_counts(:), ci(:)
+      real(dp) :: worst, top
+      integer :: d, m, mi, k, n
+      logical :: released
+      do d = 1, size(decks)
+         call read_deck("input/"//trim(decks(d))//".deck", deck, status)
+         call check(error, status%code, 0)
+         if (allocated(error)) return
+         top = huge(1.0_dp)
+         options = contact_options()
+         options%solver = "incremental"
+         if (index(decks(d), "sphere") > 0) then
+            top = 18000
+            options%loads = [top]
+         end if
+         call solve_contact(deck, options, inc, status)
+         call check(error, status%code, 0)
+         if (allocated(error)) return
+         allocate(li(inc%nsteps), ci(inc%nsteps), oracle_loads(deck%maxcont + 1), oracle_counts(deck%maxcont + 1))
+         call events(inc, li, ci, mi)
+         table = love_table(deck%np)
+         call event_path(deck, table, 1.0e-9_dp, deck%maxcont + 1, top, oracle_loads, oracle_counts, m, released)
+         call check(error, .not. released, trim(decks(d))//": the oracle's path needs a release")
+         if (allocated(error)) return
+         ! History row k: the contacts of step k and the load at which it ends (the next
+         ! contact closes), as the oracle's events; those up to the requested load.
+         n = 0
+         worst = 0
+         do k = 1, mi
+            if (li(k) > top) exit
+            n = n + 1
+            if (n > m) exit
+            call check(error, ci(k), oracle_counts(n), trim(decks(d))//": contacts at event "//to_string(n))
+            if (allocated(error)) return
+            worst = max(worst, abs(li(k) - oracle_loads(n))/oracle_loads(n))
+         end do
+         call check(error, n == m .and. m >= 4, trim(decks(d))//": "//to_string(n)//" events of the solver, "// &
+            to_string(m)//" of the oracle")
+         if (allocated(error)) return
+         call check(error, worst < 1.0e-9_dp, trim(decks(d))//": event loads within 1e-9 of the oracle's, worst "// &
+            to_string(worst))
+         if (allocated(error)) return
+         deallocate(li, ci, oracle_loads, oracle_counts)
+      end do
+   end subroutine test_oracle_events
 
    !> Independent reference: Kalker-style fixed-load active-set iteration with the
    !> oracles' dense LU solve and direct-sum gaps (test/oracles): start from the pixels
