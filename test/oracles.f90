@@ -172,13 +172,16 @@ contains
    !> the first touch's tolerance (nm) and a tie's between closing loads (relative). `released` is true when a contact's
    !> force turned tensile before the last event (the path then needs releases, which
    !> this oracle does not follow; the caller compares the events before it only).
-   subroutine event_path(problem, table, tie, max_events, max_load, loads, counts, nevents, released)
+   subroutine event_path(problem, table, tie, max_events, max_load, loads, counts, nevents, released, set_i, set_j)
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: table(0:, 0:), tie, max_load
       integer, intent(in) :: max_events
       real(dp), intent(out) :: loads(:)
       integer, intent(out) :: counts(:), nevents
       logical, intent(out) :: released
+      !> The contact set (rows, columns) the path stopped with: the set that carries
+      !> `max_load` when the path ended there.
+      integer, allocatable, intent(out), optional :: set_i(:), set_j(:)
       integer, allocatable :: i(:), j(:)
       real(dp), allocatable :: f0(:), f1(:), g0(:, :), g1(:, :)
       real(dp) :: a0, a1, last, next, rate
@@ -235,6 +238,8 @@ contains
          ! MAXCONT contacts carry up to the load where one more would close: the last event.
          if (released .or. size(i) == problem%maxcont) exit
       end do
+      if (present(set_i)) set_i = pack(spread([(p, p = 1, np)], 2, np), in_set)
+      if (present(set_j)) set_j = pack(spread([(q, q = 1, np)], 1, np), in_set)
    end subroutine event_path
 
    !> The exact 1-norm condition number ||K||_1 ||K^-1||_1 of the Appendix B stiffness

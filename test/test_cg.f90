@@ -19,7 +19,7 @@ module test_cg
    use femcod_scene, only: initial_gaps
    use femcod_random, only: random_stream, seed_stream, uniform
    use test_support, only: scratch_path, file_exists, remove_scratch, read_text
-   use oracles, only: grid_stiffness, love_quad, love_table
+   use oracles, only: grid_stiffness, love_quad, love_table, event_path, exact_state
    use, intrinsic :: iso_fortran_env, only: real128
    use femcod_analytic, only: hertz_approach, segedin_sphere
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
@@ -35,6 +35,8 @@ contains
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
       testsuite = [ &
          new_unittest("equals the event-exact solver inside steps on every input/ deck", test_against_incremental), &
+         new_unittest("equals a brute-force dense oracle's exact state inside its steps (spheres, rough)", &
+            test_against_oracle), &
          new_unittest("sphere, 0.5 nm mesh: Hertz at 1000 nN, Segedin at 18000 nN", test_sphere), &
          new_unittest("usage errors: no --loads; --plastic with legacy or at full capacity", test_usage), &
          new_unittest("--approach (displacement control): Hertz's load at the sphere's approach, both solvers", &
@@ -128,6 +130,70 @@ contains
          deallocate(loads)
       end do
    end subroutine test_against_incremental
+
+   !> An outside reference for cg (the test above compares it with femcod's event
+   !> solver): test/oracles' brute-force event path gives the contact set that carries a
+   !> load, and a dense LU solve with the quadruple-precision Love table its exact state.
+   !> At loads halfway between the oracle's events on the 2 nm and 1 nm spheres and the
+   !> rough 32^2 deck, cg (--tol 1e-11) finds the oracle's contact count and its approach
+   !> within 1e-9 of the height range (the cg error bound's scale: doc/solver.md).
+   subroutine test_against_oracle(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), parameter :: decks(3) = [character(len=20) :: "sphere_d2", "sphere_d1", "rough_selfaffine_32"]
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: cg
+      type(status_type) :: status
+      real(dp), allocatable :: table(:, :), event_loads(:), loads(:), forces(:), exact(:)
+      integer, allocatable :: counts(:), set_i(:), set_j(:), carried(:)
+      real(dp) :: range, top
+      integer :: d, m, k, n, info, pick
+      logical :: released
+      do d = 1, size(decks)
+         call read_deck("input/"//trim(decks(d))//".deck", deck, status)
+         call check(error, status%code, 0)
+         if (allocated(error)) return
+         table = love_table(deck%np)
+         top = merge(18000.0_dp, huge(1.0_dp), index(decks(d), "sphere") > 0)
+         allocate(event_loads(deck%maxcont + 1), counts(deck%maxcont + 1))
+         call event_path(deck, table, 1.0e-9_dp, deck%maxcont + 1, top, event_loads, counts, m, released)
+         call check(error, m >= 4 .and. .not. released, trim(decks(d))//": the oracle's path")
+         if (allocated(error)) return
+         ! Five loads halfway between events spread over the path, each with its exact state.
+         n = min(5, m - 1)
+         allocate(loads(n), exact(n), carried(n))
+         do k = 1, n
+            pick = 1 + (k*(m - 1))/(n + 1)
+            loads(k) = (event_loads(pick) + event_loads(pick + 1))/2
+            call event_path(deck, table, 1.0e-9_dp, deck%maxcont + 1, loads(k), event_loads, counts, m, released, &
+               set_i, set_j)
+            allocate(forces(size(set_i)))
+            call exact_state(deck, table, set_i, set_j, loads(k), forces, exact(k), info)
+            carried(k) = size(set_i)
+            deallocate(forces)
+            ! (event_path overwrote the events: make them again for the next pick.)
+            call event_path(deck, table, 1.0e-9_dp, deck%maxcont + 1, top, event_loads, counts, m, released)
+         end do
+         options = contact_options()
+         options%solver = "cg"
+         options%loads = loads
+         options%cg%tol = 1.0e-11_dp
+         options%cg%max_iterations = 20000
+         call solve_contact(deck, options, cg, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         range = maxval(deck%upper) - minval(deck%upper) + maxval(deck%lower) - minval(deck%lower)
+         do k = 1, n
+            call check(error, cg%states(k)%contacts, carried(k), trim(decks(d))//": contacts at "// &
+               to_string(loads(k))//" nN")
+            if (allocated(error)) return
+            call check(error, abs(cg%states(k)%approach - exact(k)) <= 1.0e-9_dp*range, trim(decks(d))// &
+               ": approach "//to_string(cg%states(k)%approach)//" vs the oracle's "//to_string(exact(k)))
+            if (allocated(error)) return
+         end do
+         deallocate(event_loads, counts, loads, exact, carried)
+      end do
+   end subroutine test_against_oracle
 
    !> The analytic checks of the legacy suite, with the same tolerances (1 % and 0.5 %).
    subroutine test_sphere(error)
