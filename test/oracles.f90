@@ -172,7 +172,8 @@ contains
    !> the first touch's tolerance (nm) and a tie's between closing loads (relative). `released` is true when a contact's
    !> force turned tensile before the last event (the path then needs releases, which
    !> this oracle does not follow; the caller compares the events before it only).
-   subroutine event_path(problem, table, tie, max_events, max_load, loads, counts, nevents, released, set_i, set_j)
+   subroutine event_path(problem, table, tie, max_events, max_load, loads, counts, nevents, released, set_i, set_j, &
+         hardness, above)
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: table(0:, 0:), tie, max_load
       integer, intent(in) :: max_events
@@ -182,6 +183,10 @@ contains
       !> The contact set (rows, columns) the path stopped with: the set that carries
       !> `max_load` when the path ended there.
       integer, allocatable, intent(out), optional :: set_i(:), set_j(:)
+      !> With `hardness` (GPa): per event, the contacts whose pressure at the event's load
+      !> is above it.
+      real(dp), intent(in), optional :: hardness
+      integer, intent(out), optional :: above(:)
       integer, allocatable :: i(:), j(:)
       real(dp), allocatable :: f0(:), f1(:), g0(:, :), g1(:, :)
       real(dp) :: a0, a1, last, next, rate
@@ -226,6 +231,8 @@ contains
          nevents = nevents + 1
          loads(nevents) = next
          counts(nevents) = size(i)
+         if (present(hardness) .and. present(above)) &
+            above(nevents) = count((f0 + next*f1)/problem%pixel**2 > hardness)
          last = next
          do q = 1, np
             do p = 1, np

@@ -21,6 +21,7 @@ module test_studies
    use femcod_richardson, only: power_law_fit
    use femcod_thesis, only: PIXEL_COMPLIANCE
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   use oracles, only: love_table, event_path
    use test_support, only: scratch_path, read_text, file_exists, remove_scratch, contains_text
    implicit none
    private
@@ -41,6 +42,7 @@ contains
          new_unittest("Richardson of curves converging linearly is exact", test_richardson_curves), &
          new_unittest("down-sampling chain, levels and MAXCONT", test_level_deck), &
          new_unittest("pixels above the hardness per step: incremental = legacy", test_hardness_steps), &
+         new_unittest("pixels above the hardness per step: the dense oracle's event path", test_hardness_oracle), &
          new_unittest("femcod resolution writes the study", test_resolution_command), &
          new_unittest("Fig. 4.21 capped curve: the elastic history until the first pixel reaches H", &
             test_capped_curve), &
@@ -252,6 +254,56 @@ contains
       if (allocated(error)) return
       call check(error, a%step_above_hardness(a%nsteps), count(a%contact_force/deck%pixel**2 > 5))
    end subroutine test_hardness_steps
+
+   !> The same counts against an outside reference (test/oracles' brute-force event path:
+   !> dense LU solves with the quadruple-precision Love table): at the load where each
+   !> step ends, the contacts whose pressure is above H = 5 GPa, on the 1 nm sphere to
+   !> its MAXCONT. The solver's steps are compressed to distinct loads (tied pixels join
+   !> in one event of the oracle).
+   subroutine test_hardness_oracle(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      type(contact_options) :: options
+      type(contact_result) :: a
+      real(dp), allocatable :: table(:, :), loads(:)
+      integer, allocatable :: counts(:), above(:)
+      integer :: m, k, n
+      logical :: released
+      call read_deck("input/sphere_d1.deck", deck, status)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      options%hardness = 5
+      allocate(options%loads(0))
+      options%solver = "incremental"
+      call solve_contact(deck, options, a, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      table = love_table(deck%np)
+      allocate(loads(deck%maxcont + 1), counts(deck%maxcont + 1), above(deck%maxcont + 1))
+      call event_path(deck, table, 1.0e-9_dp, deck%maxcont + 1, huge(1.0_dp), loads, counts, m, released, &
+         hardness=5.0_dp, above=above)
+      call check(error, m > 10 .and. .not. released, "the oracle's path: "//to_string(m)//" events")
+      if (allocated(error)) return
+      n = 0
+      do k = 1, a%nsteps
+         if (k > 1) then
+            if (abs(a%step_load(k) - a%step_load(k - 1)) <= 1.0e-12_dp*a%step_load(k)) cycle
+         end if
+         n = n + 1
+         if (n > m) exit
+         ! Loads within 1e-8: measured 1.05e-9 at worst (the last event, 43, with over 300 contacts, the
+         ! two dense solves of 300 x 300 systems with the deck's 1e5 rigid factor), a decade.
+         call check(error, abs(a%step_load(k) - loads(n)) <= 1.0e-8_dp*loads(n), "event "//to_string(n)// &
+            ": load "//to_string(a%step_load(k))//" vs the oracle's "//to_string(loads(n)))
+         if (allocated(error)) return
+         call check(error, a%step_above_hardness(k), above(n), "event "//to_string(n)//" at "// &
+            to_string(loads(n))//" nN: pixels above 5 GPa")
+         if (allocated(error)) return
+      end do
+      call check(error, n == m .and. maxval(above(1:m)) > 0, "events compared: "//to_string(n)//" of "// &
+         to_string(m)//"; some above 5 GPa")
+   end subroutine test_hardness_oracle
 
    !> The capped curve of Fig. 4.21 (PREFIX.hardness_capped.csv: the finest level solved
    !> again with the pressures capped at H = 5 GPa, the event path's plastic events). A row
