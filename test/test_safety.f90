@@ -9,7 +9,7 @@ module test_safety
    use femcod_deck, only: write_deck
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem
-   use femcod_process, only: process_id, host_name
+   use femcod_process, only: process_id, host_name, process_alive
    use femcod_files, only: acquire_lock, release_lock
    use femcod_strings, only: int_str
    use femcod_output_guard, only: written_by_femcod, OUTPUT_RESULT, OUTPUT_DECK, OUTPUT_WISDOM
@@ -31,6 +31,7 @@ contains
       testsuite = [ &
          new_unittest("SIGTERM: exit 143, a checkpoint, no result; --restart gives the same bytes", test_sigterm), &
          new_unittest("a prefix is locked: a live holder refuses the run, a dead one is taken over", test_lock), &
+         new_unittest("a lock's holder: alive, reaped, a zombie, stopped with SIGKILL pending", test_holder_alive), &
          new_unittest("a lock appears with its line (linked in place), no name of its own left", test_lock_whole), &
          new_unittest("--force replaces the set as a whole (no stale pressure maps)", test_force_set), &
          new_unittest("a checkpoint is not overwritten without --restart or --force", test_checkpoint_kept), &
@@ -458,4 +459,44 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_checkpoint_options
+
+   !> femcod_process' process_alive, which decides whether a lock is held: this process is
+   !> alive; a process that ended and was reaped is not; a zombie (a child whose parent
+   !> does not reap it) is not; a stopped process with SIGKILL pending (the state a run
+   !> killed by `timeout -s KILL` can be in when the next one looks) is not, while the
+   !> same stopped process without it is. Each process is made by the shell here.
+   subroutine test_holder_alive(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: file
+      integer :: pid, ios, unit
+      file = scratch_path("holder.pid")
+      call check(error, process_alive(process_id()), "this process")
+      if (allocated(error)) return
+      call execute_command_line("sh -c 'echo $$ > "//file//"'")
+      call check(error, .not. process_alive(pid_in(file)), "a process that ended")
+      if (allocated(error)) return
+      ! A zombie: the inner sleep ends at once; its parent, exec'ed into sleep 3, never
+      ! reaps it.
+      call execute_command_line("sh -c '(sleep 0 & echo $! > "//file//"; exec sleep 3)' > /dev/null 2>&1 &")
+      call execute_command_line("sleep 1")
+      pid = pid_in(file)
+      call check(error, pid > 0 .and. .not. process_alive(pid), "a zombie ("//to_string(pid)//")")
+      if (allocated(error)) return
+      ! Stopped, alive; stopped with SIGKILL sent (pending until it is scheduled), dying.
+      call execute_command_line("sh -c 'sleep 30 & echo $! > "//file//"' && kill -STOP $(cat "//file//")")
+      pid = pid_in(file)
+      call check(error, pid > 0 .and. process_alive(pid), "a stopped process")
+      if (allocated(error)) return
+      call execute_command_line("kill -KILL "//to_string(pid))
+      call check(error, .not. process_alive(pid), "a process with SIGKILL sent")
+   contains
+      integer function pid_in(path) result(value)
+         character(len=*), intent(in) :: path
+         value = -1
+         open(newunit=unit, file=path, action="read", status="old", iostat=ios)
+         if (ios /= 0) return
+         read(unit, *, iostat=ios) value
+         close(unit)
+      end function pid_in
+   end subroutine test_holder_alive
 end module test_safety

@@ -6,6 +6,7 @@
 !> has no other way to speak.
 module femcod_process
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_size_t, c_null_char, c_funptr, c_funloc
+   use, intrinsic :: iso_fortran_env, only: int64
    implicit none
    private
    public :: process_id, host_name, process_alive, catch_stop_signals, stop_signal, signal_name, local_time_iso
@@ -58,12 +59,19 @@ contains
 
    !> Whether process `pid` runs on this machine (Linux: /proc/PID/stat exists and its
    !> state is not Z, a zombie, or X, dead: a killed process whose parent is gone stays a
-   !> zombie where no init reaps it, as in some containers).
+   !> zombie where no init reaps it, as in some containers). A process that is dying is
+   !> not running either: one with SIGKILL pending (SigPnd or ShdPnd of /proc/PID/status)
+   !> or already exiting (PF_EXITING, 0x4, in the flags of /proc/PID/stat). Without this,
+   !> a run started at once after `timeout -s KILL` ended another (timeout kills its whole
+   !> group, itself too, and returns before the child has died) found the child still in
+   !> its exit and refused the lock it left (the SIGKILL test, once, in a fresh chroot).
    logical function process_alive(pid)
       integer, intent(in) :: pid
+      integer(int64), parameter :: PF_EXITING = 4, SIGKILL_BIT = 256
       character(len=32) :: path
       character(len=512) :: line
-      integer :: unit, ios, paren
+      integer(int64) :: flags, mask
+      integer :: unit, ios, paren, k, field
       process_alive = .false.
       if (pid <= 0) return
       write(path, '("/proc/",i0,"/stat")') pid
@@ -72,10 +80,39 @@ contains
       read(unit, '(a)', iostat=ios) line
       close(unit)
       if (ios /= 0) return
-      ! "PID (name) S ...": the state follows the last parenthesis.
+      ! "PID (name) S PPID PGRP SESSION TTY TPGID FLAGS ...": the state follows the last
+      ! parenthesis, the flags are the seventh field after it.
       paren = index(line, ")", back=.true.)
       if (paren == 0) return
-      process_alive = index("ZX", line(paren + 2:paren + 2)) == 0
+      if (index("ZX", line(paren + 2:paren + 2)) /= 0) return
+      k = paren + 1
+      do field = 1, 6
+         k = k + index(line(k + 1:), " ")
+      end do
+      read(line(k + 1:), *, iostat=ios) flags
+      if (ios == 0) then
+         if (iand(flags, PF_EXITING) /= 0) return
+      end if
+      write(path, '("/proc/",i0,"/status")') pid
+      open(newunit=unit, file=trim(path), action="read", status="old", iostat=ios)
+      if (ios /= 0) return
+      do
+         read(unit, '(a)', iostat=ios) line
+         if (ios /= 0) exit
+         if (index(line, "SigPnd:") == 1 .or. index(line, "ShdPnd:") == 1) then
+            line = adjustl(line(8:))
+            if (line(1:1) == achar(9)) line = adjustl(line(2:))
+            read(line, '(z16)', iostat=ios) mask
+            if (ios == 0) then
+               if (iand(mask, SIGKILL_BIT) /= 0) then
+                  close(unit)
+                  return
+               end if
+            end if
+         end if
+      end do
+      close(unit)
+      process_alive = .true.
    end function process_alive
 
    !> From now on SIGTERM, SIGINT and SIGUSR1 set the flag stop_signal() reads instead
