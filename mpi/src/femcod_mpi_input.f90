@@ -21,6 +21,7 @@ module femcod_mpi_input
    use femcod_spring, only: spring_stiffness
    use femcod_solver_options, only: cg_settings
    use femcod_mpi_cg, only: column_split, coarse_factor
+   use femcod_mpi_results, only: agree
    implicit none
    private
    public :: read_deck_columns
@@ -48,7 +49,7 @@ contains
       call MPI_Comm_rank(comm, rank)
       call MPI_Comm_size(comm, ranks)
       call read_deck_h5_header(path, problem, status)
-      call agree_status(status, comm)
+      call agree(status, comm)
       allocate(local(0, 0))
       constants = 0
       block = 1
@@ -61,7 +62,7 @@ contains
       block = coarse_factor(np, ranks, how)
       call column_split(np, ranks, block, first, count)
       call read_columns(path, comm, np, first(rank), count(rank), lower, upper, status)
-      call agree_status(status, comm)
+      call agree(status, comm)
       if (status%code /= 0) return
       ! Every height finite and within range, on every rank.
       bad = 0
@@ -150,22 +151,4 @@ contains
          map = transpose(stored)
       end subroutine read_map
    end subroutine read_columns
-
-   !> The worst status over the ranks (the first rank's message with the largest code).
-   subroutine agree_status(status, comm)
-      type(status_type), intent(inout) :: status
-      type(MPI_Comm), intent(in) :: comm
-      integer :: code, mine(2), worst(2)
-      character(len=1024) :: message
-      mine = [status%code, 0]
-      call MPI_Comm_rank(comm, mine(2))
-      worst = mine
-      call MPI_Allreduce(mine, worst, 1, MPI_2INTEGER, MPI_MAXLOC, comm)
-      code = worst(1)
-      if (code == 0) return
-      message = ""
-      if (mine(2) == worst(2)) message = status%message
-      call MPI_Bcast(message, len(message), MPI_CHARACTER, worst(2), comm)
-      if (status%code == 0) call set_error(status, code, trim(message))
-   end subroutine agree_status
 end module femcod_mpi_input

@@ -219,17 +219,20 @@ contains
       end do
    end subroutine gather_block_maxima
 
-   !> Rank 0's failure (code and message), on every rank of `comm`. Collective.
+   !> The worst failure of any rank (the largest code, the message of the first rank that
+   !> has it), on every rank of `comm`; where only rank 0 can fail, rank 0's. Collective.
    subroutine agree(status, comm)
       type(status_type), intent(inout) :: status
       type(MPI_Comm), intent(in) :: comm
-      integer :: code
-      character(len=512) :: message
-      code = status%code
+      integer :: mine(2), worst(2)
+      character(len=1024) :: message
+      call MPI_Comm_rank(comm, mine(2))
+      mine(1) = status%code
+      call MPI_Allreduce(mine, worst, 1, MPI_2INTEGER, MPI_MAXLOC, comm)
+      if (worst(1) == 0) return
       message = ""
-      if (code /= 0) message = status%message
-      call MPI_Bcast(code, 1, MPI_INTEGER, 0, comm)
-      call MPI_Bcast(message, len(message), MPI_CHARACTER, 0, comm)
-      if (code /= 0 .and. status%code == 0) call set_error(status, code, trim(message))
+      if (mine(2) == worst(2)) message = status%message
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, worst(2), comm)
+      if (status%code == 0) call set_error(status, worst(1), trim(message))
    end subroutine agree
 end module femcod_mpi_results
