@@ -8,7 +8,7 @@
 module test_architecture
    use femcod_strings, only: string_type
    use test_support, only: scratch_path, read_text
-   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
    public :: collect_architecture
@@ -255,12 +255,12 @@ contains
                   listed = .true.
                   seen(k) = .true.
                   call check(error, lengths(r) > MAX_ROUTINE_LINES, files(f)%s//" "//names(r)%s//" is "// &
-                     int_text(lengths(r))//" lines now: take it off LONG_ROUTINES")
+                     to_string(lengths(r))//" lines now: take it off LONG_ROUTINES")
                   if (allocated(error)) return
                end if
             end do
             if (.not. listed) call check(error, lengths(r) <= MAX_ROUTINE_LINES, files(f)%s//" "//names(r)%s//": "// &
-               int_text(lengths(r))//" lines, above "//int_text(MAX_ROUTINE_LINES))
+               to_string(lengths(r))//" lines, above "//to_string(MAX_ROUTINE_LINES))
             if (allocated(error)) return
          end do
       end do
@@ -331,12 +331,4 @@ contains
       if (e > 0) rest = rest(1:e - 1)
       name = rest
    end function procedure_name
-
-   pure function int_text(v) result(s)
-      integer, intent(in) :: v
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write(buf, '(i0)') v
-      s = trim(buf)
-   end function int_text
 end module test_architecture

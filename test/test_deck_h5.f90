@@ -14,7 +14,8 @@ module test_deck_h5
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
    use test_support, only: scratch_path, read_text, write_text, contains_text, file_exists
-   use testdrive, only: new_unittest, unittest_type, error_type, check
+   use test_results, only: self_command
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
    public :: collect_deck_h5
@@ -110,7 +111,7 @@ contains
       character(len=:), allocatable :: path, out, message
       integer :: k, code
       do k = 1, size(cases)
-         path = scratch_path("h5bad_"//int_text(k)//".h5")
+         path = scratch_path("h5bad_"//to_string(k)//".h5")
          out = scratch_path("h5bad_out")
          call write_bad_deck(path, k)
          call execute_command_line("rm -f "//out//".*")
@@ -138,7 +139,7 @@ contains
       if (k == 5) lower(2, 3) = ieee_value(1.0_dp, ieee_quiet_nan)
       call h5_create(path, file, status)
       if (k /= 1) call h5_attribute(file, "/", "format", DECK_H5_FORMAT, status)
-      call h5_attribute(file, "/", "label", "bad deck "//int_text(k), status)
+      call h5_attribute(file, "/", "label", "bad deck "//to_string(k), status)
       call h5_write(file, "/NP", 4, "1", status)
       call h5_write(file, "/pixel", 1.0_dp, "nm", status)
       call h5_write(file, "/MAXCONT", merge(17, 16, k == 6), "1", status)
@@ -194,13 +195,8 @@ contains
       character(len=*), intent(in) :: line
       integer, intent(out) :: code
       type(string_type), allocatable :: args(:)
-      integer :: length
-      character(len=:), allocatable :: self
       if (index(line, " 2>") > 0) then
-         call get_command_argument(0, length=length)
-         allocate(character(len=length) :: self)
-         call get_command_argument(0, self)
-         call execute_command_line(self//" --femcod "//line, exitstat=code)
+         call execute_command_line(self_command()//" "//line, exitstat=code)
          return
       end if
       args = words(line)
@@ -225,12 +221,4 @@ contains
          start = 0
       end do
    end function words
-
-   pure function int_text(v) result(s)
-      integer, intent(in) :: v
-      character(len=:), allocatable :: s
-      character(len=16) :: buf
-      write(buf, '(i0)') v
-      s = trim(buf)
-   end function int_text
 end module test_deck_h5
