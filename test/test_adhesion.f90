@@ -1,4 +1,5 @@
-!> Adhesion under displacement control (`--adhesion`, solvers/femcod_adhesion): a
+!> Adhesion under displacement control (`--adhesion`; the law in model/femcod_interface_law,
+!> the iteration in solvers/femcod_gap_cg): a
 !> paraboloid on a flat against the Maugis-Dugdale theory (Maugis 1992, its closed form in
 !> model/femcod_analytic) in its DMT and JKR limits and between, zero work against the
 !> event-exact solver, free and periodic, hysteresis on a rough surface, a periodic cell

@@ -23,7 +23,6 @@ module test_architecture
    !> and the test fails when one of them is no longer long, so the list only shrinks.
    character(len=*), parameter :: LONG_ROUTINES(*) = [character(len=64) :: &
       "src/io/femcod_heights.f90 read_nanoscope", &
-      "src/solvers/femcod_adhesion.f90 adhesive_cg", &
       "src/io/femcod_deck.f90 read_deck", &
       "src/legacy/femcod_legacy.f90 solve_legacy", &
       "src/io/femcod_heights.f90 read_ascii_matrix"]

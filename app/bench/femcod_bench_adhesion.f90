@@ -16,7 +16,7 @@ module femcod_bench_adhesion
    use femcod_scene, only: initial_gaps
    use femcod_clock, only: wall_clock
    use femcod_resolution_study, only: level_deck
-   use femcod_adhesion, only: pixel_stiffness_ratio
+   use femcod_gap_cg, only: pixel_stiffness_ratio
    use femcod_bench_common, only: bench_arguments, require_peers, write_peer_gaps, remove_file_quietly, peer_line
    implicit none
    private

@@ -38,12 +38,19 @@ module femcod_convolution
       fftwf_plan_many_dft_r2c, fftwf_plan_many_dft_c2r, fftwf_plan_many_dft, &
       fftwf_execute_dft_r2c, fftwf_execute_dft_c2r, fftwf_execute_dft, &
       fftw_destroy_plan, fftwf_destroy_plan, fftw_alloc_real, fftw_alloc_complex, fftw_free, &
-      FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, FFTW_BACKWARD
+      FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, FFTW_BACKWARD, fftw_plan_dft_r2c_2d, fftw_plan_dft_c2r_2d, &
+      fftw_init_threads, fftw_plan_with_nthreads
    !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
    implicit none
    private
    public :: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, convolution_free, &
       inverse_kernel_taps
+   public :: gap_transform, gap_transform_setup, gap_transform_apply, gap_transform_free, SPECTRUM_COMPLIANCE, &
+      SPECTRUM_STIFFNESS
+
+   !> Which operator gap_transform_apply applies: the compliance C = c (I * .) + s or the
+   !> stiffness K = C^-1.
+   integer, parameter :: SPECTRUM_COMPLIANCE = 1, SPECTRUM_STIFFNESS = 2
 
    !> Lines per block in every pass: 8 lines of M = 8192 are 0.5 MB of float32 complex, in
    !> L2 cache; 4 and 16 were slower at NP = 4096 (doc/performance.md, the convolution).
@@ -76,6 +83,21 @@ module femcod_convolution
       !> k1 = 1..MH (rounded to float32 where a float32 convolution uses it: no copy).
       real(dp), allocatable :: kernel(:, :)
    end type love_convolution
+
+   !> The whole transform grid (M = 2 NP on the free half-space, NP on a periodic cell) as
+   !> the gap-variable iteration (solvers/femcod_gap_cg) needs it: its unknowns live on all
+   !> M^2 points (on the padding too), and it applies both C and K = C^-1, each diagonal in
+   !> Fourier space. FFTW's threaded 2-D plans (OpenMP's threads) on one field and one
+   !> spectrum; both spectra divided by M^2 for FFTW's unnormalised transforms, and on a
+   !> periodic cell 0 at zero frequency (the mean gap is a constraint there).
+   type :: gap_transform
+      integer :: np = 0, m = 0
+      logical :: periodic = .false.
+      real(dp), allocatable :: compliance(:, :), stiffness(:, :)
+      type(c_ptr) :: forward, backward, real_mem, complex_mem
+      real(c_double), pointer :: field(:, :) => null()
+      complex(c_double_complex), pointer :: spectrum(:, :) => null()
+   end type gap_transform
 
 contains
 
@@ -448,4 +470,120 @@ contains
       conv%m = 0
       conv%has_single = .false.
    end subroutine convolution_free
+
+   !> The transform grid for the Love table I(0:np-1, 0:np-1) (the free half-space's, or
+   !> the periodic cell's with `periodic`), the composite compliance c and the springs' s
+   !> (nm/nN). `ok` false when C's spectrum is not positive (smallest returned in
+   !> `smallest`, nm/nN).
+   subroutine gap_transform_setup(t, table, c, s, periodic, ok, smallest)
+      type(gap_transform), intent(inout) :: t
+      real(dp), intent(in) :: table(0:, 0:), c, s
+      logical, intent(in) :: periodic
+      logical, intent(out) :: ok
+      real(dp), intent(out) :: smallest
+      integer :: np, m, p, q, i, j, threads
+      np = size(table, 1)
+      m = merge(np, 2*np, periodic)
+      t%np = np
+      t%m = m
+      t%periodic = periodic
+      t%real_mem = fftw_alloc_real(int(m, c_size_t)**2)
+      t%complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
+      call c_f_pointer(t%real_mem, t%field, [m, m])
+      call c_f_pointer(t%complex_mem, t%spectrum, [m/2 + 1, m])
+      ! The 2-D transforms on OpenMP's threads (FFTW's threaded plans); plans made after
+      ! these two are single-threaded again, as the convolution's blocks expect.
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      if (fftw_init_threads() == 0) threads = 1
+      call fftw_plan_with_nthreads(int(threads, c_int))
+      t%forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), t%field, t%spectrum, FFTW_ESTIMATE)
+      t%backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), t%spectrum, t%field, FFTW_ESTIMATE)
+      call fftw_plan_with_nthreads(1_c_int)
+      ! The kernel on the transform grid: offsets 0..NP-1 and -(NP-1)..-1 wrapped (free;
+      ! offset NP is never reached by two pixels of the grid), or the periodic cell.
+      t%field = 0
+      do j = 1, m
+         q = j - 1
+         if (q > m/2) q = q - m
+         do i = 1, m
+            p = i - 1
+            if (p > m/2) p = p - m
+            if (periodic) then
+               t%field(i, j) = table(i - 1, j - 1)
+            else if (abs(p) < np .and. abs(q) < np) then
+               t%field(i, j) = table(abs(p), abs(q))
+            end if
+         end do
+      end do
+      call fftw_execute_dft_r2c(t%forward, t%field, t%spectrum)
+      ! The kernel is even in both offsets: its spectrum is real.
+      t%compliance = c*real(t%spectrum, dp) + s
+      ! A periodic cell: no zero-frequency compliance (the mean gap is a constraint).
+      if (periodic) t%compliance(1, 1) = 1
+      smallest = minval(t%compliance)
+      ok = smallest > 0
+      if (.not. ok) return
+      t%stiffness = 1/t%compliance/real(m, dp)**2
+      t%compliance = t%compliance/real(m, dp)**2
+      if (periodic) then
+         t%stiffness(1, 1) = 0
+         t%compliance(1, 1) = 0
+      end if
+   end subroutine gap_transform_setup
+
+   !> out = L in on the transform grid (M x M), L the compliance or the stiffness
+   !> (`which`: SPECTRUM_COMPLIANCE or SPECTRUM_STIFFNESS).
+   subroutine gap_transform_apply(t, which, in, out)
+      type(gap_transform), intent(inout) :: t
+      integer, intent(in) :: which
+      real(dp), intent(in) :: in(:, :)
+      real(dp), intent(out) :: out(:, :)
+      integer :: i, j
+      !$omp parallel do private(i)
+      do j = 1, t%m
+         do i = 1, t%m
+            t%field(i, j) = in(i, j)
+         end do
+      end do
+      !$omp end parallel do
+      call fftw_execute_dft_r2c(t%forward, t%field, t%spectrum)
+      if (which == SPECTRUM_COMPLIANCE) then
+         call multiply(t%compliance)
+      else
+         call multiply(t%stiffness)
+      end if
+      call fftw_execute_dft_c2r(t%backward, t%spectrum, t%field)
+      !$omp parallel do private(i)
+      do j = 1, t%m
+         do i = 1, t%m
+            out(i, j) = t%field(i, j)
+         end do
+      end do
+      !$omp end parallel do
+   contains
+      subroutine multiply(multiplier)
+         real(dp), intent(in) :: multiplier(:, :)
+         integer :: ii, jj
+         !$omp parallel do private(ii)
+         do jj = 1, t%m
+            do ii = 1, t%m/2 + 1
+               t%spectrum(ii, jj) = t%spectrum(ii, jj)*multiplier(ii, jj)
+            end do
+         end do
+         !$omp end parallel do
+      end subroutine multiply
+   end subroutine gap_transform_apply
+
+   subroutine gap_transform_free(t)
+      type(gap_transform), intent(inout) :: t
+      if (.not. associated(t%field)) return
+      call fftw_destroy_plan(t%forward)
+      call fftw_destroy_plan(t%backward)
+      call fftw_free(t%real_mem)
+      call fftw_free(t%complex_mem)
+      nullify(t%field, t%spectrum)
+      if (allocated(t%compliance)) deallocate(t%compliance)
+      if (allocated(t%stiffness)) deallocate(t%stiffness)
+   end subroutine gap_transform_free
 end module femcod_convolution

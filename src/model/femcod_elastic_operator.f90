@@ -26,13 +26,15 @@ module femcod_elastic_operator
    use femcod_love_periodic, only: periodic_offset_table
    use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
-      convolution_free, inverse_kernel_taps
+      convolution_free, inverse_kernel_taps, gap_transform, gap_transform_setup, gap_transform_apply, &
+      gap_transform_free, SPECTRUM_COMPLIANCE, SPECTRUM_STIFFNESS
    use femcod_split_correction, only: split_correction, split_setup, split_apply, split_free
    use femcod_status, only: status_type
    use femcod_observer, only: solver_observer
    implicit none
    private
    public :: elastic_operator, grid_operator, grid_operator_setup, grid_operator_free, truncate_table, spread_load
+   public :: SPECTRUM_COMPLIANCE, SPECTRUM_STIFFNESS
 
    !> What every elastic operator has and does (module header).
    type, abstract :: elastic_operator
@@ -48,6 +50,13 @@ module femcod_elastic_operator
       !> Preconditioner taps; `preconditioned` false: none.
       logical :: preconditioned = .false.
       real(dp) :: taps(0:2, 0:2) = 0
+      !> The gap-variable iteration's transform grid, where the operator has one (made on
+      !> request; apply_spectrum): this part's field is (tm, tmj), of which the first np
+      !> rows of the first nj columns are this part's pixels, the rest padding (none on a
+      !> periodic cell). tm = 0: none. The smallest value of C's spectrum over the whole
+      !> grid (nm/nN; the iteration needs it positive).
+      integer :: tm = 0, tmj = 0
+      real(dp) :: smallest_compliance = 0
    contains
       !> out = c (I * f) on this part's columns, in double.
       procedure(displace_interface), deferred :: displace
@@ -68,6 +77,9 @@ module femcod_elastic_operator
       !> The forces (nN) a solve at a total load starts from (spread_load; femcod-mpi's
       !> operator starts from a coarse solve).
       procedure :: start_forces => spread_start
+      !> out = C in or K in (which: SPECTRUM_COMPLIANCE or SPECTRUM_STIFFNESS) on this
+      !> part's transform field (tm, tmj); K = C^-1, both with the springs' s.
+      procedure :: apply_spectrum => no_spectrum
    end type elastic_operator
 
    abstract interface
@@ -98,12 +110,15 @@ module femcod_elastic_operator
       type(split_correction) :: split
       !> The kernel is truncated (--kernel-radius): no kernel split.
       logical :: truncated = .false.
+      !> The gap-variable iteration's transform grid (set up with gap_variables).
+      type(gap_transform) :: gaps
    contains
       procedure :: displace => grid_displace
       procedure :: displace_single => grid_displace_single
       procedure :: correction_limits => grid_correction_limits
       procedure :: add_direct => grid_add_direct
       procedure :: split_correct => grid_split_correct
+      procedure :: apply_spectrum => grid_apply_spectrum
    end type grid_operator
 
 contains
@@ -153,6 +168,15 @@ contains
       applied = .false.
    end subroutine no_split
 
+   subroutine no_spectrum(op, which, in, out)
+      class(elastic_operator), intent(inout) :: op
+      integer, intent(in) :: which
+      real(dp), intent(in) :: in(:, :)
+      real(dp), intent(out) :: out(:, :)
+      ! An operator without a transform grid (tm = 0): the iteration checks tm first.
+      out = 0
+   end subroutine no_spectrum
+
    !> The start of a solve at total load P (nN): spread_load. `coarse_iterations`, the
    !> iterations a coarse solve took (none here), is added to.
    subroutine spread_start(op, total_load, how, p, coarse_iterations, status, observer)
@@ -187,15 +211,19 @@ contains
 
    !> The grid operator for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's
    !> materials, one cell of a periodic surface when `periodic`; the kernel truncated to
-   !> how%kernel_radius pixels of the deck's pixel (scaled to this grid's pixel).
-   subroutine grid_operator_setup(op, g0, problem, pixel, how, periodic)
+   !> how%kernel_radius pixels of the deck's pixel (scaled to this grid's pixel). With
+   !> `gap_variables` the operator has the gap-variable iteration's transform grid
+   !> (apply_spectrum) instead of the convolution (displace).
+   subroutine grid_operator_setup(op, g0, problem, pixel, how, periodic, gap_variables)
       type(grid_operator), intent(inout) :: op
       real(dp), intent(in) :: g0(:, :)
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: pixel
       type(cg_settings), intent(in) :: how
       logical, intent(in) :: periodic
+      logical, intent(in), optional :: gap_variables
       real(dp), allocatable :: table(:, :)
+      logical :: ok
       op%np = size(g0, 1)
       op%j0 = 0
       op%nj = size(g0, 2)
@@ -214,8 +242,16 @@ contains
       end if
       op%truncated = how%kernel_radius > 0
       if (op%truncated) call truncate_table(table, how%kernel_radius*problem%pixel/pixel)
-      call convolution_setup(op%conv, table, how%single_until > 0, how%measure_plans, periodic)
       op%self = table(0, 0)
+      if (present(gap_variables)) then
+         if (gap_variables) then
+            call gap_transform_setup(op%gaps, table, op%c, op%s, periodic, ok, op%smallest_compliance)
+            op%tm = op%gaps%m
+            op%tmj = op%gaps%m
+            return
+         end if
+      end if
+      call convolution_setup(op%conv, table, how%single_until > 0, how%measure_plans, periodic)
       allocate(op%table(0:op%np - 1, 0:op%np - 1))
       op%table(:, :) = real(table, sp)
       if (how%precondition) call inverse_kernel_taps(op%conv, op%taps, op%preconditioned)
@@ -226,6 +262,7 @@ contains
       type(grid_operator), intent(inout) :: op
       call convolution_free(op%conv)
       call split_free(op%split)
+      call gap_transform_free(op%gaps)
    end subroutine grid_operator_free
 
    !> The kernel truncated: entries at offsets beyond `radius` pixels set to 0 (--kernel-
@@ -259,6 +296,14 @@ contains
          call convolution_apply_single(op%conv, f, out, op%c)
       end if
    end subroutine grid_displace_single
+
+   subroutine grid_apply_spectrum(op, which, in, out)
+      class(grid_operator), intent(inout) :: op
+      integer, intent(in) :: which
+      real(dp), intent(in) :: in(:, :)
+      real(dp), intent(out) :: out(:, :)
+      call gap_transform_apply(op%gaps, which, in, out)
+   end subroutine grid_apply_spectrum
 
    !> Up to how%direct_corrections changes directly from the table; the kernel split takes
    !> up to the budget with the smallest window (one lattice cell), for the full kernel

@@ -22,7 +22,7 @@ module femcod_solver_options
    character(len=*), parameter :: BOUNDARY_NAMES(2) = [character(len=8) :: "free", "periodic"]
 
    !> The interface laws: the hard wall (no adhesion), Dugdale's and the exponential
-   !> adhesive laws (solvers/femcod_adhesion).
+   !> adhesive laws (model/femcod_interface_law, read by law_from_name).
    character(len=*), parameter :: LAW_NAMES(3) = [character(len=11) :: "none", "dugdale", "exponential"]
 
    !> The cg solver's own options (solvers/femcod_cg). The accelerations default to on;
@@ -108,7 +108,7 @@ module femcod_solver_options
       !> `hardness`; a capped pixel keeps the force H d^2 and interpenetrates (its
       !> plastic displacement). The cg solver only.
       logical :: plastic = .false.
-      !> Adhesion (femcod_adhesion): "none", "dugdale" or "exponential", with the work of
+      !> Adhesion (model/femcod_interface_law): "none", "dugdale" or "exponential", with the work of
       !> adhesion (nN/nm = J/m^2) and the range (nm) of the law. With --approach and the
       !> cg solver only.
       character(len=11) :: adhesion = "none"
@@ -142,7 +142,7 @@ contains
       if (allocated(options%approaches)) requested_states = requested_states + size(options%approaches)
    end function requested_states
    !> True when the run is solved in the gap variables under displacement control
-   !> (solvers/femcod_adhesion): --solver cg with --approach and an interface law other
+   !> (solvers/femcod_gap_cg): --solver cg with --approach and an interface law other
    !> than the elastic hard wall, i.e. --adhesion or --plastic. The plastic interface is
    !> path-dependent and its load is not a function of the approach where the plastic
    !> pixels carry it all (the load stays while the body sinks), so displacement control

@@ -76,8 +76,11 @@ module femcod_cg
    use femcod_elastic_operator, only: elastic_operator, grid_operator, grid_operator_setup, grid_operator_free, &
       spread_load
    use femcod_constrained_cg, only: constrained_cg, cg_residuals
+   use femcod_gap_cg, only: gap_session, gap_session_start, gap_target, gap_solver_storage_bytes
+   use femcod_interface_law, only: interface_law, make_interface_law
    use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts
-   use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings
+   use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings, by_gap_variables, &
+      requested_states
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
@@ -85,12 +88,15 @@ module femcod_cg
    private
    public :: solve_cg, coarse_start_forces, approach_error_bound, cg_storage_bytes
    public :: cg_residuals, cg_session, cg_answer, session_start, solve_target, ascending_order, &
-      refuse_beyond_full_contact
+      refuse_beyond_full_contact, unconverged_message
 
    !> What the solver carries from one target (load or approach) to the next, on this
    !> process's columns of the operator's grid: the forces (nN; the next target's warm
    !> start), the approach (nm) they give, and with --plastic the deck's gaps (nm), the
-   !> pixel force cap fmax = H d^2 (nN) and the capped (plastic) pixels.
+   !> pixel force cap fmax = H d^2 (nN) and the capped (plastic) pixels. Under
+   !> displacement control with an adhesive law or the cap (`by_gaps`), the targets are
+   !> solved in the gap variables (femcod_gap_cg), along the path in the order given, and
+   !> the session carries that path too.
    type :: cg_session
       real(dp), allocatable :: p(:, :)
       real(dp) :: approach = 0
@@ -98,17 +104,26 @@ module femcod_cg
       real(dp) :: fmax = 0
       real(dp), allocatable :: g0(:, :)
       logical, allocatable :: capped(:, :)
+      logical :: by_gaps = .false.
+      type(interface_law) :: law
+      type(gap_session) :: path
    end type cg_session
 
    !> One target's answer: the load (nN) and approach (nm), the residuals reached (over
    !> every solve the target took), the plastic rounds, and on this process's columns the
    !> gap map (nm; 0 on the elastic contacts, minus the plastic displacement on the capped
    !> pixels) and the plastic displacement map (nm, with --plastic).
+   !> In the gap variables besides: the contacts are the pixels at gap 0 (with adhesion
+   !> they may pull), and over the whole grid the pixels off contact within the law's
+   !> range, their load (nN, negative: tension) and the mean gap (nm).
    type :: cg_answer
       real(dp) :: load = 0, approach = 0
       type(cg_residuals) :: rep
       integer :: plastic_rounds = 0
       real(dp), allocatable :: gap(:, :), plastic(:, :)
+      logical :: by_gaps = .false.
+      integer :: attractive = 0
+      real(dp) :: attractive_load = 0, mean_gap = 0
    end type cg_answer
 
 contains
@@ -147,6 +162,8 @@ contains
    !> Solve at every requested load (ascending order of computation; results in the
    !> order given, with the residuals reached in each load state). A load whose residual
    !> stays above options%cg%tol after options%cg%max_iterations is a numerical failure.
+   !> Approaches with an adhesive law or the plastic cap are solved in the gap variables,
+   !> along the path in the order given (by_gap_variables).
    subroutine solve_cg(problem, options, res, status, observer)
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
@@ -161,13 +178,13 @@ contains
       real(dp), allocatable :: targets(:)
       integer, allocatable :: order(:)
       real(dp) :: tstart, t0, t1
-      integer :: np, k, kk, m, i
-      logical :: by_approach
+      integer :: k, kk, m, i
+      logical :: by_approach, by_gaps
       call wall_clock(tstart)
-      np = problem%np
       ! Displacement control (--approach): the targets are approaches, the loads the answers.
       by_approach = .false.
       if (allocated(options%approaches)) by_approach = size(options%approaches) > 0
+      by_gaps = by_gap_variables(options)
       if (by_approach) then
          targets = options%approaches
       else
@@ -185,19 +202,25 @@ contains
          call set_error(status, STATUS_USAGE, "cg: --solver cg needs --loads or --approach")
          return
       end if
-      res%estimated_peak_bytes = cg_storage_bytes(np, m, options%boundary == "periodic", options%plastic)
-      call refuse_beyond_memory("cg: NP = "//int_str(np), res%estimated_peak_bytes, options%memory_available, status)
+      call make_fine_grid(problem, options, by_gaps, fine, res%estimated_peak_bytes, status)
       if (status%code /= 0) return
-      call grid_operator_setup(fine, initial_gap_map(problem%lower, problem%upper), problem, problem%pixel, &
-         options%cg, options%boundary == "periodic")
       if (by_approach .and. .not. options%plastic) call refuse_beyond_full_contact(fine, targets, status)
       if (status%code /= 0) then
          call grid_operator_free(fine)
          return
       end if
       if (options%plastic) allocate(res%step_plastic(0))
-      call session_start(fine, session, options%plastic, options%hardness*problem%pixel**2)
-      order = ascending_order(targets)
+      call session_start(fine, session, options%plastic, options%hardness*problem%pixel**2, &
+         make_interface_law(options%adhesion, options%work, options%range, problem%pixel, options%plastic, &
+         options%hardness), by_gaps)
+      ! A path in the gap variables in the order given; loads and elastic approaches in
+      ! ascending order, each from the last. The state reported in full: the last of the
+      ! path, or the largest target.
+      if (by_gaps) then
+         order = [(k, k = 1, m)]
+      else
+         order = ascending_order(targets)
+      end if
       do kk = 1, m
          k = order(kk)
          call wall_clock(t0)
@@ -205,44 +228,18 @@ contains
          if (status%code /= 0) exit
          call wall_clock(t1)
          report(k) = answer%rep
-         ! The state at this load.
-         associate(st => res%states(k), p => session%p)
-            st%load = answer%load
-            st%reached = .true.
-            st%approach = answer%approach
-            st%iterations = answer%rep%iterations
-            st%residual = answer%rep%residual
-            st%penetration = answer%rep%penetration
-            st%contact_gap = answer%rep%contact_gap
-            st%load_error = answer%rep%load_error
-            if (.not. (by_approach .or. options%plastic .or. options%boundary == "periodic" .or. &
-               options%cg%kernel_radius > 0)) st%approach_bound = approach_error_bound(st%penetration, &
-               st%contact_gap, st%load_error, st%approach)
-            st%coarse_iterations = answer%rep%coarse_iterations
-            st%convolutions = answer%rep%convolutions
-            st%split_corrections = answer%rep%split_corrections
-            st%plastic_rounds = answer%plastic_rounds
-            if (allocated(answer%gap)) call move_alloc(answer%gap, st%gap)
-            if (allocated(answer%plastic)) call move_alloc(answer%plastic, st%plastic)
-            st%contacts = count(p > 0)
-            st%max_pressure = maxval(p)/problem%pixel**2
-            st%n_above_hardness = count(p/problem%pixel**2 > options%hardness)
-            if (options%plastic) then
-               st%n_plastic = count(session%capped)
-               st%plastic_volume = sum(st%plastic)*problem%pixel**2
-            end if
-            call gather_contacts(st, p > 0, p)
-            call append_step(res, st%contacts, st%n_above_hardness, st%load, st%approach, t1 - t0)
-            if (options%plastic) res%step_plastic = [res%step_plastic, st%n_plastic]
-            call observer%progress(kk, st%contacts, st%load, t1 - tstart)
-            if (targets(k) == maxval(targets)) then
+         call record_answer(res, res%states(k), session, answer, options, by_approach, problem%pixel, t1 - t0)
+         if (kk > 1 .and. by_gaps) call mark_jump(res%states(order(kk - 1))%contacts, res%states(k))
+         call observer%progress(kk, res%states(k)%contacts, res%states(k)%load, t1 - tstart)
+         if ((by_gaps .and. kk == m) .or. (.not. by_gaps .and. targets(k) == maxval(targets))) then
+            associate(st => res%states(k))
                res%contact_i = st%i
                res%contact_j = st%j
                res%contact_step = [(kk, i = 1, st%contacts)]
                res%contact_force = st%force
                res%reported_load = st%load
-            end if
-         end associate
+            end associate
+         end if
       end do
       call grid_operator_free(fine)
       res%stop_reason = STOP_LOADS
@@ -251,14 +248,114 @@ contains
       if (status%code /= 0) return
       do k = 1, m
          if (report(k)%residual > options%cg%tol) then
-            call set_error(status, STATUS_NUMERICAL, "cg: "//trim(merge("approach", "load    ", by_approach))//" "// &
-               format_real(targets(k))//trim(merge(" nm", " nN", by_approach))//": residual "// &
-               sig_str(report(k)%residual, 2)//" after "//int_str(report(k)%iterations)// &
-               " iterations, above --tol "//sig_str(options%cg%tol, 2)//" (raise --max-iterations)")
+            call set_error(status, STATUS_NUMERICAL, unconverged_message(by_approach, by_gaps, targets(k), &
+               report(k)%residual, report(k)%iterations, options%cg%tol))
             return
          end if
       end do
    end subroutine solve_cg
+
+   !> The message of a target whose residual stayed above --tol.
+   function unconverged_message(by_approach, by_gaps, target, residual, iterations, tol) result(message)
+      logical, intent(in) :: by_approach, by_gaps
+      real(dp), intent(in) :: target, residual, tol
+      integer, intent(in) :: iterations
+      character(len=:), allocatable :: message
+      if (by_gaps) then
+         message = "adhesion: approach "//format_real(target)//" nm: residual "//sig_str(residual, 2)//" after "// &
+            int_str(iterations)//" iterations, above --tol "//sig_str(tol, 2)// &
+            " (raise --max-iterations, or refine the pixel: adhesion_convexity in the summary)"
+      else
+         message = "cg: "//trim(merge("approach", "load    ", by_approach))//" "//format_real(target)// &
+            trim(merge(" nm", " nN", by_approach))//": residual "//sig_str(residual, 2)//" after "// &
+            int_str(iterations)//" iterations, above --tol "//sig_str(tol, 2)//" (raise --max-iterations)"
+      end if
+   end function unconverged_message
+
+   !> The grid operator for the run, after its memory estimate: the convolution, or the
+   !> transform grid of the gap variables (`by_gaps`).
+   subroutine make_fine_grid(problem, options, by_gaps, fine, estimated, status)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      logical, intent(in) :: by_gaps
+      type(grid_operator), intent(inout) :: fine
+      integer(i8), intent(out) :: estimated
+      type(status_type), intent(inout) :: status
+      integer :: m
+      m = requested_states(options)
+      if (by_gaps) then
+         estimated = gap_solver_storage_bytes(problem%np, m, options%boundary == "periodic", options%plastic)
+         call refuse_beyond_memory("cg --approach (gap variables): NP = "//int_str(problem%np), estimated, &
+            options%memory_available, status)
+      else
+         estimated = cg_storage_bytes(problem%np, m, options%boundary == "periodic", options%plastic)
+         call refuse_beyond_memory("cg: NP = "//int_str(problem%np), estimated, options%memory_available, status)
+      end if
+      if (status%code /= 0) return
+      call grid_operator_setup(fine, initial_gap_map(problem%lower, problem%upper), problem, problem%pixel, &
+         options%cg, options%boundary == "periodic", gap_variables=by_gaps)
+   end subroutine make_fine_grid
+
+   !> One target's state from its answer and the session's forces (nN), on the whole grid
+   !> of pixel `pixel` (nm); `seconds` its solve's wall time.
+   subroutine record_answer(res, st, session, answer, options, by_approach, pixel, seconds)
+      type(contact_result), intent(inout) :: res
+      type(load_state), intent(inout) :: st
+      type(cg_session), intent(in) :: session
+      type(cg_answer), intent(inout) :: answer
+      type(contact_options), intent(in) :: options
+      logical, intent(in) :: by_approach
+      real(dp), intent(in) :: pixel, seconds
+      logical, allocatable :: contact(:, :)
+      associate(p => session%p)
+         if (answer%by_gaps) then
+            contact = answer%gap == 0
+         else
+            contact = p > 0
+         end if
+         st%load = answer%load
+         st%reached = .true.
+         st%approach = answer%approach
+         st%iterations = answer%rep%iterations
+         st%residual = answer%rep%residual
+         st%penetration = answer%rep%penetration
+         st%contact_gap = answer%rep%contact_gap
+         st%load_error = answer%rep%load_error
+         if (.not. (by_approach .or. options%plastic .or. &
+            options%boundary == "periodic" .or. options%cg%kernel_radius > 0)) st%approach_bound = &
+            approach_error_bound(st%penetration, st%contact_gap, st%load_error, st%approach)
+         st%coarse_iterations = answer%rep%coarse_iterations
+         st%convolutions = answer%rep%convolutions
+         st%split_corrections = answer%rep%split_corrections
+         st%plastic_rounds = answer%plastic_rounds
+         if (allocated(answer%gap)) call move_alloc(answer%gap, st%gap)
+         if (allocated(answer%plastic)) call move_alloc(answer%plastic, st%plastic)
+         st%contacts = count(contact)
+         st%max_pressure = 0
+         if (st%contacts > 0) st%max_pressure = maxval(p, mask=contact)/pixel**2
+         st%n_above_hardness = count(p/pixel**2 > options%hardness)
+         if (options%plastic) then
+            st%n_plastic = count(session%capped)
+            st%plastic_volume = sum(st%plastic)*pixel**2
+         end if
+         st%attractive = answer%attractive
+         st%attractive_load = answer%attractive_load
+         st%mean_gap = answer%mean_gap
+         call gather_contacts(st, contact, p)
+         call append_step(res, st%contacts, st%n_above_hardness, st%load, st%approach, seconds)
+         if (options%plastic) res%step_plastic = [res%step_plastic, st%n_plastic]
+      end associate
+   end subroutine record_answer
+
+   !> A contact set that appears from none, or vanishes, between two approaches of a path
+   !> is a jump (into contact, or pull-off): the state left its branch.
+   pure subroutine mark_jump(previous_contacts, st)
+      integer, intent(in) :: previous_contacts
+      type(load_state), intent(inout) :: st
+      st%jump = 0
+      if (previous_contacts == 0 .and. st%contacts > 0) st%jump = 1
+      if (previous_contacts > 0 .and. st%contacts == 0) st%jump = -1
+   end subroutine mark_jump
 
    !> A periodic cell is in full contact when the approach (the fall of the mean gap)
    !> reaches the mean initial gap; there any load above the full-contact load gives that
@@ -297,12 +394,19 @@ contains
    end function ascending_order
 
    !> A session on `grid`: no forces yet; with `plastic`, the cap fmax (nN) per pixel and
-   !> the deck's gaps kept (the capped rounds move the operator's).
-   subroutine session_start(grid, session, plastic, fmax)
+   !> the deck's gaps kept (the capped rounds move the operator's). With `by_gaps` the
+   !> targets are approaches solved in the gap variables with the interface `law` (the
+   !> grid made with its transform grid).
+   subroutine session_start(grid, session, plastic, fmax, law, by_gaps)
       class(elastic_operator), intent(in) :: grid
       type(cg_session), intent(out) :: session
       logical, intent(in) :: plastic
       real(dp), intent(in) :: fmax
+      type(interface_law), intent(in), optional :: law
+      logical, intent(in), optional :: by_gaps
+      if (present(law)) session%law = law
+      if (present(by_gaps)) session%by_gaps = by_gaps
+      if (session%by_gaps) call gap_session_start(grid, session%path)
       allocate(session%p(grid%np, grid%nj))
       session%p = 0
       session%approach = 0
@@ -328,7 +432,9 @@ contains
       type(cg_answer), intent(out) :: answer
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
-      if (by_approach) then
+      if (session%by_gaps) then
+         call solve_by_gaps(grid, session, target, how, answer, status, observer)
+      else if (by_approach) then
          call find_load(grid, problem, session, target, how, answer, status, observer)
       else
          answer%load = target
@@ -336,6 +442,40 @@ contains
       end if
       answer%approach = session%approach
    end subroutine solve_target
+
+   !> The approach `target` (nm) on the session's path in the gap variables (femcod_gap_cg):
+   !> the forces and the approach into the session, the gaps (and with the cap the plastic
+   !> displacement and the capped set) into `answer`, with the load and the attractive
+   !> zone's sums over the whole grid.
+   subroutine solve_by_gaps(grid, session, target, how, answer, status, observer)
+      class(elastic_operator), intent(inout) :: grid
+      type(cg_session), intent(inout) :: session
+      real(dp), intent(in) :: target
+      type(cg_settings), intent(in) :: how
+      type(cg_answer), intent(inout) :: answer
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      real(dp) :: total(4)
+      answer%by_gaps = .true.
+      call gap_target(grid, session%law, session%path, grid%g0, target, how%tol, how%max_iterations, &
+         answer%rep%iterations, answer%rep%residual, status, observer)
+      if (status%code /= 0) return
+      associate(g => session%path%g, force => session%path%force)
+         session%p = force
+         session%approach = target
+         answer%gap = g
+         if (session%plastic) then
+            answer%plastic = session%path%plastic
+            session%capped = session%path%cap
+         end if
+         total = [sum(force), real(count(g > 0 .and. g < session%law%range), dp), sum(force, mask=g > 0), sum(g)]
+         call grid%sum_over_grid(total)
+         answer%load = total(1)
+         answer%attractive = nint(total(2))
+         answer%attractive_load = total(3)
+         answer%mean_gap = total(4)/real(grid%np, dp)**2
+      end associate
+   end subroutine solve_by_gaps
 
    !> The state at `load` (nN): the forces (warm start: the session's, scaled by the
    !> solver to the load) and the approach, into the session; the maps into `answer`.

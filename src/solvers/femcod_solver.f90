@@ -17,7 +17,7 @@ module femcod_solver
    use femcod_incremental, only: solve_incremental
    use femcod_incremental_state, only: incremental_state
    use femcod_cg, only: solve_cg
-   use femcod_adhesion, only: solve_adhesive, pixel_stiffness_ratio
+   use femcod_gap_cg, only: pixel_stiffness_ratio
    implicit none
    private
    public :: solve_contact, model_notes, report_lines, report_line
@@ -53,18 +53,6 @@ contains
                return
             end if
          end if
-      end if
-      ! Displacement control with an interface law (adhesion) or bounds (the plastic
-      ! cap): the constrained iteration in the gap variables.
-      if (by_gap_variables(options)) then
-         if (present(resume)) then
-            call set_error(status, STATUS_USAGE, "only the incremental solver continues from a stored state")
-         else if (present(observer)) then
-            call solve_adhesive(problem, options, res, status, observer)
-         else
-            call solve_adhesive(problem, options, res, status, nobody)
-         end if
-         return
       end if
       if (present(resume) .and. options%solver /= "incremental") then
          call set_error(status, STATUS_USAGE, "only the incremental solver continues from a stored state")
