@@ -63,10 +63,6 @@ if cmp -s "$work/mpih5.loads.csv" "$work/mpi.loads.csv" && \
 else
   echo "  FAILED   the HDF5 deck read by slabs"; failed=1
 fi
-expect 2 "--adhesion refused" mpirun_2 "$femcod_mpi" "$deck" --approach 0.5 --adhesion dugdale --work 0.05 \
-  --range 1 -o "$work/bad"
-expect 2 "--plastic with --approach refused" mpirun_2 "$femcod_mpi" "$deck" --approach 0.5 --plastic --hardness 11 \
-  -o "$work/bad"
 expect 2 "--kernel-radius on the periodic cell refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 \
   --boundary periodic --kernel-radius 4 -o "$work/bad"
 expect 2 "two decks refused" mpirun_2 "$femcod_mpi" "$deck" ../input/sphere_d2.deck --loads 10

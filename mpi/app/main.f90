@@ -43,6 +43,9 @@ program femcod_mpi
    use femcod_svg, only: svg_pressure_map
    use femcod_maps, only: state_maps
    use femcod_cg, only: cg_storage_bytes
+   use femcod_gap_cg, only: gap_solver_storage_bytes
+   use femcod_interface_law, only: make_interface_law
+   use femcod_solver_options, only: by_gap_variables
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -151,7 +154,8 @@ program femcod_mpi
    deallocate(local)
    call wall_clock(t_read)
    if (status%code == 0) call solve_loads(grid, problem, targets(), settings%solve%cg, states, status, observer, &
-      settings%solve%hardness, settings%solve%plastic, by_approach())
+      settings%solve%hardness, settings%solve%plastic, by_approach(), make_interface_law(settings%solve%adhesion, &
+      settings%solve%work, settings%solve%range, grid%pixel, settings%solve%plastic, settings%solve%hardness))
    call wall_clock(t_solve)
    if (status%code /= 0) then
       if (status%code == STATUS_INTERRUPTED) call finish(128 + stop_signal(), signal_name(stop_signal())//": "// &
@@ -217,8 +221,8 @@ contains
 
    !> The options femcod run has and femcod-mpi does not (yet): refused, not ignored.
    !> The ranks run femcod_cg's fixed-load and fixed-approach solve (with --plastic and
-   !> --kernel-radius) on the free surface or the periodic cell; the gap-variable solver
-   !> (adhesion, or the plastic cap under displacement control) runs on one node.
+   !> --kernel-radius) and its gap-variable path (--adhesion, or --plastic with
+   !> --approach) on the free surface or the periodic cell.
    subroutine refuse_unsupported(settings, status)
       type(run_settings), intent(in) :: settings
       type(status_type), intent(inout) :: status
@@ -235,12 +239,6 @@ contains
          else if (o%boundary == "periodic" .and. o%cg%kernel_radius > 0) then
             call set_error(status, STATUS_USAGE, "--kernel-radius with --boundary periodic: the ranks take the "// &
                "periodic kernel's spectrum in closed form, untruncated; it runs on one node: femcod run --solver cg")
-         else if (o%adhesion /= "none") then
-            call set_error(status, STATUS_USAGE, "--adhesion is not in the MPI solver; it runs on one node: "// &
-               "femcod run --solver cg")
-         else if (o%plastic .and. by_approach()) then
-            call set_error(status, STATUS_USAGE, "--plastic with --approach (the gap-variable solver) is not in the "// &
-               "MPI solver; it runs on one node: femcod run --solver cg; on ranks give --plastic with --loads")
          end if
       end associate
    end subroutine refuse_unsupported
@@ -270,9 +268,15 @@ contains
       type(status_type), intent(inout) :: st
       type(MPI_Comm) :: node
       integer(i8) :: on_node, worst, may
-      estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, settings%solve%boundary == "periodic", &
-         settings%solve%plastic) + &
-         ranks - 1)/ranks
+      if (by_gap_variables(settings%solve)) then
+         ! The gap variables: their transform grid besides the fixed-load solver's grid.
+         estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, settings%solve%boundary == &
+            "periodic", settings%solve%plastic) + gap_solver_storage_bytes(n, nstates, settings%solve%boundary == &
+            "periodic", settings%solve%plastic) + ranks - 1)/ranks
+      else
+         estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, settings%solve%boundary == &
+            "periodic", settings%solve%plastic) + ranks - 1)/ranks
+      end if
       call MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
       call MPI_Allreduce(estimated_rank_bytes, on_node, 1, MPI_INTEGER8, MPI_SUM, node)
       call MPI_Comm_free(node)
@@ -390,7 +394,11 @@ contains
                ', "coarse_iterations": '//int_str(st%coarse_iterations)//', "convolutions": '// &
                int_str(st%convolutions)//', "residual": '//json_number(st%residual)//', "time_s": '// &
                json_number(st%seconds)//', "transform_s": '//json_number(st%transform_seconds)// &
-               ', "communication_s": '//json_number(st%communication_seconds)//'}'
+               ', "communication_s": '//json_number(st%communication_seconds)
+            if (settings%solve%adhesion /= "none") text = text//', "attractive_pixels": '//int_str(st%attractive)// &
+               ', "attractive_load_nN": '//json_number(st%attractive_load)//', "mean_gap_nm": '// &
+               json_number(st%mean_gap)//', "jump": '//int_str(st%jump)
+            text = text//'}'
          end associate
          if (s < size(states)) text = text//', '
       end do
@@ -437,12 +445,13 @@ contains
       write(output_unit, '(a)') "of femcod run (femcod run --help) for the cg solver, with the"
       write(output_unit, '(a)') "same iteration (femcod_cg on the ranks' elastic operator):"
       write(output_unit, '(a)') "  --loads F1,F2,...  total loads (nN), or --approach D1,D2,... approaches (nm)"
-      write(output_unit, '(a)') "  --boundary free|periodic, --plastic --hardness H (with --loads), --kernel-radius R"
-      write(output_unit, '(a)') "  (free surface), --tol T (default 1e-8),"
+      write(output_unit, '(a)') "  --boundary free|periodic, --plastic --hardness H, --kernel-radius R (free surface,"
+      write(output_unit, '(a)') "  --loads), --adhesion dugdale|exponential --work W --range R (with --approach),"
+      write(output_unit, '(a)') "  --tol T (default 1e-8),"
       write(output_unit, '(a)') "  --max-iterations N, -o PREFIX, --outdir DIR, --force, --quiet; the height-file"
       write(output_unit, '(a)') "  options (--lower, --upper, --pixel, --young, --poisson, --height-unit, ...)"
-      write(output_unit, '(a)') "Refused (they run on one node with femcod run): --adhesion, --plastic with"
-      write(output_unit, '(a)') "--approach, --kernel-radius on the periodic cell, several decks, the event solvers."
+      write(output_unit, '(a)') "Refused (they run on one node with femcod run): --kernel-radius on the periodic"
+      write(output_unit, '(a)') "cell, several decks, the event solvers."
       write(output_unit, '(a)') "Writes PREFIX.h5 (/deck, /loads/<kkk> with pressure and gap maps, /run with the"
       write(output_unit, '(a)') "peak memory of every rank) and PREFIX.summary.json. Exit codes: 0 ok, 2 usage,"
       write(output_unit, '(a)') "3 bad input, 4 numerical failure, 5 I/O, 128 + signal after SIGTERM/SIGINT/SIGUSR1."

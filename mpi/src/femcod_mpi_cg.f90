@@ -49,13 +49,17 @@ module femcod_mpi_cg
    use femcod_solver_options, only: cg_settings
    use femcod_elastic_operator, only: elastic_operator, spread_load
    use femcod_cg, only: coarse_start_forces, approach_error_bound, cg_session, cg_answer, session_start, solve_target, &
-      ascending_order, refuse_beyond_full_contact
+      ascending_order, refuse_beyond_full_contact, unconverged_message
+   use femcod_interface_law, only: interface_law
+   use femcod_mpi_gap_transform, only: distributed_gap_transform, gap_transform_setup, gap_transform_apply, &
+      gap_transform_free
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
    implicit none
    private
-   public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor
+   public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor, &
+      gap_grid_setup
    public :: distribute_problem, scatter_problem, distributed_convolve
 
    !> One rank's part of the problem and of the distributed convolution: an elastic
@@ -98,8 +102,11 @@ module femcod_mpi_cg
       !> transposes) and in the solver's other communication (sums, halos; waiting for
       !> slower ranks included).
       real(dp) :: transform_seconds = 0, communication_seconds = 0
+      !> The gap-variable iteration's transform grid (gap_grid_setup; femcod_mpi_gap_transform).
+      type(distributed_gap_transform) :: gaps
    contains
       procedure :: displace => distributed_displace
+      procedure :: apply_spectrum => distributed_apply_spectrum
       procedure :: displace_single => distributed_displace_single
       procedure :: sum_over_grid => sum_over_ranks
       procedure :: max_over_grid => max_over_ranks
@@ -128,6 +135,11 @@ module femcod_mpi_cg
       integer :: above_hardness = 0
       !> This rank's columns: contact forces (nN) and gaps (nm, 0 at the contacts).
       real(dp), allocatable :: force(:, :), gap(:, :)
+      !> In the gap variables (adhesion, or the cap under displacement control), over all
+      !> ranks: the pixels off contact within the law's range, their load (nN), the mean
+      !> gap (nm), and a jump into contact (1) or off it (-1) since the last approach.
+      integer :: attractive = 0, jump = 0
+      real(dp) :: attractive_load = 0, mean_gap = 0
    end type distributed_state
 
 contains
@@ -537,6 +549,7 @@ contains
       end do
       if (c_associated(grid%column_memory)) call fftw_free(grid%column_memory)
       if (c_associated(grid%row_memory)) call fftw_free(grid%row_memory)
+      call gap_transform_free(grid%gaps)
       grid = distributed_grid(comm=MPI_COMM_NULL)
    end subroutine grid_free
 
@@ -705,9 +718,10 @@ contains
    !> solved in ascending order, each warm-started from the last; states in the order
    !> given) by femcod_cg's solve_target on this grid: the same constrained iteration,
    !> plastic rounds (`plastic`: no pressure above `hardness`, GPa) and displacement
-   !> control as `femcod run --solver cg`. `problem` is read on rank 0 only (the
-   !> materials, for the coarse start). Collective.
-   subroutine solve_loads(grid, problem, targets, how, states, status, observer, hardness, plastic, by_approach)
+   !> control as `femcod run --solver cg`. Approaches with an adhesive `law`, or with the
+   !> cap, are solved in the gap variables along the path in the order given, as there.
+   !> `problem` is read on rank 0 only (the materials, for the coarse start). Collective.
+   subroutine solve_loads(grid, problem, targets, how, states, status, observer, hardness, plastic, by_approach, law)
       type(distributed_grid), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: targets(:)
@@ -719,12 +733,15 @@ contains
       !> cap with `plastic`.
       real(dp), intent(in), optional :: hardness
       logical, intent(in), optional :: plastic, by_approach
+      !> The interface law (default: the hard wall; its cap is set here from `hardness`).
+      type(interface_law), intent(in), optional :: law
       type(cg_session) :: session
       type(cg_answer) :: answer
+      type(interface_law) :: interface
       integer, allocatable :: order(:)
       real(dp) :: t0, t1, transform0, communication0, cap
       integer :: k, kk, m
-      logical :: capped, approaches
+      logical :: capped, approaches, by_gaps
       m = size(targets)
       allocate(states(m))
       capped = .false.
@@ -733,25 +750,28 @@ contains
       if (present(by_approach)) approaches = by_approach
       cap = huge(1.0_dp)
       if (present(hardness)) cap = hardness
+      if (present(law)) interface = law
+      interface%area = grid%pixel**2
+      interface%fmax = huge(1.0_dp)
+      if (capped) interface%fmax = cap*grid%pixel**2
+      by_gaps = approaches .and. (capped .or. interface%adhesive())
+      call check_targets(grid, targets, approaches, capped, present(hardness), status)
+      if (status%code /= 0) return
       if (approaches) then
          states%approach = targets
       else
          states%load = targets
-         if (any(.not. targets > 0)) then
-            call set_error(status, STATUS_USAGE, "every load must be positive (nN)")
-            return
-         end if
       end if
-      if (capped .and. .not. present(hardness)) then
-         call set_error(status, STATUS_USAGE, "the plastic cap needs a hardness (GPa)")
-         return
-      end if
-      if (approaches .and. .not. capped) call refuse_beyond_full_contact(grid, targets, status)
+      if (by_gaps) call gap_grid_setup(grid, status)
       if (status%code /= 0) return
       if (grid%rank == 0) grid%materials = contact_problem(label="", np=problem%np, pixel=problem%pixel, &
          young=problem%young, poisson=problem%poisson)
-      call session_start(grid, session, capped, merge(cap*grid%pixel**2, 0.0_dp, capped))
-      order = ascending_order(targets)
+      call session_start(grid, session, capped, merge(cap*grid%pixel**2, 0.0_dp, capped), interface, by_gaps)
+      if (by_gaps) then
+         order = [(k, k = 1, m)]
+      else
+         order = ascending_order(targets)
+      end if
       do kk = 1, m
          k = order(kk)
          call wall_clock(t0)
@@ -764,24 +784,44 @@ contains
             approach_error_bound(states(k)%penetration, states(k)%contact_gap, states(k)%load_error, states(k)%approach)
          call wall_clock(t1)
          associate(st => states(k))
+            if (by_gaps .and. kk > 1) then
+               if (states(order(kk - 1))%contacts == 0 .and. st%contacts > 0) st%jump = 1
+               if (states(order(kk - 1))%contacts > 0 .and. st%contacts == 0) st%jump = -1
+            end if
             st%seconds = t1 - t0
             st%transform_seconds = grid%transform_seconds - transform0
             st%communication_seconds = grid%communication_seconds - communication0
             call observer%progress(kk, st%contacts, st%load, t1 - t0)
             if (st%residual > how%tol) then
-               call set_error(status, STATUS_NUMERICAL, "cg: "//trim(merge("approach", "load    ", approaches))// &
-                  " "//format_real(targets(k))//trim(merge(" nm", " nN", approaches))//": residual "// &
-                  sig_str(st%residual, 2)//" after "//int_str(st%iterations)//" iterations, above --tol "// &
-                  sig_str(how%tol, 2)//" (raise --max-iterations)")
+               call set_error(status, STATUS_NUMERICAL, unconverged_message(approaches, by_gaps, targets(k), &
+                  st%residual, st%iterations, how%tol))
                return
             end if
          end associate
       end do
    end subroutine solve_loads
 
+   !> Loads must be positive; the cap needs a hardness; approaches on a periodic cell stop
+   !> short of full contact (without the cap).
+   subroutine check_targets(grid, targets, approaches, capped, has_hardness, status)
+      type(distributed_grid), intent(inout) :: grid
+      real(dp), intent(in) :: targets(:)
+      logical, intent(in) :: approaches, capped, has_hardness
+      type(status_type), intent(inout) :: status
+      if (.not. approaches .and. any(.not. targets > 0)) then
+         call set_error(status, STATUS_USAGE, "every load must be positive (nN)")
+      else if (capped .and. .not. has_hardness) then
+         call set_error(status, STATUS_USAGE, "the plastic cap needs a hardness (GPa)")
+      else if (approaches .and. .not. capped) then
+         call refuse_beyond_full_contact(grid, targets, status)
+      end if
+   end subroutine check_targets
+
    !> One target's state from the answer and the session's forces: the residuals, this
    !> rank's maps, and the counts over all ranks (contacts, pixels above `hardness` GPa,
-   !> capped pixels) with the largest pressure (GPa) and the plastic volume (nm^3).
+   !> capped pixels) with the largest pressure (GPa) and the plastic volume (nm^3). In
+   !> the gap variables the contacts are the pixels at gap 0 (with adhesion they may
+   !> pull), as in femcod_cg.
    subroutine record_state(grid, session, answer, hardness, st)
       type(distributed_grid), intent(inout) :: grid
       type(cg_session), intent(in) :: session
@@ -789,6 +829,7 @@ contains
       real(dp), intent(in) :: hardness
       type(distributed_state), intent(inout) :: st
       real(dp) :: total(4), top(1)
+      logical, allocatable :: contact(:, :)
       st%load = answer%load
       st%approach = answer%approach
       st%iterations = answer%rep%iterations
@@ -800,6 +841,9 @@ contains
       st%contact_gap = answer%rep%contact_gap
       st%load_error = answer%rep%load_error
       st%plastic_rounds = answer%plastic_rounds
+      st%attractive = answer%attractive
+      st%attractive_load = answer%attractive_load
+      st%mean_gap = answer%mean_gap
       st%force = session%p
       if (allocated(answer%gap)) then
          call move_alloc(answer%gap, st%gap)
@@ -807,22 +851,29 @@ contains
          ! No force (at or before first touch): the gaps at this approach.
          st%gap = grid%g0 - session%approach
       end if
+      if (answer%by_gaps) then
+         contact = st%gap == 0
+      else
+         contact = session%p > 0
+      end if
       total = 0
       if (allocated(answer%plastic)) then
          call move_alloc(answer%plastic, st%plastic)
          total(3) = count(session%capped)
          total(4) = sum(st%plastic)*grid%pixel**2
       end if
-      total(1) = count(session%p > 0)
+      total(1) = count(contact)
       total(2) = count(session%p/grid%pixel**2 > hardness)
       call grid%sum_over_grid(total)
       st%contacts = nint(total(1))
       st%above_hardness = nint(total(2))
       st%n_plastic = nint(total(3))
       st%plastic_volume = total(4)
-      top(1) = maxval(session%p)/grid%pixel**2
+      top(1) = -huge(1.0_dp)
+      if (any(contact)) top(1) = maxval(session%p, mask=contact)/grid%pixel**2
       call grid%max_over_grid(top)
-      st%max_pressure = top(1)
+      st%max_pressure = 0
+      if (st%contacts > 0) st%max_pressure = top(1)
    end subroutine record_state
 
    !> The coarse start (the elastic operator's start_forces): the gaps averaged over f x f
@@ -892,6 +943,34 @@ contains
          end do
       end do
    end subroutine coarse_start
+
+   !> The transform grid of the gap variables (femcod_mpi_gap_transform) from the grid's
+   !> kernel spectrum, once. Collective.
+   subroutine gap_grid_setup(grid, status)
+      type(distributed_grid), intent(inout) :: grid
+      type(status_type), intent(inout) :: status
+      if (grid%tm > 0) return
+      call gap_transform_setup(grid%gaps, grid%comm, grid%np, grid%first, grid%count, grid%block_columns, &
+         grid%periodic, grid%kernel, grid%freq_start, grid%c, grid%s, status)
+      if (status%code /= 0) return
+      grid%tm = grid%gaps%m
+      grid%tmj = grid%gaps%columns
+      grid%smallest_compliance = grid%gaps%smallest
+   end subroutine gap_grid_setup
+
+   !> out = C in or K in on this rank's transform field (the elastic operator's
+   !> apply_spectrum), timed with the transforms. Collective.
+   subroutine distributed_apply_spectrum(op, which, in, out)
+      class(distributed_grid), intent(inout) :: op
+      integer, intent(in) :: which
+      real(dp), intent(in) :: in(:, :)
+      real(dp), intent(out) :: out(:, :)
+      real(dp) :: t0, t1
+      call wall_clock(t0)
+      call gap_transform_apply(op%gaps, which, in, out)
+      call wall_clock(t1)
+      op%transform_seconds = op%transform_seconds + (t1 - t0)
+   end subroutine distributed_apply_spectrum
 
    !> out = c (I * f) on this rank's columns, in double (the elastic operator's displace).
    subroutine distributed_displace(op, f, out)
