@@ -10,7 +10,7 @@ module stability_cases
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem, verification_spec
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, solver_from_name
    use femcod_solver, only: solve_contact
    use femcod_condensed, only: solve_active_set
    use femcod_love, only: offset_table, love_influence, love_influence_exact, love_influence_far
@@ -49,7 +49,7 @@ contains
       type(contact_options) :: options
       options%loads = loads
       if (present(max_contacts)) options%max_contacts = max_contacts
-      options%solver = solver
+      options%solver = solver_from_name(solver)
       call solve_contact(deck, options, res, status)
    end subroutine solve
 

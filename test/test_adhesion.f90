@@ -9,7 +9,8 @@ module test_adhesion
    use femcod_status, only: status_type
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, &
+      SOLVER_INCREMENTAL, SOLVER_CG, BOUNDARY_FREE, BOUNDARY_PERIODIC, LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, boundary_name
    use femcod_solver, only: solve_contact
    use femcod_analytic, only: maugis_pull_off, maugis_at_load
    use femcod_generate, only: paraboloid_problem
@@ -57,8 +58,8 @@ contains
       type(contact_options) :: options
       type(contact_result) :: res
       real(dp), parameter :: young = 1, work = 0.01_dp
-      options%solver = "cg"
-      options%adhesion = "dugdale"
+      options%solver = SOLVER_CG
+      options%adhesion = LAW_DUGDALE
       options%work = work
       options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
       options%approaches = [1.0_dp, approaches]
@@ -137,8 +138,8 @@ contains
       real(dp), parameter :: lambda = 1, radius = 1000, work = 0.01_dp, young = 1
       real(dp) :: pbar, abar, dbar, asc, dsc, a
       integer :: k
-      options%solver = "cg"
-      options%adhesion = "dugdale"
+      options%solver = SOLVER_CG
+      options%adhesion = LAW_DUGDALE
       options%work = work
       options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
       options%approaches = [0.5_dp, 1.0_dp, 1.5_dp]
@@ -180,15 +181,15 @@ contains
       do b = 1, 2
          options = contact_options()
          ! The reference: the event path (exact on its piecewise-linear path).
-         options%solver = "incremental"
-         options%boundary = trim(merge("free    ", "periodic", b == 1))
+         options%solver = SOLVER_INCREMENTAL
+         options%boundary = merge(BOUNDARY_FREE, BOUNDARY_PERIODIC, b == 1)
          options%loads = [real(dp) ::]
          options%approaches = d
          call solve_contact(deck, options, plain, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
-         options%solver = "cg"
-         options%adhesion = "exponential"
+         options%solver = SOLVER_CG
+         options%adhesion = LAW_EXPONENTIAL
          options%work = 0
          options%range = 1
          options%cg%tol = 1.0e-10_dp
@@ -197,16 +198,16 @@ contains
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
          do k = 1, 3
-            call check(error, adhesive%states(k)%contacts, plain%states(k)%contacts, trim(options%boundary)// &
+            call check(error, adhesive%states(k)%contacts, plain%states(k)%contacts, boundary_name(options%boundary)// &
                ": contacts at "//to_string(d(k)))
             if (allocated(error)) return
             call check(error, adhesive%states(k)%load, plain%states(k)%load, rel=.true., thr=1.0e-9_dp, &
-               message=trim(options%boundary)//": load at "//to_string(d(k)))
+               message=boundary_name(options%boundary)//": load at "//to_string(d(k)))
             if (allocated(error)) return
          end do
          do k = 1, 2
             call check(error, adhesive%states(3 + k)%load, adhesive%states(3 - k)%load, rel=.true., thr=1.0e-8_dp, &
-               message=trim(options%boundary)//": unloading to "//to_string(d(3 - k))//" does not retrace loading")
+               message=boundary_name(options%boundary)//": unloading to "//to_string(d(3 - k))//" does not retrace loading")
             if (allocated(error)) return
          end do
       end do
@@ -228,8 +229,8 @@ contains
       type(status_type) :: status
       call rough_scene(64, 3, deck)
       deck%young(1) = 10
-      options%solver = "cg"
-      options%adhesion = "exponential"
+      options%solver = SOLVER_CG
+      options%adhesion = LAW_EXPONENTIAL
       options%work = 0.5_dp
       options%range = 1
       options%approaches = [-6.0_dp, 1.0_dp, 4.0_dp, 1.0_dp, -6.0_dp]
@@ -263,15 +264,15 @@ contains
       type(status_type) :: status
       real(dp), parameter :: radius = 100, work = 0.01_dp, young = 1, lambda = 0.5_dp
       integer :: k
-      options%solver = "cg"
-      options%adhesion = "dugdale"
+      options%solver = SOLVER_CG
+      options%adhesion = LAW_DUGDALE
       options%work = work
       options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
       options%approaches = [1.0_dp, (-0.05_dp*k, k = 1, 10)]
       call solve_contact(paraboloid_problem(64, 1.0_dp, radius, young), options, free, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
-      options%boundary = "periodic"
+      options%boundary = BOUNDARY_PERIODIC
       call solve_contact(paraboloid_problem(64, 1.0_dp, radius, young), options, periodic, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -298,11 +299,11 @@ contains
       real(dp) :: shift
       integer :: k
       call rough_scene(32, 5, deck)
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%loads = [real(dp) ::]
       options%plastic = .true.
       options%hardness = 20
-      options%adhesion = "dugdale"
+      options%adhesion = LAW_DUGDALE
       options%work = 0
       options%range = 1
       options%cg%tol = 1.0e-11_dp
@@ -312,8 +313,8 @@ contains
       if (allocated(error)) return
       call check(error, path%states(3)%n_plastic > 0, "no plastic pixel at 2 nm")
       if (allocated(error)) return
-      options%solver = "incremental"
-      options%adhesion = "none"
+      options%solver = SOLVER_INCREMENTAL
+      options%adhesion = LAW_HARD_WALL
       options%approaches = up
       call solve_contact(deck, options, exact, status)
       call check(error, status%code, 0, status%message)
@@ -380,8 +381,8 @@ contains
       type(status_type) :: status
       real(dp), parameter :: radius = 1000, work = 0.01_dp, young = 1, lambda = 1
       integer :: k
-      options%solver = "cg"
-      options%adhesion = "dugdale"
+      options%solver = SOLVER_CG
+      options%adhesion = LAW_DUGDALE
       options%work = work
       options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
       options%approaches = [1.0_dp, (-0.1_dp*k, k = 0, 12)]

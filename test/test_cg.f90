@@ -8,7 +8,8 @@ module test_cg
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options, cg_settings, &
+      SOLVER_INCREMENTAL, SOLVER_CG, solver_name
    use femcod_solver, only: solve_contact
    use femcod_generate, only: VERIFICATION_DECKS, scene_spec, build_problem
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
@@ -91,7 +92,7 @@ contains
          if (index(VERIFICATION_DECKS(d), "d05") > 0 .or. index(VERIFICATION_DECKS(d), "d9") > 0) cycle
          call read_deck("input/"//trim(VERIFICATION_DECKS(d))//".deck", deck, status)
          options%loads = [real(dp) ::]
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, inc, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
@@ -106,9 +107,9 @@ contains
             end associate
          end do
          options%loads = loads
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, inc, status)
-         options%solver = "cg"
+         options%solver = SOLVER_CG
          options%cg = cg_settings()
          options%cg%tol = 1.0e-10_dp
          options%cg%max_iterations = 5000
@@ -175,7 +176,7 @@ contains
             call event_path(deck, table, 1.0e-9_dp, deck%maxcont + 1, top, event_loads, counts, m, released)
          end do
          options = contact_options()
-         options%solver = "cg"
+         options%solver = SOLVER_CG
          options%loads = loads
          options%cg%tol = 1.0e-11_dp
          options%cg%max_iterations = 20000
@@ -205,7 +206,7 @@ contains
       real(dp) :: estar, r, segedin, a
       call read_deck("input/sphere_d05.deck", deck, status)
       options%loads = [1000.0_dp, 18000.0_dp]
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%cg = cg_settings()
       options%cg%tol = 1.0e-8_dp
       options%cg%max_iterations = 5000
@@ -239,7 +240,7 @@ contains
       integer :: np, s, i, j, k, l
       call read_deck("input/sphere_d1.deck", deck, status)
       options%loads = [100.0_dp, 3000.0_dp]
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%cg = cg_settings()
       call solve_contact(deck, options, res, status)
       call check(error, status%code, 0, status%message)
@@ -308,7 +309,7 @@ contains
       type(status_type) :: status
       integer :: n, s
       options%loads = [real(dp) ::]
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -322,7 +323,7 @@ contains
    function plastic_options(loads, hardness, tol) result(options)
       real(dp), intent(in) :: loads(:), hardness, tol
       type(contact_options) :: options
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%loads = loads
       options%cg = cg_settings()
       options%cg%tol = tol
@@ -359,7 +360,7 @@ contains
          if (allocated(error)) return
       end do
       ! The event path: the same history, step by step, bit for bit.
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(deck, options, elastic, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -494,7 +495,7 @@ contains
       allocate(cg_force(n))
       do solver = 1, 2
          options = plastic_options([load], hardness, 1.0e-12_dp)
-         if (solver == 2) options%solver = "incremental"
+         if (solver == 2) options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, res, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
@@ -502,14 +503,14 @@ contains
          do k = 1, size(res%states(1)%force)
             cg_force((res%states(1)%i(k) - 1)*np + res%states(1)%j(k)) = res%states(1)%force(k)
          end do
-         call check(error, maxval(abs(cg_force - f)) <= 1.0e-8_dp*fmax, trim(options%solver)// &
+         call check(error, maxval(abs(cg_force - f)) <= 1.0e-8_dp*fmax, solver_name(options%solver)// &
             ": forces: largest difference "//to_string(maxval(abs(cg_force - f))/fmax)//" of H d^2")
          if (allocated(error)) return
-         call check(error, res%states(1)%n_plastic, count(capped), trim(options%solver)//": plastic pixels")
+         call check(error, res%states(1)%n_plastic, count(capped), solver_name(options%solver)//": plastic pixels")
          if (allocated(error)) return
          ! The approach in femcod's sense is the contacts' mean gap before the shift; the
          ! multiplier A here is the same quantity.
-         call check(error, abs(res%states(1)%approach - approach) <= 1.0e-8_dp*range, trim(options%solver)// &
+         call check(error, abs(res%states(1)%approach - approach) <= 1.0e-8_dp*range, solver_name(options%solver)// &
             ": approach "//to_string(res%states(1)%approach)//" against "//to_string(approach))
          if (allocated(error)) return
       end do
@@ -535,7 +536,7 @@ contains
       deck%maxcont = 400
       hardness = 20
       options = plastic_options([real(dp) ::], hardness, 1.0e-12_dp)
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -553,7 +554,7 @@ contains
       call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       call solve_contact(deck, options, cg, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -590,12 +591,12 @@ contains
          do k = 1, 3
             load = 0.02_dp*64**2*hardness(k)*deck%pixel**2
             options = plastic_options([load], hardness(k), 1.0e-8_dp)
-            if (solver == 2) options%solver = "incremental"
+            if (solver == 2) options%solver = SOLVER_INCREMENTAL
             call solve_contact(deck, options, res, status)
             call check(error, status%code, 0, status%message)
             if (allocated(error)) return
             ratio = res%states(1)%contacts*deck%pixel**2*hardness(k)/load
-            call check(error, ratio >= 1 - 1.0e-12_dp .and. ratio - 1 <= bound(k), trim(options%solver)//": H = "// &
+            call check(error, ratio >= 1 - 1.0e-12_dp .and. ratio - 1 <= bound(k), solver_name(options%solver)//": H = "// &
                to_string(hardness(k))//" GPa: area H / P = "//to_string(ratio))
             if (allocated(error)) return
          end do
@@ -665,21 +666,21 @@ contains
       deck%maxcont = deck%np**2
       do solver = 1, 2
          options = plastic_options([0.99_dp*capacity, 1.01_dp*capacity], hardness, 1.0e-10_dp)
-         if (solver == 2) options%solver = "incremental"
+         if (solver == 2) options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, res, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
-         call check(error, res%states(1)%contacts, nface, trim(options%solver)//": below A H: the face's pixels only")
+         call check(error, res%states(1)%contacts, nface, solver_name(options%solver)//": below A H: the face's pixels only")
          if (allocated(error)) return
          call check(error, res%states(2)%contacts > nface .and. res%states(2)%n_plastic == nface, &
-            trim(options%solver)//": above A H: the face plastic ("//to_string(res%states(2)%n_plastic)// &
+            solver_name(options%solver)//": above A H: the face plastic ("//to_string(res%states(2)%n_plastic)// &
             ") and more contacts ("//to_string(res%states(2)%contacts)//")")
          if (allocated(error)) return
          face = 0
          do k = 1, size(res%states(2)%force)
             if (g0(res%states(2)%i(k), res%states(2)%j(k)) == minval(g0)) face = face + res%states(2)%force(k)
          end do
-         call check(error, face, capacity, rel=.true., thr=1.0e-12_dp, message=trim(options%solver)// &
+         call check(error, face, capacity, rel=.true., thr=1.0e-12_dp, message=solver_name(options%solver)// &
             ": the face carries A H")
          if (allocated(error)) return
       end do
@@ -763,7 +764,7 @@ contains
       d(2) = d(1)/2
       do solver = 1, 2
          options = contact_options()
-         options%solver = trim(merge("cg         ", "incremental", solver == 1))
+         options%solver = merge(SOLVER_CG, SOLVER_INCREMENTAL, solver == 1)
          options%loads = [real(dp) ::]
          options%approaches = d
          options%cg = cg_settings()
@@ -773,9 +774,9 @@ contains
          if (allocated(error)) return
          do k = 1, 2
             hertz = 4*estar*sqrt(r)*d(k)**1.5_dp/3
-            call check(error, res%states(k)%reached, trim(options%solver)//": reached")
+            call check(error, res%states(k)%reached, solver_name(options%solver)//": reached")
             if (allocated(error)) return
-            call check(error, res%states(k)%load, hertz, rel=.true., thr=0.01_dp*k, message=trim(options%solver)// &
+            call check(error, res%states(k)%load, hertz, rel=.true., thr=0.01_dp*k, message=solver_name(options%solver)// &
                ": load at "//to_string(d(k))//" nm against Hertz "//to_string(hertz))
             if (allocated(error)) return
          end do
@@ -798,7 +799,7 @@ contains
       integer :: k
       call rough_scene(32, 5, deck)
       deck%maxcont = 1024
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       options%loads = [real(dp) ::]
       options%approaches = d
       call solve_contact(deck, options, down, status)
@@ -816,7 +817,7 @@ contains
       call check(error, down%states(4)%load == 0 .and. down%states(4)%contacts == 0 .and. &
          down%states(4)%approach == d(4), "below first touch")
       if (allocated(error)) return
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%approaches = d
       options%cg = cg_settings()
       options%cg%tol = 1.0e-10_dp
@@ -831,7 +832,7 @@ contains
          call check(error, cg%states(k)%contacts, down%states(k)%contacts, "cg's contacts at "//to_string(d(k)))
          if (allocated(error)) return
       end do
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       options%approaches = [real(dp) ::]
       options%loads = down%states(1:3)%load
       call solve_contact(deck, options, back, status)
@@ -890,7 +891,7 @@ contains
       integer :: np, i, j, k
       call read_deck("input/sphere_d1.deck", deck, status)
       np = deck%np
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%loads = [3000.0_dp]
       options%cg = cg_settings()
       call solve_contact(deck, options, whole, status)
@@ -962,7 +963,8 @@ contains
    end subroutine test_usage
    !> The convolution by pruned 1-D passes, the real kernel spectrum and the wrapped
    !> kernel, against the O(NP^4) direct sum over the Love table of test/oracles (quadruple
-   !> precision, independent of the code's table and of any transform): agreement to round-off in double, and to float32's unit round-off
+   !> precision, independent of the code's table and of any transform): agreement to
+   !> round-off in double, and to float32's unit round-off
    !> (6e-8) times a small growth factor in single precision (bound 1e-5 of the largest
    !> value). Odd, even and odd-prime sides.
    subroutine test_convolution(error)
@@ -1191,13 +1193,13 @@ contains
       how(10)%split_radius = 32
       do v = 0, size(how)
          if (v == 0) then
-            options%solver = "cg"
+            options%solver = SOLVER_CG
             options%cg = plain
             options%cg%tol = 1.0e-10_dp
             options%cg%max_iterations = 5000
             call solve_contact(deck, options, cg, status)
          else
-            options%solver = "cg"
+            options%solver = SOLVER_CG
             options%cg = how(v)
             options%cg%tol = 1.0e-10_dp
             options%cg%max_iterations = 5000
@@ -1276,7 +1278,7 @@ contains
       if (allocated(error)) return
       tols = [1.0e-3_dp, 1.0e-5_dp, 1.0e-7_dp]
       do v = 1, size(tols)
-         options%solver = "cg"
+         options%solver = SOLVER_CG
          options%cg = cg_settings()
          options%cg%tol = tols(v)
          call solve_contact(deck, options, cg, status)
@@ -1372,11 +1374,11 @@ contains
          options%loads = [real(dp) ::]
          options%plastic = .true.
          options%hardness = h
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, event, status)
          call check(error, status%code, 0, "event path: "//status%message)
          if (allocated(error)) return
-         options%solver = "cg"
+         options%solver = SOLVER_CG
          options%cg = cg_settings()
          options%cg%tol = 1.0e-10_dp
          options%cg%max_iterations = 5000

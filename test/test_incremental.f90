@@ -6,7 +6,8 @@ module test_incremental
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, &
+      SOLVER_INCREMENTAL, SOLVER_LEGACY, SOLVER_CG
    use femcod_solver, only: solve_contact
    use femcod_generate, only: VERIFICATION_DECKS, scene_spec, build_problem
    use femcod_love, only: offset_table
@@ -74,11 +75,11 @@ contains
          options%loads = [1.0_dp]
          if (index(VERIFICATION_DECKS(d), "sphere") > 0) options%loads = [3000.0_dp]
          if (index(VERIFICATION_DECKS(d), "rough") > 0) deallocate(options%loads)
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, inc, status)
          call check(error, status%code, 0)
          if (allocated(error)) return
-         options%solver = "legacy"
+         options%solver = SOLVER_LEGACY
          call solve_contact(deck, options, leg, status)
          call check(error, status%code, 0)
          if (allocated(error)) return
@@ -132,7 +133,7 @@ contains
          if (allocated(error)) return
          top = huge(1.0_dp)
          options = contact_options()
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          if (index(decks(d), "sphere") > 0) then
             top = 18000
             options%loads = [top]
@@ -189,7 +190,7 @@ contains
       deck%young(3) = 1.0e25_dp
       np = deck%np
       options%loads = loads
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
@@ -250,7 +251,7 @@ contains
       do k = 1, 2
          call read_deck("input/"//trim(decks(k))//".deck", deck, status)
          options%loads = [1.0_dp]
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, inc, status)
          call check(error, status%code, 0)
          if (allocated(error)) return
@@ -308,7 +309,7 @@ contains
       if (allocated(error)) return
       options%max_contacts = 600
       allocate(options%loads(0))
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(deck, options, inc, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
@@ -352,13 +353,13 @@ contains
          call check(error, omp_get_max_threads(), k, "threads set")
          if (allocated(error)) exit
          t(:, :, k) = offset_table(64)
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          options%event_search = "fft"
          allocate(options%loads(0))
          call solve_contact(deck, options, res(k), status)
          call check(error, status%code, 0, "incremental, "//to_string(k)//" threads: "//status%message)
          if (allocated(error)) exit
-         options%solver = "cg"
+         options%solver = SOLVER_CG
          options%loads = [res(k)%step_load(res(k)%nsteps)/2]
          call solve_contact(deck, options, cg(k), status)
          deallocate(options%loads)
@@ -396,10 +397,10 @@ contains
          options%loads = [real(dp) ::]
          if (index(VERIFICATION_DECKS(d), "sphere") > 0) options%loads = [3000.0_dp]
          options%event_search = "bound"
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, a, status)
          options%event_search = "fft"
-         options%solver = "incremental"
+         options%solver = SOLVER_INCREMENTAL
          call solve_contact(deck, options, b, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
@@ -416,7 +417,7 @@ contains
       end do
       ! Auto: the same events as the bound search on the last deck.
       options%event_search = "auto"
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(deck, options, b, status)
       call check(error, b%nsteps == a%nsteps, "auto: steps")
       if (allocated(error)) return

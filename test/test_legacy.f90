@@ -6,7 +6,8 @@ module test_legacy
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options, cg_settings, &
+      SOLVER_LEGACY
    use femcod_solver, only: solve_contact
    use femcod_richardson, only: convergence_rate, richardson_extrapolate
    use femcod_strings, only: string_type
@@ -51,7 +52,7 @@ contains
       call read_deck("input/"//name//".deck", deck, status)
       if (status%code /= 0) return
       options%loads = [load]
-      options%solver = "legacy"
+      options%solver = SOLVER_LEGACY
       call solve_contact(deck, options, res, status)
       if (status%code /= 0) return
       approach = res%states(1)%approach
@@ -132,7 +133,7 @@ contains
       real(dp) :: estar, r, hertz, segedin, a
       call read_deck("input/sphere_d05.deck", deck, status)
       options%loads = [1000.0_dp, 18000.0_dp]
-      options%solver = "legacy"
+      options%solver = SOLVER_LEGACY
       call solve_contact(deck, options, res, status)
       call check(error, status%code, 0)
       if (allocated(error)) return
@@ -158,7 +159,7 @@ contains
       integer :: k, info
       call read_deck("input/rough_selfaffine_32.deck", deck, status)
       allocate(options%loads(0))
-      options%solver = "legacy"
+      options%solver = SOLVER_LEGACY
       call solve_contact(deck, options, res, status)
       call check(error, status%code, 0)
       if (allocated(error)) return

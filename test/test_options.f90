@@ -13,6 +13,7 @@ module test_options
    use femcod_generate, only: scene_spec
    use test_support, only: scratch_path, read_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   use femcod_solver_options, only: SOLVER_CG
    implicit none
    private
    public :: collect_options
@@ -164,7 +165,7 @@ contains
       call check(error, status%code, 0, "parsed")
       if (allocated(error)) return
       associate(o => settings%solve)
-         call check(error, o%solver == "cg" .and. all(o%loads == [1.0_dp, 2.0_dp]) .and. o%cg%tol == 1.0e-9_dp .and. &
+         call check(error, o%solver == SOLVER_CG .and. all(o%loads == [1.0_dp, 2.0_dp]) .and. o%cg%tol == 1.0e-9_dp .and. &
             o%cg%max_iterations == 50 .and. o%hardness == 5 .and. settings%prefix == "options_out", "cg options")
          if (allocated(error)) return
       end associate

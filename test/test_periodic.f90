@@ -12,7 +12,8 @@ module test_periodic
    use femcod_status, only: status_type
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options, cg_settings, &
+      SOLVER_INCREMENTAL, SOLVER_CG, BOUNDARY_PERIODIC, solver_name
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
@@ -233,8 +234,8 @@ contains
       lambda = np*problem%pixel
       estar = 200/(1 - 0.25_dp**2)
       pstar = pi*estar*h0/lambda
-      options%solver = "cg"
-      options%boundary = "periodic"
+      options%solver = SOLVER_CG
+      options%boundary = BOUNDARY_PERIODIC
       options%cg = cg_settings()
       options%cg%tol = 1.0e-10_dp
       options%cg%max_iterations = 5000
@@ -294,8 +295,8 @@ contains
       estar = 200/(1 - 0.25_dp**2)
       pstar = sqrt(2.0_dp)*pi*estar*h0/lambda
       r = lambda**2/(4*pi**2*h0)
-      options%solver = "cg"
-      options%boundary = "periodic"
+      options%solver = SOLVER_CG
+      options%boundary = BOUNDARY_PERIODIC
       options%cg = cg_settings()
       options%cg%tol = 1.0e-10_dp
       options%cg%max_iterations = 5000
@@ -343,7 +344,7 @@ contains
          end do
       end do
       problem = elastic_on_rigid(z)
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%cg = cg_settings()
       options%cg%tol = 1.0e-12_dp
       options%cg%max_iterations = 5000
@@ -351,7 +352,7 @@ contains
       call solve_contact(problem, options, free, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
-      options%boundary = "periodic"
+      options%boundary = BOUNDARY_PERIODIC
       call solve_contact(problem, options, periodic, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -407,8 +408,8 @@ contains
       end do
       problem = elastic_on_rigid(z)
       problem%maxcont = 200
-      options%boundary = "periodic"
-      options%solver = "incremental"
+      options%boundary = BOUNDARY_PERIODIC
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(problem, options, inc, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -424,7 +425,7 @@ contains
       call solve_contact(problem, options, inc, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%cg = cg_settings()
       options%cg%tol = 1.0e-10_dp
       options%cg%max_iterations = 5000
@@ -468,26 +469,26 @@ contains
       mean_pressure = pstar/2
       load = mean_pressure*np**2
       do solver = 1, 2
-         options%solver = trim(merge("cg         ", "incremental", solver == 1))
-         options%boundary = "periodic"
+         options%solver = merge(SOLVER_CG, SOLVER_INCREMENTAL, solver == 1)
+         options%boundary = BOUNDARY_PERIODIC
          options%plastic = .true.
          options%hardness = 1.5_dp*mean_pressure
          options%cg = cg_settings()
          options%cg%tol = 1.0e-10_dp
          options%loads = [load]
          call solve_contact(problem, options, res(solver), status)
-         call check(error, status%code, 0, trim(options%solver)//": "//status%message)
+         call check(error, status%code, 0, solver_name(options%solver)//": "//status%message)
          if (allocated(error)) return
          associate(st => res(solver)%states(1))
-            call check(error, st%n_plastic > 0, trim(options%solver)//": no pixel reached H")
+            call check(error, st%n_plastic > 0, solver_name(options%solver)//": no pixel reached H")
             if (allocated(error)) return
-            call check(error, maxval(st%force) <= options%hardness*(1 + 1.0e-12_dp), trim(options%solver)// &
+            call check(error, maxval(st%force) <= options%hardness*(1 + 1.0e-12_dp), solver_name(options%solver)// &
                ": a pressure above H: "//to_string(maxval(st%force)))
             if (allocated(error)) return
-            call check(error, sum(st%force), load, rel=.true., thr=1.0e-12_dp, message=trim(options%solver)// &
+            call check(error, sum(st%force), load, rel=.true., thr=1.0e-12_dp, message=solver_name(options%solver)// &
                ": the forces' sum")
             if (allocated(error)) return
-            call check(error, real(st%contacts, dp) >= load/options%hardness, trim(options%solver)//": contacts "// &
+            call check(error, real(st%contacts, dp) >= load/options%hardness, solver_name(options%solver)//": contacts "// &
                to_string(st%contacts)//" below the bearing area "//to_string(load/options%hardness))
             if (allocated(error)) return
          end associate
@@ -607,19 +608,19 @@ contains
       pstar = pi*200/(1 - 0.25_dp**2)/lambda
       do solver = 1, 2
          options = contact_options()
-         options%solver = trim(merge("cg         ", "incremental", solver == 1))
-         options%boundary = "periodic"
+         options%solver = merge(SOLVER_CG, SOLVER_INCREMENTAL, solver == 1)
+         options%boundary = BOUNDARY_PERIODIC
          options%loads = [real(dp) ::]
          options%approaches = ratios*(1 - log(ratios))
          options%cg = cg_settings()
          options%cg%tol = 1.0e-10_dp
          options%cg%max_iterations = 5000
          call solve_contact(problem, options, res(solver), status)
-         call check(error, status%code, 0, trim(options%solver)//": "//status%message)
+         call check(error, status%code, 0, solver_name(options%solver)//": "//status%message)
          if (allocated(error)) return
          do k = 1, size(ratios)
             call check(error, res(solver)%states(k)%load/lambda**2, ratios(k)*pstar, rel=.true., thr=1.0e-3_dp, &
-               message=trim(options%solver)//": mean pressure at p/p* = "//to_string(ratios(k)))
+               message=solver_name(options%solver)//": mean pressure at p/p* = "//to_string(ratios(k)))
             if (allocated(error)) return
          end do
       end do
@@ -632,8 +633,8 @@ contains
       ! closed form above at p = p*); beyond it no load gives the approach: cg refuses it
       ! at once instead of iterating to its limit.
       options = contact_options()
-      options%solver = "cg"
-      options%boundary = "periodic"
+      options%solver = SOLVER_CG
+      options%boundary = BOUNDARY_PERIODIC
       options%loads = [real(dp) ::]
       options%approaches = [0.5_dp, 1.01_dp]
       call solve_contact(problem, options, res(1), status)

@@ -13,7 +13,8 @@ module test_safety
    use femcod_files, only: acquire_lock, release_lock
    use femcod_strings, only: int_str
    use femcod_output_guard, only: written_by_femcod, OUTPUT_RESULT, OUTPUT_DECK, OUTPUT_WISDOM
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, &
+      BOUNDARY_PERIODIC
    use femcod_incremental_state, only: incremental_state
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
    use femcod_deck, only: read_deck
@@ -439,7 +440,7 @@ contains
          case ("hardness")
             other%hardness = 5
          case ("boundary")
-            other%boundary = "periodic"
+            other%boundary = BOUNDARY_PERIODIC
          case ("loads")
             other%loads = [100.0_dp]
          case ("approaches")

@@ -16,7 +16,8 @@ module test_studies
       structure_function, structure_dimension, paraboloid_fit
    use femcod_multiscale, only: roughness_template, multiscale_result, multiscale_hertz, hertz_area
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options, cg_settings, &
+      SOLVER_INCREMENTAL, SOLVER_LEGACY
    use femcod_solver, only: solve_contact
    use femcod_richardson, only: power_law_fit
    use femcod_thesis, only: PIXEL_COMPLIANCE
@@ -239,9 +240,9 @@ contains
       options%hardness = 5
       options%max_contacts = 400
       allocate(options%loads(0))
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(deck, options, a, status)
-      options%solver = "legacy"
+      options%solver = SOLVER_LEGACY
       call solve_contact(deck, options, b, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
@@ -275,7 +276,7 @@ contains
       if (allocated(error)) return
       options%hardness = 5
       allocate(options%loads(0))
-      options%solver = "incremental"
+      options%solver = SOLVER_INCREMENTAL
       call solve_contact(deck, options, a, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return

@@ -7,7 +7,8 @@ module femcod_bench_adhesion
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem, paraboloid_problem
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options, cg_settings, &
+      SOLVER_CG, BOUNDARY_PERIODIC, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type, int_str, real_str, fixed_str
    use femcod_help, only: help_requested, print_lines
@@ -98,8 +99,8 @@ contains
       real(dp), allocatable :: pixels(:), path(:)
       real(dp) :: theory, pmin, previous, t0, t1, radius
       integer :: c, k, np
-      options%solver = "cg"
-      options%adhesion = "dugdale"
+      options%solver = SOLVER_CG
+      options%adhesion = LAW_DUGDALE
       options%work = work
       options%cg = cg_settings()
       options%cg%max_iterations = 20000
@@ -163,7 +164,7 @@ contains
       real(dp), allocatable :: path(:)
       real(dp) :: t0, t1, target, w, limit
       integer :: k, n, i, j, cmc_np
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       options%cg = cg_settings()
       options%cg%max_iterations = 20000
       allocate(options%loads(0))
@@ -189,7 +190,7 @@ contains
          return
       end if
       target = 2.5e-4_dp
-      options%adhesion = "exponential"
+      options%adhesion = LAW_EXPONENTIAL
       options%work = 0.05_dp
       options%range = 2.071_dp
       write(output_unit, '(a)') "", "Contact Mechanics Challenge interaction (E* = 25 MPa, W = 0.05 J/m^2, "// &
@@ -269,10 +270,10 @@ contains
          ! Dugdale at lambda = 0.5; the exponential law with the same work and range.
          range = 0.01_dp/0.5_dp*(9*100/(2*pi*0.01_dp*young**2))**(1.0_dp/3)
          options = contact_options()
-         options%solver = "cg"
-         options%boundary = "periodic"
+         options%solver = SOLVER_CG
+         options%boundary = BOUNDARY_PERIODIC
          allocate(options%loads(0))
-         options%adhesion = laws(iw)
+         options%adhesion = law_from_name(laws(iw))
          options%work = works(iw)
          options%range = range
          options%cg%tol = 1.0e-10_dp
@@ -310,10 +311,10 @@ contains
       call write_peer_gaps(path, g0)
       do ia = 1, 3
          options = contact_options()
-         options%solver = "cg"
-         options%boundary = "periodic"
+         options%solver = SOLVER_CG
+         options%boundary = BOUNDARY_PERIODIC
          allocate(options%loads(0))
-         options%adhesion = "exponential"
+         options%adhesion = LAW_EXPONENTIAL
          options%work = 0.05_dp
          options%range = 2.071_dp
          options%cg%max_iterations = 20000

@@ -8,7 +8,8 @@ module femcod_bench_cg
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, &
+      SOLVER_CG
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type, int_str, real_str, fixed_str
    use femcod_help, only: help_requested, print_lines
@@ -96,7 +97,7 @@ contains
             call load_wisdom(wisdom, loaded)
          end if
       end associate
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       write(output_unit, '(a)') "| NP | target % | solver | wall (s) | iterations | residual | contact % "// &
          "| peak RSS (MB) | status |"
       write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|"

@@ -8,7 +8,8 @@ module femcod_bench_frontier
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem, verification_spec
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options, cg_settings, &
+      SOLVER_LEGACY, SOLVER_CG
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type, int_str, real_str, fixed_str
    use femcod_help, only: help_requested, print_lines
@@ -172,7 +173,7 @@ contains
          do m = 1, 4
             do k = 1, size(tols)
                options = contact_options()
-               options%solver = "cg"
+               options%solver = SOLVER_CG
                options%loads = [load]
                options%cg = cg_settings()
                options%cg%tol = tols(k)
@@ -195,7 +196,7 @@ contains
          ! The Love kernel truncated (the thesis' 28 and 283 pixels, section 5.2.2 iii).
          do k = 1, size(radii)
             options = contact_options()
-            options%solver = "cg"
+            options%solver = SOLVER_CG
             options%loads = [load]
             options%cg = cg_settings()
             options%cg%max_iterations = 5000
@@ -246,7 +247,7 @@ contains
          call frontier_row(tab, "McCool (Greenwood-Williamson)", t1 - t0, -1.0_dp, rel(area, c_ref), "area only")
          if (legacy) then
             options = contact_options()
-            options%solver = "legacy"
+            options%solver = SOLVER_LEGACY
             options%loads = [load]
             call timed_solve(tab, deck, options, res, t1)
             if (status%code /= 0) then

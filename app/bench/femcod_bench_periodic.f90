@@ -7,7 +7,8 @@ module femcod_bench_periodic
    use femcod_problem, only: contact_problem
    use femcod_generate, only: RIGID_FACTOR
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options, cg_settings, &
+      SOLVER_CG, BOUNDARY_PERIODIC, boundary_from_name
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type, int_str, real_str, fixed_str
    use femcod_help, only: help_requested, print_lines
@@ -65,8 +66,8 @@ contains
       call get_option(parsed, "--peers", python)
       call require_peers(python, "periodic", code)
       if (code /= 0) return
-      options%solver = "cg"
-      options%boundary = "periodic"
+      options%solver = SOLVER_CG
+      options%boundary = BOUNDARY_PERIODIC
       options%cg = cg_settings()
       options%cg%tol = 1.0e-10_dp
       options%cg%max_iterations = 5000
@@ -136,7 +137,7 @@ contains
             pressure = fractions(k)/100*estar*slope/2
             load = pressure*BENCH_LENGTH**2
             do b = 1, size(boundaries)
-               options%boundary = boundaries(b)
+               options%boundary = boundary_from_name(boundaries(b))
                options%loads = [load]
                options%cg = cg_settings()
                options%cg%tol = tol

@@ -8,7 +8,7 @@ module femcod_bench_thesis
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem, THESIS_RIGID_FACTOR, verification_spec
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, solver_from_name
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type, int_str, real_str
    use femcod_help, only: help_requested, print_lines
@@ -180,7 +180,7 @@ contains
       type(contact_options), intent(inout) :: opts
       type(contact_result), intent(out) :: res
       type(status_type) :: status
-      opts%solver = solver
+      opts%solver = solver_from_name(solver)
       call solve_contact(problem, opts, res, status)
       if (status%code /= 0) write(error_unit, '(a)') "femcod bench: "//solver//": "//status%message
    end subroutine solve_with

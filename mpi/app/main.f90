@@ -45,7 +45,8 @@ program femcod_mpi
    use femcod_cg, only: cg_storage_bytes
    use femcod_gap_cg, only: gap_solver_storage_bytes
    use femcod_interface_law, only: make_interface_law
-   use femcod_solver_options, only: by_gap_variables
+   use femcod_solver_options, only: by_gap_variables, &
+      SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -150,7 +151,7 @@ program femcod_mpi
    call check_node_memory(np, size(targets()), status)
    if (status%code /= 0) call finish(status%code, status%message)
    call grid_setup(grid, MPI_COMM_WORLD, np, block, local, constants(2), constants(3), constants(4), &
-      settings%solve%cg, status, settings%solve%boundary == "periodic")
+      settings%solve%cg, status, settings%solve%boundary == BOUNDARY_PERIODIC)
    deallocate(local)
    call wall_clock(t_read)
    if (status%code == 0) call solve_loads(grid, problem, targets(), settings%solve%cg, states, status, observer, &
@@ -227,7 +228,7 @@ contains
       type(run_settings), intent(in) :: settings
       type(status_type), intent(inout) :: status
       associate(o => settings%solve)
-         if (o%solver /= "cg") then
+         if (o%solver /= SOLVER_CG) then
             call set_error(status, STATUS_USAGE, "--solver: the MPI ranks run the fixed-load solver only (cg); "// &
                "the event solvers run on one node: femcod run")
          else if (size(settings%decks) /= 1) then
@@ -236,7 +237,7 @@ contains
          else if (size(targets()) == 0) then
             call set_error(status, STATUS_USAGE, "give the loads or the approaches: --loads F1,F2,... or "// &
                "--approach D1,D2,...")
-         else if (o%boundary == "periodic" .and. o%cg%kernel_radius > 0) then
+         else if (o%boundary == BOUNDARY_PERIODIC .and. o%cg%kernel_radius > 0) then
             call set_error(status, STATUS_USAGE, "--kernel-radius with --boundary periodic: the ranks take the "// &
                "periodic kernel's spectrum in closed form, untruncated; it runs on one node: femcod run --solver cg")
          end if
@@ -271,11 +272,11 @@ contains
       if (by_gap_variables(settings%solve)) then
          ! The gap variables: their transform grid besides the fixed-load solver's grid.
          estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, settings%solve%boundary == &
-            "periodic", settings%solve%plastic) + gap_solver_storage_bytes(n, nstates, settings%solve%boundary == &
-            "periodic", settings%solve%plastic) + ranks - 1)/ranks
+            BOUNDARY_PERIODIC, settings%solve%plastic) + gap_solver_storage_bytes(n, nstates, &
+            settings%solve%boundary == BOUNDARY_PERIODIC, settings%solve%plastic) + ranks - 1)/ranks
       else
          estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, settings%solve%boundary == &
-            "periodic", settings%solve%plastic) + ranks - 1)/ranks
+            BOUNDARY_PERIODIC, settings%solve%plastic) + ranks - 1)/ranks
       end if
       call MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
       call MPI_Allreduce(estimated_rank_bytes, on_node, 1, MPI_INTEGER8, MPI_SUM, node)
@@ -395,7 +396,7 @@ contains
                int_str(st%convolutions)//', "residual": '//json_number(st%residual)//', "time_s": '// &
                json_number(st%seconds)//', "transform_s": '//json_number(st%transform_seconds)// &
                ', "communication_s": '//json_number(st%communication_seconds)
-            if (settings%solve%adhesion /= "none") text = text//', "attractive_pixels": '//int_str(st%attractive)// &
+            if (settings%solve%adhesion /= LAW_HARD_WALL) text = text//', "attractive_pixels": '//int_str(st%attractive)// &
                ', "attractive_load_nN": '//json_number(st%attractive_load)//', "mean_gap_nm": '// &
                json_number(st%mean_gap)//', "jump": '//int_str(st%jump)
             text = text//'}'
@@ -410,7 +411,7 @@ contains
       integer :: s
       write(output_unit, '(a)') "femcod-mpi: "//info%label
       write(output_unit, '(a)') "  grid "//int_str(np)//" x "//int_str(np)//", pixel "//format_real(grid%pixel)// &
-         " nm, "//trim(merge("periodic cell", "free surface ", settings%solve%boundary == "periodic"))//"; "// &
+         " nm, "//trim(merge("periodic cell", "free surface ", settings%solve%boundary == BOUNDARY_PERIODIC))//"; "// &
          int_str(ranks)//" MPI ranks x "//int_str(info%threads)//" threads"
       do s = 1, size(states)
          associate(st => states(s))

@@ -11,7 +11,8 @@ module test_distributed
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec, build_problem
    use femcod_analytic, only: hertz_approach
-   use femcod_solver_options, only: contact_options, cg_settings
+   use femcod_solver_options, only: contact_options, cg_settings, &
+      SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL
    use femcod_contact_result, only: contact_result
    use femcod_solver, only: solve_contact
    use femcod_observer, only: solver_observer
@@ -258,7 +259,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(contact_options) :: options
       options%loads = [3.0e3_dp, 2.0e4_dp]
-      options%boundary = "periodic"
+      options%boundary = BOUNDARY_PERIODIC
       options%plastic = .true.
       options%hardness = 10
       call against_serial(error, options)
@@ -270,7 +271,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(contact_options) :: options
       options%approaches = [0.02_dp, 0.06_dp]
-      options%boundary = "periodic"
+      options%boundary = BOUNDARY_PERIODIC
       call against_serial(error, options)
    end subroutine test_periodic_approach_against_serial
 
@@ -282,7 +283,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(contact_options) :: options
       options%approaches = [0.02_dp, 0.06_dp, 0.02_dp, -0.01_dp]
-      options%adhesion = "exponential"
+      options%adhesion = LAW_EXPONENTIAL
       options%work = 0.05_dp
       options%range = 2
       call against_serial(error, options)
@@ -294,8 +295,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(contact_options) :: options
       options%approaches = [0.03_dp, 0.08_dp, 0.03_dp]
-      options%boundary = "periodic"
-      options%adhesion = "dugdale"
+      options%boundary = BOUNDARY_PERIODIC
+      options%adhesion = LAW_DUGDALE
       options%work = 0.05_dp
       options%range = 2
       options%plastic = .true.
@@ -347,7 +348,7 @@ contains
       call check(error, status%code, 0)
       if (allocated(error)) return
       range = maxval(deck%upper) - minval(deck%upper)
-      options%solver = "cg"
+      options%solver = SOLVER_CG
       by_approach = .false.
       if (allocated(options%approaches)) by_approach = size(options%approaches) > 0
       if (by_approach) then
@@ -358,7 +359,7 @@ contains
       end if
       options%cg%tol = 1.0e-12_dp
       options%cg%max_iterations = 5000
-      by_gaps = by_approach .and. (options%plastic .or. options%adhesion /= "none")
+      by_gaps = by_approach .and. (options%plastic .or. options%adhesion /= LAW_HARD_WALL)
       group_size = 1
       do while (group_size <= min(ranks, 4))
          ! Groups of `group_size` ranks (the ranks beyond the last whole group sit this one out).
@@ -367,7 +368,7 @@ contains
          worst_code = 0
          if (group /= MPI_COMM_NULL) then
             call MPI_Comm_rank(group, group_rank)
-            call distribute_problem(deck, group, options%cg, grid, block, status, options%boundary == "periodic")
+            call distribute_problem(deck, group, options%cg, grid, block, status, options%boundary == BOUNDARY_PERIODIC)
             if (status%code == 0) call solve_loads(grid, deck, targets, options%cg, states, status, observer, &
                options%hardness, options%plastic, by_approach, make_interface_law(options%adhesion, options%work, &
                options%range, deck%pixel, options%plastic, options%hardness))

@@ -23,7 +23,9 @@ module femcod_run
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, height_file_path, is_height_file, looks_like_height_matrix
    use femcod_contact_result, only: contact_result, stop_reason_text
-   use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options
+   use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options, &
+      SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, solver_name, boundary_name, law_name, &
+      solver_from_name, boundary_from_name, law_from_name
    use femcod_observer, only: solver_observer
    use femcod_state_visitor, only: visitable
    use femcod_incremental_state, only: incremental_state
@@ -221,20 +223,20 @@ contains
       associate(o => settings%solve)
          o%checkpoint_interval = 300
          allocate(o%loads(0), o%approaches(0))
-         if (option_given(parsed, "--solver")) o%solver = option_value(parsed, "--solver")
+         if (option_given(parsed, "--solver")) o%solver = solver_from_name(option_value(parsed, "--solver"))
          call get_option(parsed, "--loads", o%loads)
          call get_option(parsed, "--approach", o%approaches)
          call get_option(parsed, "--max-contacts", o%max_contacts)
          call get_option(parsed, "--hardness", o%hardness)
          call get_option(parsed, "--plastic", o%plastic)
-         if (option_given(parsed, "--boundary")) o%boundary = option_value(parsed, "--boundary")
+         if (option_given(parsed, "--boundary")) o%boundary = boundary_from_name(option_value(parsed, "--boundary"))
          if (option_given(parsed, "--no-final-check")) o%final_check = .false.
          if (option_given(parsed, "--event-search")) o%event_search = option_value(parsed, "--event-search")
          call get_option(parsed, "--checkpoint-interval", o%checkpoint_interval)
          call get_option(parsed, "--tol", o%cg%tol)
          call get_option(parsed, "--max-iterations", o%cg%max_iterations)
          call get_option(parsed, "--kernel-radius", o%cg%kernel_radius)
-         if (option_given(parsed, "--adhesion")) o%adhesion = option_value(parsed, "--adhesion")
+         if (option_given(parsed, "--adhesion")) o%adhesion = law_from_name(option_value(parsed, "--adhesion"))
          call get_option(parsed, "--work", o%work)
          call get_option(parsed, "--range", o%range)
          o%cg%measure_plans = len(settings%wisdom) > 0
@@ -246,8 +248,8 @@ contains
       settings%from_files = len(lower) > 0 .or. len(upper) > 0
       ! The options that apply: height-file scene options with --lower/--upper only,
       ! each solver's own with that solver.
-      modes = trim(settings%solve%solver)
-      if (settings%solve%solver /= "cg") modes = modes//"|event"
+      modes = solver_name(settings%solve%solver)
+      if (settings%solve%solver /= SOLVER_CG) modes = modes//"|event"
       if (settings%from_files) modes = modes//"|heights"
       call refuse_options(parsed, modes, "heights=to height files (--lower/--upper), not to decks|"// &
          "event=to the event solvers (incremental, legacy), not to --solver cg|"// &
@@ -303,17 +305,17 @@ contains
       ! Which options go together: one rule set for run, femcod-mpi and the benchmarks.
       call validate_options(settings%solve, status)
       if (status%code /= 0) return
-      if (settings%solve%solver == "cg" .and. option_given(parsed, "--maxcont")) then
+      if (settings%solve%solver == SOLVER_CG .and. option_given(parsed, "--maxcont")) then
          call set_error(status, STATUS_USAGE, "--maxcont with --solver cg: cg solves at the loads or approaches "// &
             "asked and has no contact limit (MAXCONT bounds the event solvers)")
          return
       end if
       if (size(settings%decks) == 0) then
          call set_error(status, STATUS_USAGE, "run needs a DECK")
-      else if (settings%solve%adhesion /= "none" .and. .not. (option_given(parsed, "--work") .and. &
+      else if (settings%solve%adhesion /= LAW_HARD_WALL .and. .not. (option_given(parsed, "--work") .and. &
          option_given(parsed, "--range"))) then
          call set_error(status, STATUS_USAGE, "--adhesion needs --work W (J/m^2) and --range R (nm)")
-      else if (settings%solve%adhesion == "none" .and. (option_given(parsed, "--work") .or. &
+      else if (settings%solve%adhesion == LAW_HARD_WALL .and. (option_given(parsed, "--work") .or. &
          option_given(parsed, "--range"))) then
          call set_error(status, STATUS_USAGE, "--work and --range describe an adhesion law: add --adhesion "// &
             "dugdale|exponential")
@@ -627,9 +629,9 @@ contains
       self%target_contacts = problem%maxcont
       if (options%max_contacts > 0) self%target_contacts = min(options%max_contacts, problem%np**2)
       if (size(options%loads) > 0) self%target_load = maxval(options%loads)
-      self%growth = merge(4.0_dp, 3.0_dp, options%solver == "legacy")
+      self%growth = merge(4.0_dp, 3.0_dp, options%solver == SOLVER_LEGACY)
       self%step_word = "event"
-      if (options%solver == "cg") then
+      if (options%solver == SOLVER_CG) then
          self%step_word = trim(merge("approach", "load    ", size(options%approaches) > 0))
          self%states = requested_states(options)
       end if
@@ -711,7 +713,7 @@ contains
             ! --force: the old checkpoint is not this run's.
             call remove_file(prefix//".ckpt.h5")
          end if
-         if (options%solver == "cg" .and. len(settings%wisdom) > 0) call load_wisdom(settings%wisdom, ok)
+         if (options%solver == SOLVER_CG .and. len(settings%wisdom) > 0) call load_wisdom(settings%wisdom, ok)
          started = local_time_iso()
          ! The solvers check their storage against what this run may still take; the
          ! summary's estimate is what the run holds now plus that storage.
@@ -732,13 +734,13 @@ contains
             end if
             return
          end if
-         if (st%code == 0 .and. options%solver == "cg" .and. len(settings%wisdom) > 0) &
+         if (st%code == 0 .and. options%solver == SOLVER_CG .and. len(settings%wisdom) > 0) &
             call save_wisdom(settings%wisdom, st)
          if (st%code /= 0) return
          info%version = FEMCOD_VERSION
-         info%solver = trim(options%solver)
-         info%boundary = trim(options%boundary)
-         info%adhesion = trim(options%adhesion)
+         info%solver = solver_name(options%solver)
+         info%boundary = boundary_name(options%boundary)
+         info%adhesion = law_name(options%adhesion)
          info%work = options%work
          info%range = options%range
          info%options = settings%command_line
@@ -753,7 +755,7 @@ contains
          info%read_seconds = read_seconds
          info%digest_seconds = digest_seconds
          call wall_clock(t0)
-         call load_maps(problem, res%states, maps, options%boundary == "periodic")
+         call load_maps(problem, res%states, maps, options%boundary == BOUNDARY_PERIODIC)
          call wall_clock(t1)
          info%maps_seconds = t1 - t0
          call write_results(prefix, problem, res, maps, info, st)
@@ -888,16 +890,16 @@ contains
       integer :: k, last
       last = res%nsteps
       if (deck_path /= "") then
-         write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//trim(options%solver)//")"
+         write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//solver_name(options%solver)//")"
       else
          ! Height files: the scene's label names them (femcod run --lower FILE ...).
-         write(output_unit, '(a)') problem%label//" (solver "//trim(options%solver)//")"
+         write(output_unit, '(a)') problem%label//" (solver "//solver_name(options%solver)//")"
       end if
       write(output_unit, '(a)') "  scene     : "//problem%label
       write(output_unit, '(a)') "              NP = "//int_str(problem%np)//", d = "//format_real(problem%pixel)// &
          " nm, E = "//sig_str(problem%young(1), 4)//" / "//sig_str(problem%young(2), 4)//" / "// &
          sig_str(problem%young(3), 4)//" GPa (lower / upper / contact)"
-      if (options%solver == "cg") then
+      if (options%solver == SOLVER_CG) then
          write(output_unit, '(a)') "  loads     : "//int_str(count(res%states%reached))//" of "// &
             int_str(size(res%states))//" solved"
       else
@@ -918,7 +920,7 @@ contains
          if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
             " of them plastic (at the hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "// &
             sig_str(res%states(k)%plastic_volume, 4)//" nm^3"
-         if (options%adhesion /= "none") then
+         if (options%adhesion /= LAW_HARD_WALL) then
             write(output_unit, '(a)') "              "//int_str(res%states(k)%attractive)//" pixels off contact within the "// &
                "range ("//sig_str(res%states(k)%attractive*problem%pixel**2, 4)//" nm^2), load off contact "// &
                sig_str(res%states(k)%attractive_load, 4)//" nN, mean gap "//sig_str(res%states(k)%mean_gap, 4)//" nm"
@@ -929,10 +931,10 @@ contains
                " -> "//sig_str(res%states(k)%load, 4)//" nN)"
          end if
       end do
-      if (options%adhesion /= "none") write(output_unit, '(a)') "  adhesion  : least load "// &
+      if (options%adhesion /= LAW_HARD_WALL) write(output_unit, '(a)') "  adhesion  : least load "// &
          sig_str(minval(res%states%load, mask=res%states%reached), 6)//" nN over the approaches (the pull-off force "// &
          "where they pass it)"
-      if (options%solver == "cg") then
+      if (options%solver == SOLVER_CG) then
          write(output_unit, '(a)') "  wall time : "//sig_str(res%wall_seconds, 3)//" s"
       else
          write(output_unit, '(a)') "  wall time : "//sig_str(res%wall_seconds, 3)//" s in total, "// &

@@ -67,14 +67,15 @@ contains
       end select
    end function law_name
 
-   !> The law named `name` with work W (J/m^2) and range R (nm) on pixels of `pixel` nm,
-   !> capped at the hardness H (GPa) when `plastic`.
-   pure function make_interface_law(name, work, range, pixel, plastic, hardness) result(law)
-      character(len=*), intent(in) :: name
+   !> The law `code` (LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL) with work W (J/m^2)
+   !> and range R (nm) on pixels of `pixel` nm, capped at the hardness H (GPa) when
+   !> `plastic`.
+   pure function make_interface_law(code, work, range, pixel, plastic, hardness) result(law)
+      integer, intent(in) :: code
       real(dp), intent(in) :: work, range, pixel, hardness
       logical, intent(in) :: plastic
       type(interface_law) :: law
-      law%law = max(law_from_name(name), LAW_HARD_WALL)
+      law%law = code
       law%work = work
       law%range = range
       law%area = pixel**2

@@ -7,18 +7,27 @@ module femcod_solver_options
    use femcod_memory, only: memory_text
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL
    use femcod_strings, only: format_real, int_str, sig_str
+   use femcod_interface_law, only: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
    implicit none
    private
    public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, LAW_NAMES, requested_states
+   public :: SOLVER_INCREMENTAL, SOLVER_LEGACY, SOLVER_CG, BOUNDARY_FREE, BOUNDARY_PERIODIC, solver_name, &
+      solver_from_name, boundary_name, boundary_from_name
+   public :: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
    public :: validate_options, by_gap_variables, history_options, first_difference, tolerance_floor
    public :: refuse_beyond_memory
 
-   !> The solvers by name: the event-exact incremental solver, the Appendix B program,
-   !> and the fixed-load constrained conjugate gradients.
+   !> The solvers: the event-exact incremental solver, the Appendix B program, and the
+   !> fixed-load constrained conjugate gradients. An enumeration, with the names the
+   !> command line gives them (SOLVER_NAMES(code)), read once at the edge
+   !> (solver_from_name).
+   integer, parameter :: SOLVER_INCREMENTAL = 1, SOLVER_LEGACY = 2, SOLVER_CG = 3
    character(len=*), parameter :: SOLVER_NAMES(3) = [character(len=11) :: "incremental", "legacy", "cg"]
 
    !> The lateral boundary: the thesis' half-space with the grid alone on it (free), or
-   !> the grid as one cell of a surface that repeats in both directions (periodic).
+   !> the grid as one cell of a surface that repeats in both directions (periodic). An
+   !> enumeration, as the solvers.
+   integer, parameter :: BOUNDARY_FREE = 1, BOUNDARY_PERIODIC = 2
    character(len=*), parameter :: BOUNDARY_NAMES(2) = [character(len=8) :: "free", "periodic"]
 
    !> The interface laws: the hard wall (no adhesion), Dugdale's and the exponential
@@ -90,10 +99,10 @@ module femcod_solver_options
 
    !> The options of a run. Units: nN, GPa, s.
    type :: contact_options
-      !> One of SOLVER_NAMES.
-      character(len=11) :: solver = "incremental"
-      !> One of BOUNDARY_NAMES: "free" (default) or "periodic" (femcod_love_periodic).
-      character(len=8) :: boundary = "free"
+      !> SOLVER_INCREMENTAL (default), SOLVER_LEGACY or SOLVER_CG.
+      integer :: solver = SOLVER_INCREMENTAL
+      !> BOUNDARY_FREE (default) or BOUNDARY_PERIODIC (femcod_love_periodic).
+      integer :: boundary = BOUNDARY_FREE
       !> Stop after this many contacts, in place of the deck's MAXCONT (0: MAXCONT; the event
       !> solvers only).
       integer :: max_contacts = 0
@@ -108,10 +117,10 @@ module femcod_solver_options
       !> `hardness`; a capped pixel keeps the force H d^2 and interpenetrates (its
       !> plastic displacement). The cg solver only.
       logical :: plastic = .false.
-      !> Adhesion (model/femcod_interface_law): "none", "dugdale" or "exponential", with the work of
-      !> adhesion (nN/nm = J/m^2) and the range (nm) of the law. With --approach and the
-      !> cg solver only.
-      character(len=11) :: adhesion = "none"
+      !> The interface law (model/femcod_interface_law): LAW_HARD_WALL (no adhesion,
+      !> default), LAW_DUGDALE or LAW_EXPONENTIAL, with the work of adhesion (nN/nm =
+      !> J/m^2) and the range (nm) of the law. With --approach and the cg solver only.
+      integer :: adhesion = LAW_HARD_WALL
       real(dp) :: work = 0, range = 0
       !> Candidates whose closing load is within this fraction of the total load of the
       !> smallest one join in the same step (ties).
@@ -134,6 +143,48 @@ module femcod_solver_options
 
 contains
 
+   !> The solver's name (SOLVER_NAMES), "?" for no solver.
+   pure function solver_name(solver) result(name)
+      integer, intent(in) :: solver
+      character(len=:), allocatable :: name
+      if (solver >= 1 .and. solver <= size(SOLVER_NAMES)) then
+         name = trim(SOLVER_NAMES(solver))
+      else
+         name = "?"
+      end if
+   end function solver_name
+
+   !> The solver named `name`; 0 for any other name.
+   pure integer function solver_from_name(name) result(solver)
+      character(len=*), intent(in) :: name
+      integer :: k
+      solver = 0
+      do k = 1, size(SOLVER_NAMES)
+         if (trim(name) == trim(SOLVER_NAMES(k))) solver = k
+      end do
+   end function solver_from_name
+
+   !> The boundary's name (BOUNDARY_NAMES), "?" for none.
+   pure function boundary_name(boundary) result(name)
+      integer, intent(in) :: boundary
+      character(len=:), allocatable :: name
+      if (boundary >= 1 .and. boundary <= size(BOUNDARY_NAMES)) then
+         name = trim(BOUNDARY_NAMES(boundary))
+      else
+         name = "?"
+      end if
+   end function boundary_name
+
+   !> The boundary named `name`; 0 for any other name.
+   pure integer function boundary_from_name(name) result(boundary)
+      character(len=*), intent(in) :: name
+      integer :: k
+      boundary = 0
+      do k = 1, size(BOUNDARY_NAMES)
+         if (trim(name) == trim(BOUNDARY_NAMES(k))) boundary = k
+      end do
+   end function boundary_from_name
+
    !> The number of requested states: one per load of --loads or approach of --approach.
    pure integer function requested_states(options)
       type(contact_options), intent(in) :: options
@@ -150,14 +201,14 @@ contains
    pure logical function by_gap_variables(options)
       type(contact_options), intent(in) :: options
       by_gap_variables = .false.
-      if (options%solver /= "cg" .or. .not. allocated(options%approaches)) return
-      by_gap_variables = size(options%approaches) > 0 .and. (options%adhesion /= "none" .or. options%plastic)
+      if (options%solver /= SOLVER_CG .or. .not. allocated(options%approaches)) return
+      by_gap_variables = size(options%approaches) > 0 .and. (options%adhesion /= LAW_HARD_WALL .or. options%plastic)
    end function by_gap_variables
 
    !> The one place where the combinations of options are checked: `femcod run` (and
    !> femcod-mpi, which shares its parser) after parsing, before any file is read or any
-   !> lock taken, and solve_contact for every library caller, the benchmarks included. A refused combination names both options (STATUS_USAGE,
-   !> exit 2). Checks that need the deck (a load above the fully plastic capacity) are
+   !> lock taken, and solve_contact for every library caller, the benchmarks included. A
+   !> refused combination names both options (STATUS_USAGE, exit 2). Checks that need the deck (a load above the fully plastic capacity) are
    !> the solvers' own.
    subroutine validate_options(options, status)
       type(contact_options), intent(in) :: options
@@ -168,41 +219,41 @@ contains
       napproaches = 0
       if (allocated(options%loads)) nloads = size(options%loads)
       if (allocated(options%approaches)) napproaches = size(options%approaches)
-      if (.not. any(SOLVER_NAMES == options%solver)) then
-         call refuse("unknown solver '"//trim(options%solver)//"' (available: incremental, legacy, cg)")
-      else if (.not. any(BOUNDARY_NAMES == options%boundary)) then
-         call refuse("unknown boundary '"//trim(options%boundary)//"' (free or periodic)")
-      else if (.not. any(LAW_NAMES == options%adhesion)) then
-         call refuse("unknown adhesion law '"//trim(options%adhesion)//"' (dugdale or exponential)")
+      if (solver_name(options%solver) == "?") then
+         call refuse("unknown solver "//int_str(options%solver)//" (available: incremental, legacy, cg)")
+      else if (boundary_name(options%boundary) == "?") then
+         call refuse("unknown boundary "//int_str(options%boundary)//" (free or periodic)")
+      else if (.not. any([LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL] == options%adhesion)) then
+         call refuse("unknown adhesion law "//int_str(options%adhesion)//" (dugdale or exponential)")
       else if (nloads > 0 .and. napproaches > 0) then
          call refuse("give --loads (load control) or --approach (displacement control), not both")
-      else if (options%solver == "cg" .and. nloads + napproaches == 0) then
+      else if (options%solver == SOLVER_CG .and. nloads + napproaches == 0) then
          call refuse("--solver cg solves at given loads or approaches: add --loads F1,F2,... or --approach D1,D2,...")
-      else if (options%plastic .and. options%solver == "legacy") then
+      else if (options%plastic .and. options%solver == SOLVER_LEGACY) then
          call refuse("--plastic with --solver legacy: the legacy solver is the Appendix B program of the elastic "// &
             "interface; use --solver incremental or cg")
-      else if (options%boundary == "periodic" .and. options%solver == "legacy") then
+      else if (options%boundary == BOUNDARY_PERIODIC .and. options%solver == SOLVER_LEGACY) then
          call refuse("--boundary periodic with --solver legacy: the legacy solver is the Appendix B program of the "// &
             "free half-space; use --solver incremental or cg")
-      else if (options%adhesion /= "none" .and. options%solver /= "cg") then
-         call refuse("--adhesion with --solver "//trim(options%solver)//": the event solvers follow a path of "// &
+      else if (options%adhesion /= LAW_HARD_WALL .and. options%solver /= SOLVER_CG) then
+         call refuse("--adhesion with --solver "//solver_name(options%solver)//": the event solvers follow a path of "// &
             "contact events without tension; use --solver cg")
-      else if (options%adhesion /= "none" .and. napproaches == 0) then
+      else if (options%adhesion /= LAW_HARD_WALL .and. napproaches == 0) then
          call refuse("--adhesion needs --approach D1,D2,... (displacement control: under load control the pull-off "// &
             "is an instability)")
-      else if (options%adhesion /= "none" .and. .not. (options%work >= 0 .and. options%range > 0)) then
+      else if (options%adhesion /= LAW_HARD_WALL .and. .not. (options%work >= 0 .and. options%range > 0)) then
          call refuse("--adhesion needs --work W >= 0 (J/m^2) and --range R > 0 (nm)")
-      else if (options%solver == "cg" .and. options%cg%tol < tolerance_floor()) then
+      else if (options%solver == SOLVER_CG .and. options%cg%tol < tolerance_floor()) then
          call refuse("--tol "//sig_str(options%cg%tol, 3)//" is below what double precision resolves: the "// &
             "gaps are sums of terms as large as the height range, each rounded to 1.1e-16 of it, so a relative "// &
             "violation below 10 machine epsilons ("//sig_str(tolerance_floor(), 2)//") cannot be shown; give "// &
             "--tol "//sig_str(tolerance_floor(), 2)//" or more")
       else if (by_gap_variables(options) .and. options%cg%kernel_radius > 0) then
-         call refuse(trim(merge("--adhesion", "--plastic ", options%adhesion /= "none"))//" --approach with "// &
+         call refuse(trim(merge("--adhesion", "--plastic ", options%adhesion /= LAW_HARD_WALL))//" --approach with "// &
             "--kernel-radius: displacement control in the gap variables uses the whole Love kernel")
-      else if (options%plastic .and. options%solver /= "cg" .and. napproaches > 1) then
+      else if (options%plastic .and. options%solver /= SOLVER_CG .and. napproaches > 1) then
          if (any(options%approaches(2:) < options%approaches(:napproaches - 1))) call refuse("--approach with "// &
-            "--plastic and --solver "//trim(options%solver)//": the event path only loads; give the approaches in "// &
+            "--plastic and --solver "//solver_name(options%solver)//": the event path only loads; give the approaches in "// &
             "increasing order, or unload with --solver cg")
       end if
    contains
@@ -218,10 +269,10 @@ contains
    function history_options(options) result(text)
       type(contact_options), intent(in) :: options
       character(len=:), allocatable :: text
-      text = "solver="//trim(options%solver)//"; boundary="//trim(options%boundary)// &
+      text = "solver="//solver_name(options%solver)//"; boundary="//boundary_name(options%boundary)// &
          "; loads="//reals(options%loads)//"; approaches="//reals(options%approaches)// &
          "; max_contacts="//int_str(options%max_contacts)//"; plastic="//merge("T", "F", options%plastic)// &
-         "; hardness="//format_real(options%hardness)//"; adhesion="//trim(options%adhesion)// &
+         "; hardness="//format_real(options%hardness)//"; adhesion="//law_name(options%adhesion)// &
          "; work="//format_real(options%work)//"; range="//format_real(options%range)// &
          "; tie_tolerance="//format_real(options%tie_tolerance)//"; final_check="// &
          merge("T", "F", options%final_check)//"; event_search="//trim(options%event_search)// &

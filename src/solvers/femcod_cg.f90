@@ -80,7 +80,8 @@ module femcod_cg
    use femcod_interface_law, only: interface_law, make_interface_law
    use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts
    use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings, by_gap_variables, &
-      requested_states
+      requested_states, &
+      BOUNDARY_PERIODIC
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
@@ -284,16 +285,16 @@ contains
       integer :: m
       m = requested_states(options)
       if (by_gaps) then
-         estimated = gap_solver_storage_bytes(problem%np, m, options%boundary == "periodic", options%plastic)
+         estimated = gap_solver_storage_bytes(problem%np, m, options%boundary == BOUNDARY_PERIODIC, options%plastic)
          call refuse_beyond_memory("cg --approach (gap variables): NP = "//int_str(problem%np), estimated, &
             options%memory_available, status)
       else
-         estimated = cg_storage_bytes(problem%np, m, options%boundary == "periodic", options%plastic)
+         estimated = cg_storage_bytes(problem%np, m, options%boundary == BOUNDARY_PERIODIC, options%plastic)
          call refuse_beyond_memory("cg: NP = "//int_str(problem%np), estimated, options%memory_available, status)
       end if
       if (status%code /= 0) return
       call grid_operator_setup(fine, initial_gap_map(problem%lower, problem%upper), problem, problem%pixel, &
-         options%cg, options%boundary == "periodic", gap_variables=by_gaps)
+         options%cg, options%boundary == BOUNDARY_PERIODIC, gap_variables=by_gaps)
    end subroutine make_fine_grid
 
    !> One target's state from its answer and the session's forces (nN), on the whole grid
@@ -322,7 +323,7 @@ contains
          st%contact_gap = answer%rep%contact_gap
          st%load_error = answer%rep%load_error
          if (.not. (by_approach .or. options%plastic .or. &
-            options%boundary == "periodic" .or. options%cg%kernel_radius > 0)) st%approach_bound = &
+            options%boundary == BOUNDARY_PERIODIC .or. options%cg%kernel_radius > 0)) st%approach_bound = &
             approach_error_bound(st%penetration, st%contact_gap, st%load_error, st%approach)
          st%coarse_iterations = answer%rep%coarse_iterations
          st%convolutions = answer%rep%convolutions

@@ -32,7 +32,8 @@ module femcod_incremental_state
    use femcod_sort, only: merge_sort_index
    use femcod_memory, only: memory_text
    use femcod_state_visitor, only: state_visitor, visitable
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, &
+      BOUNDARY_PERIODIC
    use femcod_contact_result, only: contact_result, visit_result
    use femcod_event_path, only: load_path
    implicit none
@@ -140,7 +141,7 @@ contains
       self%npix = self%np*self%np
       self%maxc = self%path%max_contacts
       allocate(self%table(0:self%np - 1, 0:self%np - 1))
-      self%periodic = options%boundary == "periodic"
+      self%periodic = options%boundary == BOUNDARY_PERIODIC
       self%memory_available = options%memory_available
       if (self%periodic) then
          self%table(:, :) = periodic_offset_table(self%np)

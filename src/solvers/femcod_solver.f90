@@ -11,7 +11,8 @@ module femcod_solver
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, validate_options, by_gap_variables
+   use femcod_solver_options, only: contact_options, validate_options, by_gap_variables, &
+      SOLVER_INCREMENTAL, SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, law_name
    use femcod_observer, only: solver_observer
    use femcod_legacy, only: solve_legacy
    use femcod_incremental, only: solve_incremental
@@ -44,7 +45,7 @@ contains
       if (status%code /= 0) return
       ! The fixed-load solver cannot carry more than every pixel at H d^2; the event path
       ! stops where no pixel is left to touch, and says which loads it did not reach.
-      if (options%plastic .and. options%solver == "cg" .and. allocated(options%loads)) then
+      if (options%plastic .and. options%solver == SOLVER_CG .and. allocated(options%loads)) then
          if (size(options%loads) > 0) then
             if (maxval(options%loads) >= real(problem%np, dp)**2*options%hardness*problem%pixel**2) then
                call set_error(status, STATUS_USAGE, "--plastic: load "//format_real(maxval(options%loads))// &
@@ -54,32 +55,32 @@ contains
             end if
          end if
       end if
-      if (present(resume) .and. options%solver /= "incremental") then
+      if (present(resume) .and. options%solver /= SOLVER_INCREMENTAL) then
          call set_error(status, STATUS_USAGE, "only the incremental solver continues from a stored state")
          return
       end if
       select case (options%solver)
-      case ("incremental")
+      case (SOLVER_INCREMENTAL)
          if (present(observer)) then
             call solve_incremental(problem, options, res, status, observer, resume)
          else
             call solve_incremental(problem, options, res, status, nobody, resume)
          end if
-      case ("legacy")
+      case (SOLVER_LEGACY)
          if (present(observer)) then
             call solve_legacy(problem, options, res, status, observer)
          else
             call solve_legacy(problem, options, res, status, nobody)
          end if
-      case ("cg")
+      case (SOLVER_CG)
          if (present(observer)) then
             call solve_cg(problem, options, res, status, observer)
          else
             call solve_cg(problem, options, res, status, nobody)
          end if
       case default
-         call set_error(status, STATUS_USAGE, "unknown solver '"//trim(options%solver)// &
-            "' (available: incremental, legacy, cg)")
+         call set_error(status, STATUS_USAGE, "unknown solver "//int_str(options%solver)// &
+            " (available: incremental, legacy, cg)")
       end select
    end subroutine solve_contact
 
@@ -92,33 +93,33 @@ contains
       real(dp) :: c1, c2, s, cself, ratio
       character(len=:), allocatable :: verdict
       select case (options%solver)
-      case ("legacy")
+      case (SOLVER_LEGACY)
          lines = [string_type("nothing: the legacy solver models every node and spring of Appendix B")]
          return
-      case ("cg")
+      case (SOLVER_CG)
          lines = [string_type("handles and springs condensed: one composite compliance c1 + c2 with the springs' "// &
             "3/k on the diagonal, one composite gap")]
-         if (options%adhesion /= "none") then
+         if (options%adhesion /= LAW_HARD_WALL) then
             ratio = pixel_stiffness_ratio(problem, options%work, options%range)
             if (ratio < 1) then
                verdict = " (below 1: the discrete problem is convex at the pixel scale)"
             else
                verdict = " (above 1: single pixels may snap; a finer pixel resolves the range)"
             end if
-            lines = [lines, string_type(trim(options%adhesion)//" adhesion: W = "//sig_str(options%work, 4)// &
+            lines = [lines, string_type(law_name(options%adhesion)//" adhesion: W = "//sig_str(options%work, 4)// &
                " J/m^2, range "//sig_str(options%range, 4)//" nm; displacement control, each approach from the last "// &
                "(gap-variable constrained CG, Rey, Anciaux and Molinari 2017)"), &
                string_type("adhesion_convexity: one pixel's adhesive stiffness d^2 W/R^2 over its elastic "// &
                "stiffness = "//sig_str(ratio, 3)//verdict)]
          end if
-         if (options%plastic .and. options%adhesion == "none" .and. by_gap_variables(options)) lines = [lines, &
+         if (options%plastic .and. options%adhesion == LAW_HARD_WALL .and. by_gap_variables(options)) lines = [lines, &
             string_type("plastic cap H = "//sig_str(options%hardness, 4)//" GPa under displacement control: each "// &
             "approach from the last in the gap variables (constrained CG, Rey, Anciaux and Molinari 2017), a "// &
             "capped pixel's interpenetration kept as plastic displacement (give intermediate approaches to follow "// &
             "a path finer than the one asked)")]
          if (.not. options%plastic) lines = [lines, string_type("no plastic cap: pressures are elastic, "// &
             "n_above_hardness counts the pixels above the hardness (--plastic caps them)")]
-         if (options%boundary == "periodic") lines = [lines, periodic_note(problem%np, "cg")]
+         if (options%boundary == BOUNDARY_PERIODIC) lines = [lines, periodic_note(problem%np, SOLVER_CG)]
          if (options%cg%kernel_radius > 0) lines = [lines, string_type("Love kernel truncated beyond "// &
             sig_str(options%cg%kernel_radius, 4)//" pixels (--kernel-radius): an approximation, the convolution "// &
             "still by FFT; its error on the benchmark surface: doc/performance.md, the frontier")]
@@ -143,7 +144,7 @@ contains
       end if
       lines = [lines, string_type("interface and penalty springs: an exact diagonal compliance 3/k = "//es(s/cself)// &
          " of a pixel's self-compliance")]
-      if (options%boundary == "periodic") lines = [lines, periodic_note(problem%np, "incremental")]
+      if (options%boundary == BOUNDARY_PERIODIC) lines = [lines, periodic_note(problem%np, SOLVER_INCREMENTAL)]
       if (options%plastic) then
          lines = [lines, string_type("plastic cap H = "//sig_str(options%hardness, 4)//" GPa: a contact reaching "// &
             "H d^2 is an event; it leaves the elastic set (the factor shrinks) and its fixed force joins the gaps")]
@@ -156,12 +157,11 @@ contains
    contains
       !> What the periodic boundary changes, for `solver`.
       function periodic_note(np, solver) result(line)
-         integer, intent(in) :: np
-         character(len=*), intent(in) :: solver
+         integer, intent(in) :: np, solver
          type(string_type) :: line
          line%s = "periodic cell of "//int_str(np)//" x "//int_str(np)//" pixels: the Love kernel summed over "// &
             "all images (zero-mean displacements; approach = fall of the mean gap)"
-         if (solver == "cg") then
+         if (solver == SOLVER_CG) then
             line%s = line%s//"; cyclic transforms of "//int_str(np)//"^2, no padding (the free boundary's are "// &
                int_str(2*np)//"^2)"
          else
@@ -189,7 +189,7 @@ contains
       integer :: k
       allocate(lines(0))
       select case (options%solver)
-      case ("cg")
+      case (SOLVER_CG)
          model = model_notes(problem, options)
          do k = 1, size(model)
             call add("model", model(k)%s)
@@ -213,7 +213,7 @@ contains
                ", penetration "//sig_str(res%states(k)%penetration, 2)//" nm, |gap| on contact "// &
                sig_str(res%states(k)%contact_gap, 2)//" nm, load error "//sig_str(res%states(k)%load_error, 2)//rounds)
          end do
-      case ("incremental")
+      case (SOLVER_INCREMENTAL)
          model = model_notes(problem, options)
          do k = 1, size(model)
             call add("model", model(k)%s)

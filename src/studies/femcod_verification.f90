@@ -8,7 +8,8 @@ module femcod_verification
    use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, format_real, text_builder, add_lines, built_text
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, &
+      SOLVER_LEGACY
    use femcod_solver, only: solve_contact
    use femcod_thesis, only: TABLE_4_1_DECKS, TABLE_4_1_PIXELS, TABLE_4_1_MESH, TABLE_4_1_APPROACH, &
       TABLE_4_1_CENTRE_PRESSURE, TABLE_4_1_RATE, TABLE_4_1_ANALYTIC_APPROACH, TABLE_4_2_DECKS, TABLE_4_2_APPROACH, &
@@ -198,7 +199,7 @@ contains
       call build_problem(spec, deck, status)
       if (status%code /= 0) return
       options%loads = loads
-      options%solver = "legacy"
+      options%solver = SOLVER_LEGACY
       call solve_contact(deck, options, res, status)
       if (status%code /= 0) return
       first = res%states(1)%approach
