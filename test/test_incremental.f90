@@ -18,7 +18,7 @@ module test_incremental
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
    implicit none
    private
-   public :: collect_incremental
+   public :: collect_incremental, events
 
 contains
 

@@ -22,6 +22,8 @@ module test_periodic
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_read_string_attribute
    use femcod_status, only: STATUS_BAD_INPUT, STATUS_USAGE
    use test_support, only: scratch_path, read_text, file_exists, remove_scratch
+   use test_incremental, only: events
+   use oracles, only: event_path
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -374,10 +376,14 @@ contains
    end subroutine test_small_sphere
 
    !> The event-exact path and the cg solver on the same periodic rough cell (a random sum
-   !> of 12 waves that fit the cell, 32 x 32): at the midpoints of five steps of the event
-   !> history the cg solution has the same contacts and approach to 1e-8 (two
-   !> independent algorithms for the same complementarity problem; measured 1e-11), and
-   !> the event path's final full-field check finds no penetration.
+   !> of 12 waves that fit the cell, 32 x 32), against an outside reference: the brute-
+   !> force event path of test/oracles (dense LU solves of each contact set and
+   !> direct-sum gaps, no part of femcod's solvers) with the periodic table, whose
+   !> differences test_image_sum checks against real-space sums over 401^2 images. The
+   !> event path has the oracle's events (contacts, loads within 1e-9, the bound the free
+   !> surface's test_oracle_events holds); at the midpoints of five of its steps the cg
+   !> solution has the same contacts and approach to 1e-8 (measured 1e-11), and the event
+   !> path's final full-field check finds no penetration.
    subroutine test_event_path(error)
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: np = 32, waves = 12
@@ -386,9 +392,11 @@ contains
       type(contact_result) :: inc, cg
       type(status_type) :: status
       type(random_stream) :: rng
-      real(dp), allocatable :: z(:, :), loads(:)
-      real(dp) :: amp, phase, u
-      integer :: i, j, w, k1, k2, k, n, m
+      real(dp), allocatable :: z(:, :), loads(:), li(:), oracle_loads(:), table(:, :)
+      integer, allocatable :: ci(:), oracle_counts(:)
+      real(dp) :: amp, phase, u, worst
+      integer :: i, j, w, k1, k2, k, n, m, mi, mo
+      logical :: released
       call seed_stream(rng, 7)
       allocate(z(np, np))
       z = 0
@@ -412,6 +420,24 @@ contains
       options%solver = SOLVER_INCREMENTAL
       call solve_contact(problem, options, inc, status)
       call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      allocate(li(inc%nsteps), ci(inc%nsteps), oracle_loads(problem%maxcont + 1), oracle_counts(problem%maxcont + 1))
+      call events(inc, li, ci, mi)
+      allocate(table(0:np - 1, 0:np - 1))
+      table(:, :) = periodic_offset_table(np)
+      call event_path(problem, table, 1.0e-9_dp, problem%maxcont + 1, huge(1.0_dp), oracle_loads, oracle_counts, &
+         mo, released)
+      ! The events before the oracle's path would need a release (it follows none).
+      call check(error, mo >= 20 .and. mi >= mo, to_string(mi)//" events of the solver, "//to_string(mo)// &
+         " of the oracle")
+      if (allocated(error)) return
+      worst = 0
+      do k = 1, mo
+         call check(error, ci(k), oracle_counts(k), "contacts at event "//to_string(k)//" (oracle)")
+         if (allocated(error)) return
+         worst = max(worst, abs(li(k) - oracle_loads(k))/oracle_loads(k))
+      end do
+      call check(error, worst < 1.0e-9_dp, "event loads within 1e-9 of the oracle's, worst "//to_string(worst))
       if (allocated(error)) return
       n = inc%nsteps
       m = min(5, n - 1)
