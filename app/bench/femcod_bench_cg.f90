@@ -17,7 +17,7 @@ module femcod_bench_cg
       choice_option, real_list_option, integer_list_option, get_option, option_given
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_bench_common, only: bench_arguments, benchmark_surface, linear_law, require_peers, write_peer_gaps, &
-      remove_file_quietly, peer_line, peer_row, reset_peak, peak_mb, BENCH_LENGTH
+      remove_file_quietly, peer_line, peer_row, reset_peak, peak_mb, BENCH_LENGTH, options_refused
    implicit none
    private
    public :: bench_cg
@@ -98,6 +98,10 @@ contains
          end if
       end associate
       options%solver = SOLVER_CG
+      if (options_refused(options, "femcod bench cg")) then
+         code = 2
+         return
+      end if
       write(output_unit, '(a)') "| NP | target % | solver | wall (s) | iterations | residual | contact % "// &
          "| peak RSS (MB) | status |"
       write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|"

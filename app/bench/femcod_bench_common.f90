@@ -13,9 +13,11 @@ module femcod_bench_common
    use femcod_analytic, only: segedin_sphere
    use femcod_scene, only: initial_gaps
    use femcod_files, only: path_exists, canonical_path
+   use femcod_solver_options, only: contact_options, validate_options, requested_states
    implicit none
    private
    public :: bench_arguments, bad_arguments, benchmark_surface, linear_law, self_path, peers_script, require_peers, &
+      options_refused, &
       json_value, read_text_file, write_peer_gaps, remove_file_quietly, peer_line, peer_row, row, segedin, &
       reset_peak, peak_mb, BENCH_LENGTH
 
@@ -39,6 +41,22 @@ contains
       if (.not. ok) write(error_unit, '(a)') command//": "//bad_arguments(status, parsed)//" ("// &
          trim(merge("femcod bench --help", "--help             ", command == "femcod bench"))//")"
    end function bench_arguments
+
+   !> The benchmark's solver options checked as `femcod run` checks its own
+   !> (validate_options), before any surface is made or file read: a refused combination
+   !> is reported as `command: message` (the caller exits 2). One load stands in for the
+   !> benchmark's, which it computes case by case.
+   logical function options_refused(options, command) result(refused)
+      type(contact_options), intent(in) :: options
+      character(len=*), intent(in) :: command
+      type(contact_options) :: probe
+      type(status_type) :: status
+      probe = options
+      if (requested_states(probe) == 0) probe%loads = [1.0_dp]
+      call validate_options(probe, status)
+      refused = status%code /= 0
+      if (refused) write(error_unit, '(a)') command//": "//status%message
+   end function options_refused
 
    function bad_arguments(status, parsed) result(text)
       type(status_type), intent(in) :: status

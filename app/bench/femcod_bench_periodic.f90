@@ -16,7 +16,7 @@ module femcod_bench_periodic
       integer_list_option, get_option
    use femcod_love_periodic, only: periodic_love_spectrum
    use femcod_bench_common, only: bench_arguments, benchmark_surface, linear_law, require_peers, write_peer_gaps, &
-      remove_file_quietly, peer_line, reset_peak, peak_mb, BENCH_LENGTH
+      remove_file_quietly, peer_line, reset_peak, peak_mb, BENCH_LENGTH, options_refused
    implicit none
    private
    public :: bench_periodic
@@ -69,6 +69,11 @@ contains
       options%solver = SOLVER_CG
       options%boundary = BOUNDARY_PERIODIC
       options%cg = cg_settings()
+      options%cg%tol = tol
+      if (options_refused(options, "femcod bench periodic")) then
+         code = 2
+         return
+      end if
       options%cg%tol = 1.0e-10_dp
       options%cg%max_iterations = 5000
       estar = 200/(1 - 0.25_dp**2)

@@ -766,7 +766,7 @@ contains
       if (status%code /= 0) return
       if (grid%rank == 0) grid%materials = contact_problem(label="", np=problem%np, pixel=problem%pixel, &
          young=problem%young, poisson=problem%poisson)
-      call session_start(grid, session, capped, merge(cap*grid%pixel**2, 0.0_dp, capped), interface, by_gaps)
+      call session_start(grid, session, interface, by_gaps)
       if (by_gaps) then
          order = [(k, k = 1, m)]
       else

@@ -93,16 +93,15 @@ module femcod_cg
 
    !> What the solver carries from one target (load or approach) to the next, on this
    !> process's columns of the operator's grid: the forces (nN; the next target's warm
-   !> start), the approach (nm) they give, and with --plastic the deck's gaps (nm), the
-   !> pixel force cap fmax = H d^2 (nN) and the capped (plastic) pixels. Under
-   !> displacement control with an adhesive law or the cap (`by_gaps`), the targets are
-   !> solved in the gap variables (femcod_gap_cg), along the path in the order given, and
-   !> the session carries that path too.
+   !> start), the approach (nm) they give, the interface law (with --plastic its pixel
+   !> force cap fmax = H d^2, nN), and with the cap the deck's gaps (nm) and the capped
+   !> (plastic) pixels. Under displacement control with an adhesive law or the cap
+   !> (`by_gaps`), the targets are solved in the gap variables (femcod_gap_cg), along the
+   !> path in the order given, and the session carries that path too.
    type :: cg_session
       real(dp), allocatable :: p(:, :)
       real(dp) :: approach = 0
       logical :: plastic = .false.
-      real(dp) :: fmax = 0
       real(dp), allocatable :: g0(:, :)
       logical, allocatable :: capped(:, :)
       logical :: by_gaps = .false.
@@ -211,9 +210,8 @@ contains
          return
       end if
       if (options%plastic) allocate(res%step_plastic(0))
-      call session_start(fine, session, options%plastic, options%hardness*problem%pixel**2, &
-         make_interface_law(options%adhesion, options%work, options%range, problem%pixel, options%plastic, &
-         options%hardness), by_gaps)
+      call session_start(fine, session, make_interface_law(options%adhesion, options%work, options%range, &
+         problem%pixel, options%plastic, options%hardness), by_gaps)
       ! A path in the gap variables in the order given; loads and elastic approaches in
       ! ascending order, each from the last. The state reported in full: the last of the
       ! path, or the largest target.
@@ -394,26 +392,23 @@ contains
       end do
    end function ascending_order
 
-   !> A session on `grid`: no forces yet; with `plastic`, the cap fmax (nN) per pixel and
-   !> the deck's gaps kept (the capped rounds move the operator's). With `by_gaps` the
-   !> targets are approaches solved in the gap variables with the interface `law` (the
-   !> grid made with its transform grid).
-   subroutine session_start(grid, session, plastic, fmax, law, by_gaps)
+   !> A session on `grid` with the interface `law`: no forces yet; with the law's cap, its
+   !> fmax (nN) per pixel and the deck's gaps kept (the capped rounds move the operator's).
+   !> With `by_gaps` the targets are approaches solved in the gap variables (the grid made
+   !> with its transform grid).
+   subroutine session_start(grid, session, law, by_gaps)
       class(elastic_operator), intent(in) :: grid
       type(cg_session), intent(out) :: session
-      logical, intent(in) :: plastic
-      real(dp), intent(in) :: fmax
-      type(interface_law), intent(in), optional :: law
-      logical, intent(in), optional :: by_gaps
-      if (present(law)) session%law = law
-      if (present(by_gaps)) session%by_gaps = by_gaps
+      type(interface_law), intent(in) :: law
+      logical, intent(in) :: by_gaps
+      session%law = law
+      session%by_gaps = by_gaps
       if (session%by_gaps) call gap_session_start(grid, session%path)
       allocate(session%p(grid%np, grid%nj))
       session%p = 0
       session%approach = 0
-      session%plastic = plastic
-      session%fmax = fmax
-      if (plastic) then
+      session%plastic = law%capped()
+      if (session%plastic) then
          session%g0 = grid%g0
          allocate(session%capped(grid%np, grid%nj))
          session%capped = .false.
@@ -641,7 +636,7 @@ contains
       logical, allocatable :: grow(:, :), release(:, :)
       real(dp) :: left, total(2)
       integer :: round, ncap
-      associate(p => session%p, capped => session%capped, g0 => session%g0, fmax => session%fmax)
+      associate(p => session%p, capped => session%capped, g0 => session%g0, fmax => session%law%fmax)
       allocate(force(size(p, 1), size(p, 2)), w(size(p, 1), size(p, 2)))
       do round = 1, MAX_ROUNDS
          total = [real(count(capped), dp), sum(p)]

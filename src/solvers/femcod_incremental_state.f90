@@ -36,6 +36,7 @@ module femcod_incremental_state
       BOUNDARY_PERIODIC
    use femcod_contact_result, only: contact_result, visit_result
    use femcod_event_path, only: load_path
+   use femcod_interface_law, only: interface_law, make_interface_law
    implicit none
    private
    public :: incremental_state, CACHE_SIZE, REFILL_EVERY, factor_peak_bytes
@@ -136,6 +137,7 @@ contains
       type(contact_options), intent(in) :: options
       integer, allocatable :: items(:)
       integer :: p
+      type(interface_law) :: law
       call self%path%start(problem, options, self%res)
       self%np = problem%np
       self%npix = self%np*self%np
@@ -154,8 +156,12 @@ contains
       self%fmax = 0
       self%nplastic = 0
       allocate(self%plastic_pix(0), self%plastic_step(0), self%plastic_key(0))
-      if (options%plastic) then
-         self%fmax = options%hardness*problem%pixel**2
+      ! The cap from the one description of the interface (femcod_interface_law) that the
+      ! cg paths read too; the event path reaches it by its own exact yield events.
+      law = make_interface_law(options%adhesion, options%work, options%range, problem%pixel, options%plastic, &
+         options%hardness)
+      if (law%capped()) then
+         self%fmax = law%fmax
          self%g0_deck = self%g0
          allocate(self%res%step_plastic(0))
       end if
