@@ -29,6 +29,12 @@
 !>
 !> The passes run on as many threads as OpenMP allows (OMP_NUM_THREADS, default all
 !> cores) when the convolution is set up.
+!>
+!> Every FFTW plan of the serial library is made here: the convolution's, the gap-
+!> variable iteration's transform grid (gap_transform), and the one-off transforms of the
+!> periodic table (inverse_half_spectrum), the self-affine generator
+!> (inverse_complex_transform) and the profiles' spectra (line_transform). FFTW-MPI's
+!> plans are femcod-mpi's (mpi/src).
 module femcod_convolution
    use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_float, c_double_complex, c_float_complex, c_int, &
       c_size_t, c_f_pointer
@@ -39,7 +45,7 @@ module femcod_convolution
       fftwf_execute_dft_r2c, fftwf_execute_dft_c2r, fftwf_execute_dft, &
       fftw_destroy_plan, fftwf_destroy_plan, fftw_alloc_real, fftw_alloc_complex, fftw_free, &
       FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, FFTW_BACKWARD, fftw_plan_dft_r2c_2d, fftw_plan_dft_c2r_2d, &
-      fftw_init_threads, fftw_plan_with_nthreads
+      fftw_init_threads, fftw_plan_with_nthreads, fftw_plan_dft_2d, fftw_plan_dft_r2c_1d
    !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
    implicit none
    private
@@ -47,6 +53,8 @@ module femcod_convolution
       inverse_kernel_taps
    public :: gap_transform, gap_transform_setup, gap_transform_apply, gap_transform_free, SPECTRUM_COMPLIANCE, &
       SPECTRUM_STIFFNESS
+   public :: inverse_half_spectrum, inverse_complex_transform, line_transform, line_transform_setup, &
+      line_transform_apply, line_transform_free
 
    !> Which operator gap_transform_apply applies: the compliance C = c (I * .) + s or the
    !> stiffness K = C^-1.
@@ -98,6 +106,13 @@ module femcod_convolution
       real(c_double), pointer :: field(:, :) => null()
       complex(c_double_complex), pointer :: spectrum(:, :) => null()
    end type gap_transform
+
+   !> Real-to-complex transforms of lines of one length (the profiles of femcod_summits):
+   !> one plan, made on the caller's line and spectrum and executed on them.
+   type :: line_transform
+      type(c_ptr) :: plan
+      logical :: made = .false.
+   end type line_transform
 
 contains
 
@@ -586,4 +601,63 @@ contains
       if (allocated(t%compliance)) deallocate(t%compliance)
       if (allocated(t%stiffness)) deallocate(t%stiffness)
    end subroutine gap_transform_free
+
+   !> field = the inverse 2-D transform of a real, even spectrum's half (kh + 1) x np
+   !> (kh = np/2; FFTW's c2r of a row-major np x np transform: the first index the halved
+   !> frequency), not normalised (FFTW's sum). On FFTW's own aligned memory.
+   subroutine inverse_half_spectrum(spectrum, field)
+      complex(dp), intent(in) :: spectrum(:, :)
+      real(dp), intent(out) :: field(:, :)
+      type(c_ptr) :: plan, in_mem, out_mem
+      complex(c_double_complex), pointer :: values(:, :)
+      real(c_double), pointer :: out(:, :)
+      integer :: np, kh
+      np = size(field, 1)
+      kh = size(spectrum, 1) - 1
+      in_mem = fftw_alloc_complex(int(kh + 1, c_size_t)*int(np, c_size_t))
+      out_mem = fftw_alloc_real(int(np, c_size_t)*int(np, c_size_t))
+      call c_f_pointer(in_mem, values, [kh + 1, np])
+      call c_f_pointer(out_mem, out, [np, np])
+      plan = fftw_plan_dft_c2r_2d(int(np, c_int), int(np, c_int), values, out, FFTW_ESTIMATE)
+      values = spectrum
+      call fftw_execute_dft_c2r(plan, values, out)
+      field = out
+      call fftw_destroy_plan(plan)
+      call fftw_free(in_mem)
+      call fftw_free(out_mem)
+   end subroutine inverse_half_spectrum
+
+   !> field = the backward (unnormalised) complex 2-D transform of `spectrum`, both n x n,
+   !> planned on the caller's arrays.
+   subroutine inverse_complex_transform(spectrum, field)
+      complex(c_double_complex), intent(inout), target, contiguous :: spectrum(:, :)
+      complex(c_double_complex), intent(out), target, contiguous :: field(:, :)
+      type(c_ptr) :: plan
+      plan = fftw_plan_dft_2d(int(size(field, 2), c_int), int(size(field, 1), c_int), spectrum, field, FFTW_BACKWARD, &
+         FFTW_ESTIMATE)
+      call fftw_execute_dft(plan, spectrum, field)
+      call fftw_destroy_plan(plan)
+   end subroutine inverse_complex_transform
+
+   !> The plan of r2c transforms of `line` (n real values) into `spectrum` (n/2 + 1).
+   subroutine line_transform_setup(t, line, spectrum)
+      type(line_transform), intent(inout) :: t
+      real(dp), intent(inout), target, contiguous :: line(:)
+      complex(c_double_complex), intent(inout), target, contiguous :: spectrum(:)
+      t%plan = fftw_plan_dft_r2c_1d(int(size(line), c_int), line, spectrum, FFTW_ESTIMATE)
+      t%made = .true.
+   end subroutine line_transform_setup
+
+   subroutine line_transform_apply(t, line, spectrum)
+      type(line_transform), intent(inout) :: t
+      real(dp), intent(inout), target, contiguous :: line(:)
+      complex(c_double_complex), intent(inout), target, contiguous :: spectrum(:)
+      call fftw_execute_dft_r2c(t%plan, line, spectrum)
+   end subroutine line_transform_apply
+
+   subroutine line_transform_free(t)
+      type(line_transform), intent(inout) :: t
+      if (t%made) call fftw_destroy_plan(t%plan)
+      t%made = .false.
+   end subroutine line_transform_free
 end module femcod_convolution

@@ -27,11 +27,9 @@
 !> In the continuum limit S -> 1/|(a, b)|: the displacement over the pressure is
 !> 2/(E* |q|), as for the continuous periodic half-space.
 module femcod_love_periodic
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_double_complex, c_size_t, c_int, c_f_pointer
    use femcod_kinds, only: dp
    use femcod_lapack, only: dsyrk, dgemm
-   use femcod_fftw, only: fftw_plan_dft_c2r_2d, fftw_execute_dft_c2r, fftw_destroy_plan, fftw_alloc_real, &
-      fftw_alloc_complex, fftw_free, FFTW_ESTIMATE
+   use femcod_convolution, only: inverse_half_spectrum
    implicit none
    private
    public :: periodic_love_spectrum, periodic_love_spectrum_rows, periodic_offset_table
@@ -140,29 +138,19 @@ contains
       integer, intent(in) :: np
       real(dp) :: table(0:np - 1, 0:np - 1)
       real(dp), allocatable :: s(:, :)
-      type(c_ptr) :: plan, in_mem, out_mem
-      complex(c_double_complex), pointer :: spectrum(:, :)
-      real(c_double), pointer :: field(:, :)
+      complex(dp), allocatable :: spectrum(:, :)
       integer :: kh, k1, k2
       kh = np/2
-      allocate(s(0:kh, 0:kh))
+      allocate(s(0:kh, 0:kh), spectrum(kh + 1, np))
       s(:, :) = periodic_love_spectrum(np)
-      in_mem = fftw_alloc_complex(int(kh + 1, c_size_t)*int(np, c_size_t))
-      out_mem = fftw_alloc_real(int(np, c_size_t)*int(np, c_size_t))
-      call c_f_pointer(in_mem, spectrum, [kh + 1, np])
-      call c_f_pointer(out_mem, field, [np, np])
       ! Column-major (kh + 1) x np half spectrum of a row-major np x np transform: the
       ! first index is the halved frequency k2, the second k1 = 0 .. np-1 (mirrored).
-      plan = fftw_plan_dft_c2r_2d(int(np, c_int), int(np, c_int), spectrum, field, FFTW_ESTIMATE)
       do k1 = 0, np - 1
          do k2 = 0, kh
-            spectrum(k2 + 1, k1 + 1) = cmplx(s(k2, min(k1, np - k1)), 0, c_double_complex)
+            spectrum(k2 + 1, k1 + 1) = cmplx(s(k2, min(k1, np - k1)), 0, dp)
          end do
       end do
-      call fftw_execute_dft_c2r(plan, spectrum, field)
-      table = field/real(np, dp)**2
-      call fftw_destroy_plan(plan)
-      call fftw_free(in_mem)
-      call fftw_free(out_mem)
+      call inverse_half_spectrum(spectrum, table)
+      table = table/real(np, dp)**2
    end function periodic_offset_table
 end module femcod_love_periodic

@@ -4,7 +4,7 @@
 !> with c = (NP + 1)/2, so the grid centre is a pixel centre for odd NP and a pixel
 !> corner for even NP. No I/O here.
 module femcod_surfaces
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_double_complex, c_int
+   use, intrinsic :: iso_c_binding, only: c_double_complex
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
    use femcod_random, only: random_stream, seed_stream, normal, uniform
@@ -235,12 +235,11 @@ contains
    !> Gaussian random complex amplitudes (reproducible from `seed`), inverse FFT
    !> (FFTW), real part, mean removed, scaled to the rms height `rms` (nm).
    subroutine self_affine_surface(np, pixel, hurst, rms, seed, z)
-      use femcod_fftw, only: fftw_plan_dft_2d, fftw_execute_dft, fftw_destroy_plan, FFTW_BACKWARD, FFTW_ESTIMATE
+      use femcod_convolution, only: inverse_complex_transform
       integer, intent(in) :: np, seed
       real(dp), intent(in) :: pixel, hurst, rms
       real(dp), intent(out) :: z(np, np)
       complex(c_double_complex), allocatable :: spec(:, :), field(:, :)
-      type(c_ptr) :: plan
       type(random_stream) :: stream
       real(dp) :: qx, qy, q, qmin, qmax, a, b, amp
       integer :: i, j, fi, fj
@@ -266,9 +265,7 @@ contains
       end do
       ! FFTW is row-major: a Fortran (np, np) array is an (np, np) C array transposed,
       ! which a 2-D transform of a square grid does not mind.
-      plan = fftw_plan_dft_2d(int(np, c_int), int(np, c_int), spec, field, FFTW_BACKWARD, FFTW_ESTIMATE)
-      call fftw_execute_dft(plan, spec, field)
-      call fftw_destroy_plan(plan)
+      call inverse_complex_transform(spec, field)
       z = real(field, dp)
       z = z - sum(z)/size(z)
       if (rms_height(z) > 0) z = z*(rms/rms_height(z))

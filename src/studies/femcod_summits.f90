@@ -4,7 +4,7 @@
 !> 2.14-2.15). Heights z(i, j) in nm, row i along y, column j along x, pixel d in nm.
 !> No I/O.
 module femcod_summits
-   use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_double_complex
+   use, intrinsic :: iso_c_binding, only: c_double_complex
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT
    use femcod_richardson, only: power_law_fit
@@ -279,28 +279,28 @@ contains
    !> averaged over every row and every column (each profile's mean removed):
    !> P_k = (d/N) |Z_k|^2 (nm^3) at the frequencies f_k = k/L (1/nm), k = 1 .. N/2.
    subroutine profile_psd(z, pixel, frequency, power)
-      use femcod_fftw, only: fftw_plan_dft_r2c_1d, fftw_execute_dft_r2c, fftw_destroy_plan, FFTW_ESTIMATE
+      use femcod_convolution, only: line_transform, line_transform_setup, line_transform_apply, line_transform_free
       real(dp), intent(in) :: z(:, :), pixel
       real(dp), allocatable, intent(out) :: frequency(:), power(:)
       real(dp), allocatable :: line(:)
       complex(c_double_complex), allocatable :: spec(:)
-      type(c_ptr) :: plan
+      type(line_transform) :: plan
       integer :: n, k, p, np2
       n = size(z, 1)
       np2 = n/2
       allocate(line(n), spec(n/2 + 1), frequency(np2), power(np2))
       frequency = [(k/(n*pixel), k = 1, np2)]
       power = 0
-      plan = fftw_plan_dft_r2c_1d(int(n, c_int), line, spec, FFTW_ESTIMATE)
+      call line_transform_setup(plan, line, spec)
       do p = 1, n
          line = z(:, p) - sum(z(:, p))/n
-         call fftw_execute_dft_r2c(plan, line, spec)
+         call line_transform_apply(plan, line, spec)
          power = power + abs(spec(2:np2 + 1))**2
          line = z(p, :) - sum(z(p, :))/n
-         call fftw_execute_dft_r2c(plan, line, spec)
+         call line_transform_apply(plan, line, spec)
          power = power + abs(spec(2:np2 + 1))**2
       end do
-      call fftw_destroy_plan(plan)
+      call line_transform_free(plan)
       power = power/(2*n)*pixel/n
    end subroutine profile_psd
 
