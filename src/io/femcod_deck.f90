@@ -32,6 +32,16 @@ module femcod_deck
    character(len=*), parameter :: material_names(3) = [character(len=26) :: &
       "lower surface", "upper surface", "contact/interface elements"]
 
+   !> A deck's text and its tokens (first and last character, line), for the messages
+   !> `path:line: expected ..., found ...`: per header line 2 to 5 its first token and
+   !> count; the first height's token; the last line.
+   type :: deck_tokens
+      character(len=:), allocatable :: path, text
+      integer, allocatable :: first(:), last(:), line(:)
+      integer :: n = 0, last_line = 0, first_height = 0
+      integer :: start(2:5) = 0, count(2:5) = 0
+   end type deck_tokens
+
 contains
 
    !> Read and validate a deck. On error `status` holds `path:line: expected ..., found ...`
@@ -40,208 +50,253 @@ contains
       character(len=*), intent(in) :: path
       type(contact_problem), intent(out) :: deck
       type(status_type), intent(inout) :: status
-      character(len=:), allocatable :: text
-      integer, allocatable :: tok_first(:), tok_last(:), tok_line(:)
-      integer :: ntok, k, first_line6, i, j, last_line, header_end
-      integer(i8) :: nvalues
+      type(deck_tokens) :: t
+      integer :: i, j, header_end
       logical :: ok
-      character(len=24) :: count_text
-      integer :: ln_first(2:5), ln_count(2:5)
-
       ! An HDF5 deck (femcod_deck_h5) by its signature, whatever its name.
       if (is_hdf5_file(path)) then
          call read_deck_h5(path, deck, status)
          return
       end if
-      call read_file(path, "a deck file", text, status)
+      t%path = path
+      call read_file(path, "a deck file", t%text, status)
       if (status%code /= 0) then
          if (index(status%message, "empty file") > 0) status%message = path//":1: expected a label line, found an "// &
             "empty file"
          return
       end if
-      call check_text(path, text, status)
+      call check_text(path, t%text, status)
       if (status%code /= 0) return
       ! Lines 1 to 5 are tokenized here, the heights parsed straight from the text
       ! (heights_from_text); only a deck whose heights are refused is tokenized whole,
       ! for the message. A text of fewer than five lines is tokenized whole at once.
       header_end = 0
       do i = 1, 5
-         j = index(text(header_end + 1:), new_line("a"))
+         j = index(t%text(header_end + 1:), new_line("a"))
          if (j == 0) then
-            header_end = len(text)
+            header_end = len(t%text)
             exit
          end if
          header_end = header_end + j
       end do
-      call tokenize(text(1:header_end), ntok, tok_first, tok_last, tok_line, last_line)
-      deck%label = label_of(text)
+      call tokenize(t%text(1:header_end), t%n, t%first, t%last, t%line, t%last_line)
+      deck%label = label_of(t%text)
+      call read_header_values(t, deck, status)
+      if (status%code /= 0) return
+      allocate(deck%lower(deck%np, deck%np), deck%upper(deck%np, deck%np))
+      if (header_end < len(t%text) .and. words_little_endian()) then
+         call heights_from_text(t%text, header_end + 1, deck%lower, deck%upper, ok)
+         if (ok) return
+      end if
+      if (header_end < len(t%text)) then
+         ! The whole text: its first tokens are those of lines 1 to 5 found above (they
+         ! end at a line end), the heights follow.
+         t%first_height = t%n + 1
+         call tokenize(t%text, t%n, t%first, t%last, t%line, t%last_line)
+      end if
+      call read_height_tokens(t, deck, status)
+   end subroutine read_deck
 
-      ! Lines 2..5: exactly the named values.
-      ln_count = 0
-      ln_first = 0
-      first_line6 = ntok + 1
-      do k = 1, ntok
-         if (tok_line(k) >= 6) then
-            first_line6 = k
+   !> Lines 2 to 5: exactly the named values (NP PIXEL MAXCONT, then each material's E
+   !> and NU), each within its range.
+   subroutine read_header_values(t, deck, status)
+      type(deck_tokens), intent(inout) :: t
+      type(contact_problem), intent(inout) :: deck
+      type(status_type), intent(inout) :: status
+      integer :: k, i
+      t%count = 0
+      t%start = 0
+      t%first_height = t%n + 1
+      do k = 1, t%n
+         if (t%line(k) >= 6) then
+            t%first_height = k
             exit
          end if
-         if (tok_line(k) >= 2) then
-            if (ln_count(tok_line(k)) == 0) ln_first(tok_line(k)) = k
-            ln_count(tok_line(k)) = ln_count(tok_line(k)) + 1
+         if (t%line(k) >= 2) then
+            if (t%count(t%line(k)) == 0) t%start(t%line(k)) = k
+            t%count(t%line(k)) = t%count(t%line(k)) + 1
          end if
       end do
-      call expect_count(2, 3, "NP PIXEL MAXCONT")
+      call expect_count(t, 2, 3, "NP PIXEL MAXCONT", status)
       if (status%code /= 0) return
-      call get_int(ln_first(2), "NP, a positive integer", deck%np)
+      call get_int(t, t%start(2), "NP, a positive integer", deck%np, status)
       if (status%code /= 0) return
       if (deck%np <= 0 .or. deck%np > MAX_NP) then
-         call bad(2, "NP, an integer from 1 to "//int_str(MAX_NP), tok(ln_first(2)))
+         call refuse_token(t, 2, "NP, an integer from 1 to "//int_str(MAX_NP), t%start(2), status)
          return
       end if
-      call get_real(ln_first(2) + 1, "PIXEL, the pixel size in nm (1e-6 to 1e6)", deck%pixel)
+      call get_real(t, t%start(2) + 1, "PIXEL, the pixel size in nm (1e-6 to 1e6)", deck%pixel, status)
       if (status%code /= 0) return
       if (.not. (deck%pixel >= MIN_PIXEL .and. deck%pixel <= MAX_PIXEL)) then
-         call bad(2, "PIXEL, the pixel size in nm (1e-6 to 1e6)", tok(ln_first(2) + 1))
+         call refuse_token(t, 2, "PIXEL, the pixel size in nm (1e-6 to 1e6)", t%start(2) + 1, status)
          return
       end if
-      call get_int(ln_first(2) + 2, "MAXCONT, a positive integer", deck%maxcont)
+      call get_int(t, t%start(2) + 2, "MAXCONT, a positive integer", deck%maxcont, status)
       if (status%code /= 0) return
       if (deck%maxcont <= 0 .or. deck%maxcont > deck%np**2) then
-         call bad(2, "MAXCONT, an integer from 1 to NP**2 = "//int_str(deck%np**2), tok(ln_first(2) + 2))
+         call refuse_token(t, 2, "MAXCONT, an integer from 1 to NP**2 = "//int_str(deck%np**2), t%start(2) + 2, &
+            status)
          return
       end if
       do i = 1, 3
-         call expect_count(2 + i, 2, "E"//int_str(i)//" NU"//int_str(i)//" of the "//trim(material_names(i)))
+         call read_material(t, i, deck%young(i), deck%poisson(i), status)
          if (status%code /= 0) return
-         call get_real(ln_first(2 + i), "E"//int_str(i)//", Young's modulus in GPa (1e-12 to 1e300)", deck%young(i))
-         if (status%code /= 0) return
-         if (.not. (deck%young(i) >= MIN_YOUNG .and. deck%young(i) <= MAX_YOUNG)) then
-            call bad(2 + i, "E"//int_str(i)//", Young's modulus in GPa (1e-12 to 1e300)", tok(ln_first(2 + i)))
-            return
-         end if
-         call get_real(ln_first(2 + i) + 1, "NU"//int_str(i)//", Poisson's ratio in (-1, 0.5)", deck%poisson(i))
-         if (status%code /= 0) return
-         if (.not. (deck%poisson(i) > -1 .and. deck%poisson(i) < 0.5_dp)) then
-            call bad(2 + i, "NU"//int_str(i)//", Poisson's ratio in (-1, 0.5)", tok(ln_first(2 + i) + 1))
-            return
-         end if
       end do
+   end subroutine read_header_values
 
-      ! Heights.
-      allocate(deck%lower(deck%np, deck%np), deck%upper(deck%np, deck%np))
-      if (header_end < len(text) .and. words_little_endian()) then
-         call heights_from_text(text, header_end + 1, deck%lower, deck%upper, ok)
-         if (ok) return
+   !> Line 2 + i: E and NU of material i (GPa, dimensionless), each within its range.
+   subroutine read_material(t, i, young, poisson, status)
+      type(deck_tokens), intent(in) :: t
+      integer, intent(in) :: i
+      real(dp), intent(out) :: young, poisson
+      type(status_type), intent(inout) :: status
+      call expect_count(t, 2 + i, 2, "E"//int_str(i)//" NU"//int_str(i)//" of the "//trim(material_names(i)), status)
+      if (status%code /= 0) return
+      call get_real(t, t%start(2 + i), "E"//int_str(i)//", Young's modulus in GPa (1e-12 to 1e300)", young, status)
+      if (status%code /= 0) return
+      if (.not. (young >= MIN_YOUNG .and. young <= MAX_YOUNG)) then
+         call refuse_token(t, 2 + i, "E"//int_str(i)//", Young's modulus in GPa (1e-12 to 1e300)", t%start(2 + i), &
+            status)
+         return
       end if
-      if (header_end < len(text)) then
-         ! The whole text: its first tokens are those of lines 1 to 5 found above (they
-         ! end at a line end), the heights follow.
-         first_line6 = ntok + 1
-         call tokenize(text, ntok, tok_first, tok_last, tok_line, last_line)
-      end if
+      call get_real(t, t%start(2 + i) + 1, "NU"//int_str(i)//", Poisson's ratio in (-1, 0.5)", poisson, status)
+      if (status%code /= 0) return
+      if (.not. (poisson > -1 .and. poisson < 0.5_dp)) call refuse_token(t, 2 + i, "NU"//int_str(i)// &
+         ", Poisson's ratio in (-1, 0.5)", t%start(2 + i) + 1, status)
+   end subroutine read_material
+
+   !> The 2 NP^2 heights from the tokens of line 6 on: exactly that many, each a finite
+   !> number within 1e12 nm.
+   subroutine read_height_tokens(t, deck, status)
+      type(deck_tokens), intent(in) :: t
+      type(contact_problem), intent(inout) :: deck
+      type(status_type), intent(inout) :: status
+      integer(i8) :: nvalues
+      character(len=24) :: count_text
+      integer :: k
       ! In 64 bits: 2 NP**2 overflows a default integer for NP > 32767.
       nvalues = 2*int(deck%np, i8)**2
       write(count_text, '(i0)') nvalues
-      if (ntok - first_line6 + 1 < nvalues) then
-         call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(last_line)//": expected "// &
+      if (t%n - t%first_height + 1 < nvalues) then
+         call set_error(status, STATUS_BAD_INPUT, t%path//":"//int_str(t%last_line)//": expected "// &
             trim(count_text)//" heights (NP**2 = "//int_str(deck%np**2)//" lower, then as many upper), found "// &
-            int_str(ntok - first_line6 + 1)//" before the end of the file")
+            int_str(t%n - t%first_height + 1)//" before the end of the file")
          return
       end if
-      if (ntok - first_line6 + 1 > nvalues) then
-         k = first_line6 + int(nvalues)
-         call bad(tok_line(k), "the end of the deck after the "//trim(count_text)//" heights", tok(k))
+      if (t%n - t%first_height + 1 > nvalues) then
+         k = t%first_height + int(nvalues)
+         call refuse_token(t, t%line(k), "the end of the deck after the "//trim(count_text)//" heights", k, status)
          return
       end if
       ! The message of a bad height is built only when there is one: a string per value
       ! made reading a 1024 x 1024 deck allocation-bound.
-      k = first_line6
-      call get_heights(deck%lower, "a lower-surface height")
+      k = t%first_height
+      call get_heights(t, k, deck%lower, "a lower-surface height", status)
       if (status%code /= 0) return
-      call get_heights(deck%upper, "an upper-surface height")
+      call get_heights(t, k, deck%upper, "an upper-surface height", status)
+   end subroutine read_height_tokens
 
-   contains
+   !> Token k as a message shows it: quoted, at most 40 characters.
+   function token_text(t, k) result(s)
+      type(deck_tokens), intent(in) :: t
+      integer, intent(in) :: k
+      character(len=:), allocatable :: s
+      s = "'"//t%text(t%first(k):min(t%last(k), t%first(k) + 39))//"'"
+      if (t%last(k) - t%first(k) > 39) s = s//"..."
+   end function token_text
 
-      function tok(k) result(s)
-         integer, intent(in) :: k
-         character(len=:), allocatable :: s
-         s = "'"//text(tok_first(k):min(tok_last(k), tok_first(k) + 39))//"'"
-         if (tok_last(k) - tok_first(k) > 39) s = s//"..."
-      end function tok
+   !> `path:line: expected <expected>, found <token k>`.
+   subroutine refuse_token(t, line, expected, k, status)
+      type(deck_tokens), intent(in) :: t
+      integer, intent(in) :: line, k
+      character(len=*), intent(in) :: expected
+      type(status_type), intent(inout) :: status
+      call refuse_found(t, line, expected, token_text(t, k), status)
+   end subroutine refuse_token
 
-      subroutine bad(line, expected, found)
-         integer, intent(in) :: line
-         character(len=*), intent(in) :: expected, found
-         call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(line)//": expected "//expected// &
-            ", found "//found)
-      end subroutine bad
+   subroutine refuse_found(t, line, expected, found, status)
+      type(deck_tokens), intent(in) :: t
+      integer, intent(in) :: line
+      character(len=*), intent(in) :: expected, found
+      type(status_type), intent(inout) :: status
+      call set_error(status, STATUS_BAD_INPUT, t%path//":"//int_str(line)//": expected "//expected//", found "//found)
+   end subroutine refuse_found
 
-      subroutine expect_count(line, n, what)
-         integer, intent(in) :: line, n
-         character(len=*), intent(in) :: what
-         if (ln_count(line) /= n) then
-            if (last_line < line) then
-               call set_error(status, STATUS_BAD_INPUT, path//":"//int_str(line)//": expected "//int_str(n)// &
-                  " values ("//what//"), found the end of the file")
-            else
-               call bad(line, int_str(n)//" values ("//what//")", int_str(ln_count(line))//" values")
-            end if
-         end if
-      end subroutine expect_count
+   !> Line `line` holds exactly n values (`what`).
+   subroutine expect_count(t, line, n, what, status)
+      type(deck_tokens), intent(in) :: t
+      integer, intent(in) :: line, n
+      character(len=*), intent(in) :: what
+      type(status_type), intent(inout) :: status
+      if (t%count(line) == n) return
+      if (t%last_line < line) then
+         call set_error(status, STATUS_BAD_INPUT, t%path//":"//int_str(line)//": expected "//int_str(n)// &
+            " values ("//what//"), found the end of the file")
+      else
+         call refuse_found(t, line, int_str(n)//" values ("//what//")", int_str(t%count(line))//" values", status)
+      end if
+   end subroutine expect_count
 
-      subroutine get_int(k, what, value)
-         integer, intent(in) :: k
-         character(len=*), intent(in) :: what
-         integer, intent(out) :: value
-         logical :: ok
-         call parse_integer(text(tok_first(k):tok_last(k)), value, ok)
-         if (.not. ok) call bad(tok_line(k), what, tok(k))
-      end subroutine get_int
+   subroutine get_int(t, k, what, value, status)
+      type(deck_tokens), intent(in) :: t
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: what
+      integer, intent(out) :: value
+      type(status_type), intent(inout) :: status
+      logical :: ok
+      call parse_integer(t%text(t%first(k):t%last(k)), value, ok)
+      if (.not. ok) call refuse_token(t, t%line(k), what, k, status)
+   end subroutine get_int
 
-      !> The NP x NP heights from token k on, row by row; k ends past them. The values
-      !> are converted in parallel; the first bad one (in file order) is reported.
-      subroutine get_heights(z, what)
-         real(dp), intent(out) :: z(:, :)
-         character(len=*), intent(in) :: what
-         integer :: i, j, m, ncol, first_bad
-         logical :: ok
-         ncol = size(z, 2)
-         first_bad = huge(first_bad)
-         !$omp parallel do private(i, j, m, ok) reduction(min: first_bad) schedule(static)
-         do i = 1, size(z, 1)
-            do j = 1, ncol
-               m = k + (i - 1)*ncol + j - 1
-               call parse_real(text(tok_first(m):tok_last(m)), z(i, j), ok)
-               if (ok) ok = abs(z(i, j)) <= MAX_HEIGHT
-               if (.not. ok) first_bad = min(first_bad, m)
-            end do
+   subroutine get_real(t, k, what, value, status)
+      type(deck_tokens), intent(in) :: t
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: what
+      real(dp), intent(out) :: value
+      type(status_type), intent(inout) :: status
+      logical :: ok
+      call parse_real(t%text(t%first(k):t%last(k)), value, ok)
+      if (.not. ok) call refuse_token(t, t%line(k), what//" (a finite number)", k, status)
+   end subroutine get_real
+
+   !> The NP x NP heights from token k on, row by row; k ends past them. The values are
+   !> converted in parallel; the first bad one (in file order) is reported.
+   subroutine get_heights(t, k, z, what, status)
+      type(deck_tokens), intent(in) :: t
+      integer, intent(inout) :: k
+      real(dp), intent(out) :: z(:, :)
+      character(len=*), intent(in) :: what
+      type(status_type), intent(inout) :: status
+      integer :: i, j, m, ncol, first_bad
+      logical :: ok
+      ncol = size(z, 2)
+      first_bad = huge(first_bad)
+      !$omp parallel do private(i, j, m, ok) reduction(min: first_bad) schedule(static)
+      do i = 1, size(z, 1)
+         do j = 1, ncol
+            m = k + (i - 1)*ncol + j - 1
+            call parse_real(t%text(t%first(m):t%last(m)), z(i, j), ok)
+            if (ok) ok = abs(z(i, j)) <= MAX_HEIGHT
+            if (.not. ok) first_bad = min(first_bad, m)
          end do
-         !$omp end parallel do
-         if (first_bad < huge(first_bad)) then
-            m = first_bad
-            i = (m - k)/ncol + 1
-            j = m - k - (i - 1)*ncol + 1
-            call parse_real(text(tok_first(m):tok_last(m)), z(i, j), ok)
-            if (.not. ok) then
-               call bad(tok_line(m), what//" in nm (row "//int_str(i)//", column "//int_str(j)//") (a finite "// &
-                  "number)", tok(m))
-            else
-               call bad(tok_line(m), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", tok(m))
-            end if
-            return
+      end do
+      !$omp end parallel do
+      if (first_bad < huge(first_bad)) then
+         m = first_bad
+         i = (m - k)/ncol + 1
+         j = m - k - (i - 1)*ncol + 1
+         call parse_real(t%text(t%first(m):t%last(m)), z(i, j), ok)
+         if (.not. ok) then
+            call refuse_token(t, t%line(m), what//" in nm (row "//int_str(i)//", column "//int_str(j)//") (a finite "// &
+               "number)", m, status)
+         else
+            call refuse_token(t, t%line(m), "a height within 1e12 nm (row "//int_str(i)//", column "//int_str(j)//")", &
+               m, status)
          end if
-         k = k + size(z)
-      end subroutine get_heights
-
-      subroutine get_real(k, what, value)
-         integer, intent(in) :: k
-         character(len=*), intent(in) :: what
-         real(dp), intent(out) :: value
-         logical :: ok
-         call parse_real(text(tok_first(k):tok_last(k)), value, ok)
-         if (.not. ok) call bad(tok_line(k), what//" (a finite number)", tok(k))
-      end subroutine get_real
-   end subroutine read_deck
+         return
+      end if
+      k = k + size(z)
+   end subroutine get_heights
 
    !> Write a deck: validated first, written under a temporary name, then renamed, so
    !> that `path` is either untouched or complete. Each real is written with the fewest
