@@ -62,6 +62,14 @@ module femcod_legacy
       real(dp) :: compliance(2) = 0, interface(2) = 0, penalty = 0
    end type legacy_materials
 
+   !> Where one run's arrays start in the work arrays (Appendix B's memory pointers): the
+   !> surfaces (MPSURF), gaps (MPGAPS), their order (IPSORT), the candidates' flags
+   !> (IPSITU), the contacts (IPCONT), the contact forces (MPFORCE) and the unit
+   !> solution (MPWORK).
+   type :: legacy_pointers
+      integer :: surf = 0, gaps = 0, sort = 0, situ = 0, cont = 0, force = 0, work = 0
+   end type legacy_pointers
+
 contains
 
    !> Run the Appendix B algorithm on a problem.
@@ -76,9 +84,10 @@ contains
       type(load_path) :: path
       type(legacy_materials) :: mat
       real(dp), allocatable :: table(:, :)
+      type(legacy_pointers) :: at
       integer, allocatable :: joiners(:), joiner_ranks(:), cstep(:), ic(:), jc(:)
       real(dp) :: csum, delta, lambda, tstart, t0, t1, loss, kappa, limit
-      integer :: np, npix, n, step, ncand, njoin, nmissed, k, reason, isurf, igaps, isort, isitu, icont, iforce, iwork
+      integer :: np, npix, n, step, ncand, njoin, nmissed, k, reason
 
       call wall_clock(tstart)
       np = problem%np
@@ -88,20 +97,15 @@ contains
       if (status%code /= 0) return
       call allocate_workspace(ws, status, options%memory_available)
       if (status%code /= 0) return
-      isurf = ws%rfirst(MPSURF)
-      igaps = ws%rfirst(MPGAPS)
-      isort = ws%ifirst(IPSORT)
-      isitu = ws%ifirst(IPSITU)
-      icont = ws%ifirst(IPCONT)
-      iforce = ws%rfirst(MPFORCE)
-      iwork = ws%rfirst(MPWORK)
+      at = legacy_pointers(surf=ws%rfirst(MPSURF), gaps=ws%rfirst(MPGAPS), sort=ws%ifirst(IPSORT), &
+         situ=ws%ifirst(IPSITU), cont=ws%ifirst(IPCONT), force=ws%rfirst(MPFORCE), work=ws%rfirst(MPWORK))
 
       ! CREATEINPUT: heights into MPSURF, the initial gaps computed from them into
       ! MPGAPS, their merge sort into IPSORT, the element types' materials into IPMAT*.
-      ws%ra(isurf:isurf + npix - 1) = reshape(transpose(problem%lower), [npix])
-      ws%ra(isurf + npix:isurf + 2*npix - 1) = reshape(transpose(problem%upper), [npix])
-      ws%ra(igaps:igaps + npix - 1) = initial_gaps(surface_of(1), surface_of(2))
-      call merge_sort_index(ws%ra(igaps:igaps + npix - 1), ws%ia(isort:isort + npix - 1))
+      ws%ra(at%surf:at%surf + npix - 1) = reshape(transpose(problem%lower), [npix])
+      ws%ra(at%surf + npix:at%surf + 2*npix - 1) = reshape(transpose(problem%upper), [npix])
+      ws%ra(at%gaps:at%gaps + npix - 1) = initial_gaps(surface_of(ws, at, np, 1), surface_of(ws, at, np, 2))
+      call merge_sort_index(ws%ra(at%gaps:at%gaps + npix - 1), ws%ia(at%sort:at%sort + npix - 1))
       ws%ia(ws%ifirst(IPMAT):ws%ilast(IPMAT)) = MATERIAL_NUMBERS(:, 1)
       ws%ia(ws%ifirst(IPMAT2):ws%ilast(IPMAT2)) = MATERIAL_NUMBERS(:, 2)
       ws%ia(ws%ifirst(IPMAT3):ws%ilast(IPMAT3)) = MATERIAL_NUMBERS(:, 3)
@@ -112,14 +116,14 @@ contains
       table = offset_table(np)
       allocate(cstep(path%max_contacts), joiners(npix), joiner_ranks(npix))
 
-      associate(g0 => ws%ra(igaps:igaps + npix - 1), order => ws%ia(isort:isort + npix - 1), &
-         situ => ws%ia(isitu:ws%ilast(IPSITU)))
+      n = 0
+      associate(g0 => ws%ra(at%gaps:at%gaps + npix - 1), order => ws%ia(at%sort:at%sort + npix - 1), &
+         situ => ws%ia(at%situ:ws%ilast(IPSITU)))
          ! The first step: the smallest gap and every pixel tied with it, up to MAXCONT.
-         n = 0
          limit = first_touch_limit(g0, g0(order(1)), options%tie_tolerance)
          do k = 1, min(npix, path%max_contacts)
             if (k > 1 .and. g0(order(k)) > limit) exit
-            call add_contact(order(k), k, 1)
+            call add_contact(ws, at, n, cstep, order(k), k, 1)
          end do
 
          step = 0
@@ -136,19 +140,19 @@ contains
             res%condition = max(res%condition, kappa)
             if (status%code /= 0) return
             ncand = candidate_count(n, npix)
-            call postp_search(np, order, ncand, situ, ws%ia(icont:icont + n - 1), g0, table, csum, &
-               ws%ra(iforce:iforce + n - 1), path%approach, ws%ra(iwork:iwork + n - 1), delta, path%total, &
+            call postp_search(np, order, ncand, situ, ws%ia(at%cont:at%cont + n - 1), g0, table, csum, &
+               ws%ra(at%force:at%force + n - 1), path%approach, ws%ra(at%work:at%work + n - 1), delta, path%total, &
                options%tie_tolerance, lambda, joiners, joiner_ranks, njoin, nmissed)
             if (njoin == 0 .and. ncand < npix) then
                ! Nothing closes among the candidates: look at every pixel before giving up.
-               call postp_search(np, order, npix, situ, ws%ia(icont:icont + n - 1), g0, table, csum, &
-                  ws%ra(iforce:iforce + n - 1), path%approach, ws%ra(iwork:iwork + n - 1), delta, path%total, &
+               call postp_search(np, order, npix, situ, ws%ia(at%cont:at%cont + n - 1), g0, table, csum, &
+                  ws%ra(at%force:at%force + n - 1), path%approach, ws%ra(at%work:at%work + n - 1), delta, path%total, &
                   options%tie_tolerance, lambda, joiners, joiner_ranks, njoin, nmissed)
             end if
             res%missed_during_run = res%missed_during_run + nmissed
             if (njoin == 0) lambda = NO_EVENT
             call contact_rows_cols(ws, n, ic, jc)
-            reason = path%close_step(res, lambda, delta, ws%ra(iforce:iforce + n - 1), ws%ra(iwork:iwork + n - 1), &
+            reason = path%close_step(res, lambda, delta, ws%ra(at%force:at%force + n - 1), ws%ra(at%work:at%work + n - 1), &
                ic, jc, t0)
             if (reason /= STOP_NO_CONTACT) then
                call wall_clock(t1)
@@ -163,101 +167,134 @@ contains
                exit
             end if
             do k = 1, njoin
-               call add_contact(joiners(k), joiner_ranks(k), step + 1)
+               call add_contact(ws, at, n, cstep, joiners(k), joiner_ranks(k), step + 1)
             end do
          end do
 
-         if (options%final_check) call final_check()
+         if (options%final_check) call final_check(ws, at, n, cstep, step, table, csum, mat, problem, options, &
+            path, res, status)
          if (status%code /= 0) return
          call contact_rows_cols(ws, n, ic, jc)
-         call finish_contacts(res, ic, jc, cstep(1:n), ws%ra(iforce:iforce + n - 1), path%total)
+         call finish_contacts(res, ic, jc, cstep(1:n), ws%ra(at%force:at%force + n - 1), path%total)
       end associate
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
-
-   contains
-
-      !> Surface `which` (1 lower, 2 upper) from MPSURF, row i column j as in the deck.
-      function surface_of(which) result(z)
-         integer, intent(in) :: which
-         real(dp) :: z(np, np)
-         z = transpose(reshape(ws%ra(isurf + (which - 1)*npix:isurf + which*npix - 1), [np, np]))
-      end function surface_of
-
-      !> Contact n+1 at `pixel` (gap rank `rank`), joined at step `joined`, with no force.
-      subroutine add_contact(pixel, rank, joined)
-         integer, intent(in) :: pixel, rank, joined
-         n = n + 1
-         ws%ia(icont + n - 1) = pixel
-         ws%ra(iforce + n - 1) = 0
-         if (rank <= ws%int_blocks(IPSITU)%size) ws%ia(isitu + rank - 1) = 1
-         cstep(n) = joined
-      end subroutine add_contact
-
-      !> Appendix B's final check over all pixels: the displacement of every pixel at the
-      !> last contact goes to MPDISP2 (both bodies, c sum_k I(p - k) F_k); a pixel whose
-      !> gap is then negative is a missed contact: it is added and the state at the final
-      !> load recomputed exactly. Without missed contacts, the exact solve measures the
-      !> drift of the step accumulation.
-      subroutine final_check()
-         real(dp), allocatable :: fex(:), g0c(:)
-         real(dp) :: aex, gap, scale
-         integer :: r, q, nextra, idisp
-         integer, allocatable :: extra(:), extra_rank(:), byp(:)
-         associate(g0 => ws%ra(igaps:igaps + npix - 1), order => ws%ia(isort:isort + npix - 1), &
-            situ => ws%ia(isitu:ws%ilast(IPSITU)), ftot => ws%ra(iforce:iforce + n - 1))
-            call contact_rows_cols(ws, n, ic, jc)
-            idisp = ws%rfirst(MPDISP2)
-            allocate(extra(npix), extra_rank(npix))
-            nextra = 0
-            do r = 1, npix
-               q = order(r)
-               if (in_contact_at(r, q, situ, ws%ia(icont:icont + n - 1))) cycle
-               ws%ra(idisp + q - 1) = gap_at(0.0_dp, 0.0_dp, csum, table, (q - 1)/np + 1, q - ((q - 1)/np)*np, &
-                  ic, jc, ftot)
-               gap = g0(q) - path%approach + ws%ra(idisp + q - 1)
-               if (gap < -options%tie_tolerance*max(path%approach, tiny(1.0_dp))) then
-                  nextra = nextra + 1
-                  extra(nextra) = q
-                  extra_rank(nextra) = r
-               end if
-            end do
-            ! The handles: the bottom one fixed, the top one moved by the approach.
-            ws%ra(idisp + 4*npix) = 0
-            ws%ra(idisp + 4*npix + 1) = -path%approach
-         end associate
-         res%missed_final_check = nextra
-         if (nextra > 0 .and. path%room_for(n, nextra)) then
-            ! In pixel order, as the search over all pixels finds them.
-            allocate(byp(nextra))
-            call merge_sort_index(real(extra(1:nextra), dp), byp)
-            do q = 1, nextra
-               call add_contact(extra(byp(q)), extra_rank(byp(q)), step)
-            end do
-         end if
-         call contact_rows_cols(ws, n, ic, jc)
-         allocate(g0c(n), fex(n))
-         do q = 1, n
-            g0c(q) = ws%ra(igaps + ws%ia(icont + q - 1) - 1)
-         end do
-         ! The three springs in series at a contact share the contact material (IPMAT2 and
-         ! IPMAT3 name material 3): compliance 3/k.
-         call solve_active_set(ic, jc, g0c, csum, 3/mat%penalty, table, path%total, fex, aex, status)
-         if (status%code /= 0) return
-         associate(ftot => ws%ra(iforce:iforce + n - 1))
-            scale = max(maxval(abs(fex)), tiny(1.0_dp))
-            res%final_check_difference = max(abs(aex - path%approach)/max(abs(aex), tiny(1.0_dp)), &
-               maxval(abs(fex - ftot))/scale)
-            if (nextra > 0) then
-               ftot = fex
-               path%approach = aex
-               res%step_approach(res%nsteps) = aex
-               res%step_contacts(res%nsteps) = n
-               res%step_above_hardness(res%nsteps) = count(ftot/problem%pixel**2 > options%hardness)
-            end if
-         end associate
-      end subroutine final_check
    end subroutine solve_legacy
+
+   !> Surface `which` (1 lower, 2 upper) from MPSURF, row i column j as in the deck.
+   function surface_of(ws, at, np, which) result(z)
+      type(workspace_type), intent(in) :: ws
+      type(legacy_pointers), intent(in) :: at
+      integer, intent(in) :: np, which
+      real(dp) :: z(np, np)
+      z = transpose(reshape(ws%ra(at%surf + (which - 1)*np*np:at%surf + which*np*np - 1), [np, np]))
+   end function surface_of
+
+   !> Contact n+1 at `pixel` (gap rank `rank`), joined at step `joined`, with no force.
+   subroutine add_contact(ws, at, n, cstep, pixel, rank, joined)
+      type(workspace_type), intent(inout) :: ws
+      type(legacy_pointers), intent(in) :: at
+      integer, intent(inout) :: n, cstep(:)
+      integer, intent(in) :: pixel, rank, joined
+      n = n + 1
+      ws%ia(at%cont + n - 1) = pixel
+      ws%ra(at%force + n - 1) = 0
+      if (rank <= ws%int_blocks(IPSITU)%size) ws%ia(at%situ + rank - 1) = 1
+      cstep(n) = joined
+   end subroutine add_contact
+
+   !> Appendix B's final check over all pixels: the displacement of every pixel at the
+   !> last contact goes to MPDISP2 (both bodies, c sum_k I(p - k) F_k); a pixel whose gap
+   !> is then negative is a missed contact: it is added and the state at the final load
+   !> recomputed exactly. Without missed contacts, the exact solve measures the drift of
+   !> the step accumulation.
+   subroutine final_check(ws, at, n, cstep, step, table, csum, mat, problem, options, path, res, status)
+      type(workspace_type), intent(inout) :: ws
+      type(legacy_pointers), intent(in) :: at
+      integer, intent(inout) :: n, cstep(:)
+      integer, intent(in) :: step
+      real(dp), intent(in) :: table(0:, 0:), csum
+      type(legacy_materials), intent(in) :: mat
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(load_path), intent(inout) :: path
+      type(contact_result), intent(inout) :: res
+      type(status_type), intent(inout) :: status
+      real(dp), allocatable :: fex(:), g0c(:)
+      real(dp) :: aex, scale
+      integer :: q, nextra, npix
+      integer, allocatable :: extra(:), extra_rank(:), byp(:), ic(:), jc(:)
+      npix = problem%np**2
+      call missed_contacts(ws, at, n, table, csum, problem%np, options%tie_tolerance, path%approach, extra, &
+         extra_rank, nextra)
+      res%missed_final_check = nextra
+      if (nextra > 0 .and. path%room_for(n, nextra)) then
+         ! In pixel order, as the search over all pixels finds them.
+         allocate(byp(nextra))
+         call merge_sort_index(real(extra(1:nextra), dp), byp)
+         do q = 1, nextra
+            call add_contact(ws, at, n, cstep, extra(byp(q)), extra_rank(byp(q)), step)
+         end do
+      end if
+      call contact_rows_cols(ws, n, ic, jc)
+      allocate(g0c(n), fex(n))
+      do q = 1, n
+         g0c(q) = ws%ra(at%gaps + ws%ia(at%cont + q - 1) - 1)
+      end do
+      ! The three springs in series at a contact share the contact material (IPMAT2 and
+      ! IPMAT3 name material 3): compliance 3/k.
+      call solve_active_set(ic, jc, g0c, csum, 3/mat%penalty, table, path%total, fex, aex, status)
+      if (status%code /= 0) return
+      associate(ftot => ws%ra(at%force:at%force + n - 1))
+         scale = max(maxval(abs(fex)), tiny(1.0_dp))
+         res%final_check_difference = max(abs(aex - path%approach)/max(abs(aex), tiny(1.0_dp)), &
+            maxval(abs(fex - ftot))/scale)
+         if (nextra > 0) then
+            ftot = fex
+            path%approach = aex
+            res%step_approach(res%nsteps) = aex
+            res%step_contacts(res%nsteps) = n
+            res%step_above_hardness(res%nsteps) = count(ftot/problem%pixel**2 > options%hardness)
+         end if
+      end associate
+   end subroutine final_check
+
+   !> The pixels off contact whose gap at the last state (g0 - A + the displacement, into
+   !> MPDISP2) is below -tie A: the final check's missed contacts, with their gap ranks.
+   subroutine missed_contacts(ws, at, n, table, csum, np, tie, approach, extra, extra_rank, nextra)
+      type(workspace_type), intent(inout) :: ws
+      type(legacy_pointers), intent(in) :: at
+      integer, intent(in) :: n, np
+      real(dp), intent(in) :: table(0:, 0:), csum, tie, approach
+      integer, allocatable, intent(out) :: extra(:), extra_rank(:)
+      integer, intent(out) :: nextra
+      integer, allocatable :: ic(:), jc(:)
+      real(dp) :: gap
+      integer :: r, q, idisp, npix
+      npix = np*np
+      associate(g0 => ws%ra(at%gaps:at%gaps + npix - 1), order => ws%ia(at%sort:at%sort + npix - 1), &
+         situ => ws%ia(at%situ:ws%ilast(IPSITU)), ftot => ws%ra(at%force:at%force + n - 1))
+         call contact_rows_cols(ws, n, ic, jc)
+         idisp = ws%rfirst(MPDISP2)
+         allocate(extra(npix), extra_rank(npix))
+         nextra = 0
+         do r = 1, npix
+            q = order(r)
+            if (in_contact_at(r, q, situ, ws%ia(at%cont:at%cont + n - 1))) cycle
+            ws%ra(idisp + q - 1) = gap_at(0.0_dp, 0.0_dp, csum, table, (q - 1)/np + 1, q - ((q - 1)/np)*np, &
+               ic, jc, ftot)
+            gap = g0(q) - approach + ws%ra(idisp + q - 1)
+            if (gap < -tie*max(approach, tiny(1.0_dp))) then
+               nextra = nextra + 1
+               extra(nextra) = q
+               extra_rank(nextra) = r
+            end if
+         end do
+         ! The handles: the bottom one fixed, the top one moved by the approach.
+         ws%ra(idisp + 4*npix) = 0
+         ws%ra(idisp + 4*npix + 1) = -approach
+      end associate
+   end subroutine missed_contacts
 
    !> The element constants from the material numbers in IPMAT, IPMAT2 and IPMAT3 and
    !> the problem's materials (Young's modulus and Poisson's ratio by number).
