@@ -30,22 +30,18 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       real(dp), parameter :: pi = acos(-1.0_dp), widths(3) = [1.0_dp/6, 1.0_dp/4, 1.0_dp/3]
-      character(len=*), parameter :: boundaries(2) = [character(len=8) :: "free", "periodic"]
       integer, allocatable :: sizes(:), rough_sizes(:)
-      real(dp), allocatable :: fractions(:), z(:, :), g0(:, :), s(:, :), previous(:)
+      real(dp), allocatable :: fractions(:), z(:, :), s(:, :), previous(:)
       type(contact_problem) :: deck
       type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: res
       type(parsed_options) :: parsed
-      real(dp) :: estar, pstar, lambda, ratio, closed, slope, load, peak
+      real(dp) :: estar, pstar, lambda, ratio, closed
       real(dp), allocatable :: approach_error(:)
-      real(dp) :: tol, pressure, fraction
-      character(len=:), allocatable :: python, path
-      character(len=512) :: line
-      character(len=64) :: words(8)
-      character(len=*), parameter :: peers(2) = [character(len=25) :: "tamaas", "contactmechanics-periodic"]
-      integer :: n, np, j, k, b, width, i, ios
+      real(dp) :: tol
+      character(len=:), allocatable :: python
+      integer :: n, np, j, k, width, i
       sizes = [64, 128, 256, 512, 1024]
       rough_sizes = [512, 1024]
       fractions = [1.0_dp, 10.0_dp, 30.0_dp]
@@ -123,10 +119,33 @@ contains
          flush(output_unit)
          deallocate(z, s)
       end do
+      call rough_table(rough_sizes, fractions, tol, python, code)
+   end subroutine bench_periodic
+
+   !> The rough half of the table: the benchmark surface at each NP of `sizes` and each
+   !> contact fraction (percent), free and periodic, and the peers (`python`) on it.
+   subroutine rough_table(sizes, fractions, tol, python, code)
+      integer, intent(in) :: sizes(:)
+      real(dp), intent(in) :: fractions(:), tol
+      character(len=*), intent(in) :: python
+      integer, intent(inout) :: code
+      character(len=*), parameter :: boundaries(2) = [character(len=8) :: "free", "periodic"]
+      character(len=*), parameter :: peers(2) = [character(len=25) :: "tamaas", "contactmechanics-periodic"]
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      type(contact_options) :: options
+      type(contact_result) :: res
+      real(dp), allocatable :: g0(:, :)
+      real(dp) :: estar, slope, load, peak, pressure, fraction
+      character(len=:), allocatable :: path
+      character(len=512) :: line
+      character(len=64) :: words(8)
+      integer :: n, np, k, b, i, ios
+      options%solver = SOLVER_CG
       write(output_unit, '(a)') "", "| NP | target % | solver | boundary | wall (s) | iterations | contact % | "// &
          "mean gap (nm) | peak RSS (MB) |", "|---|---|---|---|---|---|---|---|---|"
-      do n = 1, size(rough_sizes)
-         np = rough_sizes(n)
+      do n = 1, size(sizes)
+         np = sizes(n)
          call benchmark_surface(np, "bench periodic", deck, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod bench periodic: "//status%message
@@ -178,7 +197,7 @@ contains
          end do
          if (len(python) > 0) call remove_file_quietly(path)
       end do
-   end subroutine bench_periodic
+   end subroutine rough_table
 
    !> `femcod bench periodic --help`.
    subroutine print_periodic_help()
