@@ -9,6 +9,8 @@ module test_surfaces
    use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS
    use femcod_heights, only: read_heights
    use femcod_scene, only: initial_gaps, flip_upper
+   use femcod_random, only: random_stream, seed_stream, uniform, advance_stream
+   use, intrinsic :: iso_fortran_env, only: int64
    use test_support, only: write_text, read_text, scratch_path, contains_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -25,6 +27,7 @@ contains
          new_unittest("sphere heights", test_sphere), &
          new_unittest("Weierstrass-Mandelbrot terms, eq. 3.7: 18 and 5", test_wm_terms), &
          new_unittest("self-affine surface: rms, mean, reproducible", test_self_affine), &
+         new_unittest("random stream: a jump of n is n draws (0 to 10^5 + 7)", test_stream_jump), &
          new_unittest("plane removal and down-sampling", test_transforms), &
          new_unittest("ASCII matrix: comments, errors", test_matrix), &
          new_unittest("flip and initial gaps (Fig. B.1)", test_gaps), &
@@ -102,6 +105,35 @@ contains
       if (allocated(error)) return
       call check(error, wm_terms(1000.0_dp, 1.0_dp, 5.0_dp), 5)
    end subroutine test_wm_terms
+
+   !> advance_stream(n) against n calls of uniform (the recursion itself): the next
+   !> draws agree exactly, for jumps of 0, 1, 2, 3, 1000 and 100007 (more than 2^16,
+   !> so that mulmod's two halves both carry), from two seeds.
+   subroutine test_stream_jump(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer(int64), parameter :: jumps(6) = [0_int64, 1_int64, 2_int64, 3_int64, 1000_int64, 100007_int64]
+      type(random_stream) :: drawn, jumped
+      real(dp) :: u, v
+      integer(int64) :: k
+      integer :: j, seed, d
+      do seed = 1, 2
+         do j = 1, size(jumps)
+            call seed_stream(drawn, 1000*seed + 7)
+            jumped = drawn
+            do k = 1, jumps(j)
+               call uniform(drawn, u)
+            end do
+            call advance_stream(jumped, jumps(j))
+            do d = 1, 3
+               call uniform(drawn, u)
+               call uniform(jumped, v)
+               call check(error, u == v, "seed "//to_string(seed)//", jump "//to_string(int(jumps(j)))//", draw "// &
+                  to_string(d)//": "//to_string(v)//" against "//to_string(u))
+               if (allocated(error)) return
+            end do
+         end do
+      end do
+   end subroutine test_stream_jump
 
    subroutine test_self_affine(error)
       type(error_type), allocatable, intent(out) :: error
