@@ -18,6 +18,7 @@ module femcod_generate
       self_affine_surface, remove_plane
    implicit none
    private
+   public :: scene_header
    public :: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, RIGID_FACTOR, THESIS_RIGID_FACTOR, KINDS, &
       paraboloid_problem
 
@@ -126,35 +127,8 @@ contains
          ! Rough surfaces: their lowest point at 0 nm, so heights read as protrusions.
          shape = shape - minval(shape)
       end if
-      problem%label = spec%label
-      problem%np = np
-      problem%pixel = spec%pixel
-      if (spec%maxcont > 0) then
-         problem%maxcont = spec%maxcont
-      else if (npunch > 0) then
-         problem%maxcont = npunch
-      else if (spec%kind == "flat") then
-         problem%maxcont = np*np
-      else
-         ! 5 % of the pixels: rough contacts rarely go further, and the legacy solver's
-         ! skyline grows as MAXCONT**2.
-         problem%maxcont = max(1, np*np/20)
-      end if
-      problem%young = spec%young
-      problem%poisson = spec%poisson
-      select case (spec%rigid)
-      case ("upper")
-         problem%young(2) = spec%young*spec%rigid_factor
-         problem%young(3) = spec%young*spec%rigid_factor
-      case ("lower")
-         problem%young(1) = spec%young*spec%rigid_factor
-         problem%young(3) = spec%young*spec%rigid_factor
-      case ("none")
-         problem%young(3) = spec%young*spec%rigid_factor
-      case default
-         call set_error(status, STATUS_BAD_INPUT, "mkdeck: --rigid must be upper, lower or none")
-         return
-      end select
+      call scene_header(spec, np, npunch, problem, status)
+      if (status%code /= 0) return
       allocate(problem%lower(np, np), problem%upper(np, np))
       problem%lower = 0
       problem%upper = 0
@@ -193,6 +167,46 @@ contains
          if (value <= 0) pick = default
       end function pick
    end subroutine build_problem
+
+   !> A scene's problem without its heights: label, NP, pixel, MAXCONT (MAXCONT 0 in the
+   !> spec: `npunch` for punches, NP**2 for a flat, 5 % of NP**2 otherwise) and the
+   !> materials, a rigid body and the interface elements at `rigid_factor` times E. What
+   !> femcod-mpi needs of a surface it makes on its ranks (femcod_mpi_generate).
+   subroutine scene_header(spec, np, npunch, problem, status)
+      type(scene_spec), intent(in) :: spec
+      integer, intent(in) :: np, npunch
+      type(contact_problem), intent(inout) :: problem
+      type(status_type), intent(inout) :: status
+      problem%label = spec%label
+      problem%np = np
+      problem%pixel = spec%pixel
+      if (spec%maxcont > 0) then
+         problem%maxcont = spec%maxcont
+      else if (npunch > 0) then
+         problem%maxcont = npunch
+      else if (spec%kind == "flat") then
+         problem%maxcont = np*np
+      else
+         ! 5 % of the pixels: rough contacts rarely go further, and the legacy solver's
+         ! skyline grows as MAXCONT**2.
+         problem%maxcont = max(1, np*np/20)
+      end if
+      problem%young = spec%young
+      problem%poisson = spec%poisson
+      select case (spec%rigid)
+      case ("upper")
+         problem%young(2) = spec%young*spec%rigid_factor
+         problem%young(3) = spec%young*spec%rigid_factor
+      case ("lower")
+         problem%young(1) = spec%young*spec%rigid_factor
+         problem%young(3) = spec%young*spec%rigid_factor
+      case ("none")
+         problem%young(3) = spec%young*spec%rigid_factor
+      case default
+         call set_error(status, STATUS_BAD_INPUT, "mkdeck: --rigid must be upper, lower or none")
+         return
+      end select
+   end subroutine scene_header
 
    !> The spec of a verification deck of input/ by name; an error for an unknown name.
    subroutine verification_spec(name, spec, status)

@@ -7,12 +7,14 @@ module femcod_surfaces
    use, intrinsic :: iso_c_binding, only: c_double_complex
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
-   use femcod_random, only: random_stream, seed_stream, normal, uniform
+   use femcod_random, only: random_stream, seed_stream, normal, uniform, advance_stream
+   use, intrinsic :: iso_fortran_env, only: int64
    use femcod_sort, only: merge_sort_index
    implicit none
    private
    public :: circle_punch, square_punch, sphere_cap, sinusoid_surface, weierstrass_mandelbrot, wm_terms
-   public :: self_affine_surface, remove_plane, rms_height, downsample_subsample, downsample_average, plane_tilt
+   public :: self_affine_surface, self_affine_spectrum, remove_plane, rms_height, downsample_subsample, &
+      downsample_average, plane_tilt
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -240,14 +242,33 @@ contains
       real(dp), intent(in) :: pixel, hurst, rms
       real(dp), intent(out) :: z(np, np)
       complex(c_double_complex), allocatable :: spec(:, :), field(:, :)
+      allocate(spec(np, np), field(np, np))
+      call self_affine_spectrum(np, pixel, hurst, seed, 0, np, spec)
+      ! FFTW is row-major: a Fortran (np, np) array is an (np, np) C array transposed,
+      ! which a 2-D transform of a square grid does not mind.
+      call inverse_complex_transform(spec, field)
+      z = real(field, dp)
+      z = z - sum(z)/size(z)
+      if (rms_height(z) > 0) z = z*(rms/rms_height(z))
+   end subroutine self_affine_surface
+
+   !> Columns first_column + 1 .. first_column + columns of the self-affine surface's
+   !> spectrum (self_affine_surface), into spec(np, columns): the random stream of `seed`
+   !> jumped ahead to the first of them (four uniforms per frequency: two normal
+   !> deviates), so that each of femcod-mpi's ranks draws its own columns and together
+   !> they draw what one core draws.
+   pure subroutine self_affine_spectrum(np, pixel, hurst, seed, first_column, columns, spec)
+      integer, intent(in) :: np, seed, first_column, columns
+      real(dp), intent(in) :: pixel, hurst
+      complex(c_double_complex), intent(out) :: spec(:, :)
       type(random_stream) :: stream
       real(dp) :: qx, qy, q, qmin, qmax, a, b, amp
       integer :: i, j, fi, fj
-      allocate(spec(np, np), field(np, np))
       call seed_stream(stream, seed)
+      call advance_stream(stream, 4*int(np, int64)*first_column)
       qmin = 2*pi/(np*pixel)
       qmax = pi/pixel
-      do j = 1, np
+      do j = first_column + 1, first_column + columns
          fj = j - 1
          if (fj > np/2) fj = fj - np
          qx = 2*pi*fj/(np*pixel)
@@ -260,16 +281,10 @@ contains
             call normal(stream, b)
             amp = 0
             if (q >= qmin*(1 - 1.0e-12_dp) .and. q <= qmax*(1 + 1.0e-12_dp)) amp = q**(-(1 + hurst))
-            spec(i, j) = cmplx(a*amp, b*amp, c_double_complex)
+            spec(i, j - first_column) = cmplx(a*amp, b*amp, c_double_complex)
          end do
       end do
-      ! FFTW is row-major: a Fortran (np, np) array is an (np, np) C array transposed,
-      ! which a 2-D transform of a square grid does not mind.
-      call inverse_complex_transform(spec, field)
-      z = real(field, dp)
-      z = z - sum(z)/size(z)
-      if (rms_height(z) > 0) z = z*(rms/rms_height(z))
-   end subroutine self_affine_surface
+   end subroutine self_affine_spectrum
 
    !> Root-mean-square height about the mean (nm).
    pure real(dp) function rms_height(z)
