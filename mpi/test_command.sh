@@ -66,6 +66,10 @@ fi
 expect 2 "--kernel-radius on the periodic cell refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 \
   --boundary periodic --kernel-radius 4 -o "$work/bad"
 expect 2 "two decks refused" mpirun_2 "$femcod_mpi" "$deck" ../input/sphere_d2.deck --loads 10
+expect 2 "--generate of a kind the ranks do not make refused" mpirun_2 "$femcod_mpi" --generate sphere --np 32 \
+  --pixel 1 --radius 10 --loads 10 -o "$work/bad"
+expect 2 "--generate next to a deck refused" mpirun_2 "$femcod_mpi" "$deck" --generate self-affine --np 32 \
+  --pixel 1 --loads 10 -o "$work/bad"
 expect 2 "the event solver refused" mpirun_2 "$femcod_mpi" "$deck" --solver incremental --loads 10 -o "$work/bad"
 printf 'a deck\n3 1 x\n' >"$work/broken.deck"
 expect 3 "a broken deck" mpirun_2 "$femcod_mpi" "$work/broken.deck" --loads 10 -o "$work/bad"
@@ -151,6 +155,34 @@ for args in "--loads 300,800 --kernel-radius 6" "--loads 300,800 --kernel-radius
      "$m.serial.loads.csv" "$m.loads.csv"; then answered=$((answered + 1))
   else echo "  FAILED   femcod-mpi $args: not the serial answer (exit $got)"; matrix_failed=1; fi
 done
+# --generate (the surface made on the ranks) with boundary x cap x question: the answer of
+# serial femcod run on the deck femcod mkdeck writes with the same options (approaches,
+# loads and plastic volumes to 1e-6, the same counts), or a refusal with no output.
+surface="--np 64 --pixel 2 --hurst 0.8 --rms 1 --seed 3 --shape-on lower"
+"$femcod" mkdeck self-affine $surface -o "$work/generated.deck" >/dev/null
+for boundary in free periodic; do for plastic in "" "--plastic --hardness 8"; do
+for question in "--loads 200,900" "--approach 1,0.5"; do
+  combos=$((combos + 1)); m="$work/m$combos"
+  args="--boundary $boundary $plastic $question --tol 1e-10 --max-iterations 20000 --quiet"
+  got=0; mpirun_2 "$femcod_mpi" --generate self-affine $surface $args -o "$m" >"$m.out" 2>&1 || got=$?
+  if [ "$got" -eq 2 ] && ! ls "$m".* 2>/dev/null | grep -qv '\.out$'; then refused=$((refused + 1)); continue; fi
+  "$femcod" run "$work/generated.deck" --solver cg $args -o "$m.serial" >/dev/null 2>&1 || got=1
+  if [ "$got" -eq 0 ] && grep -q '"input": "made on the ranks: self-affine' "$m.summary.json" && \
+     python3 - "$m.serial.loads.csv" "$m.loads.csv" <<'PY'
+import csv, sys
+a = list(csv.DictReader(open(sys.argv[1])))
+b = list(csv.DictReader(open(sys.argv[2])))
+assert len(a) == len(b) == 2, (len(a), len(b))
+for x, y in zip(a, b):
+    for key in ("load_nN", "approach_nm", "plastic_volume_nm3"):
+        u, v = float(x[key]), float(y[key])
+        assert abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
+    for key in ("contacts", "n_plastic"):
+        assert x[key] == y[key], (key, x[key], y[key])
+PY
+  then answered=$((answered + 1))
+  else echo "  FAILED   femcod-mpi --generate self-affine $args: not the serial answer (exit $got)"; matrix_failed=1; fi
+done; done; done
 if [ "$matrix_failed" -eq 0 ]; then
   echo "  passed   the combination matrix on 2 ranks: $combos combinations, $refused refused, $answered answered as serial"
 else

@@ -21,7 +21,10 @@ program femcod_mpi
    use femcod_memory, only: physical_memory, memory_text, resident_bytes, memory_setting, MEMORY_VARIABLE
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED, STATUS_NUMERICAL
    use femcod_strings, only: string_type, int_str, sig_str, format_real, json_string, json_number
-   use femcod_cli, only: command_arguments
+   use femcod_cli, only: command_arguments, mkdeck_table, parse_mkdeck_arguments
+   use femcod_options, only: option_spec, FLAG
+   use femcod_generate, only: scene_spec
+   use femcod_mpi_generate, only: generate_columns
    use femcod_run, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
@@ -65,7 +68,8 @@ program femcod_mpi
    integer(i8) :: estimated_rank_bytes
    type(state_maps), allocatable :: figures(:)
    integer :: provided, rank, ranks, np, block, code, k, figure
-   logical :: locked, slab_input
+   logical :: locked, slab_input, generating
+   type(scene_spec) :: generated
 
    call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
@@ -90,17 +94,27 @@ program femcod_mpi
       if (rank == 0) call print_help()
       call finish(0, "")
    end if
+   ! --generate KIND and mkdeck's options: the surface made on the ranks (no input file).
+   call take_generator_arguments(args, generated, generating, status)
+   if (status%code /= 0) call finish(status%code, status%message//" (femcod-mpi --help)")
    ! The solver is cg; `--solver cg` may be given, no other.
    if (.not. any([(args(k)%s == "--solver", k = 1, size(args))])) &
       args = [string_type("--solver"), string_type("cg"), args]
    call parse_run_arguments(args, settings, status)
+   if (status%code == 0 .and. generating) then
+      if (size(settings%decks) /= 1 .or. settings%from_files) call set_error(status, STATUS_USAGE, "--generate "// &
+         "makes the surface on the ranks: give no DECK and no --lower/--upper with it")
+   end if
    if (status%code == 0) call refuse_unsupported(settings, status)
    if (status%code /= 0) call finish(status%code, status%message//" (femcod-mpi --help)")
    prefix = settings%prefixes(1)%s
 
    ! Rank 0 reads the inputs and checks the outputs; the others wait for its verdict.
    if (rank == 0) then
-      if (settings%decks(1)%s == "") then
+      if (generating) then
+         ! Made on the ranks below: nothing to read.
+         problem%label = generated%label
+      else if (settings%decks(1)%s == "") then
          call load_scene(settings%scene, problem, status, warnings=warnings)
          if (allocated(warnings)) then
             do k = 1, size(warnings)
@@ -130,8 +144,14 @@ program femcod_mpi
    if (status%code /= 0) call finish(status%code, status%message)
 
    slab_input = .false.
-   if (settings%decks(1)%s /= "") slab_input = is_hdf5_file(settings%decks(1)%s)
-   if (slab_input) then
+   if (settings%decks(1)%s /= "" .and. .not. generating) slab_input = is_hdf5_file(settings%decks(1)%s)
+   if (generating) then
+      ! Each rank makes its own columns of the surface (FFTW-MPI).
+      call generate_columns(generated, MPI_COMM_WORLD, settings%solve%cg, header, local, constants, block, status)
+      call agree(status, MPI_COMM_WORLD)
+      if (rank == 0) problem = header
+      if (status%code /= 0) call finish(status%code, status%message)
+   else if (slab_input) then
       ! Each rank reads its own columns of the HDF5 deck (parallel HDF5, collective).
       call read_deck_columns(settings%decks(1)%s, MPI_COMM_WORLD, settings%solve%cg, header, local, constants, &
          block, status)
@@ -244,6 +264,86 @@ contains
       end associate
    end subroutine refuse_unsupported
 
+   !> `--generate KIND` with mkdeck's options for it (femcod mkdeck --help): taken out of
+   !> `args` into `spec`, and KIND left in their place as the run's deck name (it names
+   !> the results unless -o does). Nothing else changes: the rest are run's options.
+   subroutine take_generator_arguments(args, spec, generating, status)
+      type(string_type), allocatable, intent(inout) :: args(:)
+      type(scene_spec), intent(out) :: spec
+      logical, intent(out) :: generating
+      type(status_type), intent(inout) :: status
+      character(len=*), parameter :: NOT_FOR_RANKS = " --output --force --verification --dir --file --maxcont "// &
+         "--height-unit "
+      type(option_spec), allocatable :: table(:)
+      type(string_type), allocatable :: taken(:), kept(:)
+      character(len=:), allocatable :: output, verification, dir
+      integer :: k, m, j, nt, nk
+      logical :: labelled
+      generating = any([(args(k)%s == "--generate", k = 1, size(args))])
+      if (.not. generating) return
+      table = mkdeck_table()
+      ! Filled element by element (gfortran mishandles constructors of these).
+      allocate(taken(size(args) + 2), kept(size(args)))
+      nt = 1
+      nk = 0
+      labelled = .false.
+      k = 1
+      do while (k <= size(args))
+         if (args(k)%s == "--generate") then
+            if (k == size(args)) then
+               call set_error(status, STATUS_USAGE, "--generate needs a KIND (self-affine)")
+               return
+            end if
+            taken(1)%s = args(k + 1)%s
+            nk = nk + 1
+            kept(nk)%s = args(k + 1)%s
+            k = k + 2
+            cycle
+         end if
+         ! One of mkdeck's options for the surface (not its file and output options).
+         m = 0
+         if (index(NOT_FOR_RANKS, " "//args(k)%s//" ") == 0) then
+            do j = 1, size(table)
+               if (table(j)%name == args(k)%s) m = j
+            end do
+         end if
+         if (m == 0) then
+            nk = nk + 1
+            kept(nk)%s = args(k)%s
+            k = k + 1
+            cycle
+         end if
+         labelled = labelled .or. args(k)%s == "--label"
+         nt = nt + 1
+         taken(nt)%s = args(k)%s
+         if (table(m)%kind /= FLAG .and. k < size(args)) then
+            nt = nt + 1
+            taken(nt)%s = args(k + 1)%s
+            k = k + 1
+         end if
+         k = k + 1
+      end do
+      taken(nt + 1)%s = "--output"
+      taken(nt + 2)%s = "(the ranks)"
+      call parse_mkdeck_arguments(taken(1:nt + 2), spec, output, verification, dir, status)
+      if (status%code /= 0) return
+      if (.not. labelled) spec%label = "femcod-mpi --generate "//spec%kind
+      args = kept(1:nk)
+   end subroutine take_generator_arguments
+
+   !> Which input path the run took (the summary's "input").
+   function input_path() result(text)
+      character(len=:), allocatable :: text
+      if (generating) then
+         text = "made on the ranks: "//generated%kind//", NP "//int_str(generated%np)//", seed "// &
+            int_str(generated%seed)
+      else if (slab_input) then
+         text = "HDF5 deck, each rank its own columns"
+      else
+         text = "rank 0 reads, sends columns"
+      end if
+   end function input_path
+
    !> Displacement control: --approach given.
    logical function by_approach()
       by_approach = .false.
@@ -303,7 +403,9 @@ contains
       do j = 1, nloads
          outputs(3 + j)%s = prefix//".pressure_"//int_str(j)//".svg"
       end do
-      if (settings%decks(1)%s /= "") then
+      if (generating) then
+         allocate(inputs(0))
+      else if (settings%decks(1)%s /= "") then
          allocate(inputs(1))
          inputs(1)%s = settings%decks(1)%s
       else if (settings%scene%second_file /= "") then
@@ -373,8 +475,7 @@ contains
          ', "mpi_ranks": '//int_str(ranks)//', "threads_per_rank": '//int_str(info%threads)// &
          ', "wall_time_s": '//json_number(t_write - t_start)//', "read_time_s": '//json_number(t_read - t_start)// &
          ', "solve_time_s": '//json_number(t_solve - t_read)//', "write_time_s": '//json_number(t_write - t_solve)// &
-         ', "input": '//json_string(trim(merge("HDF5 deck, each rank its own columns", &
-         "rank 0 reads, sends columns         ", slab_input)))//', "peak_memory_MB_per_rank": ['
+         ', "input": '//json_string(input_path())//', "peak_memory_MB_per_rank": ['
       do s = 1, ranks
          text = text//json_number(info%peak_mb(s))//trim(merge(", ", "  ", s < ranks))
       end do
@@ -440,6 +541,9 @@ contains
    subroutine print_help()
       write(output_unit, '(a)') "usage: mpirun -np P femcod-mpi DECK --loads F1,F2,... [options]"
       write(output_unit, '(a)') "       mpirun -np P femcod-mpi --lower FILE[:DATASET] --pixel D --loads F1,... [options]"
+      write(output_unit, '(a)') "       mpirun -np P femcod-mpi --generate self-affine --np N --pixel D [--hurst H --rms R"
+      write(output_unit, '(a)') "         --seed S ...] --loads F1,... [options]   (the surface made on the ranks, as"
+      write(output_unit, '(a)') "         femcod mkdeck self-affine makes it; no input file)"
       write(output_unit, '(a)') ""
       write(output_unit, '(a)') "The fixed-load solver (femcod run --solver cg) with the grid split in column slabs"
       write(output_unit, '(a)') "across MPI ranks: FFTW-MPI transforms, parallel HDF5 output. The options are those"

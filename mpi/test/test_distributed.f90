@@ -17,6 +17,8 @@ module test_distributed
    use femcod_solver, only: solve_contact
    use femcod_observer, only: solver_observer
    use femcod_interface_law, only: make_interface_law
+   use femcod_mpi_generate, only: generate_columns
+   use femcod_scene, only: initial_gap_map
    use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, &
       coarse_factor, distribute_problem, distributed_convolve
    implicit none
@@ -33,6 +35,7 @@ contains
          new_unittest("float32 convolution within float32's round-off of the double one", test_single), &
          new_unittest("too few columns for the ranks: refused on every rank", test_too_few_columns), &
          new_unittest("Hertz at 1000 nN on the 0.5 nm sphere deck", test_hertz), &
+         new_unittest("--generate self-affine: mkdeck's surface on 1, 2 and 4 ranks, to round-off", test_generate), &
          new_unittest("the serial cg solver's answer on 1, 2 and 4 ranks, rough surface", test_against_serial), &
          new_unittest("--plastic: the serial answer and plastic set on 1, 2 and 4 ranks", test_plastic_against_serial), &
          new_unittest("--approach: the serial loads on 1, 2 and 4 ranks", test_approach_against_serial), &
@@ -183,6 +186,72 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MIN, MPI_COMM_WORLD)
       call check(error, code, STATUS_USAGE, "the smallest status code over the ranks")
    end subroutine test_too_few_columns
+
+   !> A self-affine surface made on groups of 1, 2 and 4 ranks (generate_columns: each
+   !> rank its columns of the spectrum, the random stream jumped ahead, FFTW-MPI's
+   !> transform) against the one `femcod mkdeck self-affine` makes on one core
+   !> (build_problem, then femcod_scene's gaps) with the same options, shape on either
+   !> surface: every gap within 1e-12 of the height range (the two transforms round
+   !> differently), and the same constants. NP 96 (even slabs) with the shape on the lower
+   !> surface, NP 90 (23, 23, 23, 21 columns on 4 ranks) on the upper.
+   subroutine test_generate(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck, header
+      type(status_type) :: status
+      type(MPI_Comm) :: group
+      real(dp), allocatable :: local(:, :), g0(:, :), whole(:, :)
+      integer, allocatable :: firsts(:), counts(:)
+      real(dp) :: constants(4), worst(1), range
+      integer :: ranks, rank, group_size, group_rank, block, side, code(1)
+      call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+      call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+      do side = 1, 2
+         spec%kind = "self-affine"
+         spec%label = "test"
+         spec%np = merge(96, 90, side == 1)
+         spec%pixel = 1.5_dp
+         spec%hurst = 0.7_dp
+         spec%rms = 2
+         spec%seed = 11
+         spec%shape_on = trim(merge("lower", "upper", side == 1))
+         call build_problem(spec, deck, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         g0 = initial_gap_map(deck%lower, deck%upper)
+         range = maxval(g0) - minval(g0)
+         group_size = 1
+         do while (group_size <= min(ranks, 4))
+            call MPI_Comm_split(MPI_COMM_WORLD, merge(rank/group_size, MPI_UNDEFINED, rank/group_size < &
+               ranks/group_size), rank, group)
+            worst = 0
+            code = 0
+            if (group /= MPI_COMM_NULL) then
+               call MPI_Comm_rank(group, group_rank)
+               call generate_columns(spec, group, cg_settings(), header, local, constants, block, status)
+               code(1) = status%code
+               if (code(1) == 0) then
+                  call column_split(spec%np, group_size, block, firsts, counts)
+                  allocate(whole(spec%np, spec%np))
+                  call MPI_Gatherv(local, spec%np*counts(group_rank), MPI_DOUBLE_PRECISION, whole, &
+                     spec%np*counts, spec%np*firsts, MPI_DOUBLE_PRECISION, 0, group)
+                  if (group_rank == 0) worst(1) = maxval(abs(whole - g0))/range + &
+                     abs(constants(2) - deck%pixel) + abs(header%young(3) - deck%young(3))
+                  deallocate(whole)
+               end if
+               call MPI_Comm_free(group)
+            end if
+            call MPI_Allreduce(MPI_IN_PLACE, worst, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+            call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
+            call check(error, code(1), 0, "generate on "//to_string(group_size)//" ranks")
+            if (allocated(error)) return
+            call check(error, worst(1) <= 1.0e-12_dp, "the surface on "//to_string(group_size)//" ranks, shape on "// &
+               spec%shape_on//": largest gap difference "//to_string(worst(1))//" of the height range")
+            if (allocated(error)) return
+            group_size = 2*group_size
+         end do
+      end do
+   end subroutine test_generate
 
    !> input/sphere_d05.deck (R = 15 nm, 0.5 nm pixels) at 1000 nN: Hertz's approach
    !> (eq. 4.14, femcod_analytic) within 1 %, the serial solver's tolerance (test_cg).

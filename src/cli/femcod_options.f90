@@ -17,7 +17,7 @@ module femcod_options
       parse_integer_list, split_list
    implicit none
    private
-   public :: option_spec, parsed_options, parse_options, option_help, scene_options
+   public :: option_spec, parsed_options, parse_options, option_help, scene_options, FLAG
    public :: flag_option, real_option, integer_option, text_option, choice_option, real_list_option, &
       integer_list_option
    public :: get_option, option_given, refuse_options, option_value_text
