@@ -41,11 +41,11 @@ program femcod_mpi
    use femcod_exit, only: exit_program
    use femcod_help, only: help_requested
    use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, scatter_problem, grid_setup
+   use femcod_cg, only: distributed_storage_bytes
    use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, &
       agree
    use femcod_svg, only: svg_pressure_map
    use femcod_maps, only: state_maps
-   use femcod_cg, only: cg_storage_bytes
    use femcod_gap_cg, only: gap_solver_storage_bytes
    use femcod_interface_law, only: make_interface_law
    use femcod_solver_options, only: by_gap_variables, &
@@ -360,8 +360,9 @@ contains
       end if
    end function targets
 
-   !> Each rank's storage: what it holds now and its share of the cg solver's arrays
-   !> (cg_storage_bytes over the ranks: the grid is split in column slabs). The ranks that
+   !> Each rank's storage: what it holds now and its share of the distributed solver's
+   !> arrays (distributed_storage_bytes over the ranks: the grid is split in column slabs;
+   !> with the gap variables their transform grid too). The ranks that
    !> share a node (MPI_COMM_TYPE_SHARED) share its memory, so their sum is compared with
    !> it; the largest node's sum is reported.
    subroutine check_node_memory(n, nstates, st)
@@ -369,15 +370,12 @@ contains
       type(status_type), intent(inout) :: st
       type(MPI_Comm) :: node
       integer(i8) :: on_node, worst, may
-      if (by_gap_variables(settings%solve)) then
-         ! The gap variables: their transform grid besides the fixed-load solver's grid.
-         estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, settings%solve%boundary == &
-            BOUNDARY_PERIODIC, settings%solve%plastic) + gap_solver_storage_bytes(n, nstates, &
-            settings%solve%boundary == BOUNDARY_PERIODIC, settings%solve%plastic) + ranks - 1)/ranks
-      else
-         estimated_rank_bytes = resident_bytes() + (cg_storage_bytes(n, nstates, settings%solve%boundary == &
-            BOUNDARY_PERIODIC, settings%solve%plastic) + ranks - 1)/ranks
-      end if
+      estimated_rank_bytes = distributed_storage_bytes(n, nstates, settings%solve%boundary == BOUNDARY_PERIODIC, &
+         settings%solve%plastic)
+      ! The gap variables: their transform grid besides the fixed-load solver's grid.
+      if (by_gap_variables(settings%solve)) estimated_rank_bytes = estimated_rank_bytes + &
+         gap_solver_storage_bytes(n, nstates, settings%solve%boundary == BOUNDARY_PERIODIC, settings%solve%plastic)
+      estimated_rank_bytes = resident_bytes() + (estimated_rank_bytes + ranks - 1)/ranks
       call MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
       call MPI_Allreduce(estimated_rank_bytes, on_node, 1, MPI_INTEGER8, MPI_SUM, node)
       call MPI_Comm_free(node)
