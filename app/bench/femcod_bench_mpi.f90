@@ -20,8 +20,9 @@ module femcod_bench_mpi
 contains
 
    !> `femcod bench mpi`: the whole femcod-mpi command under mpirun, as a user runs it,
-   !> against the whole serial `femcod run --solver cg`, on the benchmark surface (written
-   !> once per NP as an HDF5 height file) at the load of about --contact % contact: wall
+   !> against the whole serial `femcod run --solver cg`, on the benchmark surface (for the
+   !> serial run written once per NP as an HDF5 height file, femcod-mpi makes it on its
+   !> ranks with --generate) at the load of about --contact % contact: wall
    !> time, the solve and its shares in transforms and communication (rank 0, from the
    !> run's PREFIX.summary.json), iterations, peak memory of the largest rank, and the
    !> approach's difference from the serial run's.
@@ -30,7 +31,7 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       integer, allocatable :: sizes(:), ranks(:)
-      character(len=:), allocatable :: dir, heights, prefix, command, text, mpirun, program, common
+      character(len=:), allocatable :: dir, heights, prefix, command, text, mpirun, program, common, generated
       type(contact_problem) :: deck
       type(status_type) :: status
       type(parsed_options) :: parsed
@@ -41,7 +42,9 @@ contains
       integer :: n, np, r, ios, threads, cores, per_node
       ! What the estimate needs, per NP: convolutions (iterations + fresh); of the 1-rank
       ! run its threads, transform, communication and solve seconds, peak MB and the peak
-      ! MB of reading; of the largest run on more ranks its communication seconds and ranks.
+      ! MB of its input (the surface made on the rank) and its input seconds (making the
+      ! surface and the grid); of the largest run on more ranks its communication seconds
+      ! and ranks.
       real(dp), allocatable :: measured(:, :)
       real(dp) :: network, latency_us
       sizes = [1024, 2048, 4096]
@@ -72,7 +75,7 @@ contains
       call get_option(parsed, "--cores-per-node", per_node)
       call get_option(parsed, "--network", network)
       call get_option(parsed, "--latency", latency_us)
-      allocate(measured(9, size(sizes)))
+      allocate(measured(10, size(sizes)))
       measured = 0
       if (is_root()) mpirun = mpirun//" --allow-run-as-root"
       cores = omp_get_num_procs()
@@ -95,12 +98,16 @@ contains
             code = status%code
             return
          end if
-         common = " --lower '"//heights//":/heights' --pixel "//real_str(deck%pixel, 17)//" --loads "// &
-            real_str(load, 17)//" --tol "//real_str(tol, 3)//" --force --quiet"
+         common = " --loads "//real_str(load, 17)//" --tol "//real_str(tol, 3)//" --force --quiet"
+         ! The serial run reads the surface from its HDF5 height file; femcod-mpi makes the
+         ! same surface on its ranks (--generate: benchmark_surface's spec), no input file.
+         generated = " --generate self-affine --np "//int_str(np)//" --pixel "//real_str(deck%pixel, 17)// &
+            " --hurst 0.8 --rms 3 --seed 1 --shape-on lower --rigid upper"
          deallocate(deck%lower, deck%upper)
          ! The serial command on all cores.
          prefix = dir//"/serial_"//int_str(np)
-         command = "OMP_NUM_THREADS="//int_str(cores)//" "//self_path()//" run --solver cg"//common//" -o '"//prefix//"'"
+         command = "OMP_NUM_THREADS="//int_str(cores)//" "//self_path()//" run --solver cg --lower '"//heights// &
+            ":/heights' --pixel "//real_str(deck%pixel, 17)//common//" -o '"//prefix//"'"
          call timed(command, t_run, ios)
          if (ios /= 0) then
             write(output_unit, '(a)') "| "//int_str(np)//" | femcod run | 1 x "//int_str(cores)//" | | | | | | | | "// &
@@ -118,7 +125,7 @@ contains
             threads = max(1, cores/ranks(r))
             prefix = dir//"/mpi_"//int_str(np)//"_"//int_str(ranks(r))
             command = "OMP_NUM_THREADS="//int_str(threads)//" "//mpirun//" -np "//int_str(ranks(r))//" "//program// &
-               common//" -o '"//prefix//"'"
+               generated//common//" -o '"//prefix//"'"
             call timed(command, t_run, ios)
             if (ios /= 0) then
                write(output_unit, '(a)') "| "//int_str(np)//" | femcod-mpi | "//int_str(ranks(r))//" x "// &
@@ -128,9 +135,10 @@ contains
             text = read_text_file(prefix//".summary.json")
             t_solve = json_value(text, '"solve_time_s"')
             measured(1, n) = json_value(text, '"iterations"') + json_value(text, '"convolutions"')
-            if (ranks(r) == 1) measured([2, 3, 4, 5, 6, 9], n) = [real(threads, dp), json_value(text, '"transform_s"'), &
-               json_value(text, '"communication_s"'), t_solve, json_list_max(text, '"peak_memory_MB_per_rank"'), &
-               json_value(text, '"read_peak_memory_MB"')]
+            if (ranks(r) == 1) measured([2, 3, 4, 5, 6, 9, 10], n) = [real(threads, dp), &
+               json_value(text, '"transform_s"'), json_value(text, '"communication_s"'), t_solve, &
+               json_list_max(text, '"peak_memory_MB_per_rank"'), json_value(text, '"read_peak_memory_MB"'), &
+               json_value(text, '"read_time_s"')]
             if (ranks(r) > 1 .and. ranks(r) >= measured(8, n)) measured(7:8, n) = &
                [json_value(text, '"communication_s"'), real(ranks(r), dp)]
             approach = json_value(text, '"approach_nm"')
@@ -175,11 +183,12 @@ contains
          "The whole femcod-mpi command (bash setup.sh --mpi) under CMD -np P for each P of --ranks, each", &
          "rank with cores/P OpenMP threads, against the whole serial femcod run --solver cg on all cores:", &
          "the benchmark surface (self-affine, Hurst 0.8, rms 3 nm, 5 um square, rigid flat, seed 1),", &
-         "written once per NP as DIR/surface_NP.h5:/heights, at the load of about --contact % contact", &
+         "read by femcod run from DIR/surface_NP.h5:/heights (written once per NP) and made by", &
+         "femcod-mpi on its ranks (--generate self-affine, the same surface), at the load of about --contact % contact", &
          "(the linear law of femcod bench cg). As root, CMD gets --allow-run-as-root.", &
          "Then the estimate for 16384^2 to 65536^2 on 16 to 1024 ranks (one core each, --cores-per-node", &
-         "per node, --network GB/s per node, --latency us per message), from this run's measured costs", &
-         "(the method is printed).", ""
+         "per node, --network GB/s per node, --latency us per message), from this run's measured costs,", &
+         "the input path (the surface made on the ranks) included (the method is printed).", ""
       call print_lines(option_help(bench_mpi_table(), ""))
       write(output_unit, '(a)') "Columns: NP, run, ranks x threads, whole command s, solve s, transforms % and", &
          "communication % of the solve (rank 0: the 1-D FFTs; FFTW-MPI's transposes, the sums and halos,", &
@@ -211,8 +220,10 @@ contains
    !> times its threads), divided over the ranks, plus moving its two transposes (32 NP^2
    !> bytes): over the network at `network` GB/s per node, a share (N - 1)/N^2 per node of
    !> N, or within one node at the rate measured here on more ranks; plus 4 P messages of
-   !> `latency_us` each. Memory per rank: the 1-rank peak per pixel over P; rank 0 reads the input
-   !> besides (its peak before the solve allocates, per pixel, measured).
+   !> `latency_us` each. Memory per rank: the 1-rank peak per pixel over P. The input path
+   !> (the surface made on the ranks, and the grid's set-up): its 1-rank seconds per
+   !> pixel and log2(NP) (an FFT of the surface), divided over the ranks; its peak per
+   !> pixel (the spectrum and the surface) over P, before the solve allocates.
    subroutine print_mpi_estimate(sizes, measured, per_node, network, latency_us)
       integer, intent(in) :: sizes(:)
       real(dp), intent(in) :: measured(:, :)
@@ -221,7 +232,7 @@ contains
       real(dp), intent(in) :: network, latency_us
       integer, parameter :: targets(3) = [16384, 32768, 65536], rank_counts(4) = [16, 64, 256, 1024]
       real(dp) :: beta, sx, sy, sxx, sxy, k, r, bytes_px, read_px, local_rate, np0, conv0, conv, compute, moving, &
-         latency, x, y
+         latency, x, y, input_k, input
       integer :: n, base, t, p, nodes, count
       base = 0
       do n = 1, size(sizes)
@@ -261,32 +272,37 @@ contains
       r = max(0.0_dp, measured(5, base) - measured(3, base) - measured(4, base))*measured(2, base)/(conv0*np0**2)
       bytes_px = measured(6, base)*1048576/np0**2
       read_px = measured(9, base)*1048576/np0**2
+      input_k = measured(10, base)*measured(2, base)/(np0**2*log(np0)/log(2.0_dp))
       local_rate = 0
       if (measured(7, base) > 0) local_rate = 32*np0**2/(measured(7, base)/conv0)
       write(output_unit, '(a)') "", "Estimate (from NP = "//int_str(sizes(base))//" on 1 rank x "// &
          int_str(nint(measured(2, base)))//" threads: "//real_str(k, 3)//" core-s per pixel and log2(2 NP) in the "// &
          "transforms and "//real_str(r, 3)//" core-s per pixel in the rest, per convolution; "// &
-         int_str(nint(bytes_px))//" bytes per pixel, "//int_str(nint(read_px))//" for reading on rank 0; "// &
+         int_str(nint(bytes_px))//" bytes per pixel, "//int_str(nint(read_px))//" while making the input; "// &
+         "the input "//real_str(input_k, 3)//" core-s per pixel and log2(NP); "// &
          "convolutions ~ NP^"//fixed_str(beta, 2)//" from "// &
          int_str(count)//" sizes; within a node the transposes move "//real_str(local_rate/1.0e9_dp, 2)// &
          " GB/s on "//int_str(nint(measured(8, base)))//" ranks (measured; P ranks in one node taken to move P/"// &
          int_str(nint(measured(8, base)))//" times as much), between nodes "// &
          fixed_str(network, 1)//" GB/s per node and "//fixed_str(latency_us, 1)//" us per message, "// &
          int_str(per_node)//" ranks per node):"
-      ! The model's own check: twice the base NP on this machine's cores (1 rank with the
-      ! measured threads, and the measured larger rank count sharing them).
-      x = 2*np0
-      conv = conv0*2**beta
-      compute = (k*x**2*log(2*x)/log(2.0_dp) + r*x**2)/measured(2, base)
-      write(output_unit, '(a)') "", "Check on this machine, NP = "//int_str(nint(x))//": "//int_str(nint(conv))// &
-         " convolutions, "//int_str(nint(conv*(compute + measured(4, base)/conv0*4)))//" s on 1 rank x "// &
-         int_str(nint(measured(2, base)))//" threads"
-      if (local_rate > 0) write(output_unit, '(a)') "  and "//int_str(nint(conv*(compute + 32*x**2/local_rate)))// &
-         " s on "//int_str(nint(measured(8, base)))//" ranks sharing the same cores (run --np "//int_str(nint(x))// &
-         " to compare)."
-      write(output_unit, '(a)') "", "| NP | ranks | nodes | memory per rank GB (rank 0 reads GB) | convolutions | "// &
-         "compute s / convolution | transposes s / convolution | solve estimate s |"
-      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|"
+      ! The model's own check: twice and four times the base NP on this machine's cores (1
+      ! rank with the measured threads, and the measured larger rank count sharing them).
+      do t = 1, 2
+         x = 2**t*np0
+         conv = conv0*(2.0_dp**t)**beta
+         compute = (k*x**2*log(2*x)/log(2.0_dp) + r*x**2)/measured(2, base)
+         input = input_k*x**2*log(x)/log(2.0_dp)/measured(2, base)
+         write(output_unit, '(a)') "", "Check on this machine, NP = "//int_str(nint(x))//": "//int_str(nint(conv))// &
+            " convolutions, "//int_str(nint(conv*(compute + measured(4, base)/conv0*4)))//" s to solve and "// &
+            fixed_str(input, 1)//" s of input on 1 rank x "//int_str(nint(measured(2, base)))//" threads"
+         if (local_rate > 0) write(output_unit, '(a)') "  and "//int_str(nint(conv*(compute + 32*x**2/local_rate)))// &
+            " s on "//int_str(nint(measured(8, base)))//" ranks sharing the same cores (run --np "//int_str(nint(x))// &
+            " to compare)."
+      end do
+      write(output_unit, '(a)') "", "| NP | ranks | nodes | memory per rank GB (input GB) | convolutions | "// &
+         "compute s / convolution | transposes s / convolution | solve estimate s | input s | whole estimate s |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|---|"
       do t = 1, size(targets)
          do p = 1, size(rank_counts)
             nodes = max(1, (rank_counts(p) + per_node - 1)/per_node)
@@ -301,10 +317,13 @@ contains
                moving = 0
             end if
             latency = 4*rank_counts(p)*latency_us*1.0e-6_dp
+            input = input_k*x**2*log(x)/log(2.0_dp)/rank_counts(p)
             write(output_unit, '(a)') "| "//int_str(targets(t))//" | "//int_str(rank_counts(p))//" | "// &
                int_str(nodes)//" | "//fixed_str(bytes_px*x**2/rank_counts(p)/1.0e9_dp, 2)//" ("// &
-               fixed_str(read_px*x**2/1.0e9_dp, 1)//") | "//int_str(nint(conv))//" | "//fixed_str(compute, 3)//" | "// &
-               fixed_str(moving + latency, 3)//" | "//int_str(nint(conv*(compute + moving + latency)))//" |"
+               fixed_str(read_px*x**2/rank_counts(p)/1.0e9_dp, 2)//") | "//int_str(nint(conv))//" | "// &
+               fixed_str(compute, 3)//" | "//fixed_str(moving + latency, 3)//" | "// &
+               int_str(nint(conv*(compute + moving + latency)))//" | "//fixed_str(input, 1)//" | "// &
+               int_str(nint(conv*(compute + moving + latency) + input))//" |"
          end do
       end do
    end subroutine print_mpi_estimate
