@@ -86,6 +86,14 @@ if SLURM_CPUS_PER_TASK=1 INPUT="$deck" FEMCOD_MPI="$femcod_mpi" FEMCOD_ARGS="--l
 else
   echo "  FAILED   doc/cluster/mpi.sbatch"; sed 's/^/           /' "$work/out.txt" | head -5; failed=1
 fi
+# The Contact Mechanics Challenge script at a size this machine runs in seconds.
+if NP=64 PREFIX="$work/cmc/run" MPIRUN="mpirun $FEMCOD_MPIRUN_FLAGS -np 2" FEMCOD_MPI="$femcod_mpi" \
+   FEMCOD_ARGS="--loads 1e5 --quiet" bash ../doc/cluster/cmc.sbatch >"$work/out.txt" 2>&1 && \
+   grep -q '"input": "made on the ranks: self-affine, NP 64' "$work/cmc/run.summary.json"; then
+  echo "  passed   doc/cluster/cmc.sbatch: the surface made on the ranks, periodic, at NP 64"
+else
+  echo "  FAILED   doc/cluster/cmc.sbatch"; sed 's/^/           /' "$work/out.txt" | head -5; failed=1
+fi
 expect 5 "existing results without --force" mpirun_2 "$femcod_mpi" "$deck" --loads 50 -o "$work/mpi"
 # femcod's output rule on ranks too: an input is never an output, even with --force.
 printf '1 2 3 4\n2 3 4 1\n3 4 1 2\n4 1 2 3\n' >"$work/in.loads.csv"; cp "$work/in.loads.csv" "$work/in.copy"
