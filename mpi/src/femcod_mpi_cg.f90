@@ -60,7 +60,7 @@ module femcod_mpi_cg
    private
    public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor, &
       gap_grid_setup
-   public :: distribute_problem, scatter_problem, distributed_convolve
+   public :: distribute_problem, scatter_problem, distributed_convolve, problem_constants
 
    !> One rank's part of the problem and of the distributed convolution: an elastic
    !> operator on this rank's columns (the parent type holds the grid side, the slab, the
@@ -143,6 +143,17 @@ module femcod_mpi_cg
    end type distributed_state
 
 contains
+
+   !> What every rank needs of the deck besides its columns of the gaps: [NP, pixel (nm),
+   !> the composite compliance c, the springs' s (nm/nN)].
+   pure function problem_constants(problem) result(constants)
+      type(contact_problem), intent(in) :: problem
+      real(dp) :: constants(4)
+      constants = [real(problem%np, dp), problem%pixel, &
+         surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
+         surface_compliance(problem%young(2), problem%poisson(2), problem%pixel), &
+         3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)]
+   end function problem_constants
 
    !> The coarse start's averaging width: the smallest power of two f with f^2 >= ranks
    !> (at least 2), or 1 when NP is not a multiple of it or too small to be worth a coarse
@@ -516,10 +527,7 @@ contains
                g0(i, j) = top - g0(i, j)
             end do
          end do
-         constants = [real(np, dp), problem%pixel, &
-            surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
-            surface_compliance(problem%young(2), problem%poisson(2), problem%pixel), &
-            3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)]
+         constants = problem_constants(problem)
       else
          allocate(g0(1, 1))
       end if

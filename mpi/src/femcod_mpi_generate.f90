@@ -22,10 +22,8 @@ module femcod_mpi_generate
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, scene_header
    use femcod_surfaces, only: self_affine_spectrum
-   use femcod_love, only: surface_compliance
-   use femcod_spring, only: spring_stiffness
    use femcod_solver_options, only: cg_settings
-   use femcod_mpi_cg, only: column_split, coarse_factor
+   use femcod_mpi_cg, only: column_split, coarse_factor, problem_constants
    use femcod_strings, only: int_str
    implicit none
    private
@@ -74,10 +72,7 @@ contains
       call self_affine_columns(spec, comm, first, count, z, status)
       if (status%code /= 0) return
       call gaps_of_shape(spec, comm, z, local)
-      constants = [real(np, dp), problem%pixel, &
-         surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
-         surface_compliance(problem%young(2), problem%poisson(2), problem%pixel), &
-         3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)]
+      constants = problem_constants(problem)
    end subroutine generate_columns
 
    !> This rank's columns of the self-affine surface (femcod_surfaces' self_affine_surface

@@ -17,10 +17,8 @@ module femcod_mpi_input
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
    use femcod_problem, only: contact_problem, MAX_HEIGHT
    use femcod_deck_h5, only: read_deck_h5_header
-   use femcod_love, only: surface_compliance
-   use femcod_spring, only: spring_stiffness
    use femcod_solver_options, only: cg_settings
-   use femcod_mpi_cg, only: column_split, coarse_factor
+   use femcod_mpi_cg, only: column_split, coarse_factor, problem_constants
    use femcod_mpi_results, only: agree
    implicit none
    private
@@ -55,10 +53,7 @@ contains
       block = 1
       if (status%code /= 0) return
       np = problem%np
-      constants = [real(np, dp), problem%pixel, &
-         surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
-         surface_compliance(problem%young(2), problem%poisson(2), problem%pixel), &
-         3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)]
+      constants = problem_constants(problem)
       block = coarse_factor(np, ranks, how)
       call column_split(np, ranks, block, first, count)
       call read_columns(path, comm, np, first(rank), count(rank), lower, upper, status)
