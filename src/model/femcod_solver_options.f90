@@ -147,43 +147,49 @@ contains
    pure function solver_name(solver) result(name)
       integer, intent(in) :: solver
       character(len=:), allocatable :: name
-      if (solver >= 1 .and. solver <= size(SOLVER_NAMES)) then
-         name = trim(SOLVER_NAMES(solver))
-      else
-         name = "?"
-      end if
+      name = name_of(solver, SOLVER_NAMES)
    end function solver_name
 
    !> The solver named `name`; 0 for any other name.
    pure integer function solver_from_name(name) result(solver)
       character(len=*), intent(in) :: name
-      integer :: k
-      solver = 0
-      do k = 1, size(SOLVER_NAMES)
-         if (trim(name) == trim(SOLVER_NAMES(k))) solver = k
-      end do
+      solver = code_of(name, SOLVER_NAMES)
    end function solver_from_name
 
    !> The boundary's name (BOUNDARY_NAMES), "?" for none.
    pure function boundary_name(boundary) result(name)
       integer, intent(in) :: boundary
       character(len=:), allocatable :: name
-      if (boundary >= 1 .and. boundary <= size(BOUNDARY_NAMES)) then
-         name = trim(BOUNDARY_NAMES(boundary))
-      else
-         name = "?"
-      end if
+      name = name_of(boundary, BOUNDARY_NAMES)
    end function boundary_name
 
    !> The boundary named `name`; 0 for any other name.
    pure integer function boundary_from_name(name) result(boundary)
       character(len=*), intent(in) :: name
-      integer :: k
-      boundary = 0
-      do k = 1, size(BOUNDARY_NAMES)
-         if (trim(name) == trim(BOUNDARY_NAMES(k))) boundary = k
-      end do
+      boundary = code_of(name, BOUNDARY_NAMES)
    end function boundary_from_name
+
+   !> names(code) without its blanks; "?" for a code outside the names.
+   pure function name_of(code, names) result(name)
+      integer, intent(in) :: code
+      character(len=*), intent(in) :: names(:)
+      character(len=:), allocatable :: name
+      if (code >= 1 .and. code <= size(names)) then
+         name = trim(names(code))
+      else
+         name = "?"
+      end if
+   end function name_of
+
+   !> The position of `name` in `names`; 0 when it is none of them.
+   pure integer function code_of(name, names) result(code)
+      character(len=*), intent(in) :: name, names(:)
+      integer :: k
+      code = 0
+      do k = 1, size(names)
+         if (trim(name) == trim(names(k))) code = k
+      end do
+   end function code_of
 
    !> The number of requested states: one per load of --loads or approach of --approach.
    pure integer function requested_states(options)
