@@ -3,9 +3,11 @@
 !>     mpirun -np 4 femcod-mpi DECK --loads F1,F2 [-o PREFIX] [--tol T] ...
 !>     mpirun -np 4 femcod-mpi --lower scan.h5:/heights --pixel 2 --loads F
 !>     mpirun -np 4 femcod-mpi DECK --boundary periodic --approach D1,D2 ...
+!>     mpirun -np 4 femcod-mpi --generate self-affine --np N --pixel D --loads F ...
 !> Rank 0 reads a text deck or the height files (one copy of the heights, on rank 0 only)
 !> and sends each rank its columns; of an HDF5 deck every rank reads its own columns
-!> (femcod_mpi_input); all ranks solve (femcod_cg's solve on the distributed
+!> (femcod_mpi_input); a generated surface each rank makes its own columns of
+!> (femcod_mpi_generate); all ranks solve (femcod_cg's solve on the distributed
 !> elastic operator of femcod_mpi_cg) and write PREFIX.h5 together
 !> (femcod_mpi_results); rank 0 writes PREFIX.summary.json and prints the summary.
 !> Exit codes as femcod's: 0 ok, 2 usage, 3 bad input, 4 numerical failure, 5 I/O,

@@ -26,8 +26,10 @@
 !>
 !> The grid is an elastic operator (model/femcod_elastic_operator) whose reductions are
 !> MPI all-reduces: femcod_cg's one constrained iteration, its plastic rounds and its
-!> displacement control run on it unchanged (solve_loads), so every fixed-load and
-!> fixed-approach option of `femcod run --solver cg` on the free surface runs on ranks.
+!> displacement control run on it unchanged (solve_loads), and with its transform grid
+!> (femcod_mpi_gap_transform) the gap-variable path of adhesion and of the cap under
+!> displacement control: the options of `femcod run --solver cg` run on ranks, free
+!> surface or periodic cell.
 !>
 !> No I/O and no stop: errors come back in a status, identical on every rank.
 module femcod_mpi_cg
