@@ -118,6 +118,22 @@ else echo "  FAILED   each rank's memory estimate against its measured peak"; fa
 # combination answers (exit 0, as serial `femcod run --solver cg` does: loads, approaches
 # and plastic volumes to 1e-6, the same contact and plastic counts) or is refused (exit 2)
 # with no output and no lock; none ends in a runtime error. With --kernel-radius once more.
+# same_answer SERIAL.loads.csv MPI.loads.csv: two states each, loads, approaches and
+# plastic volumes to 1e-6 (relative, absolute below 1), the same contact and plastic counts.
+same_answer() {
+  python3 - "$1" "$2" <<'PY'
+import csv, sys
+a = list(csv.DictReader(open(sys.argv[1])))
+b = list(csv.DictReader(open(sys.argv[2])))
+assert len(a) == len(b) == 2, (len(a), len(b))
+for x, y in zip(a, b):
+    for key in ("load_nN", "approach_nm", "plastic_volume_nm3"):
+        u, v = float(x[key]), float(y[key])
+        assert abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
+    for key in ("contacts", "n_plastic"):
+        assert x[key] == y[key], (key, x[key], y[key])
+PY
+}
 matrix_deck=../input/sphere_d2.deck
 combos=0; answered=0; refused=0; matrix_failed=0
 for boundary in free periodic; do for plastic in "" "--plastic --hardness 11"; do
@@ -140,19 +156,7 @@ for restart in "" "--restart"; do
   answered=$((answered + 1))
   "$femcod" run "$matrix_deck" --solver cg $args -o "$m.serial" >/dev/null 2>&1 || \
     { echo "  FAILED   femcod-mpi $args answered, serial femcod did not"; matrix_failed=1; continue; }
-  if ! python3 - "$m.serial.loads.csv" "$m.loads.csv" <<'PY'
-import csv, sys
-a = list(csv.DictReader(open(sys.argv[1])))
-b = list(csv.DictReader(open(sys.argv[2])))
-assert len(a) == len(b) == 2, (len(a), len(b))
-for x, y in zip(a, b):
-    for key in ("load_nN", "approach_nm", "plastic_volume_nm3"):
-        u, v = float(x[key]), float(y[key])
-        assert abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
-    for key in ("contacts", "n_plastic"):
-        assert x[key] == y[key], (key, x[key], y[key])
-PY
-  then echo "  FAILED   femcod-mpi $args: not the serial answer"; matrix_failed=1; fi
+  if ! same_answer "$m.serial.loads.csv" "$m.loads.csv"; then echo "  FAILED   femcod-mpi $args: not the serial answer"; matrix_failed=1; fi
 done; done; done; done; done
 for args in "--loads 300,800 --kernel-radius 6" "--loads 300,800 --kernel-radius 6 --plastic --hardness 11"; do
   combos=$((combos + 1)); m="$work/m$combos"
@@ -176,19 +180,7 @@ for question in "--loads 200,900" "--approach 1,0.5"; do
   if [ "$got" -eq 2 ] && ! ls "$m".* 2>/dev/null | grep -qv '\.out$'; then refused=$((refused + 1)); continue; fi
   "$femcod" run "$work/generated.deck" --solver cg $args -o "$m.serial" >/dev/null 2>&1 || got=1
   if [ "$got" -eq 0 ] && grep -q '"input": "made on the ranks: self-affine' "$m.summary.json" && \
-     python3 - "$m.serial.loads.csv" "$m.loads.csv" <<'PY'
-import csv, sys
-a = list(csv.DictReader(open(sys.argv[1])))
-b = list(csv.DictReader(open(sys.argv[2])))
-assert len(a) == len(b) == 2, (len(a), len(b))
-for x, y in zip(a, b):
-    for key in ("load_nN", "approach_nm", "plastic_volume_nm3"):
-        u, v = float(x[key]), float(y[key])
-        assert abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
-    for key in ("contacts", "n_plastic"):
-        assert x[key] == y[key], (key, x[key], y[key])
-PY
-  then answered=$((answered + 1))
+     same_answer "$m.serial.loads.csv" "$m.loads.csv"; then answered=$((answered + 1))
   else echo "  FAILED   femcod-mpi --generate self-affine $args: not the serial answer (exit $got)"; matrix_failed=1; fi
 done; done; done
 if [ "$matrix_failed" -eq 0 ]; then

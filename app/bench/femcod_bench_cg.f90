@@ -16,7 +16,7 @@ module femcod_bench_cg
    use femcod_options, only: option_spec, parsed_options, option_help, real_option, integer_option, text_option, &
       choice_option, real_list_option, integer_list_option, get_option, option_given
    use femcod_wisdom, only: load_wisdom, save_wisdom
-   use femcod_bench_common, only: bench_arguments, benchmark_surface, linear_law, require_peers, write_peer_gaps, &
+   use femcod_bench_common, only: bench_arguments, surface_for_peers, require_peers, &
       remove_file_quietly, peer_line, peer_row, reset_peak, peak_mb, BENCH_LENGTH, options_refused
    implicit none
    private
@@ -31,7 +31,7 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       integer, allocatable :: sizes(:)
-      real(dp), allocatable :: fractions(:), g0(:, :)
+      real(dp), allocatable :: fractions(:)
       character(len=:), allocatable :: python, path, wisdom
       type(scene_spec) :: spec
       type(contact_problem) :: deck
@@ -108,17 +108,12 @@ contains
       do n = 1, size(sizes)
          np = sizes(n)
          length = BENCH_LENGTH
-         call benchmark_surface(np, "bench cg", deck, status)
+         call surface_for_peers(np, "bench cg", python, deck, estar, slope, path, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod bench cg: "//status%message
             code = status%code
             return
          end if
-         call linear_law(deck, estar, slope, g0)
-         path = "femcod-bench-gaps.f64"
-         if (len(python) > 0) call write_peer_gaps(path, g0)
-         ! The peers read the file: the bench's own copy of the gaps is not the solver's.
-         deallocate(g0)
          do k = 1, size(fractions)
             pressure = fractions(k)/100*estar*slope/2
             load = pressure*length**2

@@ -17,7 +17,7 @@ module femcod_bench_common
    implicit none
    private
    public :: bench_arguments, bad_arguments, benchmark_surface, linear_law, self_path, peers_script, require_peers, &
-      options_refused, &
+      options_refused, surface_for_peers, &
       json_value, read_text_file, write_peer_gaps, remove_file_quietly, peer_line, peer_row, row, segedin, &
       reset_peak, peak_mb, BENCH_LENGTH
 
@@ -90,6 +90,24 @@ contains
       spec%maxcont = 1
       call build_problem(spec, deck, status)
    end subroutine benchmark_surface
+
+   !> The benchmark surface at NP (benchmark_surface) and its linear law (E*, the rms
+   !> slope); with peers (`python` not empty) its gaps written to `path` for them to read
+   !> (the peers solve from the file: the bench keeps no copy of the gaps).
+   subroutine surface_for_peers(np, label, python, deck, estar, slope, path, status)
+      integer, intent(in) :: np
+      character(len=*), intent(in) :: label, python
+      type(contact_problem), intent(out) :: deck
+      real(dp), intent(out) :: estar, slope
+      character(len=:), allocatable, intent(out) :: path
+      type(status_type), intent(inout) :: status
+      real(dp), allocatable :: g0(:, :)
+      path = "femcod-bench-gaps.f64"
+      call benchmark_surface(np, label, deck, status)
+      if (status%code /= 0) return
+      call linear_law(deck, estar, slope, g0)
+      if (len(python) > 0) call write_peer_gaps(path, g0)
+   end subroutine surface_for_peers
 
    !> What the linear law of contact area needs: the composite modulus E* of the
    !> solver's model (elastic body on a rigid one) and the rms slope of the gaps; the

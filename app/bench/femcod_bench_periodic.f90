@@ -15,7 +15,7 @@ module femcod_bench_periodic
    use femcod_options, only: option_spec, parsed_options, option_help, real_option, text_option, real_list_option, &
       integer_list_option, get_option
    use femcod_love_periodic, only: periodic_love_spectrum
-   use femcod_bench_common, only: bench_arguments, benchmark_surface, linear_law, require_peers, write_peer_gaps, &
+   use femcod_bench_common, only: bench_arguments, surface_for_peers, require_peers, &
       remove_file_quietly, peer_line, reset_peak, peak_mb, BENCH_LENGTH, options_refused
    implicit none
    private
@@ -135,7 +135,6 @@ contains
       type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: res
-      real(dp), allocatable :: g0(:, :)
       real(dp) :: estar, slope, load, peak, pressure, fraction
       character(len=:), allocatable :: path
       character(len=512) :: line
@@ -146,17 +145,12 @@ contains
          "mean gap (nm) | peak RSS (MB) |", "|---|---|---|---|---|---|---|---|---|"
       do n = 1, size(sizes)
          np = sizes(n)
-         call benchmark_surface(np, "bench periodic", deck, status)
+         call surface_for_peers(np, "bench periodic", python, deck, estar, slope, path, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod bench periodic: "//status%message
             code = status%code
             return
          end if
-         call linear_law(deck, estar, slope, g0)
-         path = "femcod-bench-gaps.f64"
-         if (len(python) > 0) call write_peer_gaps(path, g0)
-         ! The peers read the file: the bench's own copy of the gaps is not the solver's.
-         deallocate(g0)
          do k = 1, size(fractions)
             pressure = fractions(k)/100*estar*slope/2
             load = pressure*BENCH_LENGTH**2

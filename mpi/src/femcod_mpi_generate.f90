@@ -151,15 +151,19 @@ contains
       tops(1) = maxval(z)
       call MPI_Allreduce(MPI_IN_PLACE, tops, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       allocate(g0(np, size(z, 2)))
-      do j = 1, size(z, 2)
-         do i = 1, np
-            if (spec%shape_on == "upper") then
+      if (spec%shape_on == "upper") then
+         do j = 1, size(z, 2)
+            do i = 1, np
                g0(i, j) = (0 - 0.0_dp) + (z(np + 1 - i, j) - tops(1))
-            else
-               g0(i, j) = (z(i, j) - tops(1)) + (0 - 0.0_dp)
-            end if
+            end do
          end do
-      end do
+      else
+         do j = 1, size(z, 2)
+            do i = 1, np
+               g0(i, j) = (z(i, j) - tops(1)) + (0 - 0.0_dp)
+            end do
+         end do
+      end if
       tops(1) = maxval(g0)
       call MPI_Allreduce(MPI_IN_PLACE, tops, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       g0 = tops(1) - g0
