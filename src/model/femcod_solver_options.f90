@@ -10,7 +10,7 @@ module femcod_solver_options
    use femcod_interface_law, only: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
    implicit none
    private
-   public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, LAW_NAMES, requested_states
+   public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, requested_states
    public :: SOLVER_INCREMENTAL, SOLVER_LEGACY, SOLVER_CG, BOUNDARY_FREE, BOUNDARY_PERIODIC, solver_name, &
       solver_from_name, boundary_name, boundary_from_name
    public :: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
@@ -29,10 +29,6 @@ module femcod_solver_options
    !> enumeration, as the solvers.
    integer, parameter :: BOUNDARY_FREE = 1, BOUNDARY_PERIODIC = 2
    character(len=*), parameter :: BOUNDARY_NAMES(2) = [character(len=8) :: "free", "periodic"]
-
-   !> The interface laws: the hard wall (no adhesion), Dugdale's and the exponential
-   !> adhesive laws (model/femcod_interface_law, read by law_from_name).
-   character(len=*), parameter :: LAW_NAMES(3) = [character(len=11) :: "none", "dugdale", "exponential"]
 
    !> The cg solver's own options (solvers/femcod_cg). The accelerations default to on;
    !> each can be switched off.
