@@ -72,7 +72,9 @@ contains
          new_unittest("error bound's premise: the grid stiffness is an M-matrix with positive row sums", &
          test_stiffness_m_matrix), &
          new_unittest("error bound: the event-exact approach lies within the printed bound (tol 1e-3..1e-7)", &
-         test_approach_bound) &
+         test_approach_bound), &
+         new_unittest("a warm start from one contact: the overlapping pixels join (event path's state)", &
+            test_single_contact_start) &
          ]
    end subroutine collect_cg
 
@@ -275,6 +277,39 @@ contains
          if (allocated(error)) return
       end do
    end subroutine test_gap_maps
+
+   !> From one contact pixel at 300 nN to two at 1200 nN (a rough 24^2 surface, seed 6):
+   !> the warm start's single contact has no gap gradient, so no direction moves force
+   !> onto the second pixel, which overlaps. Before the fix the iteration stalled at a
+   !> residual of 0.021 for 5000 iterations; now the overlapping pixel joins. The
+   !> reference is the event-exact solver's state at the same loads (an independent
+   !> algorithm): the same contacts, the approach to 1e-10 nm.
+   subroutine test_single_contact_start(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: inc, cg
+      type(status_type) :: status
+      integer :: k
+      call rough_scene(24, 6, deck, maxcont=60)
+      options%loads = [300.0_dp, 1200.0_dp]
+      options%solver = SOLVER_INCREMENTAL
+      call solve_contact(deck, options, inc, status)
+      options%solver = SOLVER_CG
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-10_dp
+      call solve_contact(deck, options, cg, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      do k = 1, 2
+         call check(error, cg%states(k)%contacts, inc%states(k)%contacts, "contacts at "//to_string(options%loads(k)))
+         if (allocated(error)) return
+         call check(error, abs(cg%states(k)%approach - inc%states(k)%approach) <= 1.0e-10_dp, "approach "// &
+            to_string(cg%states(k)%approach)//" against the event path's "//to_string(inc%states(k)%approach))
+         if (allocated(error)) return
+      end do
+      call check(error, inc%states(1)%contacts == 1 .and. inc%states(2)%contacts > 1, "the case starts from one contact")
+   end subroutine test_single_contact_start
 
    !> A rough surface for the plastic and accuracy checks: self-affine (Hurst 0.8, rms
    !> 3 nm), pixel 10 nm, against a rigid flat; MAXCONT `maxcont` (default NP^2).

@@ -162,9 +162,13 @@ contains
             cycle
          end if
          call search_direction(st, grid, how)
-         ! Nothing left to move: the forces are the solution to round-off; accepted at
-         ! the top of the loop, on fresh displacements.
-         if (st%stalled) cycle
+         ! Nothing left to move on the contacts: the forces are the solution to round-off,
+         ! accepted at the top of the loop on fresh displacements; unless pixels off the
+         ! contacts overlap, which then join them.
+         if (st%stalled) then
+            call join_overlapping(st, grid)
+            cycle
+         end if
          call take_step(st, grid, how, p, status)
          if (status%code /= 0) return
          call correct_displacements(st, grid, how, rep)
@@ -552,6 +556,34 @@ contains
          end do
       end do
    end function deepest_overlap
+
+   !> A direction that cannot move the forces (every contact's gap the same, as with a
+   !> single contact after a warm start from a smaller load) leaves overlapping pixels off
+   !> the contacts where they are: they enter only with a step. Such pixels join the
+   !> contacts with no force, so that the next direction, restarted, moves force onto
+   !> them; `stalled` stays only when none overlaps on any process.
+   subroutine join_overlapping(st, grid)
+      type(cg_iteration), intent(inout) :: st
+      class(elastic_operator), intent(inout) :: grid
+      real(dp) :: joined(1)
+      integer :: ii, jj
+      joined = 0
+      !$omp parallel do private(ii) reduction(+:joined)
+      do jj = 1, st%nj
+         do ii = 1, st%np
+            if (st%touching(ii, jj) == 0 .and. grid%g0(ii, jj) + st%alpha*st%w(ii, jj) - st%gbar < 0) then
+               st%touching(ii, jj) = 1
+               joined(1) = joined(1) + 1
+            end if
+         end do
+      end do
+      call grid%sum_over_grid(joined)
+      if (.not. joined(1) > 0) return
+      call list_contacts(st)
+      st%stalled = .false.
+      st%restart = .true.
+      st%kept_old = .false.
+   end subroutine join_overlapping
 
    !> `contact` from `touching`: every contact pixel, column by column.
    subroutine list_contacts(st)
