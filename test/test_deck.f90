@@ -216,6 +216,7 @@ contains
    end subroutine test_large_deck
 
    subroutine test_format_real(error)
+      use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf, ieee_negative_inf
       type(error_type), allocatable, intent(out) :: error
       call check(error, format_real(200.0_dp), "200")
       if (allocated(error)) return
@@ -226,6 +227,14 @@ contains
       call check(error, format_real(-1.5e-9_dp), "-1.5e-9")
       if (allocated(error)) return
       call check(error, format_real(0.0_dp), "0")
+      if (allocated(error)) return
+      ! Not a number and the infinities as Python's float() reads them (a friction
+      ! coefficient without contact is NaN; the digits of its bits were once written).
+      call check(error, format_real(ieee_value(1.0_dp, ieee_quiet_nan)), "nan")
+      if (allocated(error)) return
+      call check(error, format_real(ieee_value(1.0_dp, ieee_positive_inf)), "inf")
+      if (allocated(error)) return
+      call check(error, format_real(ieee_value(1.0_dp, ieee_negative_inf)), "-inf")
    end subroutine test_format_real
 
    !> format_real against the definition, searched by brute force with Fortran's own

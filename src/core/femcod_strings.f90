@@ -275,6 +275,16 @@ contains
          length = 1
          return
       end if
+      ! Not a number and the infinities as numpy, pandas and Python's float() read them.
+      if (x /= x) then
+         text = "nan"
+         length = 3
+         return
+      else if (.not. ieee_is_finite(x)) then
+         text = trim(merge("inf ", "-inf", x > 0))
+         length = len_trim(text)
+         return
+      end if
       ! Seventeen digits always read back: that case needs no check.
       if (reads_back(x, 16, buf)) then
          n = 16
