@@ -25,7 +25,8 @@ module femcod_run
    use femcod_contact_result, only: contact_result, stop_reason_text
    use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options, &
       SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, solver_name, boundary_name, law_name, &
-      solver_from_name, boundary_from_name, law_from_name
+      solver_from_name, boundary_from_name, law_from_name, run_shear_model
+   use femcod_shear_model, only: shear_model, friction_coefficient
    use femcod_observer, only: solver_observer
    use femcod_state_visitor, only: visitable
    use femcod_incremental_state, only: incremental_state
@@ -35,7 +36,7 @@ module femcod_run
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_output_guard, only: guard_outputs, OUTPUT_WISDOM, OUTPUT_RESULT
    use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, HISTORY_HEADER, LOADS_HEADER, &
-      CONTACTS_HEADER
+      CONTACTS_HEADER, FRICTION_COLUMNS
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
@@ -140,6 +141,12 @@ contains
             "approaches are followed in the order given, each from the last (loading and unloading branches, "// &
             "jumps into contact and pull-off)", mode="cg"), &
          real_option("--work", "W", "work of adhesion in J/m^2 (= nN/nm), with --adhesion", lower=0.0_dp, mode="cg"), &
+         real_option("--shear-strength", "TAU0", "friction from the pressures (thesis 5.2.3): each contact pixel "// &
+            "carries the shear strength TAU0 + ALPHA p (GPa; with --plastic capped at the shear yield stress "// &
+            "H/(3 sqrt 3)); adds friction_nN and friction_coefficient to the history and loads (default 0)", &
+            lower=0.0_dp), &
+         real_option("--shear-slope", "ALPHA", "the shear strength's pressure coefficient ALPHA (1, default 0)", &
+            lower=0.0_dp), &
          real_option("--range", "R", "range of the adhesion law in nm, with --adhesion", lower=0.0_dp, closed="()", &
             mode="cg"), &
          text_option("--fftw-wisdom", "FILE", "FFTW measures its plans once and keeps them in FILE and FILE.float32 "// &
@@ -183,6 +190,7 @@ contains
          "           "//CONTACTS_HEADER, &
          "         PREFIX.loads.csv, one row per requested load or approach:", &
          "           "//LOADS_HEADER, &
+         "         with --shear-strength/--shear-slope both end in "//FRICTION_COLUMNS(2:), &
          "         PREFIX.h5 (everything, with the pressure and gap", &
          "         maps at each requested load; doc/results.md), PREFIX.xdmf (the maps on a mesh for", &
          "         ParaView and meshio), PREFIX.summary.json (the summary as numbers with units),", &
@@ -239,6 +247,9 @@ contains
          if (option_given(parsed, "--adhesion")) o%adhesion = law_from_name(option_value(parsed, "--adhesion"))
          call get_option(parsed, "--work", o%work)
          call get_option(parsed, "--range", o%range)
+         o%shear = option_given(parsed, "--shear-strength") .or. option_given(parsed, "--shear-slope")
+         call get_option(parsed, "--shear-strength", o%shear_strength)
+         call get_option(parsed, "--shear-slope", o%shear_slope)
          o%cg%measure_plans = len(settings%wisdom) > 0
       end associate
       lower = ""
@@ -675,6 +686,7 @@ contains
       type(incremental_state) :: resume
       type(state_maps), allocatable :: maps(:)
       type(run_info) :: info
+      type(shear_model) :: shear
       character(len=:), allocatable :: fingerprint, started
       type(string_type), allocatable :: digests(:)
       logical :: resuming, ok, have_checkpoint, complete
@@ -743,6 +755,13 @@ contains
          info%adhesion = law_name(options%adhesion)
          info%work = options%work
          info%range = options%range
+         info%friction = options%shear
+         if (options%shear) then
+            shear = run_shear_model(options)
+            info%shear_strength = shear%tau0
+            info%shear_slope = shear%alpha
+            info%shear_cap = shear%tau_max
+         end if
          info%options = settings%command_line
          info%command_line = "femcod run "//settings%command_line
          info%host = host_name()
@@ -920,6 +939,9 @@ contains
          if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
             " of them plastic (at the hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "// &
             sig_str(res%states(k)%plastic_volume, 4)//" nm^3"
+         if (options%shear) write(output_unit, '(a)') "              friction "// &
+            sig_str(res%states(k)%friction, 6)//" nN, coefficient "// &
+            sig_str(friction_coefficient(res%states(k)%friction, res%states(k)%load, res%states(k)%contacts), 6)//" (shear model)"
          if (options%adhesion /= LAW_HARD_WALL) then
             write(output_unit, '(a)') "              "//int_str(res%states(k)%attractive)//" pixels off contact within the "// &
                "range ("//sig_str(res%states(k)%attractive*problem%pixel**2, 4)//" nm^2), load off contact "// &

@@ -26,7 +26,7 @@ module femcod_checkpoint
    public :: write_checkpoint, read_checkpoint
 
    !> Marks a file as a femcod checkpoint (attribute /format).
-   character(len=*), parameter :: FORMAT_TAG = "femcod checkpoint 4"
+   character(len=*), parameter :: FORMAT_TAG = "femcod checkpoint 5"
 
    !> Stores each visited field as a dataset of an open HDF5 file.
    type, extends(state_visitor) :: h5_writer

@@ -22,10 +22,11 @@ module femcod_results
    use femcod_maps, only: state_maps
    use femcod_svg, only: svg_plot, svg_pressure_map
    use femcod_richardson, only: power_law_fit
+   use femcod_shear_model, only: friction_coefficient
    implicit none
    private
    public :: write_results, run_info, result_files, write_file_set, stored_fingerprint, load_group
-   public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER
+   public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS
 
    !> The CSV files' header lines (the help prints them from here).
    character(len=*), parameter :: HISTORY_HEADER = &
@@ -33,6 +34,8 @@ module femcod_results
    character(len=*), parameter :: LOADS_HEADER = "load_nN,approach_nm,contacts,area_nm2,area_fraction,"// &
       "max_pressure_GPa,n_above_hardness,n_plastic,plastic_volume_nm3"
    character(len=*), parameter :: CONTACTS_HEADER = "i,j,step,force_nN,pressure_GPa"
+   !> The columns the shear model adds to the history and loads files.
+   character(len=*), parameter :: FRICTION_COLUMNS = ",friction_nN,friction_coefficient"
 
    !> What the run was, for /run in the HDF5 file.
    type :: run_info
@@ -43,6 +46,10 @@ module femcod_results
       !> no adhesion), its work (J/m^2) and range (nm).
       character(len=:), allocatable :: adhesion
       real(dp) :: work = 0, range = 0
+      !> With the shear model (--shear-strength, --shear-slope): true, and its tau0 (GPa),
+      !> alpha (1) and cap (GPa; huge: none). Adds the friction columns and attributes.
+      logical :: friction = .false.
+      real(dp) :: shear_strength = 0, shear_slope = 0, shear_cap = huge(1.0_dp)
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
       !> The input files, one line each: the deck, or what each height file gave
@@ -99,12 +106,12 @@ contains
       call wall_clock(t1)
       hdf5_seconds = t1 - t0
       call add(".history.csv")
-      call write_text(temps(size(temps))%s, history_csv(deck, res), status)
+      call write_text(temps(size(temps))%s, history_csv(deck, res, info%friction), status)
       call add(".contacts.csv")
       call write_text(temps(size(temps))%s, contacts_csv(deck, res), status)
       if (size(res%states) > 0) then
          call add(".loads.csv")
-         call write_text(temps(size(temps))%s, loads_csv(deck, res), status)
+         call write_text(temps(size(temps))%s, loads_csv(deck, res, info%friction), status)
       end if
       call add(".xdmf")
       call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res), status)
@@ -196,25 +203,37 @@ contains
          call set_error(status, st%code, result_name(tmp)//st%message(len(tmp) + 1:))
    end subroutine write_text
 
-   !> PREFIX.history.csv: one row per step.
-   function history_csv(deck, res) result(text)
+   !> PREFIX.history.csv: one row per step; with `friction`, the shear model's columns.
+   function history_csv(deck, res, friction) result(text)
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
+      logical, intent(in) :: friction
       character(len=:), allocatable :: text
       type(text_builder) :: b
       integer :: k
       real(dp) :: area_pixel, region
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      call add_line(b, HISTORY_HEADER)
+      call add_line(b, HISTORY_HEADER//trim(merge(FRICTION_COLUMNS, repeat(" ", len(FRICTION_COLUMNS)), friction)))
       do k = 1, res%nsteps
          call add_line(b, int_str(k)//","//int_str(res%step_contacts(k))//","// &
             format_real(res%step_load(k))//","//format_real(res%step_approach(k))//","// &
             format_real(res%step_contacts(k)*area_pixel)//","//format_real(res%step_contacts(k)*area_pixel/region)// &
-            ","//int_str(res%step_above_hardness(k))//","//int_str(step_plastic(res, k)))
+            ","//int_str(res%step_above_hardness(k))//","//int_str(step_plastic(res, k))// &
+            friction_fields(friction, res%step_friction(k), res%step_load(k), res%step_contacts(k)))
       end do
       text = built_text(b)
    end function history_csv
+
+   !> ",F_t,mu" for the friction columns (F_t nN at load F nN); "" without them.
+   function friction_fields(friction, force, load, contacts) result(text)
+      logical, intent(in) :: friction
+      real(dp), intent(in) :: force, load
+      integer, intent(in) :: contacts
+      character(len=:), allocatable :: text
+      text = ""
+      if (friction) text = ","//format_real(force)//","//format_real(friction_coefficient(force, load, contacts))
+   end function friction_fields
 
    !> The pixels at the hardness after step k (0 without the plastic cap).
    pure integer function step_plastic(res, k)
@@ -275,24 +294,27 @@ contains
       end function digits_of
    end function contacts_csv
 
-   !> PREFIX.loads.csv: the states at the requested loads that were reached.
-   function loads_csv(deck, res) result(text)
+   !> PREFIX.loads.csv: the states at the requested loads that were reached; with
+   !> `friction`, the shear model's columns.
+   function loads_csv(deck, res, friction) result(text)
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
+      logical, intent(in) :: friction
       character(len=:), allocatable :: text
       type(text_builder) :: b
       integer :: k
       real(dp) :: area_pixel, region
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      call add_line(b, LOADS_HEADER)
+      call add_line(b, LOADS_HEADER//trim(merge(FRICTION_COLUMNS, repeat(" ", len(FRICTION_COLUMNS)), friction)))
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          associate(s => res%states(k))
             call add_line(b, format_real(s%load)//","//format_real(s%approach)//","// &
                int_str(s%contacts)//","//format_real(s%contacts*area_pixel)//","// &
                format_real(s%contacts*area_pixel/region)//","//format_real(s%max_pressure)//","// &
-               int_str(s%n_above_hardness)//","//int_str(s%n_plastic)//","//format_real(s%plastic_volume))
+               int_str(s%n_above_hardness)//","//int_str(s%n_plastic)//","//format_real(s%plastic_volume)// &
+               friction_fields(friction, s%friction, s%load, s%contacts))
          end associate
       end do
       text = built_text(b)
@@ -340,6 +362,11 @@ contains
       call h5_write(file, "/history/area_fraction", res%step_contacts(1:n)*area_pixel/region, "1", local)
       call h5_write(file, "/history/n_above_hardness", res%step_above_hardness(1:n), "1", local)
       call h5_write(file, "/history/n_plastic", [(step_plastic(res, k), k = 1, n)], "1", local)
+      if (info%friction) then
+         call h5_write(file, "/history/friction", res%step_friction(1:n), "nN", local)
+         call h5_write(file, "/history/friction_coefficient", &
+            [(friction_coefficient(res%step_friction(k), res%step_load(k), res%step_contacts(k)), k = 1, n)], "1", local)
+      end if
       call h5_group(file, "/contacts", local)
       call h5_attribute(file, "/contacts", "load_nN", res%reported_load, local)
       call h5_write(file, "/contacts/i", res%contact_i, "1", local)
@@ -370,6 +397,10 @@ contains
                call h5_attribute(file, g, "cg_load_error", s%load_error, local)
                call h5_attribute(file, g, "approach_error_bound_nm", s%approach_bound, local)
             end if
+            if (info%friction) then
+               call h5_attribute(file, g, "friction_nN", s%friction, local)
+               call h5_attribute(file, g, "friction_coefficient", friction_coefficient(s%friction, s%load, s%contacts), local)
+            end if
             if (has_adhesion(info)) then
                call h5_attribute(file, g, "attractive_pixels", s%attractive, local)
                call h5_attribute(file, g, "attractive_load_nN", s%attractive_load, local)
@@ -396,6 +427,11 @@ contains
          call h5_attribute(file, "/run", "adhesion", info%adhesion, local)
          call h5_attribute(file, "/run", "work_of_adhesion_J_m2", info%work, local)
          call h5_attribute(file, "/run", "adhesion_range_nm", info%range, local)
+      end if
+      if (info%friction) then
+         call h5_attribute(file, "/run", "shear_strength_GPa", info%shear_strength, local)
+         call h5_attribute(file, "/run", "shear_slope", info%shear_slope, local)
+         if (info%shear_cap < huge(1.0_dp)) call h5_attribute(file, "/run", "shear_cap_GPa", info%shear_cap, local)
       end if
       call h5_attribute(file, "/run", "options", info%options, local)
       call h5_attribute(file, "/run", "wall_time_s", res%wall_seconds, local)
@@ -609,6 +645,8 @@ contains
                json_string(load_group(k, size(res%states)))
             if (s%reached .and. s%approach_bound >= 0) loads = loads//', "approach_error_bound_nm": '// &
                json_number(s%approach_bound)
+            if (s%reached .and. info%friction) loads = loads//', "friction_nN": '//json_number(s%friction)// &
+               ', "friction_coefficient": '//json_number(friction_coefficient(s%friction, s%load, s%contacts))
             if (s%reached .and. has_adhesion(info)) loads = loads//', "attractive_pixels": '// &
                int_str(s%attractive)//', "attractive_load_nN": '//json_number(s%attractive_load)// &
                ', "mean_gap_nm": '//json_number(s%mean_gap)//', "jump": '//int_str(s%jump)

@@ -30,6 +30,9 @@ module femcod_contact_result
       !> contact), -1 pull-off (to no contact), 0 none.
       integer :: attractive = 0, jump = 0
       real(dp) :: attractive_load = 0, mean_gap = 0
+      !> With the shear model (--shear-strength, --shear-slope; model/femcod_shear_model):
+      !> the friction force (nN), the sum of tau(p) d^2 over the contacts.
+      real(dp) :: friction = 0
       logical :: reached = .false.
       !> Fixed-load solver only: iterations, relative complementarity residual, deepest
       !> penetration (nm), largest |gap| on contact (nm), relative load error.
@@ -66,6 +69,8 @@ module femcod_contact_result
       !> plastic cap (cg); absent, no pixel is capped. Not in checkpoints.
       integer, allocatable :: step_plastic(:)
       real(dp), allocatable :: step_load(:), step_approach(:), step_seconds(:)
+      !> Per step, the friction force of the shear model (nN; 0 without one).
+      real(dp), allocatable :: step_friction(:)
       !> Requested loads, in the order given.
       type(load_state), allocatable :: states(:)
       !> Contact pixels (row, column, step joined) and their forces at the reported state.
@@ -124,6 +129,7 @@ contains
       call visitor%real_prefix("load", self%step_load, m)
       call visitor%real_prefix("approach", self%step_approach, m)
       call visitor%real_prefix("seconds", self%step_seconds, m)
+      call visitor%real_prefix("friction", self%step_friction, m)
       do k = 1, size(self%states)
          call visitor%group("states/"//int_str(k))
          associate(s => self%states(k))
@@ -133,6 +139,7 @@ contains
             call visitor%integer_value("contacts", s%contacts)
             call visitor%real_value("max_pressure", s%max_pressure)
             call visitor%integer_value("n_above_hardness", s%n_above_hardness)
+            call visitor%real_value("friction", s%friction)
             if (.not. allocated(s%i)) allocate(s%i(0), s%j(0), s%force(0))
             call visitor%integer_array("i", s%i)
             call visitor%integer_array("j", s%j)
@@ -160,7 +167,7 @@ contains
       integer :: cap
       if (.not. allocated(res%step_contacts)) then
          allocate(res%step_contacts(64), res%step_above_hardness(64), res%step_load(64), res%step_approach(64), &
-            res%step_seconds(64))
+            res%step_seconds(64), res%step_friction(64))
       end if
       do while (size(res%step_contacts) < m)
          cap = size(res%step_contacts)
@@ -179,15 +186,19 @@ contains
          allocate(rtmp(2*cap))
          rtmp(1:cap) = res%step_seconds
          call move_alloc(rtmp, res%step_seconds)
+         allocate(rtmp(2*cap))
+         rtmp(1:cap) = res%step_friction
+         call move_alloc(rtmp, res%step_friction)
       end do
    end subroutine grow_history
 
    !> Append one history row: contacts carrying load, how many of them press harder
-   !> than the hardness, total load (nN), approach (nm), seconds the step took.
-   pure subroutine append_step(res, contacts, above_hardness, load, approach, seconds)
+   !> than the hardness, total load (nN), approach (nm), seconds the step took, and the
+   !> friction force of the shear model (nN; 0 without one).
+   pure subroutine append_step(res, contacts, above_hardness, load, approach, seconds, friction)
       type(contact_result), intent(inout) :: res
       integer, intent(in) :: contacts, above_hardness
-      real(dp), intent(in) :: load, approach, seconds
+      real(dp), intent(in) :: load, approach, seconds, friction
       call grow_history(res, res%nsteps + 1)
       res%nsteps = res%nsteps + 1
       res%step_contacts(res%nsteps) = contacts
@@ -195,6 +206,7 @@ contains
       res%step_load(res%nsteps) = load
       res%step_approach(res%nsteps) = approach
       res%step_seconds(res%nsteps) = seconds
+      res%step_friction(res%nsteps) = friction
    end subroutine append_step
 
    !> Record the states at the requested loads that fall inside the current step, which

@@ -10,7 +10,8 @@ module femcod_event_path
    use femcod_kinds, only: dp
    use femcod_clock, only: wall_clock
    use femcod_problem, only: contact_problem
-   use femcod_solver_options, only: contact_options
+   use femcod_solver_options, only: contact_options, run_shear_model
+   use femcod_shear_model, only: shear_model, friction_force
    use femcod_contact_result, only: contact_result, append_step, record_load_states, record_approach_states, &
       STOP_LOADS, STOP_NO_CONTACT
    implicit none
@@ -31,6 +32,8 @@ module femcod_event_path
       integer :: max_contacts = 0
       !> Pixel size (nm) and hardness (GPa), for the pressures of the history and states.
       real(dp) :: pixel = 0, hardness = 0
+      !> The shear model, for the friction force of each step (inactive: none).
+      type(shear_model) :: shear
    contains
       procedure :: start => start_path
       procedure :: advance
@@ -60,6 +63,7 @@ contains
       if (path%has_loads) path%max_load = maxval(loads)
       path%pixel = problem%pixel
       path%hardness = options%hardness
+      path%shear = run_shear_model(options)
       path%has_approaches = .false.
       if (allocated(options%approaches)) path%has_approaches = size(options%approaches) > 0
       if (path%has_approaches) then
@@ -150,7 +154,7 @@ contains
       end if
       call wall_clock(t1)
       call append_step(res, size(ftot), count(ftot/path%pixel**2 > path%hardness), path%total, path%approach, &
-         t1 - t0)
+         t1 - t0, friction_force(path%shear, ftot, path%pixel))
    end function close_step
 
    !> Whether `joining` more contacts fit beside the `n` there are.

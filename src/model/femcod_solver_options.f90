@@ -8,6 +8,7 @@ module femcod_solver_options
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL
    use femcod_strings, only: format_real, int_str, sig_str
    use femcod_interface_law, only: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
+   use femcod_shear_model, only: shear_model, make_shear_model
    implicit none
    private
    public :: contact_options, cg_settings, SOLVER_NAMES, BOUNDARY_NAMES, requested_states
@@ -15,7 +16,7 @@ module femcod_solver_options
       solver_from_name, boundary_name, boundary_from_name
    public :: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
    public :: validate_options, by_gap_variables, history_options, first_difference, tolerance_floor
-   public :: refuse_beyond_memory
+   public :: refuse_beyond_memory, run_shear_model
 
    !> The solvers: the event-exact incremental solver, the Appendix B program, and the
    !> fixed-load constrained conjugate gradients. An enumeration, with the names the
@@ -118,6 +119,11 @@ module femcod_solver_options
       !> J/m^2) and the range (nm) of the law. With --approach and the cg solver only.
       integer :: adhesion = LAW_HARD_WALL
       real(dp) :: work = 0, range = 0
+      !> Friction from the pressures (model/femcod_shear_model): each contact pixel carries
+      !> the shear strength shear_strength + shear_slope p (GPa; capped at H/(3 sqrt 3)
+      !> with `plastic`). `shear` false: no friction is computed. Every solver.
+      logical :: shear = .false.
+      real(dp) :: shear_strength = 0, shear_slope = 0
       !> Candidates whose closing load is within this fraction of the total load of the
       !> smallest one join in the same step (ties).
       real(dp) :: tie_tolerance = 1.0e-9_dp
@@ -243,6 +249,12 @@ contains
       else if (options%adhesion /= LAW_HARD_WALL .and. napproaches == 0) then
          call refuse("--adhesion needs --approach D1,D2,... (displacement control: under load control the pull-off "// &
             "is an instability)")
+      else if (options%shear .and. options%adhesion /= LAW_HARD_WALL) then
+         call refuse("--shear-strength/--shear-slope with --adhesion: the shear model gives the friction "// &
+            "coefficient F_t/F of a compressive contact; with adhesion the load passes through zero and the "// &
+            "contact pixels carry tension")
+      else if (options%shear .and. .not. (options%shear_strength >= 0 .and. options%shear_slope >= 0)) then
+         call refuse("--shear-strength and --shear-slope are at least 0")
       else if (options%adhesion /= LAW_HARD_WALL .and. .not. (options%work >= 0 .and. options%range > 0)) then
          call refuse("--adhesion needs --work W >= 0 (J/m^2) and --range R > 0 (nm)")
       else if (options%solver == SOLVER_CG .and. options%cg%tol < tolerance_floor()) then
@@ -279,7 +291,8 @@ contains
          "; tie_tolerance="//format_real(options%tie_tolerance)//"; final_check="// &
          merge("T", "F", options%final_check)//"; event_search="//trim(options%event_search)// &
          "; tol="//format_real(options%cg%tol)//"; max_iterations="//int_str(options%cg%max_iterations)// &
-         "; kernel_radius="//format_real(options%cg%kernel_radius)
+         "; kernel_radius="//format_real(options%cg%kernel_radius)//"; shear="//merge("T", "F", options%shear)// &
+         "; shear_strength="//format_real(options%shear_strength)//"; shear_slope="//format_real(options%shear_slope)
    contains
       function reals(v) result(t)
          real(dp), allocatable, intent(in) :: v(:)
@@ -293,6 +306,14 @@ contains
          end do
       end function reals
    end function history_options
+
+   !> The run's shear model (inactive without `shear`).
+   pure function run_shear_model(options) result(model)
+      type(contact_options), intent(in) :: options
+      type(shear_model) :: model
+      if (options%shear) model = make_shear_model(options%shear_strength, options%shear_slope, options%plastic, &
+         options%hardness)
+   end function run_shear_model
 
    !> The first field in which two history_options texts differ, as "name=A there,
    !> name=B here" ("" when they are equal).

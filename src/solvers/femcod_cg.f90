@@ -80,9 +80,10 @@ module femcod_cg
    use femcod_interface_law, only: interface_law, make_interface_law
    use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts
    use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings, by_gap_variables, &
-      requested_states, &
+      requested_states, run_shear_model, &
       BOUNDARY_PERIODIC
    use femcod_observer, only: solver_observer
+   use femcod_shear_model, only: friction_force
    use femcod_strings, only: int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
    implicit none
@@ -361,7 +362,8 @@ contains
          st%attractive_load = answer%attractive_load
          st%mean_gap = answer%mean_gap
          call gather_contacts(st, contact, p)
-         call append_step(res, st%contacts, st%n_above_hardness, st%load, st%approach, seconds)
+         st%friction = friction_force(run_shear_model(options), st%force, pixel)
+         call append_step(res, st%contacts, st%n_above_hardness, st%load, st%approach, seconds, st%friction)
          if (options%plastic) res%step_plastic = [res%step_plastic, st%n_plastic]
       end associate
    end subroutine record_answer

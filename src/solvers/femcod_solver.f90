@@ -11,7 +11,7 @@ module femcod_solver
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, validate_options, by_gap_variables, &
+   use femcod_solver_options, only: contact_options, validate_options, by_gap_variables, run_shear_model, &
       SOLVER_INCREMENTAL, SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, law_name
    use femcod_observer, only: solver_observer
    use femcod_legacy, only: solve_legacy
@@ -19,6 +19,7 @@ module femcod_solver
    use femcod_incremental_state, only: incremental_state
    use femcod_cg, only: solve_cg
    use femcod_gap_cg, only: pixel_stiffness_ratio
+   use femcod_shear_model, only: shear_model, friction_force
    implicit none
    private
    public :: solve_contact, model_notes, report_lines, report_line
@@ -82,11 +83,43 @@ contains
          call set_error(status, STATUS_USAGE, "unknown solver "//int_str(options%solver)// &
             " (available: incremental, legacy, cg)")
       end select
+      if (options%shear .and. allocated(res%states)) call state_friction(res, run_shear_model(options), problem%pixel)
    end subroutine solve_contact
 
+   !> The friction force of the shear model at each reached state, from its contact forces
+   !> (nN; pixel in nm): the same sum for every solver.
+   pure subroutine state_friction(res, shear, pixel)
+      type(contact_result), intent(inout) :: res
+      type(shear_model), intent(in) :: shear
+      real(dp), intent(in) :: pixel
+      integer :: k
+      do k = 1, size(res%states)
+         if (res%states(k)%reached .and. allocated(res%states(k)%force)) &
+            res%states(k)%friction = friction_force(shear, res%states(k)%force, pixel)
+      end do
+   end subroutine state_friction
+
    !> What the solver's model leaves out for this problem, one line each (the summary's
-   !> "model" lines and /run/scene_left_out).
+   !> "model" lines and /run/scene_left_out): the solver's own, then the shear model's.
    function model_notes(problem, options) result(lines)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(string_type), allocatable :: lines(:)
+      type(shear_model) :: shear
+      character(len=:), allocatable :: cap
+      lines = solver_notes(problem, options)
+      if (.not. options%shear) return
+      shear = run_shear_model(options)
+      cap = "not capped (--plastic caps it at the shear yield stress)"
+      if (options%plastic) cap = "capped at k = H/(3 sqrt 3) = "//sig_str(shear%tau_max, 4)//" GPa (H = 3Y, "// &
+         "von Mises k = Y/sqrt 3)"
+      lines = [lines, string_type("friction from the pressures (thesis 5.2.3): tau(p) = "// &
+         sig_str(shear%tau0, 4)//" GPa + "//sig_str(shear%alpha, 4)//" p on each contact pixel, "//cap// &
+         "; F_t = sum tau d^2, no solve: the surfaces' tangential displacements (Cerruti) are not modelled")]
+   end function model_notes
+
+   !> The solver's own notes (model_notes).
+   function solver_notes(problem, options) result(lines)
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       type(string_type), allocatable :: lines(:)
@@ -175,7 +208,7 @@ contains
          character(len=:), allocatable :: text
          text = sig_str(x, 3)
       end function es
-   end function model_notes
+   end function solver_notes
 
    !> What the solver did and checked, for the summary: the model notes, then the
    !> solver's own lines, labelled.
