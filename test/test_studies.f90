@@ -45,6 +45,8 @@ contains
          new_unittest("pixels above the hardness per step: incremental = legacy", test_hardness_steps), &
          new_unittest("pixels above the hardness per step: the dense oracle's event path", test_hardness_oracle), &
          new_unittest("femcod resolution writes the study", test_resolution_command), &
+         new_unittest("femcod resolution --shear-strength/--shear-slope: tau0 A + alpha F on every row", &
+            test_resolution_friction), &
          new_unittest("Fig. 4.21 capped curve: the elastic history until the first pixel reaches H", &
             test_capped_curve), &
          new_unittest("summits of the sinusoid eq. 3.3: R = 100 nm, then R ~ d^2", test_sinusoid_summits), &
@@ -419,6 +421,51 @@ contains
          string_type("--levels"), string_type("32"), string_type("-o"), string_type(prefix), string_type("--quiet")], code)
       call check(error, code, 5)
    end subroutine test_resolution_command
+
+   !> The resolution study with the shear model (tau0 = 0.05 GPa, alpha = 0.1), elastic:
+   !> on every row of every level, friction_nN = tau0 area + alpha load (each contact
+   !> pixel carries tau0 + alpha p, and the forces sum to the load) and the coefficient
+   !> is friction over load, from the row's own area and load (this test's parser).
+   subroutine test_resolution_friction(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, text, line
+      character(len=16) :: np, method
+      real(dp) :: load, approach, area, ft, mu
+      integer :: code, k, p, q, ios, rows
+      character(len=*), parameter :: suffixes(10) = [character(len=22) :: ".resolution.csv", ".powerlaw.csv", &
+         ".estimates.csv", ".hardness.csv", ".load_displacement.svg", ".area_displacement.svg", ".area_pressure.svg", &
+         ".richardson.svg", ".hardness.svg", ".hardness_capped.csv"]
+      prefix = scratch_path("resolution_friction")
+      do k = 1, size(suffixes)
+         call remove_scratch(prefix//trim(suffixes(k)))
+      end do
+      call run_femcod([string_type("resolution"), string_type("input/rough_selfaffine_32.deck"), &
+         string_type("--levels"), string_type("32,16"), string_type("--shear-strength"), string_type("0.05"), &
+         string_type("--shear-slope"), string_type("0.1"), string_type("-o"), string_type(prefix), &
+         string_type("--quiet")], code)
+      call check(error, code, 0)
+      if (allocated(error)) return
+      text = read_text(prefix//".resolution.csv")
+      call check(error, text(1:index(text, new_line("a")) - 1), &
+         "np,method,load_nN,approach_nm,area_nm2,friction_nN,friction_coefficient")
+      if (allocated(error)) return
+      rows = 0
+      p = index(text, new_line("a")) + 1
+      do while (p < len(text))
+         q = p + index(text(p:), new_line("a")) - 2
+         line = commas_to_blanks(text(p:q))
+         p = q + 2
+         read(line, *, iostat=ios) np, method, load, approach, area, ft, mu
+         call check(error, ios, 0, "row "//line)
+         if (allocated(error)) return
+         call check(error, ft, 0.05_dp*area + 0.1_dp*load, rel=.true., thr=1.0e-12_dp, message="row "//line)
+         if (allocated(error)) return
+         call check(error, mu, ft/load, rel=.true., thr=1.0e-15_dp, message="row "//line)
+         if (allocated(error)) return
+         rows = rows + 1
+      end do
+      call check(error, rows > 20, "rows")
+   end subroutine test_resolution_friction
 
    !> Refit area = c load^e over the NP = 32 rows of resolution.csv (this test's own
    !> parser and least squares) and compare with powerlaw.csv.

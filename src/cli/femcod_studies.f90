@@ -8,6 +8,7 @@ module femcod_studies
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO, STATUS_NUMERICAL
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
+   use femcod_shear_model, only: friction_coefficient
    use femcod_strings, only: string_type, int_str, sig_str, split_list, text_builder, add_line, built_text, &
       parse_real, parse_integer, format_real, parse_real_list, parse_integer_list
    use femcod_generate, only: scene_spec
@@ -63,6 +64,11 @@ contains
          choice_option("--method", "subsample|average", "odd/odd pixels (default) or 2 x 2 means"), &
          real_option("--hardness", "H", "GPa, for the pixels above the hardness per step (default 11, polysilicon)", &
             lower=0.0_dp, closed="()"), &
+         real_option("--shear-strength", "TAU0", "friction from the pressures as in femcod run: tau = TAU0 + "// &
+            "ALPHA p (GPa) on each contact pixel; adds friction_nN and friction_coefficient to PREFIX.resolution.csv "// &
+            "and the coefficient at a common load to the summary", lower=0.0_dp), &
+         real_option("--shear-slope", "ALPHA", "the shear strength's pressure coefficient (1, default 0)", &
+            lower=0.0_dp), &
          flag_option("--force", "replace existing result files"), &
          flag_option("--quiet", "no summary, no progress lines", alias="-q"), &
          scene_options("heights")]
@@ -71,7 +77,7 @@ contains
    subroutine resolution_help()
       write(output_unit, '(a)') &
          "usage: femcod resolution DECK [--levels 512,256,128,64] [--method subsample|average] [-o PREFIX]", &
-         "                         [--hardness H] [--force] [--quiet]", &
+         "                         [--hardness H] [--shear-strength TAU0] [--shear-slope ALPHA] [--force] [--quiet]", &
          "       femcod resolution FILE --pixel D [--young E] [--poisson NU] [--maxcont M] [--remove-plane]", &
          "                         [options as above]", &
          "", &
@@ -84,7 +90,8 @@ contains
       write(output_unit, '(a)') "with a height file (FILE --pixel D):"
       call print_lines(option_help(resolution_table(), "heights"))
       write(output_unit, '(a)') "", &
-         "outputs: PREFIX.resolution.csv  np,method,load_nN,approach_nm,area_nm2 (one row per step and level)", &
+         "outputs: PREFIX.resolution.csv  np,method,load_nN,approach_nm,area_nm2 (one row per step and level;", &
+         "                                with the shear model also friction_nN,friction_coefficient)", &
          "         PREFIX.powerlaw.csv    np,exponent,prefactor (area = prefactor * load^exponent over the run)", &
          "         PREFIX.estimates.csv   np,model,load_nN,area_nm2 with model coupled (femcod), uncoupled", &
          "                                (rigid substrate, independent voxels of the single-pixel compliance,", &
@@ -115,9 +122,9 @@ contains
       type(level_observer) :: observer
       integer, allocatable :: nps(:)
       character(len=:), allocatable :: input, prefix, method
-      real(dp) :: hardness, t0, t1
+      real(dp) :: hardness, t0, t1, shear(2)
       integer :: k, n
-      logical :: force, quiet
+      logical :: force, quiet, friction
       code = 0
       if (help_requested(args)) then
          call resolution_help()
@@ -147,6 +154,10 @@ contains
       call get_option(parsed, "--method", method)
       call get_option(parsed, "--levels", nps)
       call get_option(parsed, "--hardness", hardness)
+      friction = option_given(parsed, "--shear-strength") .or. option_given(parsed, "--shear-slope")
+      shear = 0
+      call get_option(parsed, "--shear-strength", shear(1))
+      call get_option(parsed, "--shear-slope", shear(2))
       call get_option(parsed, "--force", force)
       call get_option(parsed, "--quiet", quiet)
       if (prefix == "") prefix = default_prefix(file_part(input))
@@ -185,8 +196,13 @@ contains
          call wall_clock(t0)
          observer%last_report = 0
          ! The finest level also with the pressures capped at H (Fig. 4.21's capped curve).
-         call solve_level(deck, nps(k), method, hardness, levels(k), status, observer, &
-            capped=nps(k) == maxval(nps))
+         if (friction) then
+            call solve_level(deck, nps(k), method, hardness, levels(k), status, observer, &
+               capped=nps(k) == maxval(nps), shear=shear)
+         else
+            call solve_level(deck, nps(k), method, hardness, levels(k), status, observer, &
+               capped=nps(k) == maxval(nps))
+         end if
          if (status%code /= 0) then
             status%message = "level NP = "//int_str(nps(k))//": "//status%message
             call fail(status)
@@ -203,7 +219,7 @@ contains
          end if
       end do
       call extrapolate_levels(levels)
-      texts = resolution_texts(levels, method, deck%np*deck%pixel)
+      texts = resolution_texts(levels, method, deck%np*deck%pixel, friction)
       call write_file_set(names, texts, status)
       if (status%code /= 0) then
          call fail(status)
@@ -219,6 +235,7 @@ contains
                " (eta "//sig_str(levels(k)%mccool%density, 4)//" /nm^2, R "//sig_str(levels(k)%mccool%radius, 4)// &
                " nm, sigma_s "//sig_str(levels(k)%mccool%sigma, 4)//" nm)"
          end do
+         if (friction) call print_common_friction(levels, shear(2))
          write(output_unit, '(a)') "  wrote "//prefix//".resolution.csv, .powerlaw.csv, .estimates.csv, .hardness.csv, "// &
             ".hardness_capped.csv and 5 SVG figures"
       end if
@@ -235,11 +252,41 @@ contains
       end subroutine fail
    end subroutine resolution_command
 
-   !> The CSV and SVG texts of a resolution study, in the order of the names above.
-   function resolution_texts(levels, method, side) result(texts)
+   !> The friction coefficient of every level at the largest load L all of them reached
+   !> (nN), from the history row that ends the step holding L: within that step the
+   !> contacts are the row's and their forces linear in the load, so F_t(L) = F_t(row) -
+   !> alpha (F(row) - L), exact where no pixel crosses the shear cap within the step.
+   subroutine print_common_friction(levels, alpha)
+      type(resolution_level), intent(in) :: levels(:)
+      real(dp), intent(in) :: alpha
+      real(dp) :: common, ft
+      integer :: k, i
+      common = huge(1.0_dp)
+      do k = 1, size(levels)
+         common = min(common, levels(k)%res%step_load(levels(k)%res%nsteps))
+      end do
+      write(output_unit, '(a)') "  friction coefficient at "//sig_str(common, 6)//" nN (the largest load every "// &
+         "level reached):"
+      do k = 1, size(levels)
+         associate(r => levels(k)%res)
+            i = 1
+            do while (r%step_load(i) < common .and. i < r%nsteps)
+               i = i + 1
+            end do
+            ft = r%step_friction(i) - alpha*(r%step_load(i) - common)
+            write(output_unit, '(a)') "    NP = "//int_str(levels(k)%np)//" (pixel "//sig_str(levels(k)%pixel, 4)// &
+               " nm): "//sig_str(ft/common, 6)
+         end associate
+      end do
+   end subroutine print_common_friction
+
+   !> The CSV and SVG texts of a resolution study, in the order of the names above; with
+   !> `friction`, the shear model's columns in the first.
+   function resolution_texts(levels, method, side, friction) result(texts)
       type(resolution_level), intent(in) :: levels(:)
       character(len=*), intent(in) :: method
       real(dp), intent(in) :: side
+      logical, intent(in) :: friction
       type(string_type) :: texts(10)
       type(text_builder) :: b(5)
       type(svg_series), allocatable :: s1(:), s2(:), s3(:), s4(:), s5(:)
@@ -247,7 +294,8 @@ contains
       real(dp) :: a0, px2
       character(len=:), allocatable :: npk
       a0 = side**2
-      call add_line(b(1), "np,method,load_nN,approach_nm,area_nm2")
+      call add_line(b(1), "np,method,load_nN,approach_nm,area_nm2"// &
+         trim(merge(",friction_nN,friction_coefficient", "                                 ", friction)))
       call add_line(b(2), "np,exponent,prefactor")
       call add_line(b(3), "np,model,load_nN,area_nm2")
       call add_line(b(4), "np,step,area_fraction,contacts,n_above_hardness,fraction_above_hardness")
@@ -260,7 +308,7 @@ contains
             px2 = levels(k)%pixel**2
             do i = 1, n
                call add_line(b(1), npk//","//method//","//format_real(r%step_load(i))//","// &
-                  format_real(r%step_approach(i))//","//format_real(r%step_contacts(i)*px2))
+                  format_real(r%step_approach(i))//","//format_real(r%step_contacts(i)*px2)//friction_text(i))
             end do
             call add_line(b(2), npk//","//format_real(levels(k)%exponent)//","//format_real(levels(k)%prefactor))
             do i = 1, n
@@ -339,6 +387,16 @@ contains
       texts(9)%s = svg_multi_plot("contacts above the hardness (thesis Fig. 4.21), and at it when capped", &
          "contact area / total surface area (%)", "contacts with p > H, or at H when capped (%)", s5, .false., .false.)
       texts(10)%s = built_text(b(5))
+   contains
+      !> ",F_t,mu" of row i of level k's history with the friction columns; "" without.
+      function friction_text(i) result(t)
+         integer, intent(in) :: i
+         character(len=:), allocatable :: t
+         t = ""
+         if (friction) t = ","//format_real(levels(k)%res%step_friction(i))//","// &
+            format_real(friction_coefficient(levels(k)%res%step_friction(i), levels(k)%res%step_load(i), &
+            levels(k)%res%step_contacts(i)))
+      end function friction_text
    end function resolution_texts
 
    !> One of the Fig. 3.2 panels: a summit statistic against the box size, log-log,

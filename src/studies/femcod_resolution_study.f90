@@ -100,7 +100,7 @@ contains
    !> Solve one level and compute its estimates; with `capped` true solve it a second
    !> time with the pressures capped at the hardness (the plastic events of the event
    !> path), for the capped curve of Fig. 4.21.
-   subroutine solve_level(deck, np, method, hardness, level, status, observer, capped)
+   subroutine solve_level(deck, np, method, hardness, level, status, observer, capped, shear)
       type(contact_problem), intent(in) :: deck
       integer, intent(in) :: np
       character(len=*), intent(in) :: method
@@ -110,6 +110,9 @@ contains
       !> Told of the solve's progress.
       class(solver_observer), intent(inout), optional :: observer
       logical, intent(in), optional :: capped
+      !> The shear model's tau0 (GPa) and alpha (1), for the friction of every step
+      !> (femcod_shear_model; capped at H/(3 sqrt 3) on the capped path).
+      real(dp), intent(in), optional :: shear(2)
       type(contact_problem) :: d
       type(contact_options) :: options
       real(dp), allocatable :: load(:), area(:), composite(:, :)
@@ -120,6 +123,11 @@ contains
       level%np = d%np
       level%pixel = d%pixel
       options%hardness = hardness
+      if (present(shear)) then
+         options%shear = .true.
+         options%shear_strength = shear(1)
+         options%shear_slope = shear(2)
+      end if
       allocate(options%loads(0))
       options%memory_available = available_memory()
       call solve_contact(d, options, level%res, status, observer)
