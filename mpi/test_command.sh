@@ -114,7 +114,8 @@ PY
 then echo "  passed   each rank's memory estimate against its measured peak"
 else echo "  FAILED   each rank's memory estimate against its measured peak"; failed=1; fi
 # The combination matrix on 2 ranks (issue 34): boundary x plastic cap x interface law x
-# question (loads, increasing, decreasing approaches) x --restart on the 2 nm sphere. Each
+# question (loads, increasing, decreasing approaches) x (plain, --restart, the shear model
+# --shear-strength 0 --shear-slope 0.1: friction as serial too) on the 2 nm sphere. Each
 # combination answers (exit 0, as serial `femcod run --solver cg` does: loads, approaches
 # and plastic volumes to 1e-6, the same contact and plastic counts) or is refused (exit 2)
 # with no output and no lock; none ends in a runtime error. With --kernel-radius once more.
@@ -126,8 +127,13 @@ import csv, sys
 a = list(csv.DictReader(open(sys.argv[1])))
 b = list(csv.DictReader(open(sys.argv[2])))
 assert len(a) == len(b) == 2, (len(a), len(b))
+keys = ["load_nN", "approach_nm", "plastic_volume_nm3"]
+# The friction columns of the shear model, when the serial run has them.
+assert ("friction_nN" in a[0]) == ("friction_nN" in b[0]), "friction columns in one file only"
+if "friction_nN" in a[0]:
+    keys.append("friction_nN")
 for x, y in zip(a, b):
-    for key in ("load_nN", "approach_nm", "plastic_volume_nm3"):
+    for key in keys:
         u, v = float(x[key]), float(y[key])
         assert abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
     for key in ("contacts", "n_plastic"):
@@ -138,9 +144,9 @@ matrix_deck=../input/sphere_d2.deck
 combos=0; answered=0; refused=0; matrix_failed=0
 for boundary in free periodic; do for plastic in "" "--plastic --hardness 11"; do
 for law in none dugdale exponential; do for question in "--loads 300,800" "--approach 0.5,1" "--approach 1,0.5"; do
-for restart in "" "--restart"; do
+for variant in "" "--restart" "--shear-strength 0 --shear-slope 0.1"; do
   combos=$((combos + 1))
-  args="--boundary $boundary $plastic $question --tol 1e-10 --max-iterations 20000 $restart --quiet"
+  args="--boundary $boundary $plastic $question --tol 1e-10 --max-iterations 20000 $variant --quiet"
   [ "$law" = none ] || args="$args --adhesion $law --work 0.05 --range 1"
   m="$work/m$combos"
   got=0; mpirun_2 "$femcod_mpi" "$matrix_deck" $args -o "$m" >"$m.out" 2>&1 || got=$?

@@ -50,8 +50,9 @@ program femcod_mpi
    use femcod_maps, only: state_maps
    use femcod_gap_cg, only: gap_solver_storage_bytes
    use femcod_interface_law, only: make_interface_law
-   use femcod_solver_options, only: by_gap_variables, &
+   use femcod_solver_options, only: by_gap_variables, run_shear_model, &
       SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL
+   use femcod_shear_model, only: friction_coefficient
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -178,7 +179,8 @@ program femcod_mpi
    call wall_clock(t_read)
    if (status%code == 0) call solve_loads(grid, problem, targets(), settings%solve%cg, states, status, observer, &
       settings%solve%hardness, settings%solve%plastic, by_approach(), make_interface_law(settings%solve%adhesion, &
-      settings%solve%work, settings%solve%range, grid%pixel, settings%solve%plastic, settings%solve%hardness))
+      settings%solve%work, settings%solve%range, grid%pixel, settings%solve%plastic, settings%solve%hardness), &
+      run_shear_model(settings%solve))
    call wall_clock(t_solve)
    if (status%code /= 0) then
       if (status%code == STATUS_INTERRUPTED) call finish(128 + stop_signal(), signal_name(stop_signal())//": "// &
@@ -201,6 +203,7 @@ program femcod_mpi
    info%finished = local_time_iso()
    info%ranks = ranks
    info%threads = omp_get_max_threads()
+   info%friction = settings%solve%shear
    if (.not. allocated(info%label)) info%label = ""
    info%wall_seconds = t_solve - t_start
    call write_distributed_results(prefix//".h5.part", grid, states, info, status)
@@ -455,16 +458,26 @@ contains
       character(len=:), allocatable :: text
       integer :: s
       text = "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
-         "plastic_volume_nm3"//new_line('a')
+         "plastic_volume_nm3"//trim(merge(",friction_nN,friction_coefficient", "                                 ", &
+         settings%solve%shear))//new_line('a')
       do s = 1, size(states)
          associate(st => states(s))
             text = text//format_real(st%load)//","//format_real(st%approach)//","//int_str(st%contacts)//","// &
                format_real(st%contacts*grid%pixel**2)//","//format_real(real(st%contacts, dp)/real(np, dp)**2)//","// &
                format_real(st%max_pressure)//","//int_str(st%above_hardness)//","//int_str(st%n_plastic)//","// &
-               format_real(st%plastic_volume)//new_line('a')
+               format_real(st%plastic_volume)//friction_fields(st)//new_line('a')
          end associate
       end do
    end function loads_csv
+
+   !> ",F_t,mu" of a state with the shear model; "" without.
+   function friction_fields(st) result(text)
+      type(distributed_state), intent(in) :: st
+      character(len=:), allocatable :: text
+      text = ""
+      if (settings%solve%shear) text = ","//format_real(st%friction)//","// &
+         format_real(friction_coefficient(st%friction, st%load, st%contacts))
+   end function friction_fields
 
    !> The summary as JSON: numbers with their units in the names.
    function summary_json() result(text)
@@ -500,6 +513,8 @@ contains
             if (settings%solve%adhesion /= LAW_HARD_WALL) text = text//', "attractive_pixels": '//int_str(st%attractive)// &
                ', "attractive_load_nN": '//json_number(st%attractive_load)//', "mean_gap_nm": '// &
                json_number(st%mean_gap)//', "jump": '//int_str(st%jump)
+            if (settings%solve%shear) text = text//', "friction_nN": '//json_number(st%friction)// &
+               ', "friction_coefficient": '//json_number(friction_coefficient(st%friction, st%load, st%contacts))
             text = text//'}'
          end associate
          if (s < size(states)) text = text//', '
@@ -520,6 +535,8 @@ contains
             if (st%approach_bound >= 0) bound_note = " (+- "//sig_str(st%approach_bound, 2)//" nm)"
             plastic_note = ""
             if (settings%solve%plastic) plastic_note = ", "//int_str(st%n_plastic)//" at the hardness"
+            if (settings%solve%shear) plastic_note = plastic_note//", friction "//sig_str(st%friction, 6)// &
+               " nN (coefficient "//sig_str(friction_coefficient(st%friction, st%load, st%contacts), 6)//")"
             write(output_unit, '(a)') "  load "//format_real(st%load)//" nN: approach "//sig_str(st%approach, 10)// &
                " nm"//bound_note//", "//int_str(st%contacts)//" contacts ("// &
                sig_str(100*real(st%contacts, dp)/real(np, dp)**2, 4)//" % of the area), max pressure "// &
@@ -552,7 +569,8 @@ contains
       write(output_unit, '(a)') "  --loads F1,F2,...  total loads (nN), or --approach D1,D2,... approaches (nm)"
       write(output_unit, '(a)') "  --boundary free|periodic, --plastic --hardness H, --kernel-radius R (free surface,"
       write(output_unit, '(a)') "  --loads), --adhesion dugdale|exponential --work W --range R (with --approach),"
-      write(output_unit, '(a)') "  --tol T (default 1e-8),"
+      write(output_unit, '(a)') "  --shear-strength TAU0 --shear-slope ALPHA (friction from the pressures), --tol T"
+      write(output_unit, '(a)') "  (default 1e-8),"
       write(output_unit, '(a)') "  --max-iterations N, -o PREFIX, --outdir DIR, --force, --quiet; the height-file"
       write(output_unit, '(a)') "  options (--lower, --upper, --pixel, --young, --poisson, --height-unit, ...)"
       write(output_unit, '(a)') "Refused (they run on one node with femcod run): --kernel-radius on the periodic"

@@ -53,6 +53,7 @@ module femcod_mpi_cg
    use femcod_cg, only: coarse_start_forces, approach_error_bound, cg_session, cg_answer, session_start, solve_target, &
       ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
+   use femcod_shear_model, only: shear_model, friction_force
    use femcod_mpi_gap_transform, only: distributed_gap_transform, gap_transform_setup, gap_transform_apply, &
       gap_transform_free
    use femcod_observer, only: solver_observer
@@ -142,6 +143,9 @@ module femcod_mpi_cg
       !> gap (nm), and a jump into contact (1) or off it (-1) since the last approach.
       integer :: attractive = 0, jump = 0
       real(dp) :: attractive_load = 0, mean_gap = 0
+      !> With the shear model (--shear-strength, --shear-slope): the friction force (nN)
+      !> over all ranks, femcod_shear_model's sum over the contact pixels.
+      real(dp) :: friction = 0
    end type distributed_state
 
 contains
@@ -731,7 +735,8 @@ contains
    !> control as `femcod run --solver cg`. Approaches with an adhesive `law`, or with the
    !> cap, are solved in the gap variables along the path in the order given, as there.
    !> `problem` is read on rank 0 only (the materials, for the coarse start). Collective.
-   subroutine solve_loads(grid, problem, targets, how, states, status, observer, hardness, plastic, by_approach, law)
+   subroutine solve_loads(grid, problem, targets, how, states, status, observer, hardness, plastic, by_approach, law, &
+      shear)
       type(distributed_grid), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: targets(:)
@@ -745,6 +750,9 @@ contains
       logical, intent(in), optional :: plastic, by_approach
       !> The interface law (default: the hard wall; its cap is set here from `hardness`).
       type(interface_law), intent(in), optional :: law
+      !> The shear model for each state's friction (default: none).
+      type(shear_model), intent(in), optional :: shear
+      type(shear_model) :: friction_model
       type(cg_session) :: session
       type(cg_answer) :: answer
       type(interface_law) :: interface
@@ -756,6 +764,7 @@ contains
       allocate(states(m))
       capped = .false.
       if (present(plastic)) capped = plastic
+      if (present(shear)) friction_model = shear
       approaches = .false.
       if (present(by_approach)) approaches = by_approach
       cap = huge(1.0_dp)
@@ -789,7 +798,7 @@ contains
          communication0 = grid%communication_seconds
          call solve_target(grid, problem, session, targets(k), approaches, how, answer, status, observer)
          if (status%code /= 0) return
-         call record_state(grid, session, answer, cap, states(k))
+         call record_state(grid, session, answer, cap, friction_model, states(k))
          if (.not. (approaches .or. capped .or. grid%periodic .or. how%kernel_radius > 0)) states(k)%approach_bound = &
             approach_error_bound(states(k)%penetration, states(k)%contact_gap, states(k)%load_error, states(k)%approach)
          call wall_clock(t1)
@@ -832,13 +841,14 @@ contains
    !> capped pixels) with the largest pressure (GPa) and the plastic volume (nm^3). In
    !> the gap variables the contacts are the pixels at gap 0 (with adhesion they may
    !> pull), as in femcod_cg.
-   subroutine record_state(grid, session, answer, hardness, st)
+   subroutine record_state(grid, session, answer, hardness, shear, st)
       type(distributed_grid), intent(inout) :: grid
       type(cg_session), intent(in) :: session
       type(cg_answer), intent(inout) :: answer
       real(dp), intent(in) :: hardness
+      type(shear_model), intent(in) :: shear
       type(distributed_state), intent(inout) :: st
-      real(dp) :: total(4), top(1)
+      real(dp) :: total(5), top(1)
       logical, allocatable :: contact(:, :)
       st%load = answer%load
       st%approach = answer%approach
@@ -874,7 +884,9 @@ contains
       end if
       total(1) = count(contact)
       total(2) = count(session%p/grid%pixel**2 > hardness)
+      total(5) = friction_force(shear, pack(session%p, contact), grid%pixel)
       call grid%sum_over_grid(total)
+      st%friction = total(5)
       st%contacts = nint(total(1))
       st%above_hardness = nint(total(2))
       st%n_plastic = nint(total(3))

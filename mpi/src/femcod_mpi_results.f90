@@ -15,6 +15,7 @@ module femcod_mpi_results
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_attribute
    use femcod_results, only: load_group
    use femcod_mpi_cg, only: distributed_grid, distributed_state
+   use femcod_shear_model, only: friction_coefficient
    implicit none
    private
    public :: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, agree
@@ -24,6 +25,8 @@ module femcod_mpi_results
       character(len=:), allocatable :: version, command_line, host, started, finished, label
       integer :: ranks = 1, threads = 1
       real(dp) :: wall_seconds = 0
+      !> With the shear model: each load group gets friction_nN and friction_coefficient.
+      logical :: friction = .false.
       !> Peak resident memory of each rank (MB).
       real(dp), allocatable :: peak_mb(:)
    end type distributed_run_info
@@ -66,6 +69,11 @@ contains
                call h5_attribute(file, g, "n_above_hardness", s%above_hardness, status)
                call h5_attribute(file, g, "n_plastic", s%n_plastic, status)
                call h5_attribute(file, g, "plastic_volume_nm3", s%plastic_volume, status)
+               if (info%friction) then
+                  call h5_attribute(file, g, "friction_nN", s%friction, status)
+                  call h5_attribute(file, g, "friction_coefficient", &
+                     friction_coefficient(s%friction, s%load, s%contacts), status)
+               end if
             end associate
          end do
          call h5_group(file, "/run", status)

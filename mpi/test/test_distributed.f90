@@ -11,7 +11,7 @@ module test_distributed
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec, build_problem
    use femcod_analytic, only: hertz_approach
-   use femcod_solver_options, only: contact_options, cg_settings, &
+   use femcod_solver_options, only: contact_options, cg_settings, run_shear_model, &
       SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL
    use femcod_contact_result, only: contact_result
    use femcod_solver, only: solve_contact
@@ -49,7 +49,9 @@ contains
          new_unittest("--plastic --approach (the gap variables): the serial path on 1, 2 and 4 ranks", &
             test_plastic_approach_against_serial), &
          new_unittest("--boundary periodic --approach: the serial loads on 1, 2 and 4 ranks", &
-         test_periodic_approach_against_serial) &
+         test_periodic_approach_against_serial), &
+         new_unittest("--shear-strength --shear-slope --plastic: the serial friction on 1, 2 and 4 ranks", &
+         test_friction_against_serial) &
          ]
    end subroutine collect_distributed
 
@@ -334,6 +336,21 @@ contains
       call against_serial(error, options)
    end subroutine test_periodic_against_serial
 
+   !> Friction from the pressures (tau0 = 0.1 GPa, alpha = 0.3) with the plastic cap at
+   !> 10 GPa, whose shear cap k = H/(3 sqrt 3) = 1.92 GPa binds above 6.1 GPa: the
+   !> friction force, a sum over each rank's contacts, within 1e-8 of the serial one.
+   subroutine test_friction_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%loads = [3.0e3_dp, 2.0e4_dp]
+      options%plastic = .true.
+      options%hardness = 10
+      options%shear = .true.
+      options%shear_strength = 0.1_dp
+      options%shear_slope = 0.3_dp
+      call against_serial(error, options)
+   end subroutine test_friction_against_serial
+
    !> The periodic cell under displacement control (the fall of the mean gap; 2 and 6 %
    !> of the height range, below the mean gap).
    subroutine test_periodic_approach_against_serial(error)
@@ -440,7 +457,7 @@ contains
             call distribute_problem(deck, group, options%cg, grid, block, status, options%boundary == BOUNDARY_PERIODIC)
             if (status%code == 0) call solve_loads(grid, deck, targets, options%cg, states, status, observer, &
                options%hardness, options%plastic, by_approach, make_interface_law(options%adhesion, options%work, &
-               options%range, deck%pixel, options%plastic, options%hardness))
+               options%range, deck%pixel, options%plastic, options%hardness), run_shear_model(options))
             call grid_free(grid)
             worst_code = status%code
             if (group_rank == 0) call solve_contact(deck, options, res, serial_status)
@@ -463,7 +480,10 @@ contains
                      bad(2) = bad(2) + count_differences(forces, res%states(k)%i, res%states(k)%j)
                      bad(3) = bad(3) + abs(states(k)%contacts - res%states(k)%contacts)
                      if (.not. by_gaps) load_scale = res%states(k)%load
-                     bad(4) = max(bad(4), abs(states(k)%load - res%states(k)%load)/load_scale)
+                     bad(4) = max(bad(4), abs(states(k)%load - res%states(k)%load)/load_scale, &
+                        abs(states(k)%friction - res%states(k)%friction)/max(abs(res%states(k)%friction), 1.0e-300_dp))
+                     ! With the shear model, the friction must be there, or the test shows nothing.
+                     if (options%shear .and. .not. res%states(k)%friction > 0) bad(4) = 1
                      ! Adhesion: the path must reach contact, or the test shows nothing.
                      if (by_gaps .and. k == 2 .and. res%states(k)%contacts == 0) bad(3) = bad(3) + 1
                      ! With the cap, the last load must cap pixels, or the test shows nothing.
@@ -487,8 +507,8 @@ contains
          call check(error, bad(2) == 0 .and. bad(3) == 0, "contact sets on "//to_string(group_size)//" ranks: "// &
             to_string(nint(bad(2)))//" pixels differ")
          if (allocated(error)) return
-         call check(error, bad(4) <= 1.0e-8_dp, "load on "//to_string(group_size)//" ranks off by "// &
-            to_string(bad(4))//" of the serial load")
+         call check(error, bad(4) <= 1.0e-8_dp, "load or friction on "//to_string(group_size)//" ranks off by "// &
+            to_string(bad(4))//" of the serial one")
          if (allocated(error)) return
          call check(error, bad(5) < 1, "plastic set or volume on "//to_string(group_size)//" ranks differs (n "// &
             "plastic differences + 1e9 x relative volume difference = "//to_string(bad(5))//")")
