@@ -55,6 +55,7 @@ module femcod_convolution
       SPECTRUM_STIFFNESS
    public :: inverse_half_spectrum, inverse_complex_transform, line_transform, line_transform_setup, &
       line_transform_apply, line_transform_free
+   public :: shear_transform, shear_transform_setup, shear_transform_apply, shear_transform_free
 
    !> Which operator gap_transform_apply applies: the compliance C = c (I * .) + s or the
    !> stiffness K = C^-1.
@@ -106,6 +107,24 @@ module femcod_convolution
       real(c_double), pointer :: field(:, :) => null()
       complex(c_double_complex), pointer :: spectrum(:, :) => null()
    end type gap_transform
+
+   !> The tangential (Cerruti) operator of the free half-space on the zero-padded grid
+   !> (M = 2 NP): tangential forces (t_x, t_y) on the NP x NP grid in, the displacements
+   !> u_x = xx * t_x + xy * t_y, u_y = xy * t_x + yy * t_y out (* the convolution over the
+   !> grid). xx and yy are even in both offsets and xy odd in both, so all three spectra
+   !> are real. FFTW's threaded 2-D plans, as gap_transform's.
+   type :: shear_transform
+      integer :: np = 0, m = 0
+      !> The three spectra divided by M^2 (M/2 + 1 x M).
+      real(dp), allocatable :: xx(:, :), yy(:, :), xy(:, :)
+      !> The largest eigenvalue of the 2 x 2 spectrum over the frequencies (nm/nN): a
+      !> bound on the operator's largest eigenvalue on the grid (a step for its solver).
+      real(dp) :: largest = 0
+      type(c_ptr) :: forward, backward, real_mem, complex_mem
+      real(c_double), pointer :: field(:, :) => null()
+      complex(c_double_complex), pointer :: spectrum(:, :) => null()
+      complex(dp), allocatable :: along_x(:, :)
+   end type shear_transform
 
    !> Real-to-complex transforms of lines of one length (the profiles of femcod_summits):
    !> one plan, made on the caller's line and spectrum and executed on them.
@@ -601,6 +620,135 @@ contains
       if (allocated(t%compliance)) deallocate(t%compliance)
       if (allocated(t%stiffness)) deallocate(t%stiffness)
    end subroutine gap_transform_free
+
+   !> Plans and spectra of the tangential operator from its tables xx, yy, xy (nm/nN,
+   !> offsets p, q = 0 .. NP-1 along the rows and the columns; femcod_cerruti's
+   !> tangential_tables), placed at the offsets -(NP-1) .. NP-1 of the padded grid with
+   !> xy's signs (odd in both offsets).
+   subroutine shear_transform_setup(t, xx, yy, xy)
+      type(shear_transform), intent(inout) :: t
+      real(dp), intent(in) :: xx(0:, 0:), yy(0:, 0:), xy(0:, 0:)
+      integer :: np, m, threads
+      np = size(xx, 1)
+      m = 2*np
+      t%np = np
+      t%m = m
+      t%real_mem = fftw_alloc_real(int(m, c_size_t)**2)
+      t%complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
+      call c_f_pointer(t%real_mem, t%field, [m, m])
+      call c_f_pointer(t%complex_mem, t%spectrum, [m/2 + 1, m])
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      if (fftw_init_threads() == 0) threads = 1
+      call fftw_plan_with_nthreads(int(threads, c_int))
+      t%forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), t%field, t%spectrum, FFTW_ESTIMATE)
+      t%backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), t%spectrum, t%field, FFTW_ESTIMATE)
+      call fftw_plan_with_nthreads(1_c_int)
+      t%xx = spectrum_of(xx, .false.)
+      t%yy = spectrum_of(yy, .false.)
+      t%xy = spectrum_of(xy, .true.)
+      t%largest = maxval((t%xx + t%yy)/2 + sqrt(((t%xx - t%yy)/2)**2 + t%xy**2))*real(m, dp)**2
+      allocate(t%along_x(m/2 + 1, m))
+   contains
+      !> The real spectrum / M^2 of a table placed at the offsets (with the signs of an
+      !> odd table).
+      function spectrum_of(table, odd) result(spec)
+         real(dp), intent(in) :: table(0:, 0:)
+         logical, intent(in) :: odd
+         real(dp), allocatable :: spec(:, :)
+         integer :: i, j, p, q
+         t%field = 0
+         do j = 1, m
+            q = j - 1
+            if (q > m/2) q = q - m
+            if (abs(q) >= np) cycle
+            do i = 1, m
+               p = i - 1
+               if (p > m/2) p = p - m
+               if (abs(p) >= np) cycle
+               t%field(i, j) = table(abs(p), abs(q))
+               if (odd) t%field(i, j) = t%field(i, j)*sign(1, p)*sign(1, q)
+            end do
+         end do
+         call fftw_execute_dft_r2c(t%forward, t%field, t%spectrum)
+         spec = real(t%spectrum, dp)/real(m, dp)**2
+      end function spectrum_of
+   end subroutine shear_transform_setup
+
+   !> (ux, uy) = the tangential operator applied to (tx, ty), all NP x NP (nN in, nm out).
+   subroutine shear_transform_apply(t, tx, ty, ux, uy)
+      type(shear_transform), intent(inout) :: t
+      real(dp), intent(in) :: tx(:, :), ty(:, :)
+      real(dp), intent(out) :: ux(:, :), uy(:, :)
+      complex(dp) :: sx, sy
+      integer :: i, j
+      call forward(tx)
+      !$omp parallel do private(i)
+      do j = 1, t%m
+         do i = 1, t%m/2 + 1
+            t%along_x(i, j) = t%spectrum(i, j)
+         end do
+      end do
+      !$omp end parallel do
+      call forward(ty)
+      ! The y component's spectrum in t%spectrum, the x component's in along_x.
+      !$omp parallel do private(i, sx, sy)
+      do j = 1, t%m
+         do i = 1, t%m/2 + 1
+            sx = t%along_x(i, j)
+            sy = t%spectrum(i, j)
+            t%along_x(i, j) = t%xx(i, j)*sx + t%xy(i, j)*sy
+            t%spectrum(i, j) = t%xy(i, j)*sx + t%yy(i, j)*sy
+         end do
+      end do
+      !$omp end parallel do
+      call backward(uy)
+      !$omp parallel do private(i)
+      do j = 1, t%m
+         do i = 1, t%m/2 + 1
+            t%spectrum(i, j) = t%along_x(i, j)
+         end do
+      end do
+      !$omp end parallel do
+      call backward(ux)
+   contains
+      subroutine forward(in)
+         real(dp), intent(in) :: in(:, :)
+         integer :: ii, jj
+         !$omp parallel do private(ii)
+         do jj = 1, t%m
+            do ii = 1, t%m
+               t%field(ii, jj) = 0
+               if (ii <= t%np .and. jj <= t%np) t%field(ii, jj) = in(ii, jj)
+            end do
+         end do
+         !$omp end parallel do
+         call fftw_execute_dft_r2c(t%forward, t%field, t%spectrum)
+      end subroutine forward
+      subroutine backward(out)
+         real(dp), intent(out) :: out(:, :)
+         integer :: ii, jj
+         call fftw_execute_dft_c2r(t%backward, t%spectrum, t%field)
+         !$omp parallel do private(ii)
+         do jj = 1, t%np
+            do ii = 1, t%np
+               out(ii, jj) = t%field(ii, jj)
+            end do
+         end do
+         !$omp end parallel do
+      end subroutine backward
+   end subroutine shear_transform_apply
+
+   subroutine shear_transform_free(t)
+      type(shear_transform), intent(inout) :: t
+      if (.not. associated(t%field)) return
+      call fftw_destroy_plan(t%forward)
+      call fftw_destroy_plan(t%backward)
+      call fftw_free(t%real_mem)
+      call fftw_free(t%complex_mem)
+      nullify(t%field, t%spectrum)
+      if (allocated(t%along_x)) deallocate(t%along_x, t%xx, t%yy, t%xy)
+   end subroutine shear_transform_free
 
    !> field = the inverse 2-D transform of a real, even spectrum's half (kh + 1) x np
    !> (kh = np/2; FFTW's c2r of a row-major np x np transform: the first index the halved

@@ -1,0 +1,124 @@
+!> The Cerruti kernel: the tangential surface displacements of a half-space under a
+!> uniform tangential (shear) traction on one square pixel, in closed form, as the Love
+!> kernel (femcod_love) is for a uniform pressure. The thesis' second route to friction
+!> (section 5.2.3: "the surface displacement calculation can be extended to include
+!> solutions for a surface shear distribution using a Boussinesq-Cerruti solution").
+!>
+!> A tangential point force Q_x at the origin of a half-space of shear modulus G and
+!> Poisson's ratio nu displaces its surface by (Johnson, Contact Mechanics, eq. 2.19;
+!> Love 1929)
+!>     u_x = Q_x/(2 pi G) [(1 - nu)/rho + nu x^2/rho^3],   u_y = Q_x/(2 pi G) nu x y/rho^3,
+!> and normally by -Q_x (1 - 2 nu) x/(4 pi G rho^2), the coupling that femcod leaves out
+!> (Goodman's approximation; nothing of it for two bodies of one material, or for
+!> incompressible ones: the second Dundurs constant beta is 0).
+!>
+!> Over a square pixel of side d centred at (x, y) the three integrals have primitives
+!> whose second mixed derivative is the integrand (X = x - xi, Y = y - eta, rho^2 = X^2 +
+!> Y^2):
+!>     int int X^2/rho^3:  Y ln(X + rho)  = Y asinh(X/|Y|) + (a term that cancels)
+!>     int int Y^2/rho^3:  X ln(Y + rho)  = X asinh(Y/|X|) + ...
+!>     int int X Y/rho^3:  -rho
+!> taken at the four corners with signs (+ + , - +, + -, - -) as in eq. 4.4; the sum of the
+!> first two is the Love influence. So a uniform shear traction tau_x (GPa) on the pixel
+!> at offset (p, q) (p rows, along y; q columns, along x) displaces the pixel at the
+!> origin by
+!>     u_x = d tau_x/(2 pi G) [I_XX + (1 - nu) I_YY],   u_y = d tau_x/(2 pi G) nu I_XY,
+!> and tau_y by u_y = d tau_y/(2 pi G) [I_YY + (1 - nu) I_XX], u_x = d tau_y/(2 pi G) nu I_XY,
+!> with the dimensionless integrals I of the unit pixel. x runs along the columns j, y
+!> along the rows i.
+module femcod_cerruti
+   use femcod_kinds, only: dp
+   implicit none
+   private
+   public :: cerruti_integrals, tangential_tables, second_dundurs_constant
+
+   real(dp), parameter :: pi = acos(-1.0_dp)
+
+contains
+
+   !> The dimensionless integrals of the unit pixel at offset (p rows, q columns):
+   !> w(1) = int int X^2/rho^3, w(2) = int int Y^2/rho^3, w(3) = int int X Y/rho^3 (X along
+   !> the columns).
+   pure function cerruti_integrals(p, q) result(w)
+      integer, intent(in) :: p, q
+      real(dp) :: w(3)
+      real(dp), parameter :: h = 0.5_dp
+      real(dp) :: x, y
+      x = q
+      y = p
+      w(1) = corners(along_x, x, y)
+      w(2) = corners(along_y, x, y)
+      w(3) = corners(cross, x, y)
+   contains
+      pure real(dp) function corners(f, x, y)
+         interface
+            pure real(dp) function f(a, b)
+               import :: dp
+               real(dp), intent(in) :: a, b
+            end function f
+         end interface
+         real(dp), intent(in) :: x, y
+         corners = f(x + h, y + h) - f(x + h, y - h) - f(x - h, y + h) + f(x - h, y - h)
+      end function corners
+   end function cerruti_integrals
+
+   !> Y asinh(X/|Y|): the primitive of X^2/rho^3 (0 on Y = 0, its limit).
+   pure real(dp) function along_x(a, b)
+      real(dp), intent(in) :: a, b
+      along_x = 0
+      if (b /= 0) along_x = b*asinh(a/abs(b))
+   end function along_x
+
+   !> X asinh(Y/|X|): the primitive of Y^2/rho^3.
+   pure real(dp) function along_y(a, b)
+      real(dp), intent(in) :: a, b
+      along_y = 0
+      if (a /= 0) along_y = a*asinh(b/abs(a))
+   end function along_y
+
+   !> -rho: the primitive of X Y/rho^3.
+   pure real(dp) function cross(a, b)
+      real(dp), intent(in) :: a, b
+      cross = -sqrt(a*a + b*b)
+   end function cross
+
+   !> The tangential compliance tables (nm/nN) of the two bodies together, offsets
+   !> (p, q) = 0 .. np-1 (rows, columns): a tangential force t (nN) on one pixel moves the
+   !> other by u = (xx t_x + xy t_y, xy t_x + yy t_y), the bodies' displacements added
+   !> (equal and opposite forces; their relative tangential displacement). Each body:
+   !> 1/(2 pi G d) times the pixel integrals (module header), G = E/(2 (1 + nu)). xx and
+   !> yy are even in both offsets, xy odd in both (these tables hold p, q >= 0).
+   pure subroutine tangential_tables(np, pixel, young, poisson, xx, yy, xy)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: pixel, young(2), poisson(2)
+      real(dp), intent(out) :: xx(0:np - 1, 0:np - 1), yy(0:np - 1, 0:np - 1), xy(0:np - 1, 0:np - 1)
+      real(dp) :: w(3), c(2)
+      integer :: p, q, b
+      do b = 1, 2
+         c(b) = (1 + poisson(b))/(pi*young(b)*pixel)
+      end do
+      do q = 0, np - 1
+         do p = 0, np - 1
+            w = cerruti_integrals(p, q)
+            xx(p, q) = 0
+            yy(p, q) = 0
+            xy(p, q) = 0
+            do b = 1, 2
+               xx(p, q) = xx(p, q) + c(b)*(w(1) + (1 - poisson(b))*w(2))
+               yy(p, q) = yy(p, q) + c(b)*(w(2) + (1 - poisson(b))*w(1))
+               xy(p, q) = xy(p, q) + c(b)*poisson(b)*w(3)
+            end do
+         end do
+      end do
+   end subroutine tangential_tables
+
+   !> Dundurs' second constant of two bodies (E GPa, nu): beta = [G1 (1 - 2 nu2) - G2
+   !> (1 - 2 nu1)] / [2 G1 (1 - nu2) + 2 G2 (1 - nu1)]: the coupling of normal and
+   !> tangential displacements, 0 for one material or incompressible bodies.
+   pure real(dp) function second_dundurs_constant(young, poisson) result(beta)
+      real(dp), intent(in) :: young(2), poisson(2)
+      real(dp) :: g(2)
+      g = young/(2*(1 + poisson))
+      beta = (g(1)*(1 - 2*poisson(2)) - g(2)*(1 - 2*poisson(1)))/(2*g(1)*(1 - poisson(2)) + 2*g(2)*(1 - poisson(1)))
+   end function second_dundurs_constant
+end module femcod_cerruti

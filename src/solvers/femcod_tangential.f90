@@ -1,0 +1,313 @@
+!> Tangential loading with Coulomb friction (the thesis' second route to friction, section
+!> 5.2.3): after the normal problem, the contact is loaded tangentially by a force Q (nN)
+!> or a rigid tangential shift S (nm), both along x (the columns), at its normal state.
+!>
+!> Each contact pixel i carries a tangential force t_i (nN; the traction t_i/d^2) with
+!> |t_i| <= b_i = mu f_i (f_i its normal force, mu the friction coefficient): it sticks
+!> (|t_i| < b_i, its surface moves with the rigid shift delta: u_i = delta) or slips
+!> (|t_i| = b_i, t_i along delta - u_i, the way the surface lags behind the shift). u = A t
+!> is the bodies' relative tangential displacement, A their Cerruti compliance
+!> (model/femcod_cerruti, applied by FFT: femcod_convolution's shear_transform). These are
+!> the conditions of the minimum of the complementary energy
+!>     shift given (slip control):  1/2 t.A t - delta . sum t,   |t_i| <= b_i,
+!>     load given (force control):  1/2 t.A t,  sum t = Q,       |t_i| <= b_i,
+!> a convex program whose constraints are a disc per pixel (not a bound), whose
+!> multiplier of sum t = Q is delta. It is solved by accelerated projected gradients
+!> (FISTA, Beck and Teboulle 2009, with O'Donoghue and Candes' adaptive restart) with the
+!> step 1/L, L the largest eigenvalue of the padded operator's 2 x 2 spectrum (a bound on
+!> A's): under force control the projection onto {discs, sum t = Q} is t_i = P_i(z_i +
+!> lambda), P_i the projection onto pixel i's disc and lambda (a 2-vector) the root of
+!> sum P_i(z_i + lambda) = Q, found by Newton's method (the map is monotone); at the
+!> solution delta = L lambda.
+!>
+!> The normal pressures stay as the normal problem left them (Goodman's approximation:
+!> the coupling by the second Dundurs constant beta is left out; exact for beta = 0, one
+!> material or incompressible bodies). Free half-space only. Q >= mu P: gross sliding,
+!> every pixel at b_i along x (the shift is then the onset's at Q = mu P, unbounded
+!> beyond it).
+module femcod_tangential
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
+   use femcod_strings, only: int_str, sig_str
+   use femcod_problem, only: contact_problem
+   use femcod_cerruti, only: tangential_tables
+   use femcod_convolution, only: shear_transform, shear_transform_setup, shear_transform_apply, shear_transform_free
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+   implicit none
+   private
+   public :: tangential_request, tangential_answer, solve_tangential, tangential_storage_bytes
+
+   !> What a tangential step asks: the friction coefficient, the load (nN) or, with
+   !> `by_slip`, the rigid shift (nm), both along x; the relative residual to reach and
+   !> the iterations allowed.
+   type :: tangential_request
+      real(dp) :: mu = 0
+      logical :: by_slip = .false.
+      real(dp) :: load = 0, slip = 0
+      real(dp) :: tol = 1.0e-8_dp
+      integer :: max_iterations = 20000
+   end type tangential_request
+
+   !> The answer on the contact pixels, in the order of the state's list.
+   type :: tangential_answer
+      !> Tangential forces (nN) and whether each pixel sticks.
+      real(dp), allocatable :: tx(:), ty(:)
+      logical, allocatable :: stick(:)
+      !> The rigid shift (nm, the tangential approach) and the total tangential force (nN).
+      real(dp) :: shift(2) = 0, force(2) = 0
+      !> Gross sliding (Q >= mu P): every pixel slips.
+      logical :: sliding = .false.
+      integer :: iterations = 0
+      !> The largest violation of the stick and slip conditions (nm) over the shift's size.
+      real(dp) :: residual = 0
+   end type tangential_answer
+
+   !> The iteration's state: the contact list, the bounds, the grids the operator takes,
+   !> and the contacts' displacements of the last application.
+   type :: tangential_state
+      integer :: n = 0
+      integer, allocatable :: ci(:), cj(:)
+      real(dp), allocatable :: bound(:)
+      !> u(:, k): pixel k's displacement (nm) from the last `displace`.
+      real(dp), allocatable :: u(:, :)
+      real(dp), allocatable :: gx(:, :), gy(:, :), ux(:, :), uy(:, :)
+      type(shear_transform) :: op
+   end type tangential_state
+
+contains
+
+   !> The tangential state of contact pixels (ci, cj) with normal forces f (nN) of
+   !> `problem` under `request`.
+   subroutine solve_tangential(problem, ci, cj, f, request, answer, status)
+      type(contact_problem), intent(in) :: problem
+      integer, intent(in) :: ci(:), cj(:)
+      real(dp), intent(in) :: f(:)
+      type(tangential_request), intent(in) :: request
+      type(tangential_answer), intent(out) :: answer
+      type(status_type), intent(inout) :: status
+      type(tangential_state) :: st
+      real(dp), allocatable :: xx(:, :), yy(:, :), xy(:, :), t(:, :)
+      real(dp) :: capacity
+      integer :: np
+      if (status%code /= 0) return
+      np = problem%np
+      st%n = size(ci)
+      st%ci = ci
+      st%cj = cj
+      st%bound = request%mu*max(f, 0.0_dp)
+      allocate(answer%tx(st%n), answer%ty(st%n), answer%stick(st%n), t(2, st%n), st%u(2, st%n))
+      answer%tx = 0
+      answer%ty = 0
+      answer%stick = .false.
+      capacity = sum(st%bound)
+      if (st%n == 0 .or. .not. capacity > 0) return
+      allocate(xx(0:np - 1, 0:np - 1), yy(0:np - 1, 0:np - 1), xy(0:np - 1, 0:np - 1))
+      call tangential_tables(np, problem%pixel, problem%young(1:2), problem%poisson(1:2), xx, yy, xy)
+      call shear_transform_setup(st%op, xx, yy, xy)
+      deallocate(xx, yy, xy)
+      allocate(st%gx(np, np), st%gy(np, np), st%ux(np, np), st%uy(np, np))
+      st%gx = 0
+      st%gy = 0
+      if (.not. request%by_slip .and. request%load >= capacity*(1 - 1.0e-12_dp)) then
+         call gross_sliding(st, request, capacity, t, answer)
+      else
+         call projected_gradients(st, request, t, answer, status)
+      end if
+      answer%tx = t(1, :)
+      answer%ty = t(2, :)
+      answer%force = [sum(answer%tx), sum(answer%ty)]
+      call shear_transform_free(st%op)
+   end subroutine solve_tangential
+
+   !> Q >= mu P: every pixel at its bound along x. The shift at Q = mu P is the onset's:
+   !> the largest u_x, where the last pixel to stick lets go; beyond mu P it is unbounded.
+   subroutine gross_sliding(st, request, capacity, t, answer)
+      type(tangential_state), intent(inout) :: st
+      type(tangential_request), intent(in) :: request
+      real(dp), intent(in) :: capacity
+      real(dp), intent(out) :: t(:, :)
+      type(tangential_answer), intent(inout) :: answer
+      answer%sliding = .true.
+      t(1, :) = st%bound
+      t(2, :) = 0
+      call displace(st, t)
+      answer%shift = [maxval(st%u(1, :)), sum(st%u(2, :))/st%n]
+      if (request%load > capacity*(1 + 1.0e-12_dp)) answer%shift = ieee_value(1.0_dp, ieee_quiet_nan)
+   end subroutine gross_sliding
+
+   !> st%u = A t at the contacts (nm), through the grids.
+   subroutine displace(st, t)
+      type(tangential_state), intent(inout) :: st
+      real(dp), intent(in) :: t(:, :)
+      integer :: k
+      do k = 1, st%n
+         st%gx(st%ci(k), st%cj(k)) = t(1, k)
+         st%gy(st%ci(k), st%cj(k)) = t(2, k)
+      end do
+      call shear_transform_apply(st%op, st%gx, st%gy, st%ux, st%uy)
+      do k = 1, st%n
+         st%u(1, k) = st%ux(st%ci(k), st%cj(k))
+         st%u(2, k) = st%uy(st%ci(k), st%cj(k))
+         st%gx(st%ci(k), st%cj(k)) = 0
+         st%gy(st%ci(k), st%cj(k)) = 0
+      end do
+   end subroutine displace
+
+   !> FISTA with adaptive restart (module header) from the forces shared in proportion to
+   !> the bounds; t the answer's forces (2 x n).
+   subroutine projected_gradients(st, request, t, answer, status)
+      type(tangential_state), intent(inout) :: st
+      type(tangential_request), intent(in) :: request
+      real(dp), intent(out) :: t(:, :)
+      type(tangential_answer), intent(inout) :: answer
+      type(status_type), intent(inout) :: status
+      real(dp), allocatable :: y(:, :), z(:, :), t_new(:, :)
+      real(dp) :: step, theta, theta_new, lambda(2), shift(2), scale, gap
+      integer :: it
+      step = 1/st%op%largest
+      allocate(y(2, st%n), z(2, st%n), t_new(2, st%n))
+      lambda = 0
+      if (request%by_slip) then
+         shift = [request%slip, 0.0_dp]
+         t(1, :) = 0
+      else
+         t(1, :) = st%bound*request%load/sum(st%bound)
+      end if
+      t(2, :) = 0
+      y = t
+      theta = 1
+      do it = 1, request%max_iterations
+         call displace(st, y)
+         z = y - step*st%u
+         if (request%by_slip) then
+            z(1, :) = z(1, :) + step*shift(1)
+            z(2, :) = z(2, :) + step*shift(2)
+            call project_discs(z, st%bound, t_new)
+         else
+            call project_with_load(z, st%bound, [request%load, 0.0_dp], lambda, t_new)
+            shift = lambda/step
+         end if
+         ! The gradient mapping (nm): how far the step moves the forces, in displacements.
+         scale = max(norm2(shift), maxval(abs(st%u)), tiny(1.0_dp))
+         gap = maxval(norm2(y - t_new, dim=1))/step/scale
+         ! Adaptive restart: momentum against the last step's direction.
+         if (sum((y - t_new)*(t_new - t)) > 0) then
+            theta = 1
+            y = t_new
+         else
+            theta_new = (1 + sqrt(1 + 4*theta**2))/2
+            y = t_new + ((theta - 1)/theta_new)*(t_new - t)
+            theta = theta_new
+         end if
+         t = t_new
+         if (gap < request%tol) exit
+      end do
+      answer%iterations = min(it, request%max_iterations)
+      call displace(st, t)
+      answer%shift = shift
+      call classify(st, t, shift, answer)
+      if (answer%residual > 10*request%tol) call set_error(status, STATUS_NUMERICAL, "tangential: residual "// &
+         sig_str(answer%residual, 2)//" after "//int_str(answer%iterations)//" iterations, above 10 x --tol "// &
+         sig_str(request%tol, 2))
+   end subroutine projected_gradients
+
+   !> Stick and slip from the forces t and the displacements st%u at the shift, and the
+   !> largest violation of their conditions over the shift's size: a sticking pixel moves
+   !> with the shift; a slipping one lags behind it along its force.
+   subroutine classify(st, t, shift, answer)
+      type(tangential_state), intent(in) :: st
+      real(dp), intent(in) :: t(:, :), shift(2)
+      type(tangential_answer), intent(inout) :: answer
+      real(dp) :: v(2), along, r, scale
+      integer :: k
+      scale = max(norm2(shift), maxval(abs(st%u)), tiny(1.0_dp))
+      answer%residual = 0
+      do k = 1, st%n
+         v = shift - st%u(:, k)
+         answer%stick(k) = norm2(t(:, k)) < st%bound(k)*(1 - 1.0e-9_dp)
+         if (answer%stick(k)) then
+            r = norm2(v)
+         else
+            along = dot_product(v, t(:, k))/norm2(t(:, k))
+            r = norm2(v - along*t(:, k)/norm2(t(:, k))) + max(0.0_dp, -along)
+         end if
+         answer%residual = max(answer%residual, r/scale)
+      end do
+   end subroutine classify
+
+   !> t_k = the projection of z_k onto the disc of radius b_k.
+   pure subroutine project_discs(z, b, t)
+      real(dp), intent(in) :: z(:, :), b(:)
+      real(dp), intent(out) :: t(:, :)
+      real(dp) :: r
+      integer :: k
+      do k = 1, size(b)
+         r = norm2(z(:, k))
+         if (r <= b(k)) then
+            t(:, k) = z(:, k)
+         else
+            t(:, k) = z(:, k)*(b(k)/r)
+         end if
+      end do
+   end subroutine project_discs
+
+   !> The projection of z onto {|t_k| <= b_k, sum t = q}: t_k = P_k(z_k + lambda), lambda
+   !> (warm-started) the root of sum P_k(z_k + lambda) = q by Newton's method with
+   !> halving steps; the Jacobian sum of I (inside) and (b/|w|)(I - w w^T/|w|^2) (outside).
+   pure subroutine project_with_load(z, b, q, lambda, t)
+      real(dp), intent(in) :: z(:, :), b(:), q(2)
+      real(dp), intent(inout) :: lambda(2)
+      real(dp), intent(out) :: t(:, :)
+      real(dp) :: jac(2, 2), f(2), trial(2), step(2), det, residual, target
+      integer :: it, halving
+      target = 1.0e-14_dp*sum(b)
+      call evaluate(lambda, f, jac)
+      residual = norm2(f)
+      do it = 1, 200
+         if (residual <= target) exit
+         jac(1, 1) = jac(1, 1) + 1.0e-12_dp*(jac(1, 1) + jac(2, 2))
+         jac(2, 2) = jac(2, 2) + 1.0e-12_dp*(jac(1, 1) + jac(2, 2))
+         det = jac(1, 1)*jac(2, 2) - jac(1, 2)*jac(2, 1)
+         step = -[jac(2, 2)*f(1) - jac(1, 2)*f(2), jac(1, 1)*f(2) - jac(2, 1)*f(1)]/det
+         do halving = 0, 40
+            trial = lambda + step/2.0_dp**halving
+            call evaluate(trial, f, jac)
+            if (norm2(f) < residual) exit
+         end do
+         lambda = trial
+         residual = norm2(f)
+      end do
+      call project_discs(z + spread(lambda, 2, size(b)), b, t)
+   contains
+      pure subroutine evaluate(l, f, jac)
+         real(dp), intent(in) :: l(2)
+         real(dp), intent(out) :: f(2), jac(2, 2)
+         real(dp) :: w(2), r
+         integer :: k
+         f = -q
+         jac = 0
+         do k = 1, size(b)
+            w = z(:, k) + l
+            r = norm2(w)
+            if (r <= b(k)) then
+               f = f + w
+               jac(1, 1) = jac(1, 1) + 1
+               jac(2, 2) = jac(2, 2) + 1
+            else
+               f = f + w*(b(k)/r)
+               jac(1, 1) = jac(1, 1) + b(k)/r*(1 - w(1)**2/r**2)
+               jac(2, 2) = jac(2, 2) + b(k)/r*(1 - w(2)**2/r**2)
+               jac(1, 2) = jac(1, 2) - b(k)/r*w(1)*w(2)/r**2
+               jac(2, 1) = jac(1, 2)
+            end if
+         end do
+      end subroutine evaluate
+   end subroutine project_with_load
+
+   !> The bytes the tangential step holds at NP (the padded grid's fields and spectra,
+   !> the four grids, three spectra): for the memory check.
+   pure integer(i8) function tangential_storage_bytes(np) result(bytes)
+      integer, intent(in) :: np
+      bytes = int(np, i8)**2*(8*4 + 8*4 + 16*2*2 + 8*3*2)
+   end function tangential_storage_bytes
+end module femcod_tangential

@@ -1,0 +1,340 @@
+!> Tangential loading with Coulomb friction (solvers/femcod_tangential) and its kernel
+!> (model/femcod_cerruti). The references, none of them the code under test:
+!> - the Cerruti pixel integrals against a Gauss-Legendre quadrature (this file's) of the
+!>   point-force solution's integrands over the pixel, and the self term against its
+!>   closed form 4 ln(1 + sqrt 2) (the Love integral of the unit square at its centre);
+!> - Cattaneo and Mindlin's sphere (Johnson, Contact Mechanics, 7.2): the stick radius
+!>   c/a = (1 - Q/(mu P))^(1/3) and the shift 3 mu P (2 - nu)/(16 a G) [1 - (1 - Q/(mu
+!>   P))^(2/3)] on a rigid paraboloid over an elastic body with nu = 0 (where their
+!>   solution is exact: the slip is then along x), at three resolutions;
+!> - full sliding at Q = mu P (every traction mu p) and Q -> 0 (everything sticks);
+!> - a dense quadratic program with a disc per pixel, solved here by block Gauss-Seidel
+!>   (each pixel's exact minimiser in turn) on a matrix built from this file's own
+!>   closed form of the kernel, on a small rough surface.
+module test_tangential
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type
+   use femcod_problem, only: contact_problem
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options, cg_settings, SOLVER_CG
+   use femcod_solver, only: solve_contact
+   use femcod_cerruti, only: cerruti_integrals
+   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential
+   use test_cg, only: rough_scene
+   use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
+   implicit none
+   private
+   public :: collect_tangential
+
+   real(dp), parameter :: pi = acos(-1.0_dp)
+
+contains
+
+   subroutine collect_tangential(testsuite)
+      type(unittest_type), allocatable, intent(out) :: testsuite(:)
+      testsuite = [ &
+         new_unittest("Cerruti pixel integrals: quadrature of the point solution, the self term", test_integrals), &
+         new_unittest("Cattaneo-Mindlin: stick radius and shift at a/d = 8, 16, 32, with the order", &
+            test_cattaneo_mindlin), &
+         new_unittest("Q = mu P: every traction mu p; Q -> 0: every pixel sticks", test_limits), &
+         new_unittest("a dense QP with disc constraints (block Gauss-Seidel) on a rough surface", test_dense)]
+   end subroutine collect_tangential
+
+   !> The three integrals of the unit pixel at offsets off the centre against a 32 x 32
+   !> Gauss-Legendre product rule of X^2/rho^3, Y^2/rho^3, X Y/rho^3 over the pixel (the
+   !> integrand is smooth there: 1e-11 at offset 1, less beyond); at the centre the sum of
+   !> the first two is 4 ln(1 + sqrt 2), they are equal, and the third is 0.
+   subroutine test_integrals(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: offsets(2, 6) = reshape([1, 0, 0, 1, 2, 3, 5, 1, 1, 7, 10, 9], [2, 6])
+      real(dp) :: w(3), quad(3)
+      integer :: k
+      do k = 1, size(offsets, 2)
+         w = cerruti_integrals(offsets(1, k), offsets(2, k))
+         quad = quadrature(offsets(1, k), offsets(2, k))
+         call check(error, maxval(abs(w - quad)) < 1.0e-10_dp*maxval(abs(quad)), "offset ("// &
+            to_string(offsets(1, k))//", "//to_string(offsets(2, k))//"): "//to_string(w(1))//", "// &
+            to_string(w(2))//", "//to_string(w(3))//" against "//to_string(quad(1))//", "//to_string(quad(2))// &
+            ", "//to_string(quad(3)))
+         if (allocated(error)) return
+      end do
+      w = cerruti_integrals(0, 0)
+      call check(error, abs(w(1) + w(2) - 4*log(1 + sqrt(2.0_dp))) < 1.0e-14_dp .and. abs(w(1) - w(2)) < 1.0e-14_dp &
+         .and. w(3) == 0, "the self term: "//to_string(w(1))//", "//to_string(w(2))//", "//to_string(w(3)))
+   end subroutine test_integrals
+
+   !> The Gauss-Legendre product rule (32 nodes per side, by Newton's method on the
+   !> Legendre polynomial) of the three integrands over the unit pixel at (p rows, q
+   !> columns): X along the columns.
+   function quadrature(p, q) result(v)
+      integer, intent(in) :: p, q
+      real(dp) :: v(3)
+      integer, parameter :: n = 32
+      real(dp) :: x(n), wt(n), xx, yy, r
+      integer :: a, b
+      call gauss_legendre(n, x, wt)
+      v = 0
+      do a = 1, n
+         do b = 1, n
+            xx = q + x(a)/2
+            yy = p + x(b)/2
+            r = sqrt(xx*xx + yy*yy)
+            v = v + wt(a)*wt(b)/4*[xx*xx, yy*yy, xx*yy]/r**3
+         end do
+      end do
+   end function quadrature
+
+   !> Nodes and weights of Gauss-Legendre on [-1, 1].
+   subroutine gauss_legendre(n, x, w)
+      integer, intent(in) :: n
+      real(dp), intent(out) :: x(n), w(n)
+      real(dp) :: z, p0, p1, p2, dp1
+      integer :: i, k, it
+      do i = 1, n
+         z = cos(pi*(i - 0.25_dp)/(n + 0.5_dp))
+         do it = 1, 100
+            p0 = 1
+            p1 = z
+            do k = 2, n
+               p2 = ((2*k - 1)*z*p1 - (k - 1)*p0)/k
+               p0 = p1
+               p1 = p2
+            end do
+            dp1 = n*(z*p1 - p0)/(z*z - 1)
+            z = z - p1/dp1
+            if (abs(p1/dp1) < 1.0e-16_dp) exit
+         end do
+         x(i) = z
+         w(i) = 2/((1 - z*z)*dp1**2)
+      end do
+   end subroutine gauss_legendre
+
+   !> A rigid paraboloid (R = 1000 nm) over an elastic body (E = 200 GPa, nu = 0) at the
+   !> Hertz load of a = 24 nm, solved by cg (tol 1e-10), pixels of `pixel` nm.
+   subroutine hertz_state(pixel, deck, res, error)
+      real(dp), intent(in) :: pixel
+      type(contact_problem), intent(out) :: deck
+      type(contact_result), intent(out) :: res
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      type(status_type) :: status
+      real(dp), parameter :: radius = 1000, a = 24
+      integer :: i, j, np
+      real(dp) :: c, x, y
+      np = 2*nint(1.5_dp*a/pixel) + 1
+      deck%label = "paraboloid"
+      deck%np = np
+      deck%pixel = pixel
+      deck%maxcont = np*np
+      deck%young = [200.0_dp, 200.0e5_dp, 200.0e5_dp]
+      deck%poisson = [0.0_dp, 0.0_dp, 0.0_dp]
+      allocate(deck%lower(np, np), deck%upper(np, np))
+      deck%lower = 0
+      c = (np + 1)/2.0_dp
+      do j = 1, np
+         do i = 1, np
+            x = (j - c)*pixel
+            y = (i - c)*pixel
+            deck%upper(i, j) = 10 - (x*x + y*y)/(2*radius)
+         end do
+      end do
+      options%solver = SOLVER_CG
+      options%loads = [4*200*a**3/(3*radius)]
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-10_dp
+      options%cg%max_iterations = 5000
+      call solve_contact(deck, options, res, status)
+      call check(error, status%code, 0, status%message)
+   end subroutine hertz_state
+
+   !> Cattaneo-Mindlin at Q = mu P/2 (mu = 0.3): the stick radius from the stick area
+   !> (c = sqrt(A_stick/pi)) and the shift against the closed forms (module header) with
+   !> Hertz's a. Pixels of a/8, a/16, a/32. Measured: the shift's error 1.1e-3, 1.5e-4,
+   !> 2.0e-5 (order 3.0 between the finer two); the stick radius, a count of whole pixels,
+   !> 4.0 %, 0.23 %, 0.65 % (0.25, 0.03, 0.17 pixels: the lattice's scatter, no order).
+   !> Required: the shift's error falls at each halving and is below 1e-4 at a/32; the
+   !> stick radius is within half a pixel at every resolution.
+   subroutine test_cattaneo_mindlin(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_result) :: res
+      type(tangential_request) :: request
+      type(tangential_answer) :: answer
+      type(status_type) :: status
+      real(dp), parameter :: a = 24, mu = 0.3_dp, ratio = 0.5_dp
+      real(dp) :: load, shift, stick_radius, errors(2, 3), g
+      integer :: level
+      load = 4*200*a**3/(3*1000)
+      g = 200/2.0_dp
+      shift = 3*mu*load*2/(16*a*g)*(1 - (1 - ratio)**(2.0_dp/3))
+      stick_radius = a*(1 - ratio)**(1.0_dp/3)
+      do level = 1, 3
+         call hertz_state(a/2.0_dp**(level + 2), deck, res, error)
+         if (allocated(error)) return
+         request%mu = mu
+         request%load = ratio*mu*res%states(1)%load
+         request%tol = 1.0e-9_dp
+         associate(s => res%states(1))
+            call solve_tangential(deck, s%i, s%j, s%force, request, answer, status)
+         end associate
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         errors(1, level) = abs(answer%shift(1) - shift)/shift
+         errors(2, level) = abs(sqrt(count(answer%stick)*deck%pixel**2/pi) - stick_radius)/stick_radius
+         write(*, '(a)') "           a/d = "//to_string(nint(a/deck%pixel))//": shift "//to_string(answer%shift(1))// &
+            " nm (Mindlin "//to_string(shift)//"), stick radius "// &
+            to_string(sqrt(count(answer%stick)*deck%pixel**2/pi))//" nm (Cattaneo "//to_string(stick_radius)// &
+            "), "//to_string(answer%iterations)//" iterations, residual "//to_string(answer%residual)
+      end do
+      write(*, '(a)') "           order of the shift's error: "//to_string(log(errors(1, 2)/errors(1, 3))/log(2.0_dp))// &
+         ", of the stick radius': "//to_string(log(errors(2, 2)/errors(2, 3))/log(2.0_dp))
+      call check(error, errors(1, 2) < errors(1, 1) .and. errors(1, 3) < errors(1, 2) .and. errors(1, 3) < 1.0e-4_dp, &
+         "the shift's error falls with the pixel: "//to_string(errors(1, 1))//", "//to_string(errors(1, 2))//", "// &
+         to_string(errors(1, 3)))
+      if (allocated(error)) return
+      call check(error, all(errors(2, :)*stick_radius < 0.5_dp*a/2.0_dp**[3, 4, 5]), "the stick radius within half "// &
+         "a pixel: relative errors "//to_string(errors(2, 1))//", "//to_string(errors(2, 2))//", "// &
+         to_string(errors(2, 3)))
+   end subroutine test_cattaneo_mindlin
+
+   !> At Q = mu P every pixel carries mu f along x; at Q = 1e-6 mu P every pixel sticks.
+   subroutine test_limits(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_result) :: res
+      type(tangential_request) :: request
+      type(tangential_answer) :: answer
+      type(status_type) :: status
+      call hertz_state(3.0_dp, deck, res, error)
+      if (allocated(error)) return
+      request%mu = 0.4_dp
+      associate(s => res%states(1))
+         request%load = request%mu*sum(s%force)
+         call solve_tangential(deck, s%i, s%j, s%force, request, answer, status)
+         call check(error, answer%sliding .and. all(abs(answer%tx - request%mu*s%force) <= 1.0e-15_dp*request%load) &
+            .and. all(answer%ty == 0) .and. .not. any(answer%stick), "Q = mu P: tractions mu p along x")
+         if (allocated(error)) return
+         request%load = 1.0e-6_dp*request%mu*sum(s%force)
+         call solve_tangential(deck, s%i, s%j, s%force, request, answer, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         call check(error, all(answer%stick), "Q -> 0: "//to_string(count(answer%stick))//" of "// &
+            to_string(size(answer%stick))//" pixels stick")
+      end associate
+   end subroutine test_limits
+
+   !> A rough surface (16^2, self-affine, 10 nm pixels) at 30000 nN; the shift S = 0.08 nm
+   !> along x with mu = 0.2. The reference: the tangential compliance matrix of the
+   !> contacts built from this file's kernel (the primitives Y asinh(X/|Y|), X asinh(Y/|X|),
+   !> -rho at the corners; E = 200 GPa, nu = 0.25 elastic lower, the rigid upper's share
+   !> included), and min 1/2 t.A t - S sum t_x over |t_k| <= mu f_k by block Gauss-
+   !> Seidel: each pixel in turn minimises over its disc with the others fixed, the
+   !> projection of its unconstrained minimiser (A's 2 x 2 diagonal blocks are multiples
+   !> of the identity). Agreement of every force to 1e-7 of the largest.
+   subroutine test_dense(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(tangential_request) :: request
+      type(tangential_answer) :: answer
+      type(status_type) :: status
+      real(dp), allocatable :: m(:, :), t(:), b(:), rhs(:)
+      real(dp) :: w(2), r, biggest
+      integer :: n, k, sweep
+      call rough_scene(16, 4, deck)
+      options%solver = SOLVER_CG
+      options%loads = [30000.0_dp]
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-12_dp
+      call solve_contact(deck, options, res, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      request%mu = 0.2_dp
+      request%by_slip = .true.
+      request%slip = 0.08_dp
+      request%tol = 1.0e-11_dp
+      associate(s => res%states(1))
+         n = size(s%i)
+         call solve_tangential(deck, s%i, s%j, s%force, request, answer, status)
+         call check(error, status%code, 0, status%message)
+         if (allocated(error)) return
+         m = dense_matrix(deck, s%i, s%j)
+         b = request%mu*s%force
+      end associate
+      allocate(t(2*n), rhs(2*n))
+      t = 0
+      rhs = 0
+      rhs(1:2*n:2) = request%slip
+      do sweep = 1, 20000
+         biggest = 0
+         do k = 1, n
+            ! The pixel's unconstrained minimiser given the others, then its disc.
+            w = t(2*k - 1:2*k) + (rhs(2*k - 1:2*k) - matmul(m(2*k - 1:2*k, :), t))/m(2*k - 1, 2*k - 1)
+            r = norm2(w)
+            if (r > b(k)) w = w*b(k)/r
+            biggest = max(biggest, maxval(abs(w - t(2*k - 1:2*k))))
+            t(2*k - 1:2*k) = w
+         end do
+         if (biggest < 1.0e-15_dp*maxval(b)) exit
+      end do
+      call check(error, maxval(abs(t(1:2*n:2) - answer%tx)) <= 1.0e-7_dp*maxval(abs(t)) .and. &
+         maxval(abs(t(2:2*n:2) - answer%ty)) <= 1.0e-7_dp*maxval(abs(t)), "forces against the dense QP: "// &
+         to_string(maxval(abs(t(1:2*n:2) - answer%tx)))//", "//to_string(maxval(abs(t(2:2*n:2) - answer%ty)))// &
+         " nN of "//to_string(maxval(abs(t)))//" ("//to_string(n)//" contacts, "//to_string(count(answer%stick))// &
+         " sticking, "//to_string(sweep)//" sweeps)")
+      if (allocated(error)) return
+      write(*, '(a)') "           dense QP: "//to_string(n)//" contacts, "//to_string(count(answer%stick))// &
+         " stick, largest force difference "//to_string(maxval(abs(t(1:2*n:2) - answer%tx)))//" nN of "// &
+         to_string(maxval(abs(t)))//", "//to_string(answer%iterations)//" iterations"
+      call check(error, count(answer%stick) > 0 .and. count(answer%stick) < n, "partial slip: "// &
+         to_string(count(answer%stick))//" of "//to_string(n)//" stick")
+   end subroutine test_dense
+
+   !> The 2n x 2n compliance (nm/nN) between the contacts, (x, y) of each pixel in turn,
+   !> from this file's closed form of the pixel integrals.
+   function dense_matrix(deck, ci, cj) result(m)
+      type(contact_problem), intent(in) :: deck
+      integer, intent(in) :: ci(:), cj(:)
+      real(dp), allocatable :: m(:, :)
+      real(dp) :: w(3), c, nu
+      integer :: k, l, body
+      allocate(m(2*size(ci), 2*size(ci)))
+      m = 0
+      do body = 1, 2
+         nu = deck%poisson(body)
+         c = (1 + nu)/(pi*deck%young(body)*deck%pixel)
+         do l = 1, size(ci)
+            do k = 1, size(ci)
+               w = pixel_integrals(real(cj(k) - cj(l), dp), real(ci(k) - ci(l), dp))
+               m(2*k - 1, 2*l - 1) = m(2*k - 1, 2*l - 1) + c*(w(1) + (1 - nu)*w(2))
+               m(2*k, 2*l) = m(2*k, 2*l) + c*(w(2) + (1 - nu)*w(1))
+               m(2*k - 1, 2*l) = m(2*k - 1, 2*l) + c*nu*w(3)
+               m(2*k, 2*l - 1) = m(2*k, 2*l - 1) + c*nu*w(3)
+            end do
+         end do
+      end do
+   contains
+      !> int X^2/rho^3, int Y^2/rho^3, int X Y/rho^3 over the unit pixel at (x, y).
+      function pixel_integrals(x, y) result(v)
+         real(dp), intent(in) :: x, y
+         real(dp) :: v(3)
+         real(dp) :: sx(2), sy(2)
+         integer :: a, b
+         sx = [x - 0.5_dp, x + 0.5_dp]
+         sy = [y - 0.5_dp, y + 0.5_dp]
+         v = 0
+         do a = 1, 2
+            do b = 1, 2
+               v = v + (-1)**(a + b)*[prim_xx(sx(a), sy(b)), prim_xx(sy(b), sx(a)), -sqrt(sx(a)**2 + sy(b)**2)]
+            end do
+         end do
+      end function pixel_integrals
+      !> Y ln(X + rho) by its asinh form (the term Y ln|Y| cancels over the corners).
+      real(dp) function prim_xx(xx, yy)
+         real(dp), intent(in) :: xx, yy
+         prim_xx = 0
+         if (yy /= 0) prim_xx = yy*log((xx + sqrt(xx*xx + yy*yy))/abs(yy))
+      end function prim_xx
+   end function dense_matrix
+end module test_tangential
