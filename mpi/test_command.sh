@@ -71,6 +71,8 @@ expect 2 "--generate of a kind the ranks do not make refused" mpirun_2 "$femcod_
 expect 2 "--generate next to a deck refused" mpirun_2 "$femcod_mpi" "$deck" --generate self-affine --np 32 \
   --pixel 1 --loads 10 -o "$work/bad"
 expect 2 "the event solver refused" mpirun_2 "$femcod_mpi" "$deck" --solver incremental --loads 10 -o "$work/bad"
+expect 2 "--tangential (one node only) refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 --tangential 1 \
+  --friction 0.3 -o "$work/bad"
 printf 'a deck\n3 1 x\n' >"$work/broken.deck"
 expect 3 "a broken deck" mpirun_2 "$femcod_mpi" "$work/broken.deck" --loads 10 -o "$work/bad"
 printf '1 2 3\n4 5 6\n7 8 9\n' >"$work/tiny.txt"

@@ -1,6 +1,7 @@
 !> The combination matrix (issue 34): every solver x boundary x plastic cap x interface
 !> law x way of asking (loads, increasing approaches, decreasing approaches) x (plain,
-!> restart, friction from the pressures: --shear-strength 0 --shear-slope 0.1), run
+!> restart, friction from the pressures: --shear-strength 0 --shear-slope 0.1, a
+!> tangential step: --friction 0.3 --tangential 10), run
 !> as a user runs it (this test executable as femcod, in its own process) on the thesis'
 !> 2 nm sphere (input/sphere_d2.deck, 15 x 15 pixels). Each combination either answers
 !> (exit 0, one row of PREFIX.loads.csv per state asked) or is refused (exit 2) with no
@@ -13,7 +14,10 @@
 !> answer, no solve) a combination is refused exactly where it is without (and with
 !> --adhesion), and answers the same, with friction_coefficient = 0.1 = alpha, since
 !> tau0 = 0 and the forces balance the load (to 1e-6: the legacy solver's forces carry
-!> its skyline factor's condition times eps; 1.6e-11 measured here).
+!> its skyline factor's condition times eps; 1.6e-11 measured here). With the tangential
+!> step (the free surface only: refused on the periodic cell and with adhesion, as with
+!> the shear model) the normal answer is the same too, and the tangential force of every
+!> state is Q = 10 nN (the multiplier's Newton solve holds sum t = Q to 1e-14 mu P).
 module test_matrix
    use femcod_kinds, only: dp
    use test_support, only: scratch_path, read_text, file_exists, contains_text
@@ -55,7 +59,7 @@ contains
             do p = 1, 2
                do l = 1, size(LAWS)
                   do m = 1, size(MODES)
-                     do r = 1, 3
+                     do r = 1, 4
                         n = n + 1
                         combos = combos + 1
                         prefix = dir//"/c"//to_string(n)
@@ -66,6 +70,7 @@ contains
                         if (LAWS(l) /= "none") args = args//" --adhesion "//trim(LAWS(l))//" --work 0.05 --range 1"
                         if (r == 2) args = args//" --restart"
                         if (r == 3) args = args//" --shear-strength 0 --shear-slope 0.1"
+                        if (r == 4) args = args//" --friction 0.3 --tangential 10"
                         call execute_command_line(self_command()//" "//args//" > "//prefix//".out 2> "//prefix// &
                            ".err", exitstat=code)
                         stderr = read_text(prefix//".err")
@@ -78,9 +83,13 @@ contains
                         if (allocated(error)) return
                         call check(error, .not. file_exists(prefix//".lock"), "femcod "//args//": a lock left behind")
                         if (allocated(error)) return
-                        if (r == 3 .and. LAWS(l) == "none") then
+                        if (r >= 3 .and. LAWS(l) == "none" .and. .not. (r == 4 .and. b == 2)) then
                            call check(error, (code == 2) .eqv. .not. answered(s, b, p, l, m), "femcod "//args// &
-                              ": the shear model changed whether the combination is answered")
+                              ": the friction options changed whether the combination is answered")
+                           if (allocated(error)) return
+                        end if
+                        if (r == 4 .and. b == 2) then
+                           call check(error, code == 2, "femcod "//args//": the tangential step on the periodic cell")
                            if (allocated(error)) return
                         end if
                         if (code == 2) then
@@ -99,6 +108,17 @@ contains
                         if (r == 1) then
                            answers(:, s, b, p, l, m) = column
                            answered(s, b, p, l, m) = .true.
+                        else if (r == 4) then
+                           call check(error, all(column == answers(:, s, b, p, l, m)), "femcod "//args// &
+                              ": the tangential step changed the normal answer")
+                           if (allocated(error)) return
+                           column = csv_column(prefix//".loads.csv", 10)
+                           contacts = csv_column(prefix//".loads.csv", 3)
+                           ! A state without contact (unloaded off it) carries no tangential force.
+                           where (contacts == 0) column = 10
+                           call check(error, all(abs(column - 10) <= 1.0e-12_dp*10), "femcod "//args// &
+                              ": tangential forces "//to_string(column(1))//", "//to_string(column(2))//", not Q = 10")
+                           if (allocated(error)) return
                         else if (r == 3) then
                            call check(error, all(column == answers(:, s, b, p, l, m)), "femcod "//args// &
                               ": the shear model changed the answer")

@@ -21,6 +21,12 @@ module test_tangential
    use femcod_cerruti, only: cerruti_integrals
    use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential
    use test_cg, only: rough_scene
+   use femcod_strings, only: string_type
+   use femcod_cli, only: run_femcod
+   use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
+   use femcod_status, only: STATUS_BAD_INPUT
+   use test_support, only: scratch_path, file_exists
+   use test_results, only: csv_column
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -37,7 +43,8 @@ contains
          new_unittest("Cattaneo-Mindlin: stick radius and shift at a/d = 8, 16, 32, with the order", &
             test_cattaneo_mindlin), &
          new_unittest("Q = mu P: every traction mu p; Q -> 0: every pixel sticks", test_limits), &
-         new_unittest("a dense QP with disc constraints (block Gauss-Seidel) on a rough surface", test_dense)]
+         new_unittest("a dense QP with disc constraints (block Gauss-Seidel) on a rough surface", test_dense), &
+         new_unittest("femcod run --tangential/--slip: maps obey Coulomb, columns, refusals", test_command)]
    end subroutine collect_tangential
 
    !> The three integrals of the unit pixel at offsets off the centre against a 32 x 32
@@ -65,7 +72,7 @@ contains
 
    !> The Gauss-Legendre product rule (32 nodes per side, by Newton's method on the
    !> Legendre polynomial) of the three integrands over the unit pixel at (p rows, q
-   !> columns): X along the columns.
+   !> columns): X along the columns, Y against the rows (the centre at x = q, y = -p).
    function quadrature(p, q) result(v)
       integer, intent(in) :: p, q
       real(dp) :: v(3)
@@ -77,7 +84,7 @@ contains
       do a = 1, n
          do b = 1, n
             xx = q + x(a)/2
-            yy = p + x(b)/2
+            yy = -p + x(b)/2
             r = sqrt(xx*xx + yy*yy)
             v = v + wt(a)*wt(b)/4*[xx*xx, yy*yy, xx*yy]/r**3
          end do
@@ -306,7 +313,8 @@ contains
          c = (1 + nu)/(pi*deck%young(body)*deck%pixel)
          do l = 1, size(ci)
             do k = 1, size(ci)
-               w = pixel_integrals(real(cj(k) - cj(l), dp), real(ci(k) - ci(l), dp))
+               ! x along the columns, y against the rows.
+               w = pixel_integrals(real(cj(k) - cj(l), dp), real(ci(l) - ci(k), dp))
                m(2*k - 1, 2*l - 1) = m(2*k - 1, 2*l - 1) + c*(w(1) + (1 - nu)*w(2))
                m(2*k, 2*l) = m(2*k, 2*l) + c*(w(2) + (1 - nu)*w(1))
                m(2*k - 1, 2*l) = m(2*k - 1, 2*l) + c*nu*w(3)
@@ -337,4 +345,103 @@ contains
          if (yy /= 0) prim_xx = yy*log((xx + sqrt(xx*xx + yy*yy))/abs(yy))
       end function prim_xx
    end function dense_matrix
+   !> `femcod run` on the 0.5 nm sphere deck (input/sphere_d05.deck) at 1000 and 5000 nN
+   !> with mu = 0.3: under --tangential 100 the maps in PREFIX.h5 obey what Coulomb's law
+   !> says (this test's reading of them): sum tau_x d^2 = Q, |tau| <= mu p everywhere and
+   !> = mu p where the stick map is 0 and the slip map 1, stick + slip = the contact map
+   !> (p > 0); loads.csv's tangential force is Q and its stick count the stick map's.
+   !> Under --slip 0.05 the shift column is 0.05. Refused with exit 2 and no output:
+   !> --friction alone, --tangential without --friction, both --tangential and --slip,
+   !> the periodic cell, adhesion.
+   subroutine test_command(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix
+      type(h5_file) :: file
+      type(status_type) :: st
+      real(dp), allocatable :: p(:, :), tx(:, :), ty(:, :), stick(:, :), slip(:, :), column(:)
+      character(len=24) :: refused(5, 6)
+      integer :: code, k, n
+      prefix = scratch_path("tangential_run")
+      call run_femcod([string_type("run"), string_type("input/sphere_d05.deck"), string_type("--solver"), &
+         string_type("cg"), string_type("--loads"), string_type("1000,5000"), string_type("--tangential"), &
+         string_type("100"), string_type("--friction"), string_type("0.3"), string_type("-o"), string_type(prefix), &
+         string_type("--quiet"), string_type("--force")], code)
+      call check(error, code, 0, "the run")
+      if (allocated(error)) return
+      call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
+      do k = 1, 2
+         call h5_read(file, "/loads/00"//to_string(k)//"/pressure", p, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/loads/00"//to_string(k)//"/shear_x", tx, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/loads/00"//to_string(k)//"/shear_y", ty, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/loads/00"//to_string(k)//"/stick", stick, st, STATUS_BAD_INPUT)
+         call h5_read(file, "/loads/00"//to_string(k)//"/slip", slip, st, STATUS_BAD_INPUT)
+         call check(error, abs(sum(tx)*0.25_dp - 100) <= 1.0e-10_dp*100 .and. all(sqrt(tx**2 + ty**2) <= &
+            0.3_dp*p*(1 + 1.0e-12_dp)), "load "//to_string(k)//": sum tau_x d^2 = Q, |tau| <= mu p")
+         if (allocated(error)) exit
+         call check(error, all((stick + slip == 1) .eqv. (p > 0)) .and. all(abs(pack(sqrt(tx**2 + ty**2), &
+            slip == 1) - pack(0.3_dp*p, slip == 1)) <= 1.0e-12_dp*maxval(p)), "load "//to_string(k)// &
+            ": stick + slip = contact, |tau| = mu p where it slips")
+         if (allocated(error)) exit
+         n = nint(sum(stick))
+         call check(error, n > 0 .and. n < count(p > 0), "partial slip at load "//to_string(k))
+         if (allocated(error)) exit
+         column = csv_column(prefix//".loads.csv", 12)
+         call check(error, nint(column(k)), n, "stick_contacts of load "//to_string(k))
+         if (allocated(error)) exit
+      end do
+      call h5_close(file, st)
+      if (allocated(error)) return
+      column = csv_column(prefix//".loads.csv", 10)
+      call check(error, all(abs(column - 100) <= 1.0e-10_dp*100), "tangential_force_nN = Q")
+      if (allocated(error)) return
+      call run_femcod([string_type("run"), string_type("input/sphere_d05.deck"), string_type("--loads"), &
+         string_type("1000"), string_type("--slip"), string_type("0.05"), string_type("--friction"), &
+         string_type("0.3"), string_type("-o"), string_type(prefix), string_type("--quiet"), string_type("--force")], &
+         code)
+      call check(error, code, 0, "the --slip run")
+      if (allocated(error)) return
+      column = csv_column(prefix//".loads.csv", 11)
+      call check(error, column(1), 0.05_dp, "tangential_shift_nm = S")
+      if (allocated(error)) return
+      refused(:, 1) = [character(len=24) :: "--friction", "0.3", "", "", ""]
+      refused(:, 2) = [character(len=24) :: "--tangential", "10", "", "", ""]
+      refused(:, 3) = [character(len=24) :: "--tangential", "10", "--slip", "0.1", "--friction"]
+      refused(:, 4) = [character(len=24) :: "--tangential", "10", "--friction", "0.3", "--boundary"]
+      refused(:, 5) = [character(len=24) :: "--tangential", "10", "--friction", "0.3", "--adhesion"]
+      refused(:, 6) = [character(len=24) :: "--slip", "0.1", "--friction", "0", ""]
+      do k = 1, size(refused, 2)
+         prefix = scratch_path("tangential_refused"//to_string(k))
+         call run_femcod([string_type("run"), string_type("input/sphere_d2.deck"), string_type("--solver"), &
+            string_type("cg"), string_type("--approach"), string_type("1"), string_type("-o"), string_type(prefix), &
+            string_type("--quiet"), (string_type(trim(refused(n, k))), n = 1, count(refused(:, k) /= "")), &
+            extra(k)], code)
+         call check(error, code == 2 .and. .not. file_exists(prefix//".h5"), "refused with exit 2, nothing "// &
+            "written: "//trim(refused(1, k))//" "//trim(refused(2, k))//" "//trim(refused(3, k))//" "// &
+            trim(refused(4, k))//" "//trim(refused(5, k))//" (exit "//to_string(code)//")")
+         if (allocated(error)) return
+      end do
+   contains
+      !> The value of the last option of case k (its own words).
+      function extra(k) result(words)
+         integer, intent(in) :: k
+         type(string_type), allocatable :: words(:)
+         select case (k)
+         case (3)
+            allocate(words(1))
+            words(1)%s = "0.3"
+         case (4)
+            allocate(words(1))
+            words(1)%s = "periodic"
+         case (5)
+            allocate(words(5))
+            words(1)%s = "dugdale"
+            words(2)%s = "--work"
+            words(3)%s = "0.1"
+            words(4)%s = "--range"
+            words(5)%s = "1"
+         case default
+            allocate(words(0))
+         end select
+      end function extra
+   end subroutine test_command
 end module test_tangential

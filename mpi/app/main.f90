@@ -262,6 +262,9 @@ contains
          else if (size(targets()) == 0) then
             call set_error(status, STATUS_USAGE, "give the loads or the approaches: --loads F1,F2,... or "// &
                "--approach D1,D2,...")
+         else if (o%tangential) then
+            call set_error(status, STATUS_USAGE, "--tangential/--slip: the tangential step runs on one node: "// &
+               "femcod run")
          else if (o%boundary == BOUNDARY_PERIODIC .and. o%cg%kernel_radius > 0) then
             call set_error(status, STATUS_USAGE, "--kernel-radius with --boundary periodic: the ranks take the "// &
                "periodic kernel's spectrum in closed form, untruncated; it runs on one node: femcod run --solver cg")
@@ -574,7 +577,7 @@ contains
       write(output_unit, '(a)') "  --max-iterations N, -o PREFIX, --outdir DIR, --force, --quiet; the height-file"
       write(output_unit, '(a)') "  options (--lower, --upper, --pixel, --young, --poisson, --height-unit, ...)"
       write(output_unit, '(a)') "Refused (they run on one node with femcod run): --kernel-radius on the periodic"
-      write(output_unit, '(a)') "cell, several decks, the event solvers."
+      write(output_unit, '(a)') "cell, --tangential and --slip, several decks, the event solvers."
       write(output_unit, '(a)') "Writes PREFIX.h5 (/deck, /loads/<kkk> with pressure and gap maps, /run with the"
       write(output_unit, '(a)') "peak memory of every rank) and PREFIX.summary.json. Exit codes: 0 ok, 2 usage,"
       write(output_unit, '(a)') "3 bad input, 4 numerical failure, 5 I/O, 128 + signal after SIGTERM/SIGINT/SIGUSR1."

@@ -22,11 +22,12 @@ module femcod_run
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, height_file_path, is_height_file, looks_like_height_matrix
-   use femcod_contact_result, only: contact_result, stop_reason_text
+   use femcod_contact_result, only: contact_result, load_state, stop_reason_text
    use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options, &
       SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, solver_name, boundary_name, law_name, &
       solver_from_name, boundary_from_name, law_from_name, run_shear_model
    use femcod_shear_model, only: shear_model, friction_coefficient
+   use femcod_cerruti, only: second_dundurs_constant
    use femcod_observer, only: solver_observer
    use femcod_state_visitor, only: visitable
    use femcod_incremental_state, only: incremental_state
@@ -147,6 +148,13 @@ contains
             lower=0.0_dp), &
          real_option("--shear-slope", "ALPHA", "the shear strength's pressure coefficient ALPHA (1, default 0)", &
             lower=0.0_dp), &
+         real_option("--tangential", "Q", "after the normal problem, a tangential force Q (nN, along x) at each "// &
+            "state with Coulomb friction (--friction): partial slip by the Cerruti kernel, stick and slip maps, the "// &
+            "tangential shift; Q >= mu P slides (free surface)", lower=0.0_dp), &
+         real_option("--slip", "S", "as --tangential, a rigid tangential shift S (nm, along x) instead of a force", &
+            lower=0.0_dp), &
+         real_option("--friction", "MU", "the Coulomb coefficient of --tangential or --slip", lower=0.0_dp, &
+            closed="()"), &
          real_option("--range", "R", "range of the adhesion law in nm, with --adhesion", lower=0.0_dp, closed="()", &
             mode="cg"), &
          text_option("--fftw-wisdom", "FILE", "FFTW measures its plans once and keeps them in FILE and FILE.float32 "// &
@@ -203,6 +211,48 @@ contains
          "         130 SIGINT, 138 SIGUSR1)"
    end subroutine run_help
 
+   !> The solver's options from the parsed arguments of `femcod run` (no rules checked:
+   !> validate_options and parse_run_arguments do that).
+   subroutine solve_options_from(parsed, o)
+      type(parsed_options), intent(in) :: parsed
+      type(contact_options), intent(out) :: o
+      o%checkpoint_interval = 300
+      allocate(o%loads(0), o%approaches(0))
+      if (option_given(parsed, "--solver")) o%solver = solver_from_name(option_value(parsed, "--solver"))
+      call get_option(parsed, "--loads", o%loads)
+      call get_option(parsed, "--approach", o%approaches)
+      call get_option(parsed, "--max-contacts", o%max_contacts)
+      call get_option(parsed, "--hardness", o%hardness)
+      call get_option(parsed, "--plastic", o%plastic)
+      if (option_given(parsed, "--boundary")) o%boundary = boundary_from_name(option_value(parsed, "--boundary"))
+      if (option_given(parsed, "--no-final-check")) o%final_check = .false.
+      if (option_given(parsed, "--event-search")) o%event_search = option_value(parsed, "--event-search")
+      call get_option(parsed, "--checkpoint-interval", o%checkpoint_interval)
+      call get_option(parsed, "--tol", o%cg%tol)
+      call get_option(parsed, "--max-iterations", o%cg%max_iterations)
+      call get_option(parsed, "--kernel-radius", o%cg%kernel_radius)
+      if (option_given(parsed, "--adhesion")) o%adhesion = law_from_name(option_value(parsed, "--adhesion"))
+      call get_option(parsed, "--work", o%work)
+      call get_option(parsed, "--range", o%range)
+      o%shear = option_given(parsed, "--shear-strength") .or. option_given(parsed, "--shear-slope")
+      call get_option(parsed, "--shear-strength", o%shear_strength)
+      call get_option(parsed, "--shear-slope", o%shear_slope)
+      o%tangential = option_given(parsed, "--tangential") .or. option_given(parsed, "--slip")
+      o%by_slip = option_given(parsed, "--slip")
+      call get_option(parsed, "--tangential", o%tangential_load)
+      call get_option(parsed, "--slip", o%slip)
+      call get_option(parsed, "--friction", o%friction)
+   end subroutine solve_options_from
+
+   !> The text of option `name` ("" when not given).
+   function option_value(p, name) result(v)
+      type(parsed_options), intent(in) :: p
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: v
+      v = ""
+      call get_option(p, name, v)
+   end function option_value
+
    !> The arguments of `femcod run` as settings: parsed against run_table, the options
    !> that do not apply refused, the rules between options checked. No I/O.
    subroutine parse_run_arguments(args, settings, status)
@@ -228,30 +278,8 @@ contains
       call get_option(parsed, "--quiet", settings%quiet)
       call get_option(parsed, "--force", settings%force)
       call get_option(parsed, "--restart", settings%restart)
-      associate(o => settings%solve)
-         o%checkpoint_interval = 300
-         allocate(o%loads(0), o%approaches(0))
-         if (option_given(parsed, "--solver")) o%solver = solver_from_name(option_value(parsed, "--solver"))
-         call get_option(parsed, "--loads", o%loads)
-         call get_option(parsed, "--approach", o%approaches)
-         call get_option(parsed, "--max-contacts", o%max_contacts)
-         call get_option(parsed, "--hardness", o%hardness)
-         call get_option(parsed, "--plastic", o%plastic)
-         if (option_given(parsed, "--boundary")) o%boundary = boundary_from_name(option_value(parsed, "--boundary"))
-         if (option_given(parsed, "--no-final-check")) o%final_check = .false.
-         if (option_given(parsed, "--event-search")) o%event_search = option_value(parsed, "--event-search")
-         call get_option(parsed, "--checkpoint-interval", o%checkpoint_interval)
-         call get_option(parsed, "--tol", o%cg%tol)
-         call get_option(parsed, "--max-iterations", o%cg%max_iterations)
-         call get_option(parsed, "--kernel-radius", o%cg%kernel_radius)
-         if (option_given(parsed, "--adhesion")) o%adhesion = law_from_name(option_value(parsed, "--adhesion"))
-         call get_option(parsed, "--work", o%work)
-         call get_option(parsed, "--range", o%range)
-         o%shear = option_given(parsed, "--shear-strength") .or. option_given(parsed, "--shear-slope")
-         call get_option(parsed, "--shear-strength", o%shear_strength)
-         call get_option(parsed, "--shear-slope", o%shear_slope)
-         o%cg%measure_plans = len(settings%wisdom) > 0
-      end associate
+      call solve_options_from(parsed, settings%solve)
+      settings%solve%cg%measure_plans = len(settings%wisdom) > 0
       lower = ""
       upper = ""
       call get_option(parsed, "--lower", lower)
@@ -323,6 +351,11 @@ contains
       end if
       if (size(settings%decks) == 0) then
          call set_error(status, STATUS_USAGE, "run needs a DECK")
+      else if (option_given(parsed, "--tangential") .and. option_given(parsed, "--slip")) then
+         call set_error(status, STATUS_USAGE, "give --tangential Q (a force) or --slip S (a shift), not both")
+      else if (option_given(parsed, "--friction") .and. .not. settings%solve%tangential) then
+         call set_error(status, STATUS_USAGE, "--friction MU is the Coulomb coefficient of a tangential step: add "// &
+            "--tangential Q or --slip S")
       else if (settings%solve%adhesion /= LAW_HARD_WALL .and. .not. (option_given(parsed, "--work") .and. &
          option_given(parsed, "--range"))) then
          call set_error(status, STATUS_USAGE, "--adhesion needs --work W (J/m^2) and --range R (nm)")
@@ -342,14 +375,6 @@ contains
       end if
       if (status%code /= 0) return
       call assign_prefixes(settings, status)
-   contains
-      function option_value(p, name) result(v)
-         type(parsed_options), intent(in) :: p
-         character(len=*), intent(in) :: name
-         character(len=:), allocatable :: v
-         v = ""
-         call get_option(p, name, v)
-      end function option_value
    end subroutine parse_run_arguments
 
    !> `femcod run ARGS`: `code` is the exit code (of the first failing deck in a batch;
@@ -756,6 +781,9 @@ contains
          info%work = options%work
          info%range = options%range
          info%friction = options%shear
+         info%tangential = options%tangential
+         info%coulomb = options%friction
+         info%beta = second_dundurs_constant(problem%young(1:2), problem%poisson(1:2))
          if (options%shear) then
             shear = run_shear_model(options)
             info%shear_strength = shear%tau0
@@ -939,6 +967,7 @@ contains
          if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
             " of them plastic (at the hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "// &
             sig_str(res%states(k)%plastic_volume, 4)//" nm^3"
+         if (options%tangential) call print_tangential(res%states(k), problem%pixel)
          if (options%shear) write(output_unit, '(a)') "              friction "// &
             sig_str(res%states(k)%friction, 6)//" nN, coefficient "// &
             sig_str(friction_coefficient(res%states(k)%friction, res%states(k)%load, res%states(k)%contacts), 6)//" (shear model)"
@@ -972,6 +1001,29 @@ contains
             lines(k)%text
       end do
    end subroutine print_summary
+
+   !> A state's tangential step in the summary: the force and shift along x, the stick
+   !> area, or gross sliding.
+   subroutine print_tangential(s, pixel)
+      type(load_state), intent(in) :: s
+      real(dp), intent(in) :: pixel
+      integer :: stick
+      if (.not. allocated(s%stick)) then
+         write(output_unit, '(a)') "              tangential: no contact"
+         return
+      end if
+      stick = count(s%stick)
+      if (s%sliding) then
+         write(output_unit, '(a)') "              tangential "//sig_str(s%tangential_force(1), 6)//" nN: gross "// &
+            "sliding, every contact at mu p (shift "//sig_str(s%tangential_shift(1), 6)//" nm at the onset)"
+      else
+         write(output_unit, '(a)') "              tangential "//sig_str(s%tangential_force(1), 6)//" nN, shift "// &
+            sig_str(s%tangential_shift(1), 6)//" nm; "//int_str(stick)//" of "//int_str(size(s%stick))// &
+            " contacts stick ("//sig_str(stick*pixel**2, 4)//" nm^2, "// &
+            sig_str(100*real(stick, dp)/size(s%stick), 4)//" %); "//int_str(s%tangential_iterations)// &
+            " iterations, residual "//sig_str(s%tangential_residual, 2)
+      end if
+   end subroutine print_tangential
 
    !> A progress line on standard error at most every 5 s, with an estimate of the time
    !> left from the cost model: a run to n contacts costs ~ n**growth; with a load

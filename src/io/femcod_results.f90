@@ -16,7 +16,7 @@ module femcod_results
    use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real, xml_escape, sig_str, &
       json_string, json_number, format_reals, integer_text
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, write_bytes
-   use femcod_contact_result, only: contact_result, stop_reason_text
+   use femcod_contact_result, only: contact_result, load_state, stop_reason_text
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
       h5_read_string_attribute, h5_flat_view
    use femcod_maps, only: state_maps
@@ -26,7 +26,7 @@ module femcod_results
    implicit none
    private
    public :: write_results, run_info, result_files, write_file_set, stored_fingerprint, load_group
-   public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS
+   public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, TANGENTIAL_COLUMNS
 
    !> The CSV files' header lines (the help prints them from here).
    character(len=*), parameter :: HISTORY_HEADER = &
@@ -36,6 +36,12 @@ module femcod_results
    character(len=*), parameter :: CONTACTS_HEADER = "i,j,step,force_nN,pressure_GPa"
    !> The columns the shear model adds to the history and loads files.
    character(len=*), parameter :: FRICTION_COLUMNS = ",friction_nN,friction_coefficient"
+   !> The maps of a tangential step in each load group (and on the mesh).
+   character(len=*), parameter :: TANGENTIAL_MAPS(4) = [character(len=7) :: "shear_x", "shear_y", "stick", "slip"]
+   character(len=*), parameter :: TANGENTIAL_UNITS(4) = [character(len=3) :: "GPa", "GPa", "1", "1"]
+   !> The columns a tangential step adds to the loads file.
+   character(len=*), parameter :: TANGENTIAL_COLUMNS = ",tangential_force_nN,tangential_shift_nm,stick_contacts,"// &
+      "stick_fraction"
 
    !> What the run was, for /run in the HDF5 file.
    type :: run_info
@@ -50,6 +56,11 @@ module femcod_results
       !> alpha (1) and cap (GPa; huge: none). Adds the friction columns and attributes.
       logical :: friction = .false.
       real(dp) :: shear_strength = 0, shear_slope = 0, shear_cap = huge(1.0_dp)
+      !> With a tangential step (--tangential, --slip): true, its Coulomb coefficient, and
+      !> Dundurs' beta of the materials (the coupling left out). Adds the tangential
+      !> columns, attributes and maps.
+      logical :: tangential = .false.
+      real(dp) :: coulomb = 0, beta = 0
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
       !> The input files, one line each: the deck, or what each height file gave
@@ -111,10 +122,10 @@ contains
       call write_text(temps(size(temps))%s, contacts_csv(deck, res), status)
       if (size(res%states) > 0) then
          call add(".loads.csv")
-         call write_text(temps(size(temps))%s, loads_csv(deck, res, info%friction), status)
+         call write_text(temps(size(temps))%s, loads_csv(deck, res, info%friction, info%tangential), status)
       end if
       call add(".xdmf")
-      call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res), status)
+      call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res, info%tangential), status)
       call add(".load_approach.svg")
       call write_text(temps(size(temps))%s, svg_plot("femcod: "//deck%label, "approach (nm)", "total load (nN)", &
          res%step_approach(1:res%nsteps), res%step_load(1:res%nsteps), .false., .false.), status)
@@ -235,6 +246,22 @@ contains
       if (friction) text = ","//format_real(force)//","//format_real(friction_coefficient(force, load, contacts))
    end function friction_fields
 
+   !> ",Q,delta,stick,stick_fraction" of a state's tangential step (x components; "" when
+   !> the state has none).
+   function tangential_fields(s, tangential) result(text)
+      type(load_state), intent(in) :: s
+      logical, intent(in) :: tangential
+      character(len=:), allocatable :: text
+      text = ""
+      if (.not. tangential) return
+      if (.not. allocated(s%stick)) then
+         text = ",0,0,0,nan"
+         return
+      end if
+      text = ","//format_real(s%tangential_force(1))//","//format_real(s%tangential_shift(1))//","// &
+         int_str(count(s%stick))//","//format_real(real(count(s%stick), dp)/max(size(s%stick), 1))
+   end function tangential_fields
+
    !> The pixels at the hardness after step k (0 without the plastic cap).
    pure integer function step_plastic(res, k)
       type(contact_result), intent(in) :: res
@@ -296,17 +323,18 @@ contains
 
    !> PREFIX.loads.csv: the states at the requested loads that were reached; with
    !> `friction`, the shear model's columns.
-   function loads_csv(deck, res, friction) result(text)
+   function loads_csv(deck, res, friction, tangential) result(text)
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
-      logical, intent(in) :: friction
+      logical, intent(in) :: friction, tangential
       character(len=:), allocatable :: text
       type(text_builder) :: b
       integer :: k
       real(dp) :: area_pixel, region
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      call add_line(b, LOADS_HEADER//trim(merge(FRICTION_COLUMNS, repeat(" ", len(FRICTION_COLUMNS)), friction)))
+      call add_line(b, LOADS_HEADER//trim(merge(FRICTION_COLUMNS, repeat(" ", len(FRICTION_COLUMNS)), friction))// &
+         trim(merge(TANGENTIAL_COLUMNS, repeat(" ", len(TANGENTIAL_COLUMNS)), tangential)))
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          associate(s => res%states(k))
@@ -314,7 +342,7 @@ contains
                int_str(s%contacts)//","//format_real(s%contacts*area_pixel)//","// &
                format_real(s%contacts*area_pixel/region)//","//format_real(s%max_pressure)//","// &
                int_str(s%n_above_hardness)//","//int_str(s%n_plastic)//","//format_real(s%plastic_volume)// &
-               friction_fields(friction, s%friction, s%load, s%contacts))
+               friction_fields(friction, s%friction, s%load, s%contacts)//tangential_fields(s, tangential))
          end associate
       end do
       text = built_text(b)
@@ -397,6 +425,7 @@ contains
                call h5_attribute(file, g, "cg_load_error", s%load_error, local)
                call h5_attribute(file, g, "approach_error_bound_nm", s%approach_bound, local)
             end if
+            if (info%tangential) call write_tangential(file, g, deck, s, local)
             if (info%friction) then
                call h5_attribute(file, g, "friction_nN", s%friction, local)
                call h5_attribute(file, g, "friction_coefficient", friction_coefficient(s%friction, s%load, s%contacts), local)
@@ -414,7 +443,7 @@ contains
                compress=mostly_zero(s%plastic))
          end associate
       end do
-      call write_mesh(file, deck, res, local)
+      call write_mesh(file, deck, res, info%tangential, local)
       call h5_group(file, "/run", local)
       call h5_attribute(file, "/run", "femcod_version", info%version, local)
       if (allocated(info%command_line)) call h5_attribute(file, "/run", "command_line", info%command_line, local)
@@ -427,6 +456,10 @@ contains
          call h5_attribute(file, "/run", "adhesion", info%adhesion, local)
          call h5_attribute(file, "/run", "work_of_adhesion_J_m2", info%work, local)
          call h5_attribute(file, "/run", "adhesion_range_nm", info%range, local)
+      end if
+      if (info%tangential) then
+         call h5_attribute(file, "/run", "coulomb_friction", info%coulomb, local)
+         call h5_attribute(file, "/run", "dundurs_beta", info%beta, local)
       end if
       if (info%friction) then
          call h5_attribute(file, "/run", "shear_strength_GPa", info%shear_strength, local)
@@ -511,14 +544,16 @@ contains
    !> row 1 on top, as in the figures, in the XY plane. Cell (i, j) is number
    !> (i-1)*NP + (j-1), the C order of the NP x NP maps, which /mesh/cells/* show as
    !> lists (virtual datasets, no copy). Both arrays are deflated (regular: small).
-   subroutine write_mesh(file, deck, res, status)
+   subroutine write_mesh(file, deck, res, tangential, status)
       type(h5_file), intent(in) :: file
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
+      !> With the maps of a tangential step (shear_x, shear_y, stick, slip).
+      logical, intent(in) :: tangential
       type(status_type), intent(inout) :: status
       real(dp), allocatable :: nodes(:, :)
       integer, allocatable :: quads(:, :)
-      integer :: n, a, b, i, j, c, k
+      integer :: n, a, b, i, j, c, k, m
       if (status%code /= 0) return
       n = deck%np
       allocate(nodes((n + 1)**2, 2), quads(n*n, 4))
@@ -552,8 +587,55 @@ contains
             load_group(k, size(res%states))//"/pressure", "GPa", status)
          call h5_flat_view(file, "/mesh/cells/"//xdmf_name("gap_nm", k, size(res%states)), &
             load_group(k, size(res%states))//"/gap", "nm", status)
+         if (.not. tangential) cycle
+         do m = 1, size(TANGENTIAL_MAPS)
+            call h5_flat_view(file, "/mesh/cells/"//xdmf_name(trim(TANGENTIAL_MAPS(m)), k, size(res%states)), &
+               load_group(k, size(res%states))//"/"//trim(TANGENTIAL_MAPS(m)), trim(TANGENTIAL_UNITS(m)), status)
+         end do
       end do
    end subroutine write_mesh
+
+   !> A state's tangential step in its load group: the shift (nm, x and y), the force (nN),
+   !> the sticking pixels, gross sliding, the iterations and residual as attributes; the
+   !> traction maps tau_x, tau_y (GPa) and the stick and slip maps (1 where the contact
+   !> sticks, or slips; 0 elsewhere).
+   subroutine write_tangential(file, g, deck, s, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: g
+      type(contact_problem), intent(in) :: deck
+      type(load_state), intent(in) :: s
+      type(status_type), intent(inout) :: status
+      real(dp), allocatable :: map(:, :, :)
+      integer :: k
+      allocate(map(deck%np, deck%np, 4))
+      map = 0
+      if (allocated(s%stick)) then
+         do k = 1, size(s%stick)
+            map(s%i(k), s%j(k), :) = [s%shear_x(k)/deck%pixel**2, s%shear_y(k)/deck%pixel**2, &
+               merge(1.0_dp, 0.0_dp, s%stick(k)), merge(0.0_dp, 1.0_dp, s%stick(k))]
+         end do
+      end if
+      call h5_attribute(file, g, "tangential_force_nN", s%tangential_force(1), status)
+      call h5_attribute(file, g, "tangential_force_y_nN", s%tangential_force(2), status)
+      call h5_attribute(file, g, "tangential_shift_nm", s%tangential_shift(1), status)
+      call h5_attribute(file, g, "tangential_shift_y_nm", s%tangential_shift(2), status)
+      call h5_attribute(file, g, "stick_contacts", int(sum(map(:, :, 3))), status)
+      call h5_attribute(file, g, "stick_area_nm2", sum(map(:, :, 3))*deck%pixel**2, status)
+      call h5_attribute(file, g, "gross_sliding", merge(1, 0, s%sliding), status)
+      call h5_attribute(file, g, "tangential_iterations", s%tangential_iterations, status)
+      call h5_attribute(file, g, "tangential_residual", s%tangential_residual, status)
+      call h5_write(file, g//"/shear_x", map(:, :, 1), "GPa", status, compress=mostly_zero(map(:, :, 1)))
+      call h5_write(file, g//"/shear_y", map(:, :, 2), "GPa", status, compress=mostly_zero(map(:, :, 2)))
+      call h5_write(file, g//"/stick", map(:, :, 3), "1", status, compress=mostly_zero(map(:, :, 3)))
+      call h5_write(file, g//"/slip", map(:, :, 4), "1", status, compress=mostly_zero(map(:, :, 4)))
+   end subroutine write_tangential
+
+   !> The contacts that stick after a state's tangential step (0 without one).
+   pure integer function stick_count(s)
+      type(load_state), intent(in) :: s
+      stick_count = 0
+      if (allocated(s%stick)) stick_count = count(s%stick)
+   end function stick_count
 
    !> Whether at least half of a map is zero: such maps (the pressure below half contact, a
    !> flat surface, no plastic displacement) are stored deflated (h5_write's compress), a
@@ -576,10 +658,12 @@ contains
    !> quadrilaterals in the XY plane (/mesh), with the surfaces and, for every reached
    !> load, its pressure and gap as cell arrays (the load in nN is in the array's name
    !> and in the HDF5 group).
-   function xdmf_text(h5name, deck, res) result(x)
+   function xdmf_text(h5name, deck, res, tangential) result(x)
       character(len=*), intent(in) :: h5name
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
+      !> With the maps of a tangential step.
+      logical, intent(in) :: tangential
       character(len=:), allocatable :: x
       character(len=1), parameter :: nl = new_line("a")
       character(len=:), allocatable :: file
@@ -599,6 +683,9 @@ contains
          if (.not. res%states(k)%reached) cycle
          x = x//attribute(xdmf_name("pressure_GPa", k, size(res%states)))// &
             attribute(xdmf_name("gap_nm", k, size(res%states)))
+         if (tangential) x = x//attribute(xdmf_name("shear_x", k, size(res%states)))// &
+            attribute(xdmf_name("shear_y", k, size(res%states)))//attribute(xdmf_name("stick", k, size(res%states)))// &
+            attribute(xdmf_name("slip", k, size(res%states)))
       end do
       x = x//'  </Grid>'//nl//' </Domain>'//nl//'</Xdmf>'//nl
    contains
@@ -645,6 +732,10 @@ contains
                json_string(load_group(k, size(res%states)))
             if (s%reached .and. s%approach_bound >= 0) loads = loads//', "approach_error_bound_nm": '// &
                json_number(s%approach_bound)
+            if (s%reached .and. info%tangential) loads = loads//', "tangential_force_nN": '// &
+               json_number(s%tangential_force(1))//', "tangential_shift_nm": '//json_number(s%tangential_shift(1))// &
+               ', "stick_contacts": '//int_str(stick_count(s))//', "stick_area_nm2": '// &
+               json_number(stick_count(s)*area_pixel)//', "gross_sliding": '//trim(merge("true ", "false", s%sliding))
             if (s%reached .and. info%friction) loads = loads//', "friction_nN": '//json_number(s%friction)// &
                ', "friction_coefficient": '//json_number(friction_coefficient(s%friction, s%load, s%contacts))
             if (s%reached .and. has_adhesion(info)) loads = loads//', "attractive_pixels": '// &

@@ -25,7 +25,7 @@
 !>     u_x = d tau_x/(2 pi G) [I_XX + (1 - nu) I_YY],   u_y = d tau_x/(2 pi G) nu I_XY,
 !> and tau_y by u_y = d tau_y/(2 pi G) [I_YY + (1 - nu) I_XX], u_x = d tau_y/(2 pi G) nu I_XY,
 !> with the dimensionless integrals I of the unit pixel. x runs along the columns j, y
-!> along the rows i.
+!> against the rows i (up the page: the axes of PREFIX.xdmf's mesh and of the figures).
 module femcod_cerruti
    use femcod_kinds, only: dp
    implicit none
@@ -38,14 +38,14 @@ contains
 
    !> The dimensionless integrals of the unit pixel at offset (p rows, q columns):
    !> w(1) = int int X^2/rho^3, w(2) = int int Y^2/rho^3, w(3) = int int X Y/rho^3 (X along
-   !> the columns).
+   !> the columns, Y against the rows: the pixel's centre at x = q, y = -p).
    pure function cerruti_integrals(p, q) result(w)
       integer, intent(in) :: p, q
       real(dp) :: w(3)
       real(dp), parameter :: h = 0.5_dp
       real(dp) :: x, y
       x = q
-      y = p
+      y = -p
       w(1) = corners(along_x, x, y)
       w(2) = corners(along_y, x, y)
       w(3) = corners(cross, x, y)

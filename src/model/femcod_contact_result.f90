@@ -33,6 +33,17 @@ module femcod_contact_result
       !> With the shear model (--shear-strength, --shear-slope; model/femcod_shear_model):
       !> the friction force (nN), the sum of tau(p) d^2 over the contacts.
       real(dp) :: friction = 0
+      !> With a tangential step (--tangential, --slip; solvers/femcod_tangential): the
+      !> contacts' tangential forces (nN, in the order of i, j) and whether each sticks,
+      !> the rigid tangential shift (nm, x and y: the tangential approach) and the total
+      !> tangential force (nN), gross sliding (Q >= mu P), and the iteration's count and
+      !> relative residual.
+      real(dp), allocatable :: shear_x(:), shear_y(:)
+      logical, allocatable :: stick(:)
+      real(dp) :: tangential_shift(2) = 0, tangential_force(2) = 0
+      logical :: sliding = .false.
+      integer :: tangential_iterations = 0
+      real(dp) :: tangential_residual = 0
       logical :: reached = .false.
       !> Fixed-load solver only: iterations, relative complementarity residual, deepest
       !> penetration (nm), largest |gap| on contact (nm), relative load error.

@@ -124,6 +124,11 @@ module femcod_solver_options
       !> with `plastic`). `shear` false: no friction is computed. Every solver.
       logical :: shear = .false.
       real(dp) :: shear_strength = 0, shear_slope = 0
+      !> Tangential loading with Coulomb friction (solvers/femcod_tangential) at every
+      !> reached state: the coefficient `friction`, and the tangential force (nN) or, with
+      !> `by_slip`, the rigid shift (nm), along x. `tangential` false: none.
+      logical :: tangential = .false., by_slip = .false.
+      real(dp) :: friction = 0, tangential_load = 0, slip = 0
       !> Candidates whose closing load is within this fraction of the total load of the
       !> smallest one join in the same step (ties).
       real(dp) :: tie_tolerance = 1.0e-9_dp
@@ -270,6 +275,7 @@ contains
             "--plastic and --solver "//solver_name(options%solver)//": the event path only loads; give the approaches in "// &
             "increasing order, or unload with --solver cg")
       end if
+      if (status%code == 0 .and. options%tangential) call refuse_tangential(options, status)
    contains
       subroutine refuse(message)
          character(len=*), intent(in) :: message
@@ -292,7 +298,10 @@ contains
          merge("T", "F", options%final_check)//"; event_search="//trim(options%event_search)// &
          "; tol="//format_real(options%cg%tol)//"; max_iterations="//int_str(options%cg%max_iterations)// &
          "; kernel_radius="//format_real(options%cg%kernel_radius)//"; shear="//merge("T", "F", options%shear)// &
-         "; shear_strength="//format_real(options%shear_strength)//"; shear_slope="//format_real(options%shear_slope)
+         "; shear_strength="//format_real(options%shear_strength)//"; shear_slope="//format_real(options%shear_slope)// &
+         "; tangential="//merge("T", "F", options%tangential)//"; by_slip="//merge("T", "F", options%by_slip)// &
+         "; friction="//format_real(options%friction)//"; tangential_load="//format_real(options%tangential_load)// &
+         "; slip="//format_real(options%slip)
    contains
       function reals(v) result(t)
          real(dp), allocatable, intent(in) :: v(:)
@@ -306,6 +315,26 @@ contains
          end do
       end function reals
    end function history_options
+
+   !> What a tangential step (`tangential`) is refused with: a friction coefficient that is
+   !> not positive, a load or shift below zero, adhesion (tension in the contact: no
+   !> Coulomb bound), the periodic cell (the Cerruti kernel is the free half-space's).
+   subroutine refuse_tangential(options, status)
+      type(contact_options), intent(in) :: options
+      type(status_type), intent(inout) :: status
+      if (.not. options%friction > 0) then
+         call set_error(status, STATUS_USAGE, "--tangential Q and --slip S need --friction MU > 0 (the Coulomb "// &
+            "coefficient)")
+      else if (.not. (options%tangential_load >= 0 .and. options%slip >= 0)) then
+         call set_error(status, STATUS_USAGE, "--tangential Q and --slip S are at least 0 (along x)")
+      else if (options%adhesion /= LAW_HARD_WALL) then
+         call set_error(status, STATUS_USAGE, "--tangential/--slip with --adhesion: the Coulomb bound mu p needs a "// &
+            "compressive contact, and adhesive contacts carry tension")
+      else if (options%boundary == BOUNDARY_PERIODIC) then
+         call set_error(status, STATUS_USAGE, "--tangential/--slip with --boundary periodic: the Cerruti kernel is "// &
+            "the free half-space's; use --boundary free")
+      end if
+   end subroutine refuse_tangential
 
    !> The run's shear model (inactive without `shear`).
    pure function run_shear_model(options) result(model)

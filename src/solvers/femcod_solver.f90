@@ -12,6 +12,7 @@ module femcod_solver
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options, validate_options, by_gap_variables, run_shear_model, &
+      refuse_beyond_memory, &
       SOLVER_INCREMENTAL, SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, law_name
    use femcod_observer, only: solver_observer
    use femcod_legacy, only: solve_legacy
@@ -20,6 +21,9 @@ module femcod_solver
    use femcod_cg, only: solve_cg
    use femcod_gap_cg, only: pixel_stiffness_ratio
    use femcod_shear_model, only: shear_model, friction_force
+   use femcod_cerruti, only: second_dundurs_constant
+   use femcod_clock, only: wall_clock
+   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential, tangential_storage_bytes
    implicit none
    private
    public :: solve_contact, model_notes, report_lines, report_line
@@ -84,7 +88,51 @@ contains
             " (available: incremental, legacy, cg)")
       end select
       if (options%shear .and. allocated(res%states)) call state_friction(res, run_shear_model(options), problem%pixel)
+      if (options%tangential .and. allocated(res%states) .and. status%code == 0) &
+         call tangential_states(problem, options, res, status)
    end subroutine solve_contact
+
+   !> The tangential step (solvers/femcod_tangential) at each reached state with contacts,
+   !> after its memory check: the answer into the state.
+   subroutine tangential_states(problem, options, res, status)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(contact_result), intent(inout) :: res
+      type(status_type), intent(inout) :: status
+      type(tangential_request) :: request
+      type(tangential_answer) :: answer
+      real(dp) :: t0, t1
+      integer :: k
+      call wall_clock(t0)
+      call refuse_beyond_memory("the tangential step: NP = "//int_str(problem%np), &
+         tangential_storage_bytes(problem%np), options%memory_available, status)
+      if (status%code /= 0) return
+      request%mu = options%friction
+      request%by_slip = options%by_slip
+      request%load = options%tangential_load
+      request%slip = options%slip
+      do k = 1, size(res%states)
+         associate(s => res%states(k))
+            if (.not. s%reached .or. .not. allocated(s%force)) cycle
+            call solve_tangential(problem, s%i, s%j, s%force, request, answer, status)
+            if (status%code /= 0) then
+               status%message = "state "//int_str(k)//" (load "//sig_str(s%load, 6)//" nN): "//status%message
+               return
+            end if
+            call move_alloc(answer%tx, s%shear_x)
+            call move_alloc(answer%ty, s%shear_y)
+            call move_alloc(answer%stick, s%stick)
+            s%tangential_shift = answer%shift
+            s%tangential_force = answer%force
+            s%sliding = answer%sliding
+            s%tangential_iterations = answer%iterations
+            s%tangential_residual = answer%residual
+         end associate
+      end do
+      ! The solve's wall time includes the tangential steps.
+      call wall_clock(t1)
+      res%wall_seconds = res%wall_seconds + (t1 - t0)
+   end subroutine tangential_states
 
    !> The friction force of the shear model at each reached state, from its contact forces
    !> (nN; pixel in nm): the same sum for every solver.
@@ -108,6 +156,11 @@ contains
       type(shear_model) :: shear
       character(len=:), allocatable :: cap
       lines = solver_notes(problem, options)
+      if (options%tangential) lines = [lines, string_type("tangential step (Coulomb, mu = "// &
+         sig_str(options%friction, 4)//"): the Cerruti kernel of the free half-space, the normal pressures as the "// &
+         "normal problem left them (Goodman's approximation; Dundurs' beta = "// &
+         sig_str(second_dundurs_constant(problem%young(1:2), problem%poisson(1:2)), 3)//", exact only at 0: one "// &
+         "material or incompressible bodies)")]
       if (.not. options%shear) return
       shear = run_shear_model(options)
       cap = "not capped (--plastic caps it at the shear yield stress)"

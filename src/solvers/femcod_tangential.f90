@@ -14,8 +14,10 @@
 !> a convex program whose constraints are a disc per pixel (not a bound), whose
 !> multiplier of sum t = Q is delta. It is solved by accelerated projected gradients
 !> (FISTA, Beck and Teboulle 2009, with O'Donoghue and Candes' adaptive restart) with the
-!> step 1/L, L the largest eigenvalue of the padded operator's 2 x 2 spectrum (a bound on
-!> A's): under force control the projection onto {discs, sum t = Q} is t_i = P_i(z_i +
+!> step 1/L, L A's largest eigenvalue on the contacts by power iteration (times 1.25, and
+!> at most the padded operator's bound; a step that proves too long is halved): on a rough
+!> 512^2 surface at 6 % contact 217 iterations instead of 987 with the padded bound, the
+!> lowest frequency's of the whole grid. Under force control the projection onto {discs, sum t = Q} is t_i = P_i(z_i +
 !> lambda), P_i the projection onto pixel i's disc and lambda (a 2-vector) the root of
 !> sum P_i(z_i + lambda) = Q, found by Newton's method (the map is monotone); at the
 !> solution delta = L lambda.
@@ -111,6 +113,9 @@ contains
       if (.not. request%by_slip .and. request%load >= capacity*(1 - 1.0e-12_dp)) then
          call gross_sliding(st, request, capacity, t, answer)
       else
+         t = 0
+         if (.not. request%by_slip) t(1, :) = st%bound*request%load/capacity
+         answer%shift = [request%slip, 0.0_dp]
          call projected_gradients(st, request, t, answer, status)
       end if
       answer%tx = t(1, :)
@@ -153,27 +158,22 @@ contains
       end do
    end subroutine displace
 
-   !> FISTA with adaptive restart (module header) from the forces shared in proportion to
-   !> the bounds; t the answer's forces (2 x n).
+   !> FISTA with adaptive restart (module header) from the forces t (feasible: within the
+   !> discs, and summing to Q under force control); t the answer's forces (2 x n).
    subroutine projected_gradients(st, request, t, answer, status)
       type(tangential_state), intent(inout) :: st
       type(tangential_request), intent(in) :: request
-      real(dp), intent(out) :: t(:, :)
+      real(dp), intent(inout) :: t(:, :)
       type(tangential_answer), intent(inout) :: answer
       type(status_type), intent(inout) :: status
       real(dp), allocatable :: y(:, :), z(:, :), t_new(:, :)
-      real(dp) :: step, theta, theta_new, lambda(2), shift(2), scale, gap
+      real(dp) :: step, theta, theta_new, lambda(2), shift(2), scale, gap, best
       integer :: it
-      step = 1/st%op%largest
+      step = 1/contact_largest(st)
+      best = huge(1.0_dp)
       allocate(y(2, st%n), z(2, st%n), t_new(2, st%n))
-      lambda = 0
-      if (request%by_slip) then
-         shift = [request%slip, 0.0_dp]
-         t(1, :) = 0
-      else
-         t(1, :) = st%bound*request%load/sum(st%bound)
-      end if
-      t(2, :) = 0
+      shift = answer%shift
+      lambda = shift*step
       y = t
       theta = 1
       do it = 1, request%max_iterations
@@ -190,6 +190,17 @@ contains
          ! The gradient mapping (nm): how far the step moves the forces, in displacements.
          scale = max(norm2(shift), maxval(abs(st%u)), tiny(1.0_dp))
          gap = maxval(norm2(y - t_new, dim=1))/step/scale
+         ! A step too long for A (the power iteration's estimate short of its largest
+         ! eigenvalue) shows as a gap growing without bound: half the step, no momentum.
+         if (gap > 1.0e3_dp*best .and. step > (1/st%op%largest)*(1 + 1.0e-12_dp)) then
+            step = max(step/2, 1/st%op%largest)
+            lambda = shift*step
+            theta = 1
+            y = t
+            best = huge(1.0_dp)
+            cycle
+         end if
+         best = min(best, gap)
          ! Adaptive restart: momentum against the last step's direction.
          if (sum((y - t_new)*(t_new - t)) > 0) then
             theta = 1
@@ -210,6 +221,28 @@ contains
          sig_str(answer%residual, 2)//" after "//int_str(answer%iterations)//" iterations, above 10 x --tol "// &
          sig_str(request%tol, 2))
    end subroutine projected_gradients
+
+   !> A bound on the largest eigenvalue of A on the contacts (nm/nN), the step's inverse:
+   !> power iteration (20 products, from the bounds along x and y) gives it from below,
+   !> to within the ratio of its two largest; 1.25 times that, and never more than the
+   !> padded operator's bound, which holds on any set but is the whole grid's (the
+   !> lowest frequency's, ~ NP) where a rough surface's contacts are a few per cent of it.
+   real(dp) function contact_largest(st) result(largest)
+      type(tangential_state), intent(inout) :: st
+      real(dp), allocatable :: x(:, :)
+      integer :: it
+      allocate(x(2, st%n))
+      x(1, :) = st%bound
+      x(2, :) = st%bound/2
+      largest = 0
+      do it = 1, 20
+         x = x/norm2(x)
+         call displace(st, x)
+         largest = sum(x*st%u)
+         x = st%u
+      end do
+      largest = min(1.25_dp*largest, st%op%largest)
+   end function contact_largest
 
    !> Stick and slip from the forces t and the displacements st%u at the shift, and the
    !> largest violation of their conditions over the shift's size: a sticking pixel moves
