@@ -16,9 +16,11 @@ module test_tangential
    use femcod_status, only: status_type
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, cg_settings, SOLVER_CG
+   use femcod_solver_options, only: contact_options, cg_settings, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_solver, only: solve_contact
-   use femcod_cerruti, only: cerruti_integrals
+   use femcod_cerruti, only: cerruti_integrals, periodic_tangential_spectra
+   use femcod_convolution, only: shear_transform, shear_transform_setup_periodic, shear_transform_apply, &
+      shear_transform_free
    use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential
    use test_cg, only: rough_scene
    use femcod_strings, only: string_type
@@ -40,10 +42,12 @@ contains
       type(unittest_type), allocatable, intent(out) :: testsuite(:)
       testsuite = [ &
          new_unittest("Cerruti pixel integrals: quadrature of the point solution, the self term", test_integrals), &
+         new_unittest("periodic Cerruti kernel: differences equal real-space image sums (NP 8, 9)", test_periodic_kernel), &
          new_unittest("Cattaneo-Mindlin: stick radius and shift at a/d = 8, 16, 32, with the order", &
             test_cattaneo_mindlin), &
          new_unittest("Q = mu P: every traction mu p; Q -> 0: every pixel sticks", test_limits), &
          new_unittest("a dense QP with disc constraints (block Gauss-Seidel) on a rough surface", test_dense), &
+         new_unittest("the same on a periodic rough cell, its matrix from real-space image sums", test_dense_periodic), &
          new_unittest("femcod run --tangential/--slip: maps obey Coulomb, columns, refusals", test_command)]
    end subroutine collect_tangential
 
@@ -69,6 +73,76 @@ contains
       call check(error, abs(w(1) + w(2) - 4*log(1 + sqrt(2.0_dp))) < 1.0e-14_dp .and. abs(w(1) - w(2)) < 1.0e-14_dp &
          .and. w(3) == 0, "the self term: "//to_string(w(1))//", "//to_string(w(2))//", "//to_string(w(3)))
    end subroutine test_integrals
+
+   !> The periodic cell's tangential kernel (femcod_cerruti's spectra from the alias sums
+   !> of femcod_love_periodic, applied by the periodic shear transform to a unit force at
+   !> pixel (1, 1), along x and along y) against the free pixel integrals summed in real
+   !> space over the images NP (m, n), |m|, |n| <= R: the differences T(p, q) - T(0, 0)
+   !> (the mean is a convention), the sums at R = 60, 120 and 240 extrapolated to R ->
+   !> infinity as the tail falls (a/R from the second order of the images' Taylor series,
+   !> b/R^2 from the lattice's edge: measured, one extrapolation left 1.7e-6 and 4.3e-7 at
+   !> R = 60/120 and 120/240), to 1e-8 of the self term. One elastic body (E = 200 GPa,
+   !> nu = 0.3) and a rigid one.
+   subroutine test_periodic_kernel(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(shear_transform) :: op
+      real(dp), allocatable :: xx(:, :), yy(:, :), xy(:, :), fx(:, :), fy(:, :), ux(:, :), uy(:, :), vx(:, :), vy(:, :)
+      real(dp) :: worst, direct(3), self, scale
+      integer :: np, p, q, c
+      integer, parameter :: sizes(2) = [8, 9]
+      real(dp), parameter :: young(2) = [200.0_dp, 2.0e12_dp], poisson(2) = [0.3_dp, 0.3_dp]
+      do c = 1, size(sizes)
+         np = sizes(c)
+         allocate(xx(np/2 + 1, np), yy(np/2 + 1, np), xy(np/2 + 1, np), fx(np, np), fy(np, np), ux(np, np), &
+            uy(np, np), vx(np, np), vy(np, np))
+         call periodic_tangential_spectra(np, 1.0_dp, young, poisson, xx, yy, xy)
+         call shear_transform_setup_periodic(op, xx, yy, xy)
+         fx = 0
+         fy = 0
+         fx(1, 1) = 1
+         call shear_transform_apply(op, fx, fy, ux, uy)
+         fx(1, 1) = 0
+         fy(1, 1) = 1
+         call shear_transform_apply(op, fx, fy, vx, vy)
+         call shear_transform_free(op)
+         scale = (1 + poisson(1))/(pi*young(1))
+         self = scale*sum(cerruti_integrals(0, 0)*[1.0_dp, 1 - poisson(1), 0.0_dp])
+         worst = 0
+         do q = 0, np/2
+            do p = 0, np/2
+               ! Richardson in 1/R to second order: the tail a/R + b/R^2 cancels.
+               direct = scale*(8*image_sum(p, q, 240) - 6*image_sum(p, q, 120) + image_sum(p, q, 60))/3
+               worst = max(worst, abs((ux(p + 1, q + 1) - ux(1, 1)) - direct(1)), &
+                  abs((vy(p + 1, q + 1) - vy(1, 1)) - direct(2)), abs(uy(p + 1, q + 1) - direct(3)), &
+                  abs(vx(p + 1, q + 1) - direct(3)))
+            end do
+         end do
+         call check(error, worst < 1.0e-8_dp*self, "NP "//to_string(np)//": largest difference "// &
+            to_string(worst/self)//" of the self term")
+         if (allocated(error)) return
+         deallocate(xx, yy, xy, fx, fy, ux, uy, vx, vy)
+      end do
+   contains
+      !> sum over |m|, |n| <= r of [K(p + m NP, q + n NP) - K(m NP, n NP)] for the xx, yy
+      !> and xy combinations of the pixel integrals (the elastic body's; the rigid one's
+      !> share is below the tolerance), without the factor (1 + nu)/(pi E).
+      function image_sum(p, q, r) result(total)
+         integer, intent(in) :: p, q, r
+         real(dp) :: total(3), w(3), w0(3)
+         integer :: m, n
+         total = 0
+         !$omp parallel do private(m, w, w0) reduction(+:total)
+         do n = -r, r
+            do m = -r, r
+               w = cerruti_integrals(p + m*np, q + n*np)
+               w0 = cerruti_integrals(m*np, n*np)
+               w = w - w0
+               total = total + [w(1) + (1 - poisson(1))*w(2), w(2) + (1 - poisson(1))*w(1), poisson(1)*w(3)]
+            end do
+         end do
+         !$omp end parallel do
+      end function image_sum
+   end subroutine test_periodic_kernel
 
    !> The Gauss-Legendre product rule (32 nodes per side, by Newton's method on the
    !> Legendre polynomial) of the three integrands over the unit pixel at (p rows, q
@@ -240,6 +314,21 @@ contains
    !> of the identity). Agreement of every force to 1e-7 of the largest.
    subroutine test_dense(error)
       type(error_type), allocatable, intent(out) :: error
+      call dense_case(error, .false.)
+   end subroutine test_dense
+
+   !> test_dense on a periodic 12^2 cell (seed 4, 24000 nN, S = 0.08 nm), the matrix from
+   !> the periodic table of the pixel integrals summed over the images in real space (this
+   !> file's closed form, R = 30, 60, 120 extrapolated, and the zero-mean convention: the
+   !> table's sum over the cell is 0), not from the code's Fourier-space kernel.
+   subroutine test_dense_periodic(error)
+      type(error_type), allocatable, intent(out) :: error
+      call dense_case(error, .true.)
+   end subroutine test_dense_periodic
+
+   subroutine dense_case(error, periodic)
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in) :: periodic
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(contact_result) :: res
@@ -247,11 +336,12 @@ contains
       type(tangential_answer) :: answer
       type(status_type) :: status
       real(dp), allocatable :: m(:, :), t(:), b(:), rhs(:)
-      real(dp) :: w(2), r, biggest
+      real(dp) :: w(2), r, biggest, tol
       integer :: n, k, sweep
-      call rough_scene(16, 4, deck)
+      call rough_scene(merge(12, 16, periodic), 4, deck)
       options%solver = SOLVER_CG
-      options%loads = [30000.0_dp]
+      options%loads = [merge(24000.0_dp, 30000.0_dp, periodic)]
+      if (periodic) options%boundary = BOUNDARY_PERIODIC
       options%cg = cg_settings()
       options%cg%tol = 1.0e-12_dp
       call solve_contact(deck, options, res, status)
@@ -261,12 +351,13 @@ contains
       request%by_slip = .true.
       request%slip = 0.08_dp
       request%tol = 1.0e-11_dp
+      request%periodic = periodic
       associate(s => res%states(1))
          n = size(s%i)
          call solve_tangential(deck, s%i, s%j, s%force, request, answer, status)
          call check(error, status%code, 0, status%message)
          if (allocated(error)) return
-         m = dense_matrix(deck, s%i, s%j)
+         m = dense_matrix(deck, s%i, s%j, periodic)
          b = request%mu*s%force
       end associate
       allocate(t(2*n), rhs(2*n))
@@ -285,36 +376,51 @@ contains
          end do
          if (biggest < 1.0e-15_dp*maxval(b)) exit
       end do
-      call check(error, maxval(abs(t(1:2*n:2) - answer%tx)) <= 1.0e-7_dp*maxval(abs(t)) .and. &
-         maxval(abs(t(2:2*n:2) - answer%ty)) <= 1.0e-7_dp*maxval(abs(t)), "forces against the dense QP: "// &
+      ! The periodic reference's table is good to about 1e-8 of the self term (its image
+      ! sums' extrapolation), which the QP's conditioning amplifies: 1e-6 there (1.1e-7
+      ! measured); the free one's is exact to round-off (1.1e-11 measured).
+      tol = merge(1.0e-6_dp, 1.0e-7_dp, periodic)
+      call check(error, maxval(abs(t(1:2*n:2) - answer%tx)) <= tol*maxval(abs(t)) .and. &
+         maxval(abs(t(2:2*n:2) - answer%ty)) <= tol*maxval(abs(t)), "forces against the dense QP: "// &
          to_string(maxval(abs(t(1:2*n:2) - answer%tx)))//", "//to_string(maxval(abs(t(2:2*n:2) - answer%ty)))// &
          " nN of "//to_string(maxval(abs(t)))//" ("//to_string(n)//" contacts, "//to_string(count(answer%stick))// &
          " sticking, "//to_string(sweep)//" sweeps)")
       if (allocated(error)) return
-      write(*, '(a)') "           dense QP: "//to_string(n)//" contacts, "//to_string(count(answer%stick))// &
+      write(*, '(a)') "           dense QP"//trim(merge(" (periodic)", "           ", periodic))//": "//to_string(n)// &
+         " contacts, "//to_string(count(answer%stick))// &
          " stick, largest force difference "//to_string(maxval(abs(t(1:2*n:2) - answer%tx)))//" nN of "// &
          to_string(maxval(abs(t)))//", "//to_string(answer%iterations)//" iterations"
       call check(error, count(answer%stick) > 0 .and. count(answer%stick) < n, "partial slip: "// &
          to_string(count(answer%stick))//" of "//to_string(n)//" stick")
-   end subroutine test_dense
+   end subroutine dense_case
 
    !> The 2n x 2n compliance (nm/nN) between the contacts, (x, y) of each pixel in turn,
-   !> from this file's closed form of the pixel integrals.
-   function dense_matrix(deck, ci, cj) result(m)
+   !> from this file's closed form of the pixel integrals: directly on the free surface;
+   !> on a periodic cell from the cell's table (periodic_table).
+   function dense_matrix(deck, ci, cj, periodic) result(m)
       type(contact_problem), intent(in) :: deck
       integer, intent(in) :: ci(:), cj(:)
-      real(dp), allocatable :: m(:, :)
+      logical, intent(in) :: periodic
+      real(dp), allocatable :: m(:, :), table(:, :, :)
       real(dp) :: w(3), c, nu
       integer :: k, l, body
       allocate(m(2*size(ci), 2*size(ci)))
       m = 0
+      if (periodic) then
+         allocate(table(3, 0:deck%np - 1, 0:deck%np - 1))
+         table(:, :, :) = periodic_table(deck%np)
+      end if
       do body = 1, 2
          nu = deck%poisson(body)
          c = (1 + nu)/(pi*deck%young(body)*deck%pixel)
          do l = 1, size(ci)
             do k = 1, size(ci)
-               ! x along the columns, y against the rows.
-               w = pixel_integrals(real(cj(k) - cj(l), dp), real(ci(l) - ci(k), dp))
+               if (periodic) then
+                  w = table(:, modulo(ci(k) - ci(l), deck%np), modulo(cj(k) - cj(l), deck%np))
+               else
+                  ! x along the columns, y against the rows.
+                  w = own_integrals(real(cj(k) - cj(l), dp), real(ci(l) - ci(k), dp))
+               end if
                m(2*k - 1, 2*l - 1) = m(2*k - 1, 2*l - 1) + c*(w(1) + (1 - nu)*w(2))
                m(2*k, 2*l) = m(2*k, 2*l) + c*(w(2) + (1 - nu)*w(1))
                m(2*k - 1, 2*l) = m(2*k - 1, 2*l) + c*nu*w(3)
@@ -322,37 +428,76 @@ contains
             end do
          end do
       end do
+   end function dense_matrix
+
+   !> The three pixel integrals on a periodic cell of np pixels, at row offsets p and
+   !> column offsets q (0 .. np-1): the differences from offset (0, 0) summed over the
+   !> images |m|, |n| <= R at R = 30, 60, 120 and extrapolated in 1/R to second order,
+   !> then shifted to a zero sum over the cell.
+   function periodic_table(np) result(table)
+      integer, intent(in) :: np
+      real(dp), allocatable :: table(:, :, :)
+      real(dp) :: mean(3)
+      integer :: p, q, k
+      allocate(table(3, 0:np - 1, 0:np - 1))
+      do q = 0, np - 1
+         do p = 0, np - 1
+            table(:, p, q) = (8*differences(p, q, 120) - 6*differences(p, q, 60) + differences(p, q, 30))/3
+         end do
+      end do
+      do k = 1, 3
+         mean(k) = sum(table(k, :, :))/np**2
+         table(k, :, :) = table(k, :, :) - mean(k)
+      end do
    contains
-      !> int X^2/rho^3, int Y^2/rho^3, int X Y/rho^3 over the unit pixel at (x, y).
-      function pixel_integrals(x, y) result(v)
-         real(dp), intent(in) :: x, y
-         real(dp) :: v(3)
-         real(dp) :: sx(2), sy(2)
-         integer :: a, b
-         sx = [x - 0.5_dp, x + 0.5_dp]
-         sy = [y - 0.5_dp, y + 0.5_dp]
-         v = 0
-         do a = 1, 2
-            do b = 1, 2
-               v = v + (-1)**(a + b)*[prim_xx(sx(a), sy(b)), prim_xx(sy(b), sx(a)), -sqrt(sx(a)**2 + sy(b)**2)]
+      function differences(p, q, r) result(total)
+         integer, intent(in) :: p, q, r
+         real(dp) :: total(3)
+         integer :: m, n
+         total = 0
+         !$omp parallel do private(m) reduction(+:total)
+         do n = -r, r
+            do m = -r, r
+               total = total + own_integrals(real(q + n*np, dp), real(-(p + m*np), dp)) - &
+                  own_integrals(real(n*np, dp), real(-m*np, dp))
             end do
          end do
-      end function pixel_integrals
-      !> Y ln(X + rho) by its asinh form (the term Y ln|Y| cancels over the corners).
-      real(dp) function prim_xx(xx, yy)
-         real(dp), intent(in) :: xx, yy
-         prim_xx = 0
-         if (yy /= 0) prim_xx = yy*log((xx + sqrt(xx*xx + yy*yy))/abs(yy))
-      end function prim_xx
-   end function dense_matrix
+         !$omp end parallel do
+      end function differences
+   end function periodic_table
+
+   !> int X^2/rho^3, int Y^2/rho^3, int X Y/rho^3 over the unit pixel at (x, y): this
+   !> file's own closed form, the primitives at the four corners.
+   pure function own_integrals(x, y) result(v)
+      real(dp), intent(in) :: x, y
+      real(dp) :: v(3)
+      real(dp) :: sx(2), sy(2)
+      integer :: a, b
+      sx = [x - 0.5_dp, x + 0.5_dp]
+      sy = [y - 0.5_dp, y + 0.5_dp]
+      v = 0
+      do a = 1, 2
+         do b = 1, 2
+            v = v + (-1)**(a + b)*[prim_xx(sx(a), sy(b)), prim_xx(sy(b), sx(a)), -sqrt(sx(a)**2 + sy(b)**2)]
+         end do
+      end do
+   end function own_integrals
+
+   !> Y ln(X + rho) by its asinh form (the term Y ln|Y| cancels over the corners).
+   pure real(dp) function prim_xx(xx, yy)
+      real(dp), intent(in) :: xx, yy
+      prim_xx = 0
+      if (yy /= 0) prim_xx = yy*log((xx + sqrt(xx*xx + yy*yy))/abs(yy))
+   end function prim_xx
+
    !> `femcod run` on the 0.5 nm sphere deck (input/sphere_d05.deck) at 1000 and 5000 nN
    !> with mu = 0.3: under --tangential 100 the maps in PREFIX.h5 obey what Coulomb's law
    !> says (this test's reading of them): sum tau_x d^2 = Q, |tau| <= mu p everywhere and
    !> = mu p where the stick map is 0 and the slip map 1, stick + slip = the contact map
    !> (p > 0); loads.csv's tangential force is Q and its stick count the stick map's.
    !> Under --slip 0.05 the shift column is 0.05. Refused with exit 2 and no output:
-   !> --friction alone, --tangential without --friction, both --tangential and --slip,
-   !> the periodic cell, adhesion.
+   !> --friction alone, --tangential without --friction, both --tangential and --slip, a
+   !> negative or zero friction coefficient, adhesion.
    subroutine test_command(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix
@@ -406,7 +551,7 @@ contains
       refused(:, 1) = [character(len=24) :: "--friction", "0.3", "", "", ""]
       refused(:, 2) = [character(len=24) :: "--tangential", "10", "", "", ""]
       refused(:, 3) = [character(len=24) :: "--tangential", "10", "--slip", "0.1", "--friction"]
-      refused(:, 4) = [character(len=24) :: "--tangential", "10", "--friction", "0.3", "--boundary"]
+      refused(:, 4) = [character(len=24) :: "--tangential", "10", "--friction", "-1", ""]
       refused(:, 5) = [character(len=24) :: "--tangential", "10", "--friction", "0.3", "--adhesion"]
       refused(:, 6) = [character(len=24) :: "--slip", "0.1", "--friction", "0", ""]
       do k = 1, size(refused, 2)
@@ -429,9 +574,6 @@ contains
          case (3)
             allocate(words(1))
             words(1)%s = "0.3"
-         case (4)
-            allocate(words(1))
-            words(1)%s = "periodic"
          case (5)
             allocate(words(5))
             words(1)%s = "dugdale"

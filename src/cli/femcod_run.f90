@@ -150,7 +150,7 @@ contains
             lower=0.0_dp), &
          real_option("--tangential", "Q", "after the normal problem, a tangential force Q (nN, along x) at each "// &
             "state with Coulomb friction (--friction): partial slip by the Cerruti kernel, stick and slip maps, the "// &
-            "tangential shift; Q >= mu P slides (free surface)", lower=0.0_dp), &
+            "tangential shift; Q >= mu P slides", lower=0.0_dp), &
          real_option("--slip", "S", "as --tangential, a rigid tangential shift S (nm, along x) instead of a force", &
             lower=0.0_dp), &
          real_option("--friction", "MU", "the Coulomb coefficient of --tangential or --slip", lower=0.0_dp, &

@@ -28,9 +28,10 @@
 !> against the rows i (up the page: the axes of PREFIX.xdmf's mesh and of the figures).
 module femcod_cerruti
    use femcod_kinds, only: dp
+   use femcod_love_periodic, only: periodic_cerruti_spectra
    implicit none
    private
-   public :: cerruti_integrals, tangential_tables, second_dundurs_constant
+   public :: cerruti_integrals, tangential_tables, second_dundurs_constant, periodic_tangential_spectra
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -111,6 +112,44 @@ contains
          end do
       end do
    end subroutine tangential_tables
+
+   !> The periodic cell's tangential compliance spectra (nm/nN; the DFT of the tables of
+   !> the kernel summed over all images, zero-mean), in the layout of a 2-D r2c transform
+   !> of the NP x NP grid: xx(kp + 1, kq + 1), kp = 0 .. NP/2 the rows' frequency (the
+   !> halved one), kq = 0 .. NP-1 the columns' (wrapped). From femcod_love_periodic's
+   !> alias sums: with X along the columns and Y up the rows, the xy spectrum is +C(kx)
+   !> C(ky) in the rows' frequency kp = -ky (the sign of y = -p; module header).
+   subroutine periodic_tangential_spectra(np, pixel, young, poisson, xx, yy, xy)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: pixel, young(2), poisson(2)
+      real(dp), intent(out) :: xx(np/2 + 1, np), yy(np/2 + 1, np), xy(np/2 + 1, np)
+      real(dp), allocatable :: wxx(:, :), wc(:, :)
+      real(dp) :: c(2), w1, w2, w3
+      integer :: kp, kq, q, b
+      allocate(wxx(0:np/2, 0:np/2), wc(0:np/2, 0:np/2))
+      call periodic_cerruti_spectra(np, wxx, wc)
+      do b = 1, 2
+         c(b) = (1 + poisson(b))/(pi*young(b)*pixel)
+      end do
+      do kq = 0, np - 1
+         q = min(kq, np - kq)
+         do kp = 0, np/2
+            ! wxx(kx, ky): the X^2 integral at column frequency kx, row frequency ky.
+            w1 = wxx(q, kp)
+            w2 = wxx(kp, q)
+            w3 = wc(q, kp)
+            if (kq > np/2) w3 = -w3
+            xx(kp + 1, kq + 1) = 0
+            yy(kp + 1, kq + 1) = 0
+            xy(kp + 1, kq + 1) = 0
+            do b = 1, 2
+               xx(kp + 1, kq + 1) = xx(kp + 1, kq + 1) + c(b)*(w1 + (1 - poisson(b))*w2)
+               yy(kp + 1, kq + 1) = yy(kp + 1, kq + 1) + c(b)*(w2 + (1 - poisson(b))*w1)
+               xy(kp + 1, kq + 1) = xy(kp + 1, kq + 1) + c(b)*poisson(b)*w3
+            end do
+         end do
+      end do
+   end subroutine periodic_tangential_spectra
 
    !> Dundurs' second constant of two bodies (E GPa, nu): beta = [G1 (1 - 2 nu2) - G2
    !> (1 - 2 nu1)] / [2 G1 (1 - nu2) + 2 G2 (1 - nu1)]: the coupling of normal and

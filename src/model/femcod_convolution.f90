@@ -55,7 +55,8 @@ module femcod_convolution
       SPECTRUM_STIFFNESS
    public :: inverse_half_spectrum, inverse_complex_transform, line_transform, line_transform_setup, &
       line_transform_apply, line_transform_free
-   public :: shear_transform, shear_transform_setup, shear_transform_apply, shear_transform_free
+   public :: shear_transform, shear_transform_setup, shear_transform_setup_periodic, shear_transform_apply, &
+      shear_transform_free
 
    !> Which operator gap_transform_apply applies: the compliance C = c (I * .) + s or the
    !> stiffness K = C^-1.
@@ -674,6 +675,33 @@ contains
          spec = real(t%spectrum, dp)/real(m, dp)**2
       end function spectrum_of
    end subroutine shear_transform_setup
+
+   !> The tangential operator of a periodic cell (M = NP, no padding) from its spectra
+   !> (nm/nN, the r2c layout NP/2 + 1 x NP: femcod_cerruti's periodic_tangential_spectra).
+   subroutine shear_transform_setup_periodic(t, xx, yy, xy)
+      type(shear_transform), intent(inout) :: t
+      real(dp), intent(in) :: xx(:, :), yy(:, :), xy(:, :)
+      integer :: m, threads
+      m = size(xx, 2)
+      t%np = m
+      t%m = m
+      t%real_mem = fftw_alloc_real(int(m, c_size_t)**2)
+      t%complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
+      call c_f_pointer(t%real_mem, t%field, [m, m])
+      call c_f_pointer(t%complex_mem, t%spectrum, [m/2 + 1, m])
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      if (fftw_init_threads() == 0) threads = 1
+      call fftw_plan_with_nthreads(int(threads, c_int))
+      t%forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), t%field, t%spectrum, FFTW_ESTIMATE)
+      t%backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), t%spectrum, t%field, FFTW_ESTIMATE)
+      call fftw_plan_with_nthreads(1_c_int)
+      t%xx = xx/real(m, dp)**2
+      t%yy = yy/real(m, dp)**2
+      t%xy = xy/real(m, dp)**2
+      t%largest = maxval((xx + yy)/2 + sqrt(((xx - yy)/2)**2 + xy**2))
+      allocate(t%along_x(m/2 + 1, m))
+   end subroutine shear_transform_setup_periodic
 
    !> (ux, uy) = the tangential operator applied to (tx, ty), all NP x NP (nN in, nm out).
    subroutine shear_transform_apply(t, tx, ty, ux, uy)

@@ -32,7 +32,7 @@ module femcod_love_periodic
    use femcod_convolution, only: inverse_half_spectrum
    implicit none
    private
-   public :: periodic_love_spectrum, periodic_love_spectrum_rows, periodic_offset_table
+   public :: periodic_love_spectrum, periodic_love_spectrum_rows, periodic_offset_table, periodic_cerruti_spectra
 
    real(dp), parameter :: pi = 3.141592653589793238462643383279502884_dp
 
@@ -99,6 +99,86 @@ contains
       end do
       !$omp end parallel do
    end subroutine sampled_factors
+
+   !> The periodic Cerruti integrals' spectra (femcod_cerruti): with the transforms
+   !>     int int X^2/rho^3 -> fy^2/|f|^3,   int int X Y/rho^3 -> -fx fy/|f|^3
+   !> (f in cycles per pixel; their sum with Y^2/rho^3 is Love's 1/|f|) and 1/|v|^3 =
+   !> 4/sqrt(pi) int_0^inf t^2 exp(-t^2 |v|^2) dt, the alias sums separate as S's do:
+   !>     xx(kx, ky) = sum s(ax + m) s(ay + n) (ay + n)^2/|v|^3 = 4/sqrt(pi) int t^2 A(ax) B(ay) dt,
+   !>     c(kx, ky)  = sum s s (ax + m) (ay + n)/|v|^3         = 4/sqrt(pi) int t^2 C(ax) C(ay) dt,
+   !> ax = kx/NP, ay = ky/NP, kx, ky = 0 .. NP/2, with B(a, t) = sum_m s(a + m) (a + m)^2
+   !> exp(-t^2 (a + m)^2) and C the same with (a + m) (sampled_box_moments). The same
+   !> trapezoidal rule in u = ln t as S (its integrand t^3 A B decays as exp(-pi^2/(4 t^2))
+   !> at small t); xx is not symmetric: the Y^2 integral's spectrum is its transpose. A
+   !> and B are even in a, C odd; all three 0 at zero frequency (zero-mean displacements).
+   subroutine periodic_cerruti_spectra(np, xx, c)
+      integer, intent(in) :: np
+      real(dp), intent(out) :: xx(0:np/2, 0:np/2), c(0:np/2, 0:np/2)
+      real(dp), allocatable :: a(:, :), b(:, :), cc(:, :)
+      real(dp), parameter :: step = 0.125_dp
+      real(dp) :: u_low, u_high, t, w
+      integer :: kh, nodes, j, k
+      kh = np/2
+      u_low = log(1.0e-17_dp)
+      u_high = log(7.0_dp*max(np, 1))
+      nodes = ceiling((u_high - u_low)/step) + 1
+      allocate(a(0:kh, nodes), b(0:kh, nodes), cc(0:kh, nodes))
+      !$omp parallel do private(t, w, k)
+      do j = 1, nodes
+         t = exp(u_low + (j - 1)*step)
+         w = sqrt(4/sqrt(pi)*step*t**3)
+         do k = 0, kh
+            a(k, j) = w*sampled_box_gaussian(real(k, dp)/real(np, dp), t)
+            call sampled_box_moments(real(k, dp)/real(np, dp), t, b(k, j), cc(k, j))
+            b(k, j) = w*b(k, j)
+            cc(k, j) = w*cc(k, j)
+         end do
+      end do
+      !$omp end parallel do
+      call dgemm("N", "T", kh + 1, kh + 1, nodes, 1.0_dp, a, kh + 1, b, kh + 1, 0.0_dp, xx, kh + 1)
+      call dgemm("N", "T", kh + 1, kh + 1, nodes, 1.0_dp, cc, kh + 1, cc, kh + 1, 0.0_dp, c, kh + 1)
+      xx(0, 0) = 0
+      c(0, 0) = 0
+   end subroutine periodic_cerruti_spectra
+
+   !> B(a, t) = sum_m s(a + m) (a + m)^2 exp(-t^2 (a + m)^2) and C(a, t) = sum_m s(a + m)
+   !> (a + m) exp(-t^2 (a + m)^2), 0 <= a <= 1/2: directly for t >= 1 (s(a + m) (a + m) =
+   !> (-1)^m sin(pi a)/pi), else by Poisson's summation, with g(x) = exp(-pi^2 x^2/t^2):
+   !>     B = sqrt(pi)/(2 t^3) [g(1/2) - 2 sum_k>=1 ((k - 1/2) g(k - 1/2) - (k + 1/2) g(k + 1/2)) cos(2 pi k a)],
+   !>     C = 1/(sqrt(pi) t) sum_k>=1 (g(k - 1/2) - g(k + 1/2)) sin(2 pi k a).
+   !> Both are 0 at a = 0 (and C at a = 1/2).
+   pure subroutine sampled_box_moments(a, t, b, c)
+      real(dp), intent(in) :: a, t
+      real(dp), intent(out) :: b, c
+      real(dp) :: x, sa, e
+      integer :: m, mmax, k
+      b = 0
+      c = 0
+      if (a == 0) return
+      if (t >= 1) then
+         sa = sin(pi*a)/pi
+         mmax = ceiling(6.3_dp/t + 0.5_dp)
+         do m = -mmax, mmax
+            x = a + m
+            e = merge(1, -1, mod(m, 2) == 0)*sa*exp(-(t*x)**2)
+            b = b + e*x
+            c = c + e
+         end do
+      else
+         b = g(0.5_dp)
+         do k = 1, ceiling(2*t + 0.5_dp) + 1
+            b = b - 2*((k - 0.5_dp)*g(k - 0.5_dp) - (k + 0.5_dp)*g(k + 0.5_dp))*cos(2*pi*k*a)
+            c = c + (g(k - 0.5_dp) - g(k + 0.5_dp))*sin(2*pi*k*a)
+         end do
+         b = sqrt(pi)/(2*t**3)*b
+         c = c/(sqrt(pi)*t)
+      end if
+   contains
+      pure real(dp) function g(y)
+         real(dp), intent(in) :: y
+         g = exp(-(pi*y/t)**2)
+      end function g
+   end subroutine sampled_box_moments
 
    !> A(a, t) = sum_m s(a + m) exp(-t^2 (a + m)^2), 0 <= a <= 1/2, t > 0: the samples
    !> at the pixel centres, shifted by a, of the pixel box smoothed by a Gaussian.

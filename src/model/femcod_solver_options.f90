@@ -318,7 +318,7 @@ contains
 
    !> What a tangential step (`tangential`) is refused with: a friction coefficient that is
    !> not positive, a load or shift below zero, adhesion (tension in the contact: no
-   !> Coulomb bound), the periodic cell (the Cerruti kernel is the free half-space's).
+   !> Coulomb bound).
    subroutine refuse_tangential(options, status)
       type(contact_options), intent(in) :: options
       type(status_type), intent(inout) :: status
@@ -330,9 +330,6 @@ contains
       else if (options%adhesion /= LAW_HARD_WALL) then
          call set_error(status, STATUS_USAGE, "--tangential/--slip with --adhesion: the Coulomb bound mu p needs a "// &
             "compressive contact, and adhesive contacts carry tension")
-      else if (options%boundary == BOUNDARY_PERIODIC) then
-         call set_error(status, STATUS_USAGE, "--tangential/--slip with --boundary periodic: the Cerruti kernel is "// &
-            "the free half-space's; use --boundary free")
       end if
    end subroutine refuse_tangential
 

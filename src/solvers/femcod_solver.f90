@@ -111,6 +111,7 @@ contains
       request%by_slip = options%by_slip
       request%load = options%tangential_load
       request%slip = options%slip
+      request%periodic = options%boundary == BOUNDARY_PERIODIC
       do k = 1, size(res%states)
          associate(s => res%states(k))
             if (.not. s%reached .or. .not. allocated(s%force)) cycle
@@ -157,7 +158,8 @@ contains
       character(len=:), allocatable :: cap
       lines = solver_notes(problem, options)
       if (options%tangential) lines = [lines, string_type("tangential step (Coulomb, mu = "// &
-         sig_str(options%friction, 4)//"): the Cerruti kernel of the free half-space, the normal pressures as the "// &
+         sig_str(options%friction, 4)//"): the Cerruti kernel of the "//trim(merge("periodic cell  ", "free half-space", &
+         options%boundary == BOUNDARY_PERIODIC))//", the normal pressures as the "// &
          "normal problem left them (Goodman's approximation; Dundurs' beta = "// &
          sig_str(second_dundurs_constant(problem%young(1:2), problem%poisson(1:2)), 3)//", exact only at 0: one "// &
          "material or incompressible bodies)")]

@@ -24,7 +24,9 @@
 !>
 !> The normal pressures stay as the normal problem left them (Goodman's approximation:
 !> the coupling by the second Dundurs constant beta is left out; exact for beta = 0, one
-!> material or incompressible bodies). Free half-space only. Q >= mu P: gross sliding,
+!> material or incompressible bodies). The free half-space, or a periodic cell (the kernel
+!> summed over the images, zero-mean displacements: the shift is then measured from the
+!> mean surface, as the normal approach from the mean gap). Q >= mu P: gross sliding,
 !> every pixel at b_i along x (the shift is then the onset's at Q = mu P, unbounded
 !> beyond it).
 module femcod_tangential
@@ -32,8 +34,9 @@ module femcod_tangential
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
    use femcod_strings, only: int_str, sig_str
    use femcod_problem, only: contact_problem
-   use femcod_cerruti, only: tangential_tables
-   use femcod_convolution, only: shear_transform, shear_transform_setup, shear_transform_apply, shear_transform_free
+   use femcod_cerruti, only: tangential_tables, periodic_tangential_spectra
+   use femcod_convolution, only: shear_transform, shear_transform_setup, shear_transform_setup_periodic, &
+      shear_transform_apply, shear_transform_free
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    implicit none
    private
@@ -48,6 +51,8 @@ module femcod_tangential
       real(dp) :: load = 0, slip = 0
       real(dp) :: tol = 1.0e-8_dp
       integer :: max_iterations = 20000
+      !> The grid as one cell of a periodic surface (the kernel summed over the images).
+      logical :: periodic = .false.
    end type tangential_request
 
    !> The answer on the contact pixels, in the order of the state's list.
@@ -103,9 +108,15 @@ contains
       answer%stick = .false.
       capacity = sum(st%bound)
       if (st%n == 0 .or. .not. capacity > 0) return
-      allocate(xx(0:np - 1, 0:np - 1), yy(0:np - 1, 0:np - 1), xy(0:np - 1, 0:np - 1))
-      call tangential_tables(np, problem%pixel, problem%young(1:2), problem%poisson(1:2), xx, yy, xy)
-      call shear_transform_setup(st%op, xx, yy, xy)
+      if (request%periodic) then
+         allocate(xx(np/2 + 1, np), yy(np/2 + 1, np), xy(np/2 + 1, np))
+         call periodic_tangential_spectra(np, problem%pixel, problem%young(1:2), problem%poisson(1:2), xx, yy, xy)
+         call shear_transform_setup_periodic(st%op, xx, yy, xy)
+      else
+         allocate(xx(0:np - 1, 0:np - 1), yy(0:np - 1, 0:np - 1), xy(0:np - 1, 0:np - 1))
+         call tangential_tables(np, problem%pixel, problem%young(1:2), problem%poisson(1:2), xx, yy, xy)
+         call shear_transform_setup(st%op, xx, yy, xy)
+      end if
       deallocate(xx, yy, xy)
       allocate(st%gx(np, np), st%gy(np, np), st%ux(np, np), st%uy(np, np))
       st%gx = 0
