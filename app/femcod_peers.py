@@ -7,6 +7,7 @@ dependency, see doc/performance.md):
 
     PYTHON app/femcod_peers.py PEER GAPS NP PIXEL ESTAR PRESSURE TOL
     PYTHON app/femcod_peers.py tamaas-adhesion GAPS NP PIXEL ESTAR MEAN_GAP TOL LAW W RANGE
+    PYTHON app/femcod_peers.py tamaas-tangential GAPS NP PIXEL YOUNG PRESSURE TOL NU MU FRACTION
 
 GAPS is NP*NP float64 values (Fortran order, nm): the initial gap between the elastic
 surface and the rigid flat, 0 at the first touch; PIXEL in nm, ESTAR = E/(1-nu^2) in GPa, PRESSURE the nominal mean pressure in GPa,
@@ -25,6 +26,14 @@ cell at a prescribed mean gap MEAN_GAP (nm) with tamaas' adhesion functional, LA
 (J/m^2 = nN/nm) and range RANGE (nm; W = 0: no functional), by its gap-variable solver
 (Rey, Anciaux and Molinari 2017), from the undeformed surfaces; its eighth field is the
 total load (nN, the mean traction times the cell's area).
+
+`tamaas-tangential` (called by `femcod bench tangential --peers PYTHON`) solves the periodic
+cell at the mean pressure PRESSURE (GPa) and the mean tangential traction FRACTION * MU *
+PRESSURE along femcod's x (the columns: tamaas' second axis) with Coulomb friction MU, by
+tamaas' PolonskyKeerTan on a surface_2d model of Young's modulus YOUNG and Poisson's ratio
+NU; its eighth field is the fraction of the cell that sticks, and it writes the tractions
+(femcod's x, femcod's y up the page, the pressure; GPa, NP*NP float64 each in Fortran order)
+to GAPS.tractions.
 """
 import contextlib
 import os
@@ -139,6 +148,30 @@ def run_tamaas_adhesion(gap, n, pixel, estar, mean_gap, tol, law, work, rho):
     return t1 - t0, "-", float(error), contact, "converged" if error < tol else "not_converged", load
 
 
+def run_tamaas_tangential(gap, n, pixel, young, pressure, tol, nu, mu, fraction, path):
+    import tamaas as tm
+    height = np.ascontiguousarray(gap.max() - gap)
+    length = n * pixel
+    model = tm.ModelFactory.createModel(tm.model_type.surface_2d, [length, length], [n, n])
+    model.E = young
+    model.nu = nu
+    solver = tm.PolonskyKeerTan(model, height, tol, mu)
+    solver.max_iter = 20000
+    with quiet_stdout():
+        t0 = time.perf_counter()
+        error = solver.solve([0.0, fraction * mu * pressure, pressure])
+        t1 = time.perf_counter()
+    traction = np.asarray(model.traction)
+    # tamaas' second axis is femcod's x (the columns); its first runs down femcod's rows.
+    tx, ty, p = traction[..., 1], -traction[..., 0], traction[..., 2]
+    np.concatenate([tx.ravel(order="F"), ty.ravel(order="F"), p.ravel(order="F")]).astype("<f8").tofile(
+        path + ".tractions")
+    contact = p > 0
+    stick = contact & (np.hypot(tx, ty) < mu * p * (1 - 1e-6))
+    return (t1 - t0, "-", float(error), np.count_nonzero(contact) / n ** 2,
+            "converged" if error < tol else "not_converged", float(np.count_nonzero(stick)) / n ** 2)
+
+
 PEERS = {"aspher": run_aspher, "contactmechanics": run_contactmechanics, "tamaas": run_tamaas,
          "contactmechanics-periodic": run_contactmechanics_periodic}
 
@@ -148,7 +181,11 @@ def main():
     n = int(n)
     gap = np.fromfile(path, dtype="<f8").reshape((n, n), order="F")
     try:
-        if peer == "tamaas-adhesion":
+        if peer == "tamaas-tangential":
+            nu, mu, fraction = sys.argv[8:11]
+            answer = run_tamaas_tangential(gap, n, float(pixel), float(estar), float(pressure), float(tol),
+                                           float(nu), float(mu), float(fraction), path)
+        elif peer == "tamaas-adhesion":
             law, work, rho = sys.argv[8:11]
             answer = run_tamaas_adhesion(gap, n, float(pixel), float(estar), float(pressure), float(tol), law,
                                          float(work), float(rho))

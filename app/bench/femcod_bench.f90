@@ -11,6 +11,7 @@ module femcod_bench
    use femcod_bench_periodic, only: bench_periodic
    use femcod_bench_frontier, only: bench_frontier
    use femcod_bench_adhesion, only: bench_adhesion
+   use femcod_bench_tangential, only: bench_tangential
    implicit none
    private
    public :: bench_command
@@ -42,6 +43,9 @@ contains
             return
          case ("adhesion")
             call bench_adhesion(args(2:), code)
+            return
+         case ("tangential")
+            call bench_tangential(args(2:), code)
             return
          case ("mpi")
             call bench_mpi(args(2:), code)

@@ -45,6 +45,7 @@ contains
             "       femcod bench periodic [--np LIST] [--contact LIST]  (--help for more)", &
             "       femcod bench frontier [--np N] [--contact LIST] [--svg FILE]  (--help for more)", &
             "       femcod bench adhesion [--full]  (--help for more)", &
+            "       femcod bench tangential [--full] [--figure FILE] [--peers PYTHON]  (--help for more)", &
             "       femcod bench mpi [--np LIST] [--ranks LIST]  (--help for more; needs femcod-mpi)", &
             "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
             "event, peak memory (resident, per case), error against the reference. The rough surface:", &

@@ -154,7 +154,8 @@ contains
       integer :: m, mmax, k
       b = 0
       c = 0
-      if (a == 0) return
+      ! Below t = 0.15 both are below exp(-pi^2/(4 t^2)) / t^3 < 1e-44 of their scale.
+      if (a == 0 .or. t < 0.15_dp) return
       if (t >= 1) then
          sa = sin(pi*a)/pi
          mmax = ceiling(6.3_dp/t + 0.5_dp)
