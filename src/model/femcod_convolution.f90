@@ -516,25 +516,13 @@ contains
       logical, intent(in) :: periodic
       logical, intent(out) :: ok
       real(dp), intent(out) :: smallest
-      integer :: np, m, p, q, i, j, threads
+      integer :: np, m, p, q, i, j
       np = size(table, 1)
       m = merge(np, 2*np, periodic)
       t%np = np
       t%m = m
       t%periodic = periodic
-      t%real_mem = fftw_alloc_real(int(m, c_size_t)**2)
-      t%complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
-      call c_f_pointer(t%real_mem, t%field, [m, m])
-      call c_f_pointer(t%complex_mem, t%spectrum, [m/2 + 1, m])
-      ! The 2-D transforms on OpenMP's threads (FFTW's threaded plans); plans made after
-      ! these two are single-threaded again, as the convolution's blocks expect.
-      threads = 1
-      !$ threads = omp_get_max_threads()
-      if (fftw_init_threads() == 0) threads = 1
-      call fftw_plan_with_nthreads(int(threads, c_int))
-      t%forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), t%field, t%spectrum, FFTW_ESTIMATE)
-      t%backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), t%spectrum, t%field, FFTW_ESTIMATE)
-      call fftw_plan_with_nthreads(1_c_int)
+      call threaded_2d_plans(m, t%real_mem, t%complex_mem, t%field, t%spectrum, t%forward, t%backward)
       ! The kernel on the transform grid: offsets 0..NP-1 and -(NP-1)..-1 wrapped (free;
       ! offset NP is never reached by two pixels of the grid), or the periodic cell.
       t%field = 0
@@ -566,6 +554,28 @@ contains
          t%compliance(1, 1) = 0
       end if
    end subroutine gap_transform_setup
+
+   !> An M x M real field and its half spectrum on FFTW's aligned memory, with the 2-D
+   !> r2c and c2r plans between them on OpenMP's threads (FFTW's threaded plans); plans
+   !> made after these are single-threaded again, as the convolution's blocks expect.
+   subroutine threaded_2d_plans(m, real_mem, complex_mem, field, spectrum, forward, backward)
+      integer, intent(in) :: m
+      type(c_ptr), intent(out) :: real_mem, complex_mem, forward, backward
+      real(c_double), pointer, intent(out) :: field(:, :)
+      complex(c_double_complex), pointer, intent(out) :: spectrum(:, :)
+      integer :: threads
+      real_mem = fftw_alloc_real(int(m, c_size_t)**2)
+      complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
+      call c_f_pointer(real_mem, field, [m, m])
+      call c_f_pointer(complex_mem, spectrum, [m/2 + 1, m])
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      if (fftw_init_threads() == 0) threads = 1
+      call fftw_plan_with_nthreads(int(threads, c_int))
+      forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), field, spectrum, FFTW_ESTIMATE)
+      backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), spectrum, field, FFTW_ESTIMATE)
+      call fftw_plan_with_nthreads(1_c_int)
+   end subroutine threaded_2d_plans
 
    !> out = L in on the transform grid (M x M), L the compliance or the stiffness
    !> (`which`: SPECTRUM_COMPLIANCE or SPECTRUM_STIFFNESS).
@@ -629,22 +639,12 @@ contains
    subroutine shear_transform_setup(t, xx, yy, xy)
       type(shear_transform), intent(inout) :: t
       real(dp), intent(in) :: xx(0:, 0:), yy(0:, 0:), xy(0:, 0:)
-      integer :: np, m, threads
+      integer :: np, m
       np = size(xx, 1)
       m = 2*np
       t%np = np
       t%m = m
-      t%real_mem = fftw_alloc_real(int(m, c_size_t)**2)
-      t%complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
-      call c_f_pointer(t%real_mem, t%field, [m, m])
-      call c_f_pointer(t%complex_mem, t%spectrum, [m/2 + 1, m])
-      threads = 1
-      !$ threads = omp_get_max_threads()
-      if (fftw_init_threads() == 0) threads = 1
-      call fftw_plan_with_nthreads(int(threads, c_int))
-      t%forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), t%field, t%spectrum, FFTW_ESTIMATE)
-      t%backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), t%spectrum, t%field, FFTW_ESTIMATE)
-      call fftw_plan_with_nthreads(1_c_int)
+      call threaded_2d_plans(m, t%real_mem, t%complex_mem, t%field, t%spectrum, t%forward, t%backward)
       t%xx = spectrum_of(xx, .false.)
       t%yy = spectrum_of(yy, .false.)
       t%xy = spectrum_of(xy, .true.)
@@ -681,21 +681,11 @@ contains
    subroutine shear_transform_setup_periodic(t, xx, yy, xy)
       type(shear_transform), intent(inout) :: t
       real(dp), intent(in) :: xx(:, :), yy(:, :), xy(:, :)
-      integer :: m, threads
+      integer :: m
       m = size(xx, 2)
       t%np = m
       t%m = m
-      t%real_mem = fftw_alloc_real(int(m, c_size_t)**2)
-      t%complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
-      call c_f_pointer(t%real_mem, t%field, [m, m])
-      call c_f_pointer(t%complex_mem, t%spectrum, [m/2 + 1, m])
-      threads = 1
-      !$ threads = omp_get_max_threads()
-      if (fftw_init_threads() == 0) threads = 1
-      call fftw_plan_with_nthreads(int(threads, c_int))
-      t%forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), t%field, t%spectrum, FFTW_ESTIMATE)
-      t%backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), t%spectrum, t%field, FFTW_ESTIMATE)
-      call fftw_plan_with_nthreads(1_c_int)
+      call threaded_2d_plans(m, t%real_mem, t%complex_mem, t%field, t%spectrum, t%forward, t%backward)
       t%xx = xx/real(m, dp)**2
       t%yy = yy/real(m, dp)**2
       t%xy = xy/real(m, dp)**2
