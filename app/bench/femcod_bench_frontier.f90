@@ -13,6 +13,7 @@ module femcod_bench_frontier
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type, int_str, real_str, fixed_str
    use femcod_help, only: help_requested, print_lines
+   use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_options, only: option_spec, parsed_options, option_help, flag_option, real_option, integer_option, &
       text_option, real_list_option, get_option, option_given
    use femcod_scene, only: initial_gaps
@@ -77,6 +78,14 @@ contains
       call get_option(parsed, "--deck", deck_path)
       if (option_given(parsed, "--no-deck")) deck_path = ""
       call get_option(parsed, "--deck-load", deck_load)
+      ! The figure's name before any work: femcod's rule for every file it writes.
+      if (len(svg_path) > 0) call guard_outputs([string_type(svg_path)], [string_type(deck_path)], &
+         option_given(parsed, "--force"), OUTPUT_RESULT, status)
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod bench frontier: "//status%message
+         code = status%code
+         return
+      end if
       ! The thesis deck first, so that a bad --deck fails before the table's work.
       if (len(deck_path) > 0) then
          call frontier_deck(deck_path, option_given(parsed, "--deck"), thesis, status)
@@ -373,6 +382,7 @@ contains
       table = [integer_option("--np", "N", "pixels per side of the benchmark surface (default 256)", lower=16), &
          real_list_option("--contact", "F1,...", "contact fractions in percent (default 1,5)", lower=0.0_dp), &
          text_option("--svg", "FILE", "write the figure (log time against log area error, Pareto front)"), &
+         flag_option("--force", "replace an existing figure that femcod wrote"), &
          text_option("--deck", "FILE", "a thesis deck solved the same ways, the Appendix B program too (default "// &
             "input/sphere_d1.deck, built in: the bench runs from any directory)"), &
          flag_option("--no-deck", "the benchmark surface only (no thesis deck, no Appendix B program)"), &

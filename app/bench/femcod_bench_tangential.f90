@@ -12,7 +12,9 @@ module femcod_bench_tangential
    use femcod_solver, only: solve_contact
    use femcod_strings, only: string_type, int_str, real_str, fixed_str
    use femcod_help, only: help_requested, print_lines
-   use femcod_options, only: option_spec, parsed_options, option_help, flag_option, text_option, get_option
+   use femcod_options, only: option_spec, parsed_options, option_help, flag_option, text_option, get_option, &
+      option_given
+   use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_scene, only: initial_gap_map
    use femcod_clock, only: wall_clock
    use femcod_svg, only: svg_series, svg_multi_plot, add_series
@@ -33,6 +35,7 @@ contains
       type(option_spec), allocatable :: table(:)
       table = [flag_option("--full", "Cattaneo-Mindlin at a/d = 64 too"), &
          text_option("--figure", "FILE", "write the stick fraction against Q/(mu P) as an SVG figure"), &
+         flag_option("--force", "replace an existing figure that femcod wrote"), &
          text_option("--peers", "PYTHON", "beside tamaas' PolonskyKeerTan in that Python (app/femcod_peers.py)")]
    end function bench_tangential_table
 
@@ -42,6 +45,8 @@ contains
       integer, intent(out) :: code
       type(parsed_options) :: parsed
       character(len=:), allocatable :: python, figure
+      type(string_type), allocatable :: inputs(:)
+      type(status_type) :: status
       logical :: full
       code = 0
       full = .false.
@@ -60,6 +65,12 @@ contains
       call get_option(parsed, "--figure", figure)
       call require_peers(python, "tangential", code)
       if (code /= 0) return
+      ! The figure's name before any work: femcod's rule for every file it writes.
+      if (len(figure) > 0) then
+         allocate(inputs(0))
+         call guard_outputs([string_type(figure)], inputs, option_given(parsed, "--force"), OUTPUT_RESULT, status)
+         if (failed(status, code)) return
+      end if
       call mindlin_table(full, code)
       if (code == 0) call stick_table(figure, code)
       if (code == 0) call stiffness_table(code)
@@ -67,7 +78,7 @@ contains
    end subroutine bench_tangential
 
    subroutine print_tangential_help()
-      write(output_unit, '(a)') "usage: femcod bench tangential [--full] [--figure FILE] [--peers PYTHON]", &
+      write(output_unit, '(a)') "usage: femcod bench tangential [--full] [--figure FILE [--force]] [--peers PYTHON]", &
          "1. Cattaneo-Mindlin: a rigid paraboloid (R = 1000 nm) on E = 200 GPa, nu = 0, at Hertz's a = 24 nm,", &
          "   Q = mu P/2 (mu = 0.3), pixels a/8, a/16, a/32 (a/64 with --full): the shift and the stick radius", &
          "   against the closed forms, the order of the shift's error, iterations, wall time.", &
