@@ -22,6 +22,8 @@ module test_tangential
    use femcod_convolution, only: shear_transform, shear_transform_setup_periodic, shear_transform_apply, &
       shear_transform_free
    use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential
+   use femcod_observer, only: solver_observer
+   use femcod_status, only: STATUS_INTERRUPTED
    use test_cg, only: rough_scene
    use femcod_strings, only: string_type
    use femcod_cli, only: run_femcod
@@ -36,6 +38,14 @@ module test_tangential
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
+   !> An observer that asks to stop at its third question (a stop signal, as femcod run's
+   !> observer reports SIGTERM).
+   type, extends(solver_observer) :: stop_soon
+      integer :: asked = 0
+   contains
+      procedure :: stop_requested => third_time
+   end type stop_soon
+
 contains
 
    subroutine collect_tangential(testsuite)
@@ -48,7 +58,8 @@ contains
          new_unittest("Q = mu P: every traction mu p; Q -> 0: every pixel sticks", test_limits), &
          new_unittest("a dense QP with disc constraints (block Gauss-Seidel) on a rough surface", test_dense), &
          new_unittest("the same on a periodic rough cell, its matrix from real-space image sums", test_dense_periodic), &
-         new_unittest("femcod run --tangential/--slip: maps obey Coulomb, columns, refusals", test_command)]
+         new_unittest("femcod run --tangential/--slip: maps obey Coulomb, columns, refusals", test_command), &
+         new_unittest("a stop request ends the tangential step: STATUS_INTERRUPTED, no answer", test_stop)]
    end subroutine collect_tangential
 
    !> The three integrals of the unit pixel at offsets off the centre against a 32 x 32
@@ -586,4 +597,33 @@ contains
          end select
       end function extra
    end subroutine test_command
+   logical function third_time(self)
+      class(stop_soon), intent(inout) :: self
+      self%asked = self%asked + 1
+      third_time = self%asked >= 3
+   end function third_time
+
+   !> The Hertz state at a/d = 8 with Q = mu P/2 takes about 100 iterations; the observer
+   !> is asked every 10, and asks to stop at its third question: the step ends with
+   !> STATUS_INTERRUPTED (femcod run's exit 128 + N) after 30 iterations, the question
+   !> asked three times.
+   subroutine test_stop(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_result) :: res
+      type(tangential_request) :: request
+      type(tangential_answer) :: answer
+      type(status_type) :: status
+      type(stop_soon) :: observer
+      call hertz_state(3.0_dp, deck, res, error)
+      if (allocated(error)) return
+      request%mu = 0.3_dp
+      associate(s => res%states(1))
+         request%load = 0.5_dp*request%mu*sum(s%force)
+         call solve_tangential(deck, s%i, s%j, s%force, request, answer, status, observer)
+      end associate
+      call check(error, status%code == STATUS_INTERRUPTED .and. observer%asked == 3 .and. &
+         index(status%message, "stopped after 30 iterations") > 0, "status "//to_string(status%code)//": "// &
+         status%message//" (asked "//to_string(observer%asked)//" times)")
+   end subroutine test_stop
 end module test_tangential

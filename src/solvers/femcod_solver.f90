@@ -88,17 +88,23 @@ contains
             " (available: incremental, legacy, cg)")
       end select
       if (options%shear .and. allocated(res%states)) call state_friction(res, run_shear_model(options), problem%pixel)
-      if (options%tangential .and. allocated(res%states) .and. status%code == 0) &
-         call tangential_states(problem, options, res, status)
+      if (options%tangential .and. allocated(res%states) .and. status%code == 0) then
+         if (present(observer)) then
+            call tangential_states(problem, options, res, status, observer)
+         else
+            call tangential_states(problem, options, res, status, nobody)
+         end if
+      end if
    end subroutine solve_contact
 
    !> The tangential step (solvers/femcod_tangential) at each reached state with contacts,
    !> after its memory check: the answer into the state.
-   subroutine tangential_states(problem, options, res, status)
+   subroutine tangential_states(problem, options, res, status, observer)
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       type(contact_result), intent(inout) :: res
       type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
       type(tangential_request) :: request
       type(tangential_answer) :: answer
       real(dp) :: t0, t1
@@ -115,7 +121,7 @@ contains
       do k = 1, size(res%states)
          associate(s => res%states(k))
             if (.not. s%reached .or. .not. allocated(s%force)) cycle
-            call solve_tangential(problem, s%i, s%j, s%force, request, answer, status)
+            call solve_tangential(problem, s%i, s%j, s%force, request, answer, status, observer)
             if (status%code /= 0) then
                status%message = "state "//int_str(k)//" (load "//sig_str(s%load, 6)//" nN): "//status%message
                return

@@ -31,7 +31,8 @@
 !> beyond it).
 module femcod_tangential
    use femcod_kinds, only: dp, i8
-   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
+   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED
+   use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str
    use femcod_problem, only: contact_problem
    use femcod_cerruti, only: tangential_tables, periodic_tangential_spectra
@@ -84,15 +85,18 @@ module femcod_tangential
 contains
 
    !> The tangential state of contact pixels (ci, cj) with normal forces f (nN) of
-   !> `problem` under `request`.
-   subroutine solve_tangential(problem, ci, cj, f, request, answer, status)
+   !> `problem` under `request`. `observer`, when given, is asked every 10 iterations
+   !> whether to stop (a stop signal): STATUS_INTERRUPTED then.
+   subroutine solve_tangential(problem, ci, cj, f, request, answer, status, observer)
       type(contact_problem), intent(in) :: problem
       integer, intent(in) :: ci(:), cj(:)
       real(dp), intent(in) :: f(:)
       type(tangential_request), intent(in) :: request
       type(tangential_answer), intent(out) :: answer
       type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout), optional :: observer
       type(tangential_state) :: st
+      type(solver_observer) :: nobody
       real(dp), allocatable :: xx(:, :), yy(:, :), xy(:, :), t(:, :)
       real(dp) :: capacity
       integer :: np
@@ -127,7 +131,11 @@ contains
          t = 0
          if (.not. request%by_slip) t(1, :) = st%bound*request%load/capacity
          answer%shift = [request%slip, 0.0_dp]
-         call projected_gradients(st, request, t, answer, status)
+         if (present(observer)) then
+            call projected_gradients(st, request, t, answer, status, observer)
+         else
+            call projected_gradients(st, request, t, answer, status, nobody)
+         end if
       end if
       answer%tx = t(1, :)
       answer%ty = t(2, :)
@@ -171,12 +179,13 @@ contains
 
    !> FISTA with adaptive restart (module header) from the forces t (feasible: within the
    !> discs, and summing to Q under force control); t the answer's forces (2 x n).
-   subroutine projected_gradients(st, request, t, answer, status)
+   subroutine projected_gradients(st, request, t, answer, status, observer)
       type(tangential_state), intent(inout) :: st
       type(tangential_request), intent(in) :: request
       real(dp), intent(inout) :: t(:, :)
       type(tangential_answer), intent(inout) :: answer
       type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
       real(dp), allocatable :: y(:, :), z(:, :), t_new(:, :)
       real(dp) :: step, theta, theta_new, lambda(2), shift(2), scale, gap, best
       integer :: it
@@ -188,6 +197,13 @@ contains
       y = t
       theta = 1
       do it = 1, request%max_iterations
+         if (mod(it, 10) == 0) then
+            if (observer%stop_requested()) then
+               call set_error(status, STATUS_INTERRUPTED, "stopped after "//int_str(it)//" iterations of the "// &
+                  "tangential step")
+               return
+            end if
+         end if
          call displace(st, y)
          z = y - step*st%u
          if (request%by_slip) then
