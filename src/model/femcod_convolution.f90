@@ -577,6 +577,18 @@ contains
       call fftw_plan_with_nthreads(1_c_int)
    end subroutine threaded_2d_plans
 
+   !> Undo threaded_2d_plans: the plans destroyed, FFTW's memory freed.
+   subroutine free_2d_plans(real_mem, complex_mem, field, spectrum, forward, backward)
+      type(c_ptr), intent(inout) :: real_mem, complex_mem, forward, backward
+      real(c_double), pointer, intent(inout) :: field(:, :)
+      complex(c_double_complex), pointer, intent(inout) :: spectrum(:, :)
+      call fftw_destroy_plan(forward)
+      call fftw_destroy_plan(backward)
+      call fftw_free(real_mem)
+      call fftw_free(complex_mem)
+      nullify(field, spectrum)
+   end subroutine free_2d_plans
+
    !> out = L in on the transform grid (M x M), L the compliance or the stiffness
    !> (`which`: SPECTRUM_COMPLIANCE or SPECTRUM_STIFFNESS).
    subroutine gap_transform_apply(t, which, in, out)
@@ -623,11 +635,7 @@ contains
    subroutine gap_transform_free(t)
       type(gap_transform), intent(inout) :: t
       if (.not. associated(t%field)) return
-      call fftw_destroy_plan(t%forward)
-      call fftw_destroy_plan(t%backward)
-      call fftw_free(t%real_mem)
-      call fftw_free(t%complex_mem)
-      nullify(t%field, t%spectrum)
+      call free_2d_plans(t%real_mem, t%complex_mem, t%field, t%spectrum, t%forward, t%backward)
       if (allocated(t%compliance)) deallocate(t%compliance)
       if (allocated(t%stiffness)) deallocate(t%stiffness)
    end subroutine gap_transform_free
@@ -645,14 +653,10 @@ contains
       t%np = np
       t%m = m
       call threaded_2d_plans(m, t%real_mem, t%complex_mem, t%field, t%spectrum, t%forward, t%backward)
-      t%xx = spectrum_of(xx, .false.)
-      t%yy = spectrum_of(yy, .false.)
-      t%xy = spectrum_of(xy, .true.)
-      t%largest = maxval((t%xx + t%yy)/2 + sqrt(((t%xx - t%yy)/2)**2 + t%xy**2))*real(m, dp)**2
-      allocate(t%along_x(m/2 + 1, m))
+      call keep_shear_spectra(t, spectrum_of(xx, .false.), spectrum_of(yy, .false.), spectrum_of(xy, .true.))
    contains
-      !> The real spectrum / M^2 of a table placed at the offsets (with the signs of an
-      !> odd table).
+      !> The real spectrum of a table placed at the offsets (with the signs of an odd
+      !> table).
       function spectrum_of(table, odd) result(spec)
          real(dp), intent(in) :: table(0:, 0:)
          logical, intent(in) :: odd
@@ -672,9 +676,22 @@ contains
             end do
          end do
          call fftw_execute_dft_r2c(t%forward, t%field, t%spectrum)
-         spec = real(t%spectrum, dp)/real(m, dp)**2
+         spec = real(t%spectrum, dp)
       end function spectrum_of
    end subroutine shear_transform_setup
+
+   !> The shear transform's spectra xx, yy, xy (nm/nN, the r2c layout) divided by M^2 for
+   !> FFTW's unnormalised transforms, the largest eigenvalue of their 2 x 2 matrix over
+   !> the frequencies, and the x component's spectrum buffer.
+   subroutine keep_shear_spectra(t, xx, yy, xy)
+      type(shear_transform), intent(inout) :: t
+      real(dp), intent(in) :: xx(:, :), yy(:, :), xy(:, :)
+      t%xx = xx/real(t%m, dp)**2
+      t%yy = yy/real(t%m, dp)**2
+      t%xy = xy/real(t%m, dp)**2
+      t%largest = maxval((xx + yy)/2 + sqrt(((xx - yy)/2)**2 + xy**2))
+      allocate(t%along_x(t%m/2 + 1, t%m))
+   end subroutine keep_shear_spectra
 
    !> The tangential operator of a periodic cell (M = NP, no padding) from its spectra
    !> (nm/nN, the r2c layout NP/2 + 1 x NP: femcod_cerruti's periodic_tangential_spectra).
@@ -686,11 +703,7 @@ contains
       t%np = m
       t%m = m
       call threaded_2d_plans(m, t%real_mem, t%complex_mem, t%field, t%spectrum, t%forward, t%backward)
-      t%xx = xx/real(m, dp)**2
-      t%yy = yy/real(m, dp)**2
-      t%xy = xy/real(m, dp)**2
-      t%largest = maxval((xx + yy)/2 + sqrt(((xx - yy)/2)**2 + xy**2))
-      allocate(t%along_x(m/2 + 1, m))
+      call keep_shear_spectra(t, xx, yy, xy)
    end subroutine shear_transform_setup_periodic
 
    !> (ux, uy) = the tangential operator applied to (tx, ty), all NP x NP (nN in, nm out).
@@ -760,11 +773,7 @@ contains
    subroutine shear_transform_free(t)
       type(shear_transform), intent(inout) :: t
       if (.not. associated(t%field)) return
-      call fftw_destroy_plan(t%forward)
-      call fftw_destroy_plan(t%backward)
-      call fftw_free(t%real_mem)
-      call fftw_free(t%complex_mem)
-      nullify(t%field, t%spectrum)
+      call free_2d_plans(t%real_mem, t%complex_mem, t%field, t%spectrum, t%forward, t%backward)
       if (allocated(t%along_x)) deallocate(t%along_x, t%xx, t%yy, t%xy)
    end subroutine shear_transform_free
 

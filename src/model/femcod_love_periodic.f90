@@ -35,6 +35,8 @@ module femcod_love_periodic
    public :: periodic_love_spectrum, periodic_love_spectrum_rows, periodic_offset_table, periodic_cerruti_spectra
 
    real(dp), parameter :: pi = 3.141592653589793238462643383279502884_dp
+   !> The trapezoidal rule's step in u = ln t (module header).
+   real(dp), parameter :: NODE_STEP = 0.125_dp
 
 contains
 
@@ -77,28 +79,37 @@ contains
    subroutine sampled_factors(np, a)
       integer, intent(in) :: np
       real(dp), allocatable, intent(out) :: a(:, :)
-      !> Step in u = ln t, and the ends: below t = 1e-17 the integrand is 2/sqrt(pi)
-      !> (A = 1 + O(t^2)), so the part left out is 1e-17; above t = 7 NP every factor
-      !> exp(-t^2 |v|^2) with |v| >= 1/NP is below exp(-49).
-      real(dp), parameter :: step = 0.125_dp
-      real(dp) :: u_low, u_high, t, w
-      integer :: kh, nodes, j, k
+      real(dp), allocatable :: nodes(:)
+      real(dp) :: t, w
+      integer :: kh, j, k
       kh = np/2
-      u_low = log(1.0e-17_dp)
-      u_high = log(7.0_dp*max(np, 1))
-      nodes = ceiling((u_high - u_low)/step) + 1
-      allocate(a(0:kh, nodes))
+      nodes = integration_nodes(np)
+      allocate(a(0:kh, size(nodes)))
       !$omp parallel do private(t, w, k)
-      do j = 1, nodes
-         t = exp(u_low + (j - 1)*step)
+      do j = 1, size(nodes)
+         t = nodes(j)
          ! Trapezoidal weight (dt = t du), its square root shared by the two factors.
-         w = sqrt(2/sqrt(pi)*step*t)
+         w = sqrt(2/sqrt(pi)*NODE_STEP*t)
          do k = 0, kh
             a(k, j) = w*sampled_box_gaussian(real(k, dp)/real(np, dp), t)
          end do
       end do
       !$omp end parallel do
    end subroutine sampled_factors
+
+   !> The nodes t_j = exp(u_j) of the trapezoidal rule in u = ln t, step NODE_STEP, for a
+   !> cell of NP pixels. The ends: below t = 1e-17 S's integrand is 2/sqrt(pi) (A = 1 +
+   !> O(t^2)), so the part left out is 1e-17 (the Cerruti moments' is 0 there); above
+   !> t = 7 NP every factor exp(-t^2 |v|^2) with |v| >= 1/NP is below exp(-49).
+   pure function integration_nodes(np) result(nodes)
+      integer, intent(in) :: np
+      real(dp), allocatable :: nodes(:)
+      real(dp) :: u_low, u_high
+      integer :: j
+      u_low = log(1.0e-17_dp)
+      u_high = log(7.0_dp*max(np, 1))
+      nodes = [(exp(u_low + (j - 1)*NODE_STEP), j = 1, ceiling((u_high - u_low)/NODE_STEP) + 1)]
+   end function integration_nodes
 
    !> The periodic Cerruti integrals' spectra (femcod_cerruti): with the transforms
    !>     int int X^2/rho^3 -> fy^2/|f|^3,   int int X Y/rho^3 -> -fx fy/|f|^3
@@ -114,19 +125,17 @@ contains
    subroutine periodic_cerruti_spectra(np, xx, c)
       integer, intent(in) :: np
       real(dp), intent(out) :: xx(0:np/2, 0:np/2), c(0:np/2, 0:np/2)
-      real(dp), allocatable :: a(:, :), b(:, :), cc(:, :)
-      real(dp), parameter :: step = 0.125_dp
-      real(dp) :: u_low, u_high, t, w
+      real(dp), allocatable :: a(:, :), b(:, :), cc(:, :), ts(:)
+      real(dp) :: t, w
       integer :: kh, nodes, j, k
       kh = np/2
-      u_low = log(1.0e-17_dp)
-      u_high = log(7.0_dp*max(np, 1))
-      nodes = ceiling((u_high - u_low)/step) + 1
+      ts = integration_nodes(np)
+      nodes = size(ts)
       allocate(a(0:kh, nodes), b(0:kh, nodes), cc(0:kh, nodes))
       !$omp parallel do private(t, w, k)
       do j = 1, nodes
-         t = exp(u_low + (j - 1)*step)
-         w = sqrt(4/sqrt(pi)*step*t**3)
+         t = ts(j)
+         w = sqrt(4/sqrt(pi)*NODE_STEP*t**3)
          do k = 0, kh
             a(k, j) = w*sampled_box_gaussian(real(k, dp)/real(np, dp), t)
             call sampled_box_moments(real(k, dp)/real(np, dp), t, b(k, j), cc(k, j))
