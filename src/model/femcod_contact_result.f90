@@ -4,6 +4,7 @@ module femcod_contact_result
    use femcod_kinds, only: dp, i8
    use femcod_state_visitor, only: state_visitor
    use femcod_strings, only: int_str
+   use femcod_shear_model, only: shear_model, friction_force
    implicit none
    private
    public :: contact_result, load_state, append_step, visit_result, record_approach_states
@@ -225,9 +226,11 @@ contains
    !> Within a step the response is linear, so the interpolation is exact. The contacts
    !> (ic, jc) and their forces are kept for the maps; at the largest requested load
    !> also for the contacts file.
-   pure subroutine record_load_states(res, lam, bounded, total, approach, delta, ftot, funit, pixel, hardness, ic, jc)
+   pure subroutine record_load_states(res, lam, bounded, total, approach, delta, ftot, funit, pixel, hardness, ic, jc, &
+      shear)
       type(contact_result), intent(inout) :: res
       real(dp), intent(in) :: lam, total, approach, delta, ftot(:), funit(:), pixel, hardness
+      type(shear_model), intent(in) :: shear
       integer, intent(in) :: ic(:), jc(:)
       logical, intent(in) :: bounded
       integer :: s
@@ -237,7 +240,7 @@ contains
          if (bounded .and. res%states(s)%load > total + lam) cycle
          dl = max(res%states(s)%load - total, 0.0_dp)
          res%states(s)%approach = approach + dl*delta
-         call fill_state(res%states(s), ftot + dl*funit, pixel, hardness, ic, jc)
+         call fill_state(res%states(s), ftot + dl*funit, pixel, hardness, ic, jc, shear)
          if (res%states(s)%load == maxval(res%states%load)) then
             res%contact_force = res%states(s)%force
             res%reported_load = res%states(s)%load
@@ -249,9 +252,10 @@ contains
    !> state's approach is its target D; within the step the approach is approach + l delta,
    !> so D is reached at l = (D - approach)/delta, where the load is total + l.
    pure subroutine record_approach_states(res, lam, bounded, total, approach, delta, ftot, funit, pixel, hardness, &
-      ic, jc)
+      ic, jc, shear)
       type(contact_result), intent(inout) :: res
       real(dp), intent(in) :: lam, total, approach, delta, ftot(:), funit(:), pixel, hardness
+      type(shear_model), intent(in) :: shear
       integer, intent(in) :: ic(:), jc(:)
       logical, intent(in) :: bounded
       integer :: s
@@ -262,7 +266,7 @@ contains
          dl = max(res%states(s)%approach - approach, 0.0_dp)/delta
          if (bounded .and. dl > lam) cycle
          res%states(s)%load = total + dl
-         call fill_state(res%states(s), ftot + dl*funit, pixel, hardness, ic, jc)
+         call fill_state(res%states(s), ftot + dl*funit, pixel, hardness, ic, jc, shear)
          if (res%states(s)%approach == maxval(res%states%approach)) then
             res%contact_force = res%states(s)%force
             res%reported_load = res%states(s)%load
@@ -271,15 +275,18 @@ contains
    end subroutine record_approach_states
 
    !> A state reached with the contact forces f (nN) at pixels (ic, jc): its contacts,
-   !> largest pressure and count above the hardness (GPa), pixel d (nm).
-   pure subroutine fill_state(state, f, pixel, hardness, ic, jc)
+   !> largest pressure and count above the hardness (GPa), pixel d (nm), and the friction
+   !> force of the shear model (0 without one).
+   pure subroutine fill_state(state, f, pixel, hardness, ic, jc, shear)
       type(load_state), intent(inout) :: state
       real(dp), intent(in) :: f(:), pixel, hardness
       integer, intent(in) :: ic(:), jc(:)
+      type(shear_model), intent(in) :: shear
       state%contacts = size(f)
       state%max_pressure = 0
       if (size(f) > 0) state%max_pressure = maxval(f)/pixel**2
       state%n_above_hardness = count(f/pixel**2 > hardness)
+      state%friction = friction_force(shear, f, pixel)
       state%reached = .true.
       state%i = ic
       state%j = jc

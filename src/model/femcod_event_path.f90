@@ -32,7 +32,7 @@ module femcod_event_path
       integer :: max_contacts = 0
       !> Pixel size (nm) and hardness (GPa), for the pressures of the history and states.
       real(dp) :: pixel = 0, hardness = 0
-      !> The shear model, for the friction force of each step (inactive: none).
+      !> The shear model, for the friction force of each step and state (inactive: none).
       type(shear_model) :: shear
    contains
       procedure :: start => start_path
@@ -127,26 +127,26 @@ contains
          ! Displacement control: the states where the approach crosses a target.
          if (lam >= NO_EVENT) then
             call record_approach_states(res, NO_EVENT, .false., path%total, path%approach, delta, ftot, funit, &
-               path%pixel, path%hardness, ic, jc)
+               path%pixel, path%hardness, ic, jc, path%shear)
             reason = STOP_NO_CONTACT
             if (path%max_approach > path%approach .and. delta > 0) &
                call path%advance((path%max_approach - path%approach)/delta, delta, ftot, funit)
          else
             call record_approach_states(res, lam, .true., path%total, path%approach, delta, ftot, funit, &
-               path%pixel, path%hardness, ic, jc)
+               path%pixel, path%hardness, ic, jc, path%shear)
             call path%advance(lam, delta, ftot, funit)
             if (path%max_approach <= path%approach) reason = STOP_LOADS
          end if
       else if (lam >= NO_EVENT) then
          call record_load_states(res, NO_EVENT, .false., path%total, path%approach, delta, ftot, funit, &
-            path%pixel, path%hardness, ic, jc)
+            path%pixel, path%hardness, ic, jc, path%shear)
          reason = STOP_NO_CONTACT
          if (path%has_loads) then
             if (path%max_load > path%total) call path%advance(path%max_load - path%total, delta, ftot, funit)
          end if
       else
          call record_load_states(res, lam, .true., path%total, path%approach, delta, ftot, funit, &
-            path%pixel, path%hardness, ic, jc)
+            path%pixel, path%hardness, ic, jc, path%shear)
          call path%advance(lam, delta, ftot, funit)
          if (path%has_loads) then
             if (path%max_load <= path%total) reason = STOP_LOADS

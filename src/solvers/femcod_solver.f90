@@ -20,7 +20,7 @@ module femcod_solver
    use femcod_incremental_state, only: incremental_state
    use femcod_cg, only: solve_cg
    use femcod_gap_cg, only: pixel_stiffness_ratio
-   use femcod_shear_model, only: shear_model, friction_force
+   use femcod_shear_model, only: shear_model
    use femcod_cerruti, only: second_dundurs_constant
    use femcod_clock, only: wall_clock
    use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential, tangential_storage_bytes
@@ -87,7 +87,6 @@ contains
          call set_error(status, STATUS_USAGE, "unknown solver "//int_str(options%solver)// &
             " (available: incremental, legacy, cg)")
       end select
-      if (options%shear .and. allocated(res%states)) call state_friction(res, run_shear_model(options), problem%pixel)
       if (options%tangential .and. allocated(res%states) .and. status%code == 0) then
          if (present(observer)) then
             call tangential_states(problem, options, res, status, observer)
@@ -140,19 +139,6 @@ contains
       call wall_clock(t1)
       res%wall_seconds = res%wall_seconds + (t1 - t0)
    end subroutine tangential_states
-
-   !> The friction force of the shear model at each reached state, from its contact forces
-   !> (nN; pixel in nm): the same sum for every solver.
-   pure subroutine state_friction(res, shear, pixel)
-      type(contact_result), intent(inout) :: res
-      type(shear_model), intent(in) :: shear
-      real(dp), intent(in) :: pixel
-      integer :: k
-      do k = 1, size(res%states)
-         if (res%states(k)%reached .and. allocated(res%states(k)%force)) &
-            res%states(k)%friction = friction_force(shear, res%states(k)%force, pixel)
-      end do
-   end subroutine state_friction
 
    !> What the solver's model leaves out for this problem, one line each (the summary's
    !> "model" lines and /run/scene_left_out): the solver's own, then the shear model's.
