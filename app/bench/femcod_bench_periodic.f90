@@ -111,8 +111,7 @@ contains
             write(output_unit, '(a)') "| "//int_str(np)//" | 1/"//int_str(nint(1/widths(k)))//" | "//int_str(width)// &
                " | "//fixed_str(2*widths(k)*np, 2)//" | "//real_str(res%states(k)%approach, 8)//" | "// &
                real_str(closed, 8)//" | "//real_str(approach_error(k), 2)//" | "// &
-               trim(merge(fixed_str(log(previous(k)/approach_error(k))/log(2.0_dp), 2), "-                 ", &
-               previous(k) > 0 .and. approach_error(k) > 0))//" | "//real_str(np/s(1, 0) - 1, 3)//" | "// &
+               order_text(previous(k), approach_error(k))//" | "//real_str(np/s(1, 0) - 1, 3)//" | "// &
                fixed_str(res%wall_seconds, 2)//" |"
          end do
          previous = approach_error
@@ -222,4 +221,15 @@ contains
             lower=0.0_dp, closed="()"), &
          text_option("--peers", "PYTHON", "a Python with tamaas and ContactMechanics installed")]
    end function bench_periodic_table
+   !> The observed order of convergence between two halvings of the width's error,
+   !> log2(previous/now), or "-" where it is not defined (the first size, a zero error).
+   function order_text(previous, now) result(text)
+      real(dp), intent(in) :: previous, now
+      character(len=:), allocatable :: text
+      if (previous > 0 .and. now > 0) then
+         text = fixed_str(log(previous/now)/log(2.0_dp), 2)
+      else
+         text = "-"
+      end if
+   end function order_text
 end module femcod_bench_periodic
