@@ -32,6 +32,9 @@ contains
       manifest = read_text(corpus//"/MANIFEST")
       call check(error, len(manifest) > 0, "reading "//corpus//"/MANIFEST")
       if (allocated(error)) return
+      call check(error, file_exists(command_for("bench ")), "the femcod program fpm builds beside the tests: "// &
+         command_for("bench "))
+      if (allocated(error)) return
       ncases = 0
       a = 1
       do while (a <= len(manifest))
@@ -56,8 +59,9 @@ contains
          call check(error, .not. file_exists(dir//"/SET-UP-FAILED"), name//": the set-up run failed")
          if (allocated(error)) return
          args = expand(args, dir, out)
-         call execute_command_line(limit//self_command()//" "//args//" > "//dir//".stdout 2> "//dir//".stderr", &
-            exitstat=code)
+         fragment = expand(fragment, dir, out)
+         call execute_command_line(limit//command_for(args)//" "//args//" > "//dir//".stdout 2> "//dir// &
+            ".stderr", exitstat=code)
          message = read_text(dir//".stderr")
          call check(error, code, expected, name//": exit code (message: "//trim(message)//")")
          if (allocated(error)) return
@@ -132,6 +136,22 @@ contains
       end select
       call write_text(dir//".before", file_listing(dir))
    end subroutine set_up
+
+   !> The program a case runs: this executable playing femcod, or for `bench` (which lives
+   !> in app/, not in this executable) the femcod program fpm built beside it, from the
+   !> same sources: build/<profile>/app/femcod for build/<profile>/test/femcod-test.
+   function command_for(args) result(cmd)
+      character(len=*), intent(in) :: args
+      character(len=:), allocatable :: cmd, self
+      integer :: length, at
+      cmd = self_command()
+      if (index(args, "bench ") /= 1) return
+      call get_command_argument(0, length=length)
+      allocate(character(len=length) :: self)
+      call get_command_argument(0, self)
+      at = index(self, "/test/", back=.true.)
+      cmd = self(1:at)//"app/femcod"
+   end function command_for
 
    !> Every file under `dir` with its CRC and size (cksum), sorted.
    function file_listing(dir) result(listing)

@@ -16,7 +16,8 @@ module femcod_bench_cg
    use femcod_options, only: option_spec, parsed_options, option_help, real_option, integer_option, text_option, &
       choice_option, real_list_option, integer_list_option, get_option, option_given
    use femcod_wisdom, only: load_wisdom, save_wisdom
-   use femcod_bench_common, only: bench_arguments, surface_for_peers, require_peers, &
+   use femcod_output_guard, only: OUTPUT_WISDOM
+   use femcod_bench_common, only: guard_bench_files, bench_arguments, surface_for_peers, require_peers, &
       remove_file_quietly, peer_line, peer_row, reset_peak, peak_mb, BENCH_LENGTH, options_refused
    implicit none
    private
@@ -74,6 +75,9 @@ contains
       call get_option(parsed, "--peers", python)
       call get_option(parsed, "--fftw-wisdom", wisdom)
       call require_peers(python, "cg", code)
+      ! The wisdom file is read and brought up to date: it must be FFTW wisdom if it exists.
+      if (len(wisdom) > 0) call guard_bench_files([string_type(wisdom), string_type(wisdom//".float32")], &
+         OUTPUT_WISDOM, "cg", code)
       if (code /= 0) return
       associate(method => options%cg)
          if (option_given(parsed, "--nested")) method%nested = switch("--nested")

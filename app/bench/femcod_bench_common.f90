@@ -14,10 +14,11 @@ module femcod_bench_common
    use femcod_scene, only: initial_gaps
    use femcod_files, only: path_exists, canonical_path
    use femcod_solver_options, only: contact_options, validate_options, requested_states
+   use femcod_output_guard, only: guard_outputs
    implicit none
    private
    public :: bench_arguments, bad_arguments, benchmark_surface, linear_law, self_path, peers_script, require_peers, &
-      options_refused, surface_for_peers, &
+      require_program, prepare_directory, guard_bench_files, options_refused, surface_for_peers, &
       json_value, read_text_file, write_peer_gaps, remove_file_quietly, peer_line, peer_row, row, segedin, &
       reset_peak, peak_mb, BENCH_LENGTH
 
@@ -155,11 +156,77 @@ contains
       character(len=*), intent(in) :: python, command
       integer, intent(inout) :: code
       if (len(python) == 0 .or. code /= 0) return
+      call require_program("--peers", python, command, code)
+      if (code /= 0) return
       if (len(peers_script()) > 0) return
       write(error_unit, '(a)') "femcod bench "//command//": --peers needs femcod_peers.py: app/femcod_peers.py "// &
          "of the source tree (run from its root) or the copy setup.sh installs in PREFIX/share/femcod; found neither"
       code = 2
    end subroutine require_peers
+
+   !> A program an option names (its first word, for a launcher with options) must be
+   !> there before any work: a path to an executable file, or a name on PATH (exit 2).
+   subroutine require_program(option, program, command, code)
+      character(len=*), intent(in) :: option, program, command
+      integer, intent(inout) :: code
+      character(len=:), allocatable :: first
+      integer :: blank, found, launched
+      if (code /= 0) return
+      first = trim(adjustl(program))
+      blank = index(first, " ")
+      if (blank > 0) first = first(1:blank - 1)
+      found = 1
+      if (len(first) > 0 .and. scan(first, "'") == 0) &
+         call execute_command_line("p=$(command -v '"//first//"' 2> /dev/null) && test -f ""$p"" && "// &
+            "test -x ""$p"" || exit 1", exitstat=found, cmdstat=launched)
+      if (found == 0) return
+      write(error_unit, '(a)') "femcod bench "//command//": "//option//" "//program//": no such program ("//first// &
+         " is not an executable file and not on PATH)"
+      code = 2
+   end subroutine require_program
+
+   !> The directory a bench writes into (`--dir`), made before any work: a name that is a
+   !> file is refused (exit 2), a directory that cannot be made is an I/O error (exit 5).
+   subroutine prepare_directory(dir, command, code)
+      character(len=*), intent(in) :: dir, command
+      integer, intent(inout) :: code
+      integer :: ios
+      logical :: is_dir
+      if (code /= 0) return
+      if (path_exists(dir)) then
+         call execute_command_line("test -d '"//dir//"'", exitstat=ios)
+         is_dir = ios == 0
+         if (.not. is_dir) then
+            write(error_unit, '(a)') "femcod bench "//command//": --dir "//dir//": exists and is not a directory"
+            code = 2
+         end if
+         return
+      end if
+      call execute_command_line("mkdir -p -- '"//dir//"' 2> /dev/null", exitstat=ios)
+      if (ios /= 0) then
+         write(error_unit, '(a)') "femcod bench "//command//": --dir "//dir//": cannot make the directory"
+         code = 5
+      end if
+   end subroutine prepare_directory
+
+   !> The files a bench is about to write (each of kind `kind`, OUTPUT_* of
+   !> femcod_output_guard) replace only what femcod wrote: a user's file of that name is
+   !> left as it is (exit 5), a directory of that name refused (exit 2). A bench reruns
+   !> over its own files without --force, as it always has.
+   subroutine guard_bench_files(names, kind, command, code)
+      type(string_type), intent(in) :: names(:)
+      integer, intent(in) :: kind
+      character(len=*), intent(in) :: command
+      integer, intent(inout) :: code
+      type(status_type) :: status
+      type(string_type), allocatable :: none(:)
+      if (code /= 0) return
+      allocate(none(0))
+      call guard_outputs(names, none, .true., kind, status)
+      if (status%code == 0) return
+      write(error_unit, '(a)') "femcod bench "//command//": "//status%message
+      code = status%code
+   end subroutine guard_bench_files
 
    !> The number after `"key": ` in the JSON text (its first occurrence; 0 when absent).
    real(dp) function json_value(t, key)

@@ -14,7 +14,9 @@ module femcod_bench_io
    use femcod_files, only: write_file
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
    use femcod_svg, only: svg_pressure_map
-   use femcod_bench_common, only: bench_arguments, benchmark_surface, linear_law, self_path, json_value, &
+   use femcod_output_guard, only: OUTPUT_DECK
+   use femcod_bench_common, only: prepare_directory, guard_bench_files, &
+      bench_arguments, benchmark_surface, linear_law, self_path, json_value, &
       read_text_file, BENCH_LENGTH
    implicit none
    private
@@ -35,6 +37,7 @@ contains
       integer, allocatable :: sizes(:)
       character(len=:), allocatable :: dir, deck_path, prefix, command, text, svg
       type(contact_problem) :: deck, back
+      type(string_type), allocatable :: decks(:)
       type(status_type) :: status
       type(parsed_options) :: parsed
       type(h5_file) :: file
@@ -64,7 +67,13 @@ contains
       end if
       call get_option(parsed, "--np", sizes)
       call get_option(parsed, "--dir", dir)
-      call execute_command_line("mkdir -p '"//dir//"'", exitstat=ios)
+      call prepare_directory(dir, "io", code)
+      allocate(decks(size(sizes)))
+      do n = 1, size(sizes)
+         decks(n)%s = dir//"/io_"//int_str(sizes(n))//".deck"
+      end do
+      call guard_bench_files(decks, OUTPUT_DECK, "io", code)
+      if (code /= 0) return
       write(output_unit, '(a)') "| NP | deck write s (values/s) | deck read s (values/s) | femcod run s | solver s "// &
          "| outside the solver s (% of solve, s/Mpixel) | read / digests / maps / h5 / text s | figure s "// &
          "| largest figure KB |"

@@ -10,8 +10,11 @@ module femcod_bench_mpi
    use femcod_options, only: option_spec, parsed_options, option_help, real_option, integer_option, text_option, &
       integer_list_option, get_option
    use femcod_clock, only: wall_clock
-   use femcod_hdf5, only: h5_file, h5_close, h5_create, h5_write
-   use femcod_bench_common, only: bench_arguments, benchmark_surface, linear_law, self_path, json_value, &
+   use femcod_hdf5, only: h5_file, h5_close, h5_create, h5_write, h5_attribute
+   use femcod_output_guard, only: OUTPUT_RESULT
+   use femcod_about, only: FEMCOD_VERSION
+   use femcod_bench_common, only: require_program, prepare_directory, guard_bench_files, &
+      bench_arguments, benchmark_surface, linear_law, self_path, json_value, &
       read_text_file, BENCH_LENGTH
    implicit none
    private
@@ -77,9 +80,9 @@ contains
       call get_option(parsed, "--latency", latency_us)
       allocate(measured(10, size(sizes)))
       measured = 0
-      if (is_root()) mpirun = mpirun//" --allow-run-as-root"
       cores = omp_get_num_procs()
-      call execute_command_line("mkdir -p '"//dir//"'", exitstat=ios)
+      call check_before_work(sizes, dir, mpirun, program, code)
+      if (code /= 0) return
       write(output_unit, '(a)') "| NP | run | ranks x threads | whole command s | solve s | transforms % | "// &
          "communication % | iterations | peak MB (largest rank) | contact % | approach vs serial |"
       write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|---|---|"
@@ -92,6 +95,7 @@ contains
          heights = dir//"/surface_"//int_str(np)//".h5"
          call h5_create(heights, file, status)
          call h5_write(file, "/heights", deck%lower, "nm", status)
+         call h5_attribute(file, "/", "femcod_version", FEMCOD_VERSION, status)
          call h5_close(file, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod bench mpi: "//status%message
@@ -168,12 +172,6 @@ contains
          call wall_clock(t1)
          seconds = t1 - t0
       end subroutine timed
-
-      logical function is_root()
-         integer :: stat
-         call execute_command_line('test "$(id -u)" -eq 0', exitstat=stat)
-         is_root = stat == 0
-      end function is_root
    end subroutine bench_mpi
 
    !> `femcod bench mpi --help`.
@@ -344,4 +342,32 @@ contains
       read(t(at:at + ends - 2), *, iostat=ios) values
       if (ios == 0) json_list_max = maxval(values)
    end function json_list_max
+   !> Before any work: the launcher and femcod-mpi exist (exit 2), the directory can be
+   !> made, and no height file it is about to write replaces one femcod did not write.
+   !> As root, the launcher gains --allow-run-as-root.
+   subroutine check_before_work(sizes, dir, mpirun, program, code)
+      integer, intent(in) :: sizes(:)
+      character(len=:), allocatable, intent(inout) :: mpirun
+      character(len=*), intent(in) :: dir, program
+      integer, intent(inout) :: code
+      type(string_type), allocatable :: surfaces(:)
+      integer :: n
+      call require_program("--mpirun", mpirun, "mpi", code)
+      call require_program("--femcod-mpi", program, "mpi", code)
+      call prepare_directory(dir, "mpi", code)
+      allocate(surfaces(size(sizes)))
+      do n = 1, size(sizes)
+         surfaces(n)%s = dir//"/surface_"//int_str(sizes(n))//".h5"
+      end do
+      call guard_bench_files(surfaces, OUTPUT_RESULT, "mpi", code)
+      if (is_root()) mpirun = mpirun//" --allow-run-as-root"
+   end subroutine check_before_work
+
+   !> True when this process runs as root (mpirun then needs --allow-run-as-root).
+   logical function is_root()
+      integer :: stat
+      call execute_command_line('test "$(id -u)" -eq 0', exitstat=stat)
+      is_root = stat == 0
+   end function is_root
+
 end module femcod_bench_mpi
