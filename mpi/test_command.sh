@@ -120,7 +120,8 @@ else echo "  FAILED   each rank's memory estimate against its measured peak"; fa
 # --shear-strength 0 --shear-slope 0.1: friction as serial too) on the 2 nm sphere. Each
 # combination answers (exit 0, as serial `femcod run --solver cg` does: loads, approaches
 # and plastic volumes to 1e-6, the same contact and plastic counts) or is refused (exit 2)
-# with no output and no lock; none ends in a runtime error. With --kernel-radius once more.
+# with no output and no lock; none ends in a runtime error. With --kernel-radius once more,
+# under load and under displacement control (the gap variables).
 # same_answer SERIAL.loads.csv MPI.loads.csv: two states each, loads, approaches and
 # plastic volumes to 1e-6 (relative, absolute below 1), the same contact and plastic counts.
 same_answer() {
@@ -173,6 +174,15 @@ for args in "--loads 300,800 --kernel-radius 6" "--loads 300,800 --kernel-radius
   if [ "$got" -eq 0 ] && cmp -s <(cut -d, -f3,8 "$m.loads.csv") <(cut -d, -f3,8 "$m.serial.loads.csv") && \
      python3 -c 'import csv,sys; a,b=[list(csv.DictReader(open(f))) for f in sys.argv[1:]]; assert len(a)==len(b)==2; assert all(abs(float(x["approach_nm"])-float(y["approach_nm"]))<=1e-6 for x,y in zip(a,b))' \
      "$m.serial.loads.csv" "$m.loads.csv"; then answered=$((answered + 1))
+  else echo "  FAILED   femcod-mpi $args: not the serial answer (exit $got)"; matrix_failed=1; fi
+done
+# The cut kernel in the gap variables (displacement control with the cap or a law).
+for args in "--approach 0.5,1 --kernel-radius 6 --plastic --hardness 11" \
+            "--approach 1,0.5 --kernel-radius 6 --adhesion exponential --work 0.05 --range 1"; do
+  combos=$((combos + 1)); m="$work/m$combos"
+  got=0; mpirun_2 "$femcod_mpi" "$matrix_deck" $args --tol 1e-10 --quiet -o "$m" >"$m.out" 2>&1 || got=$?
+  "$femcod" run "$matrix_deck" --solver cg $args --tol 1e-10 --quiet -o "$m.serial" >/dev/null 2>&1 || got=1
+  if [ "$got" -eq 0 ] && same_answer "$m.serial.loads.csv" "$m.loads.csv"; then answered=$((answered + 1))
   else echo "  FAILED   femcod-mpi $args: not the serial answer (exit $got)"; matrix_failed=1; fi
 done
 # --generate (the surface made on the ranks) with boundary x cap x question: the answer of

@@ -407,7 +407,7 @@ contains
    !> law in the summary file and /run, each approach's attractive pixels and mean gap
    !> in the summary file, and pull-off as a jump; what does not apply is refused with
    !> exit code 2 and writes nothing: --adhesion without --approach, with the incremental
-   !> solver, with --kernel-radius, without --range; --work without --adhesion.
+   !> solver, with the shear model, without --range; --work without --adhesion.
    subroutine test_run_adhesion(error)
       type(error_type), allocatable, intent(out) :: error
       type(string_type), allocatable :: base(:)
@@ -434,7 +434,7 @@ contains
          string_type("10")]
       cases(2)%extra = [string_type("--adhesion"), string_type("dugdale"), string_type("--work"), string_type("1"), &
          string_type("--range"), string_type("0.5"), string_type("--approach"), string_type("0.5")]
-      cases(3)%extra = [cases(1)%extra(1:8), string_type("--kernel-radius"), string_type("10"), &
+      cases(3)%extra = [cases(1)%extra(1:8), string_type("--shear-strength"), string_type("0.1"), &
          string_type("--approach"), string_type("0.5")]
       cases(4)%extra = [cases(1)%extra(1:6), string_type("--approach"), string_type("0.5")]
       cases(5)%extra = [string_type("--solver"), string_type("cg"), string_type("--work"), string_type("1"), &

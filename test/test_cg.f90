@@ -9,7 +9,7 @@ module test_cg
    use femcod_cli, only: run_femcod
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options, cg_settings, &
-      SOLVER_INCREMENTAL, SOLVER_CG, solver_name
+      SOLVER_INCREMENTAL, SOLVER_CG, LAW_DUGDALE, LAW_HARD_WALL, solver_name
    use femcod_solver, only: solve_contact
    use femcod_generate, only: VERIFICATION_DECKS, scene_spec, build_problem
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, &
@@ -20,7 +20,7 @@ module test_cg
    use femcod_scene, only: initial_gaps
    use femcod_random, only: random_stream, seed_stream, uniform
    use test_support, only: scratch_path, file_exists, remove_scratch, read_text
-   use oracles, only: grid_stiffness, love_quad, love_table, event_path, exact_state
+   use oracles, only: grid_stiffness, love_quad, love_table, event_path, exact_state, spring_compliance
    use, intrinsic :: iso_fortran_env, only: real128
    use femcod_analytic, only: hertz_approach, segedin_sphere
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
@@ -48,6 +48,8 @@ contains
             test_approach_cli), &
          new_unittest("--kernel-radius: beyond the grid bit for bit; truncated, the table's own direct sum", &
             test_kernel_radius), &
+         new_unittest("--kernel-radius in the gap variables (--approach): the cut table's dense solve", &
+            test_kernel_radius_gap_variables), &
          new_unittest("the gap maps it hands over equal a direct sum over the Love table", test_gap_maps), &
          new_unittest("--plastic: a hardness no pixel reaches gives the elastic answer bit for bit (both)", &
             test_plastic_inert), &
@@ -1015,6 +1017,97 @@ contains
       call check(error, abs(cut%states(1)%approach - whole%states(1)%approach) > 1.0e-3_dp*whole%states(1)%approach, &
          "a 5-pixel kernel changes the approach")
    end subroutine test_kernel_radius
+
+   !> The truncated kernel under displacement control, in the gap variables (the hard
+   !> wall: --adhesion dugdale --work 0; and --plastic --approach). Reference, independent
+   !> of femcod's tables and transforms: the oracles' quad-precision Love table cut at 5
+   !> pixels and a dense LU solve of the answer's contact set (oracles' exact_state) at the
+   !> answer's load, which must give back the prescribed approach (to 1e-8 nm at
+   !> --tol 1e-11: the solver's stopping rule bounds the gap error by tol times the
+   !> height range, 30 nm here) and the answer's forces; every gap of the cut table's
+   !> direct sum (with the contacts' springs, 3/k) is >= 0. The plastic path against the
+   !> fixed-load cg (force variables, the same cut) at the load it found: the same
+   !> approach to 1e-8 nm.
+   subroutine test_kernel_radius_gap_variables(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res, fixed
+      type(status_type) :: status
+      real(dp), allocatable :: table(:, :), forces(:), g0(:, :)
+      real(dp) :: approach, c, gap
+      integer :: np, i, j, k, info
+      call read_deck("input/sphere_d1.deck", deck, status)
+      np = deck%np
+      options%solver = SOLVER_CG
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-11_dp
+      options%cg%kernel_radius = 5
+      options%adhesion = LAW_DUGDALE
+      options%work = 0
+      options%range = 1
+      options%approaches = [0.3_dp]
+      call solve_contact(deck, options, res, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      allocate(table(0:np - 1, 0:np - 1))
+      table = love_table(np)
+      do j = 0, np - 1
+         do i = 0, np - 1
+            if (i*i + j*j > 25) table(i, j) = 0
+         end do
+      end do
+      associate(st => res%states(1))
+         call check(error, size(st%force) > 4, "a contact of several pixels: "//to_string(size(st%force)))
+         if (allocated(error)) return
+         allocate(forces(size(st%force)))
+         call exact_state(deck, table, st%i, st%j, st%load, forces, approach, info)
+         call check(error, info, 0, "the dense solve")
+         if (allocated(error)) return
+         call check(error, abs(approach - 0.3_dp) <= 1.0e-8_dp, "the dense solve's approach "//to_string(approach)// &
+            " at the answer's load "//to_string(st%load)//" nN, where 0.3 nm was prescribed")
+         if (allocated(error)) return
+         call check(error, maxval(abs(forces - st%force)) <= 1.0e-6_dp*maxval(st%force), "the forces against the "// &
+            "dense solve: "//to_string(maxval(abs(forces - st%force))))
+         if (allocated(error)) return
+         call check(error, all(st%force >= 0), "a negative force")
+         if (allocated(error)) return
+         ! Off the contact set, the cut table's direct sum leaves every gap open.
+         c = surface_compliance(deck%young(1), deck%poisson(1), deck%pixel) + &
+            surface_compliance(deck%young(2), deck%poisson(2), deck%pixel)
+         g0 = transpose(reshape(initial_gaps(deck%lower, deck%upper), [np, np]))
+         do j = 1, np
+            do i = 1, np
+               gap = g0(i, j) - 0.3_dp
+               do k = 1, size(st%force)
+                  gap = gap + c*table(abs(i - st%i(k)), abs(j - st%j(k)))*st%force(k)
+                  ! The contact's own springs: the two interface springs and the penalty (3/k).
+                  if (st%i(k) == i .and. st%j(k) == j) gap = gap + 3*spring_compliance(deck)*st%force(k)
+               end do
+               call check(error, gap >= -1.0e-8_dp, "pixel ("//to_string(i)//", "//to_string(j)//") penetrates: "// &
+                  to_string(gap)//" nm")
+               if (allocated(error)) return
+            end do
+         end do
+      end associate
+      ! The plastic cap by displacement control, cut the same way, against the fixed load.
+      options%adhesion = LAW_HARD_WALL
+      options%plastic = .true.
+      options%hardness = 11
+      options%approaches = [0.5_dp]
+      call solve_contact(deck, options, res, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, res%states(1)%n_plastic > 0, "the cap binds at 0.5 nm")
+      if (allocated(error)) return
+      options%loads = [res%states(1)%load]
+      deallocate(options%approaches)
+      call solve_contact(deck, options, fixed, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, abs(fixed%states(1)%approach - 0.5_dp) <= 1.0e-8_dp, "the fixed-load cg's approach "// &
+         to_string(fixed%states(1)%approach)//" at the load the gap variables found for 0.5 nm")
+   end subroutine test_kernel_radius_gap_variables
 
    subroutine test_usage(error)
       type(error_type), allocatable, intent(out) :: error

@@ -267,9 +267,6 @@ contains
             "gaps are sums of terms as large as the height range, each rounded to 1.1e-16 of it, so a relative "// &
             "violation below 10 machine epsilons ("//sig_str(tolerance_floor(), 2)//") cannot be shown; give "// &
             "--tol "//sig_str(tolerance_floor(), 2)//" or more")
-      else if (by_gap_variables(options) .and. options%cg%kernel_radius > 0) then
-         call refuse(trim(merge("--adhesion", "--plastic ", options%adhesion /= LAW_HARD_WALL))//" --approach with "// &
-            "--kernel-radius: displacement control in the gap variables uses the whole Love kernel")
       else if (options%plastic .and. options%solver /= SOLVER_CG .and. napproaches > 1) then
          if (any(options%approaches(2:) < options%approaches(:napproaches - 1))) call refuse("--approach with "// &
             "--plastic and --solver "//solver_name(options%solver)//": the event path only loads; give the approaches in "// &
