@@ -14,11 +14,9 @@
 !> 128 + the signal's number after SIGTERM, SIGINT or SIGUSR1 (no checkpoint: cg keeps none).
 program femcod_mpi
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use, intrinsic :: iso_c_binding, only: c_int
    use mpi_f08
    use omp_lib, only: omp_get_max_threads
-   use femcod_fftw_mpi, only: fftw_init_threads, fftw_plan_with_nthreads, fftw_mpi_init, fftwf_init_threads, &
-      fftwf_plan_with_nthreads, fftwf_mpi_init, fftw_mpi_cleanup
+   use femcod_fftw_mpi, only: start_distributed_fftw, stop_distributed_fftw
    use femcod_kinds, only: dp, i8
    use femcod_memory, only: physical_memory, memory_text, resident_bytes, memory_setting, MEMORY_VARIABLE
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED, STATUS_NUMERICAL
@@ -72,6 +70,7 @@ program femcod_mpi
    type(state_maps), allocatable :: figures(:)
    integer :: provided, rank, ranks, np, block, code, k, figure
    logical :: locked, slab_input, generating
+   character(len=:), allocatable :: fftw_message
    type(scene_spec) :: generated
 
    call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
@@ -79,12 +78,8 @@ program femcod_mpi
    call MPI_Comm_size(MPI_COMM_WORLD, ranks)
    call wall_clock(t_start)
    started = local_time_iso()
-   if (fftw_init_threads() == 0) call finish(STATUS_NUMERICAL, "FFTW's threads would not start")
-   call fftw_mpi_init()
-   if (fftwf_init_threads() == 0) call finish(STATUS_NUMERICAL, "FFTW's float32 threads would not start")
-   call fftwf_mpi_init()
-   call fftw_plan_with_nthreads(int(omp_get_max_threads(), c_int))
-   call fftwf_plan_with_nthreads(int(omp_get_max_threads(), c_int))
+   call start_distributed_fftw(omp_get_max_threads(), fftw_message)
+   if (len(fftw_message) > 0) call finish(STATUS_NUMERICAL, fftw_message)
    call catch_stop_signals()
    locked = .false.
 
@@ -430,7 +425,7 @@ contains
       character(len=*), intent(in) :: message
       if (rank == 0 .and. locked) call release_lock(prefix//".lock")
       if (rank == 0 .and. code /= 0 .and. message /= "") write(error_unit, '(a)') "femcod-mpi: "//message
-      call fftw_mpi_cleanup()
+      call stop_distributed_fftw()
       call MPI_Finalize()
       call exit_program(code)
    end subroutine finish
