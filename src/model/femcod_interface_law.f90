@@ -9,7 +9,8 @@
 !>   (`--plastic`, H the hardness in GPa, d the pixel in nm); fmax = huge: no cap.
 !> The event path (solvers/femcod_incremental) caps at the same fmax by its own exact
 !> yield events; the fixed-load rounds (femcod_cg's capped_solve) and the gap-variable
-!> iteration (femcod_gap_cg) read fmax from here.
+!> iteration (femcod_gap_cg) read fmax from here, and move their plastic set by the one
+!> rule written here (plastic_round), at most MAX_PLASTIC_ROUNDS times a solve.
 !>
 !> The law is an enumeration; its name is read once (law_from_name) at the edge.
 module femcod_interface_law
@@ -17,10 +18,12 @@ module femcod_interface_law
    implicit none
    private
    public :: interface_law, LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name, pixel_tension, &
-      make_interface_law
+      make_interface_law, MAX_PLASTIC_ROUNDS
 
    !> The laws (module header).
    integer, parameter :: LAW_HARD_WALL = 0, LAW_DUGDALE = 1, LAW_EXPONENTIAL = 2
+   !> Rounds of the plastic set per solve at most, in either cg path.
+   integer, parameter :: MAX_PLASTIC_ROUNDS = 200
 
    !> A law and its bounds for pixels of area `area` (nm^2).
    type :: interface_law
@@ -34,6 +37,8 @@ module femcod_interface_law
       procedure :: capped => law_capped
       !> True with an adhesive law (not the hard wall).
       procedure :: adhesive => law_adhesive
+      !> One round of the plastic set.
+      procedure :: plastic_round
    end type interface_law
 
 contains
@@ -91,6 +96,21 @@ contains
       class(interface_law), intent(in) :: law
       law_adhesive = law%law /= LAW_HARD_WALL
    end function law_adhesive
+
+   !> One round of the plastic set under the cap, the rule of both cg paths (the force
+   !> variables' capped_solve, the gap variables' rounds): a pixel not capped whose force
+   !> (nN) exceeds fmax joins the set, a capped pixel whose gap (nm) exceeds `opened` (nm)
+   !> leaves it. `capped` becomes the next round's set; `join` and `leave` say which
+   !> pixels moved (the caller asks its grid whether any did, over every rank).
+   pure subroutine plastic_round(law, force, gap, opened, capped, join, leave)
+      class(interface_law), intent(in) :: law
+      real(dp), intent(in) :: force(:, :), gap(:, :), opened
+      logical, intent(inout) :: capped(:, :)
+      logical, intent(out) :: join(:, :), leave(:, :)
+      join = .not. capped .and. force > law%fmax
+      leave = capped .and. gap > opened
+      capped = (capped .or. join) .and. .not. leave
+   end subroutine plastic_round
 
    !> The adhesive tension d^2 phi'(g) of one pixel (nN, positive: it pulls the surfaces
    !> together), and the curvature d^2 phi''(g) (nN/nm), at gap g >= 0 (nm).

@@ -77,7 +77,7 @@ module femcod_cg
       spread_load
    use femcod_constrained_cg, only: constrained_cg, cg_residuals
    use femcod_gap_cg, only: gap_session, gap_session_start, gap_target, gap_solver_storage_bytes
-   use femcod_interface_law, only: interface_law, make_interface_law
+   use femcod_interface_law, only: interface_law, make_interface_law, MAX_PLASTIC_ROUNDS
    use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts
    use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings, by_gap_variables, &
       requested_states, run_shear_model, &
@@ -653,14 +653,14 @@ contains
       class(solver_observer), intent(inout) :: observer
       !> The gap that takes a capped pixel out of the elastic problem (it never touches).
       real(dp), parameter :: EXCLUDED = 1.0e30_dp
-      integer, parameter :: MAX_ROUNDS = 200
       real(dp), allocatable :: force(:, :), w(:, :), gap(:, :)
       logical, allocatable :: grow(:, :), release(:, :)
       real(dp) :: left, total(2)
       integer :: round, ncap
       associate(p => session%p, capped => session%capped, g0 => session%g0, fmax => session%law%fmax)
-      allocate(force(size(p, 1), size(p, 2)), w(size(p, 1), size(p, 2)))
-      do round = 1, MAX_ROUNDS
+      allocate(force(size(p, 1), size(p, 2)), w(size(p, 1), size(p, 2)), grow(size(p, 1), size(p, 2)), &
+         release(size(p, 1), size(p, 2)))
+      do round = 1, MAX_PLASTIC_ROUNDS
          total = [real(count(capped), dp), sum(p)]
          call grid%sum_over_grid(total)
          ncap = nint(total(1))
@@ -686,19 +686,17 @@ contains
          force = merge(fmax, p, capped)
          call grid%displace(force, w)
          gap = g0 - session%approach + w + grid%s*force
-         grow = .not. capped .and. p > fmax
-         release = capped .and. gap > how%tol*grid%scale
+         call session%law%plastic_round(p, gap, how%tol*grid%scale, capped, grow, release)
          if (.not. grid%any_over_grid(any(grow) .or. any(release))) exit
          ! A released pixel starts from the force it had.
          where (release) p = fmax
-         capped = (capped .or. grow) .and. .not. release
       end do
       grid%g0 = g0
-      answer%plastic_rounds = min(round, MAX_ROUNDS)
+      answer%plastic_rounds = min(round, MAX_PLASTIC_ROUNDS)
       if (status%code /= 0) return
-      if (round > MAX_ROUNDS) then
+      if (round > MAX_PLASTIC_ROUNDS) then
          call set_error(status, STATUS_NUMERICAL, "cg --plastic: the plastic set did not settle in "// &
-            int_str(MAX_ROUNDS)//" rounds at load "//format_real(load)//" nN")
+            int_str(MAX_PLASTIC_ROUNDS)//" rounds at load "//format_real(load)//" nN")
          return
       end if
       p = merge(fmax, p, capped)

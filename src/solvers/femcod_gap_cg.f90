@@ -57,15 +57,13 @@ module femcod_gap_cg
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_elastic_operator, only: elastic_operator, SPECTRUM_COMPLIANCE, SPECTRUM_STIFFNESS
-   use femcod_interface_law, only: interface_law, pixel_tension
+   use femcod_interface_law, only: interface_law, pixel_tension, MAX_PLASTIC_ROUNDS
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str, format_real
    implicit none
    private
    public :: gap_session, gap_session_start, gap_target, pixel_stiffness_ratio, gap_solver_storage_bytes
 
-   !> Rounds of the capped set per solve at most.
-   integer, parameter :: MAX_ROUNDS = 200
    !> Substeps between two approaches at most (each at most half the range otherwise).
    integer, parameter :: MAX_SUBSTEPS = 1000
 
@@ -201,7 +199,7 @@ contains
    !> capped_solve: the capped pixels carry fmax whatever their gap (a constant gradient,
    !> unbounded: below 0 they interpenetrate), the others are solved as above; then the
    !> contacts above fmax join the set and the capped pixels whose gap opened leave it,
-   !> until neither happens (at most MAX_ROUNDS).
+   !> until neither happens (law%plastic_round; at most MAX_PLASTIC_ROUNDS, else exit 4).
    subroutine gap_cg(op, law, g0, a, tol, max_iterations, x, g, force, cap, iterations, residual, status, observer)
       class(elastic_operator), intent(inout) :: op
       type(interface_law), intent(in) :: law
@@ -225,7 +223,12 @@ contains
          call gradient(op, law, g, cap, it)
          call free_set(op, g, cap, it, residual)
          if (residual <= tol .and. law%capped()) then
-            if (next_round(op, law, g, cap, it)) cycle
+            if (next_round(op, law, g, cap, it)) then
+               if (it%round <= MAX_PLASTIC_ROUNDS) cycle
+               call set_error(status, STATUS_NUMERICAL, "cg --plastic: the plastic set did not settle in "// &
+                  int_str(MAX_PLASTIC_ROUNDS)//" rounds at the approach "//format_real(a)//" nm")
+               return
+            end if
          end if
          if (residual <= tol .or. iterations >= max_iterations) exit
          if (op%any_over_grid(observer%stop_requested())) then
@@ -374,9 +377,9 @@ contains
       residual = worst(1)*(op%c*op%self + op%s)/it%scale
    end subroutine free_set
 
-   !> A round of the capped set ends: pixels in contact above the cap join it, capped
-   !> pixels whose gap opened leave it. True (and the directions restarted) when either
-   !> happened and the rounds are not used up.
+   !> A round of the capped set ends (law%plastic_round): pixels in contact above the cap
+   !> join it, capped pixels whose gap opened leave it. True (the round counted and the
+   !> directions restarted) when either happened on any rank.
    logical function next_round(op, law, g, cap, it) result(again)
       class(elastic_operator), intent(inout) :: op
       type(interface_law), intent(in) :: law
@@ -384,12 +387,14 @@ contains
       logical, intent(inout) :: cap(:, :)
       type(gap_iteration), intent(inout) :: it
       logical, allocatable :: join(:, :), leave(:, :)
-      join = .not. cap .and. g == 0 .and. it%kx(1:op%np, 1:op%nj) + it%mu > law%fmax
-      leave = cap .and. g > 0
-      again = op%any_over_grid(any(join) .or. any(leave)) .and. it%round < MAX_ROUNDS
+      allocate(join(op%np, op%nj), leave(op%np, op%nj))
+      ! A pixel's force: K x + mu on the contacts; off them the adhesive tension (or 0),
+      ! never above the cap.
+      call law%plastic_round(merge(it%kx(1:op%np, 1:op%nj) + it%mu, 0.0_dp, g == 0), g, 0.0_dp, cap, join, &
+         leave)
+      again = op%any_over_grid(any(join) .or. any(leave))
       if (.not. again) return
       it%round = it%round + 1
-      cap = (cap .or. join) .and. .not. leave
       it%d = 0
       it%rz_old = 0
    end function next_round
