@@ -10,6 +10,7 @@ module stability_cases
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, build_problem, verification_spec
    use femcod_contact_result, only: contact_result
+   use test_support, only: pivot_loss_of, missed_final_check_of
    use femcod_solver_options, only: contact_options, solver_from_name
    use femcod_solver, only: solve_contact
    use femcod_condensed, only: solve_active_set
@@ -85,7 +86,7 @@ contains
          if (status%code /= 0) return
          rows(k)%legacy = (res%states(1)%approach - reference)/reference
          rows(k)%legacy_roundoff = abs(res%states(1)%approach - inc)/inc
-         rows(k)%pivot_loss = res%pivot_loss
+         rows(k)%pivot_loss = pivot_loss_of(res)
          rows(k)%condition = legacy_condition(deck, res)
       end do
    end subroutine stiffness_sweep
@@ -311,7 +312,7 @@ contains
       deck%lower(7, 11) = deck%lower(7, 11) + 1000
       call solve(deck, solver, [real(dp) ::], res, status, max_contacts=3)
       if (status%code /= 0) return
-      missed = res%missed_final_check
+      missed = missed_final_check_of(res)
       np = deck%np
       ! The closed form with the oracles' coefficients and gaps (test/oracles).
       allocate(table(0:np - 1, 0:np - 1))

@@ -8,7 +8,7 @@ module test_adhesion
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
    use femcod_problem, only: contact_problem
-   use femcod_contact_result, only: contact_result
+   use femcod_contact_result, only: contact_result, cg_iterations_in_all
    use femcod_solver_options, only: contact_options, &
       SOLVER_INCREMENTAL, SOLVER_CG, BOUNDARY_FREE, BOUNDARY_PERIODIC, LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, boundary_name
    use femcod_solver, only: solve_contact
@@ -65,7 +65,7 @@ contains
       options%approaches = [1.0_dp, approaches]
       call solve_contact(paraboloid_problem(np, pixel, radius, young), options, res, status)
       pmin = minval(res%states%load)/(pi*work*radius)
-      iterations = sum(res%states%iterations)
+      iterations = cg_iterations_in_all(res)
    end subroutine sphere_pull_off
 
    !> DMT limit: lambda = 0.1, R = 100 nm, d = 1 nm. The least load over an unloading

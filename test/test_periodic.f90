@@ -21,7 +21,7 @@ module test_periodic
    use femcod_scene, only: initial_gaps
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_read_string_attribute
    use femcod_status, only: STATUS_BAD_INPUT, STATUS_USAGE
-   use test_support, only: scratch_path, read_text, file_exists, remove_scratch
+   use test_support, only: scratch_path, read_text, file_exists, remove_scratch, missed_final_check_of
    use test_incremental, only: events
    use oracles, only: event_path
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
@@ -458,7 +458,7 @@ contains
       call solve_contact(problem, options, cg, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
-      call check(error, inc%missed_final_check, 0, "the event path's final check found penetrating pixels")
+      call check(error, missed_final_check_of(inc), 0, "the event path's final check found penetrating pixels")
       if (allocated(error)) return
       do k = 1, m
          call check(error, cg%states(k)%contacts, inc%states(k)%contacts, "contacts at "//to_string(loads(k))//" nN")

@@ -1,8 +1,13 @@
-!> Helpers shared by the test suites: scratch files and text checks.
+!> Helpers shared by the test suites: scratch files and text checks, and the solvers'
+!> diagnostics read from a result (femcod_contact_result's accessors, one number each).
 module test_support
+   use femcod_kinds, only: dp
+   use femcod_contact_result, only: contact_result, event_path_diagnostics, legacy_diagnostics, event_checks, &
+      legacy_checks
    implicit none
    private
    public :: write_text, read_text, scratch_path, contains_text, remove_scratch, file_exists
+   public :: pivot_loss_of, condition_of, missed_final_check_of, fft_steps_of
 
    character(len=*), parameter :: scratch_dir = "build/test-scratch"
 
@@ -61,4 +66,35 @@ contains
       character(len=*), intent(in) :: text, part
       contains_text = index(text, part) > 0
    end function contains_text
+   !> The legacy solver's largest TRFACT pivot loss (1 for another solver).
+   real(dp) function pivot_loss_of(res) result(r)
+      type(contact_result), intent(in) :: res
+      type(legacy_diagnostics) :: checks
+      checks = legacy_checks(res)
+      r = checks%pivot_loss
+   end function pivot_loss_of
+
+   !> The legacy solver's largest condition estimate (0 for another solver).
+   real(dp) function condition_of(res) result(r)
+      type(contact_result), intent(in) :: res
+      type(legacy_diagnostics) :: checks
+      checks = legacy_checks(res)
+      r = checks%condition
+   end function condition_of
+
+   !> The event path's penetrating pixels found by its final check.
+   integer function missed_final_check_of(res) result(n)
+      type(contact_result), intent(in) :: res
+      type(event_path_diagnostics) :: checks
+      checks = event_checks(res)
+      n = checks%missed_final_check
+   end function missed_final_check_of
+
+   !> The event path's steps searched by the full-field FFT.
+   integer function fft_steps_of(res) result(n)
+      type(contact_result), intent(in) :: res
+      type(event_path_diagnostics) :: checks
+      checks = event_checks(res)
+      n = checks%fft_steps
+   end function fft_steps_of
 end module test_support

@@ -7,7 +7,7 @@ module femcod_bench_cg
    use femcod_status, only: status_type
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec
-   use femcod_contact_result, only: contact_result
+   use femcod_contact_result, only: contact_result, cg_state_diagnostics, cg_work
    use femcod_solver_options, only: contact_options, &
       SOLVER_CG
    use femcod_solver, only: solve_contact
@@ -39,6 +39,7 @@ contains
       type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: res
+      type(cg_state_diagnostics) :: work
       type(parsed_options) :: parsed
       real(dp) :: tol, estar, slope, pressure, load, length, peak
       integer :: i, n, k, np
@@ -133,11 +134,12 @@ contains
                status = status_type()
                cycle
             end if
+            work = cg_work(res, 1)
             write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | "// &
-               fixed_str(res%wall_seconds, 2)//" | "//int_str(res%states(1)%iterations)//" (+"// &
-               int_str(res%states(1)%coarse_iterations)//" coarse, "//int_str(res%states(1)%convolutions)// &
-               " fresh, "//int_str(res%states(1)%split_corrections)//" split) | "// &
-               real_str(res%states(1)%residual, 2)//" | "// &
+               fixed_str(res%wall_seconds, 2)//" | "//int_str(work%iterations)//" (+"// &
+               int_str(work%coarse_iterations)//" coarse, "//int_str(work%convolutions)// &
+               " fresh, "//int_str(work%split_corrections)//" split) | "// &
+               real_str(work%residual, 2)//" | "// &
                fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)//" | "//fixed_str(peak, 0)//" | converged |"
             flush(output_unit)
             if (len(python) == 0) cycle

@@ -6,7 +6,7 @@ module femcod_bench_periodic
    use femcod_status, only: status_type
    use femcod_problem, only: contact_problem
    use femcod_generate, only: RIGID_FACTOR
-   use femcod_contact_result, only: contact_result
+   use femcod_contact_result, only: contact_result, cg_state_diagnostics, cg_work, cg_iterations_in_all
    use femcod_solver_options, only: contact_options, cg_settings, &
       SOLVER_CG, BOUNDARY_PERIODIC, boundary_from_name
    use femcod_solver, only: solve_contact
@@ -170,7 +170,7 @@ contains
                end if
                write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | "// &
                   trim(boundaries(b))//" | "//fixed_str(res%wall_seconds, 2)//" | "// &
-                  int_str(res%states(1)%iterations)//" (+"//int_str(res%states(1)%coarse_iterations)//" coarse) | "// &
+                  int_str(cg_iterations_in_all(res))//" (+"//int_str(first_state_coarse(res))//" coarse) | "// &
                   fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 3)//" | "// &
                   real_str(sum(res%states(1)%gap)/real(np, dp)**2, 7)//" | "//fixed_str(peak, 0)//" |"
                flush(output_unit)
@@ -232,4 +232,12 @@ contains
          text = "-"
       end if
    end function order_text
+   !> The cg solver's iterations on the coarser grids at the first state.
+   integer function first_state_coarse(res) result(n)
+      type(contact_result), intent(in) :: res
+      type(cg_state_diagnostics) :: work
+      work = cg_work(res, 1)
+      n = work%coarse_iterations
+   end function first_state_coarse
+
 end module femcod_bench_periodic

@@ -498,14 +498,14 @@ contains
       do s = 1, size(states)
          associate(st => states(s))
             text = text//'{"load_nN": '//json_number(st%load)//', "approach_nm": '//json_number(st%approach)
-            if (st%approach_bound >= 0) text = text//', "approach_error_bound_nm": '//json_number(st%approach_bound)
+            if (st%cg%approach_bound >= 0) text = text//', "approach_error_bound_nm": '//json_number(st%cg%approach_bound)
             text = text//', "contacts": '//int_str(st%contacts)//', "area_fraction": '// &
                json_number(real(st%contacts, dp)/real(np, dp)**2)//', "max_pressure_GPa": '// &
                json_number(st%max_pressure)//', "n_above_hardness": '//int_str(st%above_hardness)// &
                ', "n_plastic": '//int_str(st%n_plastic)//', "plastic_volume_nm3": '// &
-               json_number(st%plastic_volume)//', "iterations": '//int_str(st%iterations)// &
-               ', "coarse_iterations": '//int_str(st%coarse_iterations)//', "convolutions": '// &
-               int_str(st%convolutions)//', "residual": '//json_number(st%residual)//', "time_s": '// &
+               json_number(st%plastic_volume)//', "iterations": '//int_str(st%cg%iterations)// &
+               ', "coarse_iterations": '//int_str(st%cg%coarse_iterations)//', "convolutions": '// &
+               int_str(st%cg%convolutions)//', "residual": '//json_number(st%cg%residual)//', "time_s": '// &
                json_number(st%seconds)//', "transform_s": '//json_number(st%transform_seconds)// &
                ', "communication_s": '//json_number(st%communication_seconds)
             if (settings%solve%adhesion /= LAW_HARD_WALL) text = text//', "attractive_pixels": '//int_str(st%attractive)// &
@@ -530,7 +530,7 @@ contains
       do s = 1, size(states)
          associate(st => states(s))
             bound_note = ""
-            if (st%approach_bound >= 0) bound_note = " (+- "//sig_str(st%approach_bound, 2)//" nm)"
+            if (st%cg%approach_bound >= 0) bound_note = " (+- "//sig_str(st%cg%approach_bound, 2)//" nm)"
             plastic_note = ""
             if (settings%solve%plastic) plastic_note = ", "//int_str(st%n_plastic)//" at the hardness"
             if (settings%solve%shear) plastic_note = plastic_note//", friction "//sig_str(st%friction, 6)// &
@@ -539,9 +539,9 @@ contains
                " nm"//bound_note//", "//int_str(st%contacts)//" contacts ("// &
                sig_str(100*real(st%contacts, dp)/real(np, dp)**2, 4)//" % of the area), max pressure "// &
                sig_str(st%max_pressure, 4)//" GPa"//plastic_note
-            write(output_unit, '(a)') "    "//int_str(st%iterations)//" iterations (+ "//int_str(st%coarse_iterations)// &
-               " on coarser grids), "//int_str(st%convolutions)//" fresh convolutions, residual "// &
-               sig_str(st%residual, 2)//", "//sig_str(st%seconds, 3)//" s (rank 0: transforms "// &
+            write(output_unit, '(a)') "    "//int_str(st%cg%iterations)//" iterations (+ "//int_str(st%cg%coarse_iterations)// &
+               " on coarser grids), "//int_str(st%cg%convolutions)//" fresh convolutions, residual "// &
+               sig_str(st%cg%residual, 2)//", "//sig_str(st%seconds, 3)//" s (rank 0: transforms "// &
                sig_str(st%transform_seconds, 3)//" s, communication "//sig_str(st%communication_seconds, 3)//" s)"
          end associate
       end do

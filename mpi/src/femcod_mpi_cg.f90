@@ -54,6 +54,7 @@ module femcod_mpi_cg
       ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
    use femcod_shear_model, only: shear_model, friction_force
+   use femcod_contact_result, only: cg_state_diagnostics
    use femcod_mpi_gap_transform, only: distributed_gap_transform, gap_transform_setup, gap_transform_apply, &
       gap_transform_free
    use femcod_observer, only: solver_observer
@@ -121,19 +122,20 @@ module femcod_mpi_cg
 
    !> What the solver reached at one load (the same quantities as femcod_cg's residuals).
    type :: distributed_state
-      real(dp) :: load = 0, approach = 0, residual = 0, penetration = 0, contact_gap = 0, load_error = 0
+      real(dp) :: load = 0, approach = 0
       real(dp) :: max_pressure = 0, seconds = 0
-      !> The approach's error bound (nm, femcod_cg's approach_error_bound) where the solver
-      !> has one (fixed loads, the full kernel, no cap); -1 elsewhere.
-      real(dp) :: approach_bound = -1
-      !> With --plastic: the capped pixels (all ranks), the plastic volume (nm^3), the
-      !> plastic rounds; this rank's columns of the plastic displacement (nm).
-      integer :: n_plastic = 0, plastic_rounds = 0
+      !> The cg iteration's work at this state, as on one core (femcod_contact_result):
+      !> iterations, residuals, the approach's error bound where there is one (fixed
+      !> loads, the full kernel, no cap; -1 elsewhere), the plastic rounds.
+      type(cg_state_diagnostics) :: cg
+      !> With --plastic: the capped pixels (all ranks), the plastic volume (nm^3); this
+      !> rank's columns of the plastic displacement (nm).
+      integer :: n_plastic = 0
       real(dp) :: plastic_volume = 0
       real(dp), allocatable :: plastic(:, :)
       !> Of `seconds`: in the transforms and in communication (distributed_grid).
       real(dp) :: transform_seconds = 0, communication_seconds = 0
-      integer :: contacts = 0, iterations = 0, coarse_iterations = 0, convolutions = 0, split_corrections = 0
+      integer :: contacts = 0
       !> Pixels whose pressure is above the hardness given to solve_loads (all ranks).
       integer :: above_hardness = 0
       !> This rank's columns: contact forces (nN) and gaps (nm, 0 at the contacts).
@@ -799,8 +801,9 @@ contains
          call solve_target(grid, problem, session, targets(k), approaches, how, answer, status, observer)
          if (status%code /= 0) return
          call record_state(grid, session, answer, cap, friction_model, states(k))
-         if (.not. (approaches .or. capped .or. grid%periodic .or. how%kernel_radius > 0)) states(k)%approach_bound = &
-            approach_error_bound(states(k)%penetration, states(k)%contact_gap, states(k)%load_error, states(k)%approach)
+         if (.not. (approaches .or. capped .or. grid%periodic .or. how%kernel_radius > 0)) states(k)%cg%approach_bound = &
+            approach_error_bound(states(k)%cg%penetration, states(k)%cg%contact_gap, states(k)%cg%load_error, &
+            states(k)%approach)
          call wall_clock(t1)
          associate(st => states(k))
             if (by_gaps .and. kk > 1) then
@@ -811,9 +814,9 @@ contains
             st%transform_seconds = grid%transform_seconds - transform0
             st%communication_seconds = grid%communication_seconds - communication0
             call observer%progress(kk, st%contacts, st%load, t1 - t0)
-            if (st%residual > how%tol) then
+            if (st%cg%residual > how%tol) then
                call set_error(status, STATUS_NUMERICAL, unconverged_message(approaches, by_gaps, targets(k), &
-                  st%residual, st%iterations, how%tol))
+                  st%cg%residual, st%cg%iterations, how%tol))
                return
             end if
          end associate
@@ -852,15 +855,15 @@ contains
       logical, allocatable :: contact(:, :)
       st%load = answer%load
       st%approach = answer%approach
-      st%iterations = answer%rep%iterations
-      st%coarse_iterations = answer%rep%coarse_iterations
-      st%convolutions = answer%rep%convolutions
-      st%split_corrections = answer%rep%split_corrections
-      st%residual = answer%rep%residual
-      st%penetration = answer%rep%penetration
-      st%contact_gap = answer%rep%contact_gap
-      st%load_error = answer%rep%load_error
-      st%plastic_rounds = answer%plastic_rounds
+      st%cg%iterations = answer%rep%iterations
+      st%cg%coarse_iterations = answer%rep%coarse_iterations
+      st%cg%convolutions = answer%rep%convolutions
+      st%cg%split_corrections = answer%rep%split_corrections
+      st%cg%residual = answer%rep%residual
+      st%cg%penetration = answer%rep%penetration
+      st%cg%contact_gap = answer%rep%contact_gap
+      st%cg%load_error = answer%rep%load_error
+      st%cg%plastic_rounds = answer%plastic_rounds
       st%attractive = answer%attractive
       st%attractive_load = answer%attractive_load
       st%mean_gap = answer%mean_gap

@@ -22,7 +22,7 @@ module femcod_run
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, height_file_path, is_height_file, looks_like_height_matrix
-   use femcod_contact_result, only: contact_result, load_state, stop_reason_text
+   use femcod_contact_result, only: contact_result, load_state, stop_reason_text, cg_state_diagnostics, cg_work
    use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options, &
       SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, solver_name, boundary_name, law_name, &
       solver_from_name, boundary_from_name, law_from_name, run_shear_model
@@ -934,6 +934,7 @@ contains
       type(contact_options), intent(in) :: options
       type(contact_result), intent(in) :: res
       type(report_line), allocatable :: lines(:)
+      type(cg_state_diagnostics) :: work
       integer :: k, last
       last = res%nsteps
       if (deck_path /= "") then
@@ -959,8 +960,9 @@ contains
       end if
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
+         work = cg_work(res, k)
          write(output_unit, '(a)') "  at load   : "//sig_str(res%states(k)%load, 6)//" nN: approach "// &
-            sig_str(res%states(k)%approach, 6)//" nm"//trim(bound_text(res%states(k)%approach_bound))//", "// &
+            sig_str(res%states(k)%approach, 6)//" nm"//trim(bound_text(work%approach_bound))//", "// &
             int_str(res%states(k)%contacts)//" contacts ("// &
             sig_str(res%states(k)%contacts*problem%pixel**2, 4)//" nm^2), max pressure "// &
             sig_str(res%states(k)%max_pressure, 4)//" GPa"

@@ -16,7 +16,8 @@ module femcod_results
    use femcod_strings, only: string_type, int_str, text_builder, add_line, built_text, format_real, xml_escape, sig_str, &
       json_string, json_number, format_reals, integer_text
    use femcod_files, only: atomic_rename, remove_file, temporary_name, path_exists, write_bytes
-   use femcod_contact_result, only: contact_result, load_state, stop_reason_text
+   use femcod_contact_result, only: contact_result, load_state, stop_reason_text, event_path_diagnostics, &
+      legacy_diagnostics, cg_diagnostics, cg_state_diagnostics, event_checks, legacy_checks, cg_work
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
       h5_read_string_attribute, h5_flat_view
    use femcod_maps, only: state_maps
@@ -360,6 +361,7 @@ contains
       type(status_type) :: local
       character(len=:), allocatable :: g, scene
       real(dp) :: area_pixel, region, exponent, prefactor
+      type(cg_state_diagnostics) :: work
       integer :: k, n
       if (status%code /= 0) return
       n = res%nsteps
@@ -418,12 +420,13 @@ contains
             call h5_attribute(file, g, "n_plastic", s%n_plastic, local)
             call h5_attribute(file, g, "plastic_volume_nm3", s%plastic_volume, local)
             if (info%solver == "cg") then
-               call h5_attribute(file, g, "cg_iterations", s%iterations, local)
-               call h5_attribute(file, g, "cg_residual", s%residual, local)
-               call h5_attribute(file, g, "cg_penetration_nm", s%penetration, local)
-               call h5_attribute(file, g, "cg_contact_gap_nm", s%contact_gap, local)
-               call h5_attribute(file, g, "cg_load_error", s%load_error, local)
-               call h5_attribute(file, g, "approach_error_bound_nm", s%approach_bound, local)
+               work = cg_work(res, k)
+               call h5_attribute(file, g, "cg_iterations", work%iterations, local)
+               call h5_attribute(file, g, "cg_residual", work%residual, local)
+               call h5_attribute(file, g, "cg_penetration_nm", work%penetration, local)
+               call h5_attribute(file, g, "cg_contact_gap_nm", work%contact_gap, local)
+               call h5_attribute(file, g, "cg_load_error", work%load_error, local)
+               call h5_attribute(file, g, "approach_error_bound_nm", work%approach_bound, local)
             end if
             if (info%tangential) call write_tangential(file, g, deck, s, local)
             if (info%friction) then
@@ -478,15 +481,7 @@ contains
       if (allocated(info%inputs)) call h5_attribute(file, "/run", "inputs", joined(info%inputs), local)
       if (allocated(info%digests)) call h5_attribute(file, "/run", "input_sha256", joined(info%digests), local)
       if (allocated(info%fingerprint)) call h5_attribute(file, "/run", "fingerprint", info%fingerprint, local)
-      call h5_write(file, "/run/missed_during_run", res%missed_during_run, "1", local)
-      call h5_write(file, "/run/missed_final_check", res%missed_final_check, "1", local)
-      call h5_write(file, "/run/max_penetration", res%max_penetration, "nm", local)
-      call h5_write(file, "/run/final_resolve_difference", res%final_check_difference, "1", local)
-      call h5_write(file, "/run/releases", res%releases, "1", local)
-      call h5_write(file, "/run/fft_search_steps", res%fft_steps, "1", local)
-      call h5_write(file, "/run/trfact_pivot_loss", res%pivot_loss, "1", local)
-      call h5_write(file, "/run/trfact_condition", res%condition, "1", local)
-      call h5_write(file, "/run/exact_evaluations", real(res%evaluations, dp), "1", local)
+      call write_run_checks(file, res, local)
       call area_fit(deck, res, exponent, prefactor)
       call h5_write(file, "/run/area_load_exponent", exponent, "1", local)
       call h5_write(file, "/run/area_load_prefactor", prefactor, "nm^2/nN^exponent", local)
@@ -716,7 +711,10 @@ contains
       character(len=1), parameter :: nl = new_line("a")
       character(len=:), allocatable :: loads
       real(dp) :: area_pixel, exponent, prefactor
+      type(event_path_diagnostics) :: checks
+      type(cg_state_diagnostics) :: work
       integer :: k, last
+      checks = event_checks(res)
       area_pixel = deck%pixel**2
       last = res%nsteps
       loads = ""
@@ -730,8 +728,9 @@ contains
                ', "n_above_hardness": '//int_str(s%n_above_hardness)//', "n_plastic": '// &
                int_str(s%n_plastic)//', "plastic_volume_nm3": '//json_number(s%plastic_volume)//', "hdf5_group": '// &
                json_string(load_group(k, size(res%states)))
-            if (s%reached .and. s%approach_bound >= 0) loads = loads//', "approach_error_bound_nm": '// &
-               json_number(s%approach_bound)
+            work = cg_work(res, k)
+            if (s%reached .and. work%approach_bound >= 0) loads = loads//', "approach_error_bound_nm": '// &
+               json_number(work%approach_bound)
             if (s%reached .and. info%tangential) loads = loads//', "tangential_force_nN": '// &
                json_number(s%tangential_force(1))//', "tangential_shift_nm": '//json_number(s%tangential_shift(1))// &
                ', "stick_contacts": '//int_str(stick_count(s))//', "stick_area_nm2": '// &
@@ -777,32 +776,34 @@ contains
          ', "write_text_and_figures": '//json_number(write_seconds(2))//'},'//nl// &
          '  "memory_bytes": {"estimated_peak": '//int_str(res%estimated_peak_bytes)//', "peak": '// &
          int_str(peak_resident_bytes())//'},'//nl// &
-         '  "checks": {"penetrating_pixels_at_end": '//int_str(res%missed_final_check)// &
-         ', "deepest_penetration_nm": '//json_number(res%max_penetration)//', "found_late": '// &
-         int_str(res%missed_during_run)//', "releases": '//int_str(res%releases)// &
-         ', "exact_resolve_difference": '//json_number(res%final_check_difference)//'},'//nl// &
+         '  "checks": {"penetrating_pixels_at_end": '//int_str(checks%missed_final_check)// &
+         ', "deepest_penetration_nm": '//json_number(checks%max_penetration)//', "found_late": '// &
+         int_str(checks%missed_during_run)//', "releases": '//int_str(checks%releases)// &
+         ', "exact_resolve_difference": '//json_number(checks%final_check_difference)//'},'//nl// &
          '  "solver_details": '//solver_details()//nl//'}'//nl
    contains
-      !> What each solver counts of its own work.
+      !> What each solver counts of its own work: the type of diagnostics it returned.
       function solver_details() result(d)
          character(len=:), allocatable :: d
          integer :: m
-         select case (info%solver)
-         case ("incremental")
-            d = '{"exact_pixel_evaluations": '//int_str(res%evaluations)//', "fft_search_steps": '// &
-               int_str(res%fft_steps)//', "cache_hits": '//int_str(res%cache_hits)//', "cache_misses": '// &
-               int_str(res%cache_misses)//', "cache_refills": '//int_str(res%cache_refills)//'}'
-         case ("legacy")
-            d = '{"trfact_condition": '//json_number(res%condition)//', "trfact_pivot_loss": '// &
-               json_number(res%pivot_loss)//'}'
-         case default
+         d = '{}'
+         if (.not. allocated(res%diagnostics)) return
+         select type (diag => res%diagnostics)
+         type is (event_path_diagnostics)
+            d = '{"exact_pixel_evaluations": '//int_str(diag%evaluations)//', "fft_search_steps": '// &
+               int_str(diag%fft_steps)//', "cache_hits": '//int_str(diag%cache_hits)//', "cache_misses": '// &
+               int_str(diag%cache_misses)//', "cache_refills": '//int_str(diag%cache_refills)//'}'
+         type is (legacy_diagnostics)
+            d = '{"trfact_condition": '//json_number(diag%condition)//', "trfact_pivot_loss": '// &
+               json_number(diag%pivot_loss)//'}'
+         type is (cg_diagnostics)
             d = '{"cg": ['
             do m = 1, size(res%states)
                d = d//'{"load_nN": '//json_number(res%states(m)%load)//', "iterations": '// &
-                  int_str(res%states(m)%iterations)//', "residual": '//json_number(res%states(m)%residual)// &
-                  ', "penetration_nm": '//json_number(res%states(m)%penetration)//', "contact_gap_nm": '// &
-                  json_number(res%states(m)%contact_gap)//', "load_error": '//json_number(res%states(m)%load_error)// &
-                  '}'//trim(merge(", ", "  ", m < size(res%states)))
+                  int_str(diag%states(m)%iterations)//', "residual": '//json_number(diag%states(m)%residual)// &
+                  ', "penetration_nm": '//json_number(diag%states(m)%penetration)//', "contact_gap_nm": '// &
+                  json_number(diag%states(m)%contact_gap)//', "load_error": '// &
+                  json_number(diag%states(m)%load_error)//'}'//trim(merge(", ", "  ", m < size(res%states)))
             end do
             d = d//']}'
          end select
@@ -815,6 +816,28 @@ contains
          if (allocated(t)) r = t
       end function text_or_empty
    end function summary_json
+
+   !> /run's datasets of the solver's checks: the event path's (zeros for cg) and the
+   !> legacy solver's conditioning (its defaults, pivot loss 1 and condition 0, for the
+   !> others), the same datasets for every solver.
+   subroutine write_run_checks(file, res, local)
+      type(h5_file), intent(inout) :: file
+      type(contact_result), intent(in) :: res
+      type(status_type), intent(inout) :: local
+      type(event_path_diagnostics) :: checks
+      type(legacy_diagnostics) :: legacy
+      checks = event_checks(res)
+      legacy = legacy_checks(res)
+      call h5_write(file, "/run/missed_during_run", checks%missed_during_run, "1", local)
+      call h5_write(file, "/run/missed_final_check", checks%missed_final_check, "1", local)
+      call h5_write(file, "/run/max_penetration", checks%max_penetration, "nm", local)
+      call h5_write(file, "/run/final_resolve_difference", checks%final_check_difference, "1", local)
+      call h5_write(file, "/run/releases", checks%releases, "1", local)
+      call h5_write(file, "/run/fft_search_steps", checks%fft_steps, "1", local)
+      call h5_write(file, "/run/trfact_pivot_loss", legacy%pivot_loss, "1", local)
+      call h5_write(file, "/run/trfact_condition", legacy%condition, "1", local)
+      call h5_write(file, "/run/exact_evaluations", real(checks%evaluations, dp), "1", local)
+   end subroutine write_run_checks
 
    !> The file name without its directory.
    function base_name(path) result(name)

@@ -40,7 +40,7 @@ module femcod_legacy
    use femcod_trfact, only: trfact, trfact_condition, TRFACT_FACTOR, TRFACT_SOLVE
    use femcod_postp, only: candidate_count, postp_search, in_contact_at
    use femcod_condensed, only: solve_active_set, gap_at
-   use femcod_contact_result, only: contact_result, STOP_MAXCONT, STOP_NO_CONTACT, finish_contacts
+   use femcod_contact_result, only: contact_result, STOP_MAXCONT, STOP_NO_CONTACT, finish_contacts, legacy_diagnostics
    use femcod_solver_options, only: contact_options
    use femcod_observer, only: solver_observer
    use femcod_event_path, only: load_path, first_touch_limit, NO_EVENT
@@ -88,6 +88,8 @@ contains
       integer, allocatable :: joiners(:), joiner_ranks(:), cstep(:), ic(:), jc(:)
       real(dp) :: csum, delta, lambda, tstart, t0, t1, loss, kappa, limit
       integer :: np, npix, n, step, ncand, njoin, nmissed, k, reason
+      !> What the run found and how well its systems were conditioned (res%diagnostics).
+      type(legacy_diagnostics) :: checks
 
       call wall_clock(tstart)
       np = problem%np
@@ -136,8 +138,8 @@ contains
             step = step + 1
             call wall_clock(t0)
             call legacy_unit_solution(ws, n, table, mat, problem%pixel, delta, status, loss, kappa)
-            res%pivot_loss = max(res%pivot_loss, loss)
-            res%condition = max(res%condition, kappa)
+            checks%pivot_loss = max(checks%pivot_loss, loss)
+            checks%condition = max(checks%condition, kappa)
             if (status%code /= 0) return
             ncand = candidate_count(n, npix)
             call postp_search(np, order, ncand, situ, ws%ia(at%cont:at%cont + n - 1), g0, table, csum, &
@@ -149,7 +151,7 @@ contains
                   ws%ra(at%force:at%force + n - 1), path%approach, ws%ra(at%work:at%work + n - 1), delta, path%total, &
                   options%tie_tolerance, lambda, joiners, joiner_ranks, njoin, nmissed)
             end if
-            res%missed_during_run = res%missed_during_run + nmissed
+            checks%missed_during_run = checks%missed_during_run + nmissed
             if (njoin == 0) lambda = NO_EVENT
             call contact_rows_cols(ws, n, ic, jc)
             reason = path%close_step(res, lambda, delta, ws%ra(at%force:at%force + n - 1), ws%ra(at%work:at%work + n - 1), &
@@ -172,7 +174,8 @@ contains
          end do
 
          if (options%final_check) call final_check(ws, at, n, cstep, step, table, csum, mat, problem, options, &
-            path, res, status)
+            path, res, checks, status)
+         allocate(res%diagnostics, source=checks)
          if (status%code /= 0) return
          call contact_rows_cols(ws, n, ic, jc)
          call finish_contacts(res, ic, jc, cstep(1:n), ws%ra(at%force:at%force + n - 1), path%total)
@@ -208,7 +211,7 @@ contains
    !> is then negative is a missed contact: it is added and the state at the final load
    !> recomputed exactly. Without missed contacts, the exact solve measures the drift of
    !> the step accumulation.
-   subroutine final_check(ws, at, n, cstep, step, table, csum, mat, problem, options, path, res, status)
+   subroutine final_check(ws, at, n, cstep, step, table, csum, mat, problem, options, path, res, checks, status)
       type(workspace_type), intent(inout) :: ws
       type(legacy_pointers), intent(in) :: at
       integer, intent(inout) :: n, cstep(:)
@@ -219,6 +222,7 @@ contains
       type(contact_options), intent(in) :: options
       type(load_path), intent(inout) :: path
       type(contact_result), intent(inout) :: res
+      type(legacy_diagnostics), intent(inout) :: checks
       type(status_type), intent(inout) :: status
       real(dp), allocatable :: fex(:), g0c(:)
       real(dp) :: aex, scale
@@ -227,7 +231,7 @@ contains
       npix = problem%np**2
       call missed_contacts(ws, at, n, table, csum, problem%np, options%tie_tolerance, path%approach, extra, &
          extra_rank, nextra)
-      res%missed_final_check = nextra
+      checks%missed_final_check = nextra
       if (nextra > 0 .and. path%room_for(n, nextra)) then
          ! In pixel order, as the search over all pixels finds them.
          allocate(byp(nextra))
@@ -247,7 +251,7 @@ contains
       if (status%code /= 0) return
       associate(ftot => ws%ra(at%force:at%force + n - 1))
          scale = max(maxval(abs(fex)), tiny(1.0_dp))
-         res%final_check_difference = max(abs(aex - path%approach)/max(abs(aex), tiny(1.0_dp)), &
+         checks%final_check_difference = max(abs(aex - path%approach)/max(abs(aex), tiny(1.0_dp)), &
             maxval(abs(fex - ftot))/scale)
          if (nextra > 0) then
             ftot = fex

@@ -1,5 +1,9 @@
 !> What a contact solver returns: the step history, the states at requested loads,
-!> the contact pixels with their forces, and what was checked.
+!> the contact pixels with their forces (the common result, the same for every solver),
+!> and each solver's own account of its work and checks, a type that extends
+!> solver_diagnostics: event_path_diagnostics (incremental), legacy_diagnostics (the
+!> Appendix B program: the event path's checks and TRFACT's conditioning) and
+!> cg_diagnostics (per state: iterations, residuals, the approach's error bound).
 module femcod_contact_result
    use femcod_kinds, only: dp, i8
    use femcod_state_visitor, only: state_visitor
@@ -8,6 +12,8 @@ module femcod_contact_result
    implicit none
    private
    public :: contact_result, load_state, append_step, visit_result, record_approach_states
+   public :: solver_diagnostics, event_path_diagnostics, legacy_diagnostics, cg_diagnostics, cg_state_diagnostics, &
+      event_checks, legacy_checks, cg_work, visit_event_checks, cg_iterations_in_all, largest_cg_residual
    public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text, record_load_states, finish_contacts, &
       gather_contacts
 
@@ -19,10 +25,9 @@ module femcod_contact_result
       integer :: contacts = 0
       real(dp) :: max_pressure = 0
       integer :: n_above_hardness = 0
-      !> With the plastic cap (--plastic): the pixels at the hardness, the rounds of the
-      !> plastic set the cg solver took, and the plastic volume (nm^3): the sum of the
-      !> capped pixels' interpenetrations times d^2.
-      integer :: n_plastic = 0, plastic_rounds = 0
+      !> With the plastic cap (--plastic): the pixels at the hardness, and the plastic
+      !> volume (nm^3): the sum of the capped pixels' interpenetrations times d^2.
+      integer :: n_plastic = 0
       real(dp) :: plastic_volume = 0
       !> With adhesion (--adhesion): the pixels off contact within the law's range
       !> (0 < gap < R: the attractive area), the load off contact (nN, negative: the
@@ -46,18 +51,6 @@ module femcod_contact_result
       integer :: tangential_iterations = 0
       real(dp) :: tangential_residual = 0
       logical :: reached = .false.
-      !> Fixed-load solver only: iterations, relative complementarity residual, deepest
-      !> penetration (nm), largest |gap| on contact (nm), relative load error.
-      integer :: iterations = 0
-      real(dp) :: residual = 0, penetration = 0, contact_gap = 0, load_error = 0
-      !> Fixed-load solver at a given load (elastic, full kernel, not periodic): the
-      !> approach is within approach_bound (nm) of the exact answer of the discrete
-      !> problem (femcod_cg's approach_error_bound); -1 where the solver has no bound.
-      real(dp) :: approach_bound = -1
-      !> Fixed-load solver only: iterations on all coarser grids together, fresh
-      !> convolutions of the forces on the finest grid, and corrections there by the
-      !> kernel split instead of a fresh convolution.
-      integer :: coarse_iterations = 0, convolutions = 0, split_corrections = 0
       !> The contact pixels (row, column) and their forces (nN) at this load.
       integer, allocatable :: i(:), j(:)
       real(dp), allocatable :: force(:)
@@ -69,6 +62,66 @@ module femcod_contact_result
       !> interpenetration of the capped pixels, 0 elsewhere).
       real(dp), allocatable :: plastic(:, :)
    end type load_state
+
+   !> What a solver reports of its own work beyond the common result; each solver's
+   !> type extends it, and contact_result holds the one its solver made.
+   type, abstract :: solver_diagnostics
+   end type solver_diagnostics
+
+   !> The event-exact path (incremental solver): what its candidate search found and
+   !> what the final checks over all pixels found.
+   type, extends(solver_diagnostics) :: event_path_diagnostics
+      !> Contacts found late by the candidate search (joined with a penetration), and by
+      !> the final check over all pixels.
+      integer :: missed_during_run = 0, missed_final_check = 0
+      !> Contacts released (force reached zero) during the run.
+      integer :: releases = 0
+      !> Exact pixel evaluations made by the candidate search.
+      integer(i8) :: evaluations = 0
+      !> Contacts whose bordering columns came from the candidate cache, contacts that
+      !> needed their own triangular solves, cache refills and the columns they made.
+      integer :: cache_hits = 0, cache_misses = 0, cache_refills = 0, cache_columns = 0
+      !> Steps whose event search used the full-field FFT.
+      integer :: fft_steps = 0
+      !> Largest relative difference between the accumulated state and an exact
+      !> active-set solve at the end (a consistency check of the step accumulation).
+      real(dp) :: final_check_difference = 0
+      !> Deepest penetration of any pixel not in contact at the end (nm, >= 0), from the
+      !> full-field check.
+      real(dp) :: max_penetration = 0
+   end type event_path_diagnostics
+
+   !> The Appendix B program (legacy solver): the event path's checks, and its skyline
+   !> system's conditioning.
+   type, extends(event_path_diagnostics) :: legacy_diagnostics
+      !> The largest TRFACT pivot loss of the run (about log10 of it digits lost to
+      !> cancellation).
+      real(dp) :: pivot_loss = 1
+      !> The largest 1-norm condition estimate of its skyline system (TRFACT + LAPACK
+      !> dlacn2).
+      real(dp) :: condition = 0
+   end type legacy_diagnostics
+
+   !> The cg solver's work at one state.
+   type :: cg_state_diagnostics
+      !> Iterations, relative complementarity residual, deepest penetration (nm), largest
+      !> |gap| on contact (nm), relative load error.
+      integer :: iterations = 0
+      real(dp) :: residual = 0, penetration = 0, contact_gap = 0, load_error = 0
+      !> At a given load (elastic, full kernel, not periodic): the approach is within
+      !> approach_bound (nm) of the exact answer of the discrete problem (femcod_cg's
+      !> approach_error_bound); -1 where there is no bound.
+      real(dp) :: approach_bound = -1
+      !> Iterations on all coarser grids together, fresh convolutions of the forces on
+      !> the finest grid, and corrections there by the kernel split instead of a fresh
+      !> convolution; with the plastic cap, the rounds of the plastic set.
+      integer :: coarse_iterations = 0, convolutions = 0, split_corrections = 0, plastic_rounds = 0
+   end type cg_state_diagnostics
+
+   !> The cg solver: its work at each requested state (in the order of the states).
+   type, extends(solver_diagnostics) :: cg_diagnostics
+      type(cg_state_diagnostics), allocatable :: states(:)
+   end type cg_diagnostics
 
    !> Results of a run. Units: nN, nm, GPa. What continues a run (the history, the
    !> states reached, the counters) is listed once in `visit_result` for checkpoints.
@@ -91,36 +144,14 @@ module femcod_contact_result
       !> Load at which `contact_force` is reported.
       real(dp) :: reported_load = 0
       integer :: stop_reason = 0
-      !> Contacts found late by the candidate search (joined with a penetration),
-      !> and by the final check over all pixels.
-      integer :: missed_during_run = 0, missed_final_check = 0
-      !> Contacts released (force reached zero) during the run.
-      integer :: releases = 0
-      !> Exact pixel evaluations made by the candidate search (incremental solver).
-      integer(i8) :: evaluations = 0
-      !> Incremental solver: contacts whose bordering columns came from the candidate
-      !> cache, contacts that needed their own triangular solves, and cache refills.
-      integer :: cache_hits = 0, cache_misses = 0, cache_refills = 0, cache_columns = 0
-      !> Incremental solver: steps whose event search used the full-field FFT.
-      integer :: fft_steps = 0
-      !> Largest relative difference between the accumulated state and an exact
-      !> active-set solve at the end (a consistency check of the step accumulation).
-      real(dp) :: final_check_difference = 0
-      !> Deepest penetration of any pixel not in contact at the end (nm, >= 0), from the
-      !> full-field check.
-      real(dp) :: max_penetration = 0
-      !> Legacy solver: the largest TRFACT pivot loss of the run (about log10 of it digits
-      !> lost to cancellation; 1 for the incremental solver, which has no springs in its
-      !> matrix).
-      real(dp) :: pivot_loss = 1
-      !> Legacy solver: the largest 1-norm condition estimate of its skyline system
-      !> (TRFACT + LAPACK dlacn2); 0 for the incremental solver.
-      real(dp) :: condition = 0
       real(dp) :: wall_seconds = 0
       !> The memory the run was estimated to need at its largest (bytes: what the process
       !> held when the solver began and the solver's storage model; 0 where the solver has
       !> none), checked against the machine's before the solve.
       integer(i8) :: estimated_peak_bytes = 0
+      !> The solver's own account (a type extending solver_diagnostics); read it with
+      !> event_checks, legacy_checks and cg_work.
+      class(solver_diagnostics), allocatable :: diagnostics
    end type contact_result
 
 contains
@@ -158,6 +189,14 @@ contains
             call visitor%real_array("force", s%force)
          end associate
       end do
+   end subroutine visit_result
+
+   !> The event path's counters that continue with its run (after visit_result's fields,
+   !> in the checkpoint's group "counters"); the final checks belong to the run that
+   !> finishes.
+   subroutine visit_event_checks(self, visitor)
+      type(event_path_diagnostics), intent(inout) :: self
+      class(state_visitor), intent(inout) :: visitor
       call visitor%group("counters")
       call visitor%integer_value("missed_during_run", self%missed_during_run)
       call visitor%integer_value("releases", self%releases)
@@ -167,7 +206,70 @@ contains
       call visitor%integer_value("cache_refills", self%cache_refills)
       call visitor%integer_value("cache_columns", self%cache_columns)
       call visitor%integer_value("fft_steps", self%fft_steps)
-   end subroutine visit_result
+   end subroutine visit_event_checks
+
+   !> The event path's checks of a result (legacy's included); zeros for another solver.
+   pure function event_checks(res) result(checks)
+      type(contact_result), intent(in) :: res
+      type(event_path_diagnostics) :: checks
+      if (.not. allocated(res%diagnostics)) return
+      select type (d => res%diagnostics)
+      type is (event_path_diagnostics)
+         checks = d
+      type is (legacy_diagnostics)
+         checks = d%event_path_diagnostics
+      end select
+   end function event_checks
+
+   !> The legacy solver's account; its defaults (pivot loss 1, condition 0) for another.
+   pure function legacy_checks(res) result(checks)
+      type(contact_result), intent(in) :: res
+      type(legacy_diagnostics) :: checks
+      if (.not. allocated(res%diagnostics)) return
+      select type (d => res%diagnostics)
+      type is (legacy_diagnostics)
+         checks = d
+      end select
+   end function legacy_checks
+
+   !> The cg solver's work at state k; the defaults (0 iterations, no bound) for another
+   !> solver or a state it did not reach.
+   pure function cg_work(res, k) result(work)
+      type(contact_result), intent(in) :: res
+      integer, intent(in) :: k
+      type(cg_state_diagnostics) :: work
+      if (.not. allocated(res%diagnostics)) return
+      select type (d => res%diagnostics)
+      type is (cg_diagnostics)
+         if (allocated(d%states)) then
+            if (k >= 1 .and. k <= size(d%states)) work = d%states(k)
+         end if
+      end select
+   end function cg_work
+
+   !> The cg solver's iterations over all its states (0 for another solver).
+   pure integer function cg_iterations_in_all(res) result(n)
+      type(contact_result), intent(in) :: res
+      integer :: k
+      n = 0
+      do k = 1, size(res%states)
+         associate(work => cg_work(res, k))
+            n = n + work%iterations
+         end associate
+      end do
+   end function cg_iterations_in_all
+
+   !> The cg solver's largest residual over its states (0 for another solver).
+   pure real(dp) function largest_cg_residual(res) result(r)
+      type(contact_result), intent(in) :: res
+      integer :: k
+      r = 0
+      do k = 1, size(res%states)
+         associate(work => cg_work(res, k))
+            r = max(r, work%residual)
+         end associate
+      end do
+   end function largest_cg_residual
 
    !> Room for at least `m` history rows: 64 at first, doubled as needed (amortised O(1)
    !> per appended row).

@@ -78,7 +78,8 @@ module femcod_cg
    use femcod_constrained_cg, only: constrained_cg, cg_residuals
    use femcod_gap_cg, only: gap_session, gap_session_start, gap_target, gap_solver_storage_bytes
    use femcod_interface_law, only: interface_law, make_interface_law, MAX_PLASTIC_ROUNDS
-   use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts
+   use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts, &
+      cg_diagnostics, cg_state_diagnostics
    use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings, by_gap_variables, &
       requested_states, run_shear_model, &
       BOUNDARY_PERIODIC
@@ -193,6 +194,8 @@ contains
       !> Told of every load solved (progress).
       class(solver_observer), intent(inout) :: observer
       type(cg_residuals), allocatable :: report(:)
+      !> The solver's work at each state (res%diagnostics).
+      type(cg_diagnostics) :: work
       type(grid_operator) :: fine
       type(cg_session) :: session
       type(cg_answer) :: answer
@@ -212,7 +215,7 @@ contains
          targets = options%loads
       end if
       m = size(targets)
-      allocate(report(m), res%states(m))
+      allocate(report(m), res%states(m), work%states(m))
       if (by_approach) then
          res%states%approach = targets
          res%states%load = 0
@@ -248,7 +251,8 @@ contains
          if (status%code /= 0) exit
          call wall_clock(t1)
          report(k) = answer%rep
-         call record_answer(res, res%states(k), session, answer, options, by_approach, problem%pixel, t1 - t0)
+         call record_answer(res, res%states(k), work%states(k), session, answer, options, by_approach, problem%pixel, &
+            t1 - t0)
          if (kk > 1 .and. by_gaps) call mark_jump(res%states(order(kk - 1))%contacts, res%states(k))
          call observer%progress(kk, res%states(k)%contacts, res%states(k)%load, t1 - tstart)
          if ((by_gaps .and. kk == m) .or. (.not. by_gaps .and. targets(k) == maxval(targets))) then
@@ -262,6 +266,7 @@ contains
          end if
       end do
       call grid_operator_free(fine)
+      allocate(res%diagnostics, source=work)
       res%stop_reason = STOP_LOADS
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
@@ -318,9 +323,10 @@ contains
 
    !> One target's state from its answer and the session's forces (nN), on the whole grid
    !> of pixel `pixel` (nm); `seconds` its solve's wall time.
-   subroutine record_answer(res, st, session, answer, options, by_approach, pixel, seconds)
+   subroutine record_answer(res, st, work, session, answer, options, by_approach, pixel, seconds)
       type(contact_result), intent(inout) :: res
       type(load_state), intent(inout) :: st
+      type(cg_state_diagnostics), intent(inout) :: work
       type(cg_session), intent(in) :: session
       type(cg_answer), intent(inout) :: answer
       type(contact_options), intent(in) :: options
@@ -336,18 +342,18 @@ contains
          st%load = answer%load
          st%reached = .true.
          st%approach = answer%approach
-         st%iterations = answer%rep%iterations
-         st%residual = answer%rep%residual
-         st%penetration = answer%rep%penetration
-         st%contact_gap = answer%rep%contact_gap
-         st%load_error = answer%rep%load_error
+         work%iterations = answer%rep%iterations
+         work%residual = answer%rep%residual
+         work%penetration = answer%rep%penetration
+         work%contact_gap = answer%rep%contact_gap
+         work%load_error = answer%rep%load_error
          if (.not. (by_approach .or. options%plastic .or. &
-            options%boundary == BOUNDARY_PERIODIC .or. options%cg%kernel_radius > 0)) st%approach_bound = &
-            approach_error_bound(st%penetration, st%contact_gap, st%load_error, st%approach)
-         st%coarse_iterations = answer%rep%coarse_iterations
-         st%convolutions = answer%rep%convolutions
-         st%split_corrections = answer%rep%split_corrections
-         st%plastic_rounds = answer%plastic_rounds
+            options%boundary == BOUNDARY_PERIODIC .or. options%cg%kernel_radius > 0)) work%approach_bound = &
+            approach_error_bound(work%penetration, work%contact_gap, work%load_error, st%approach)
+         work%coarse_iterations = answer%rep%coarse_iterations
+         work%convolutions = answer%rep%convolutions
+         work%split_corrections = answer%rep%split_corrections
+         work%plastic_rounds = answer%plastic_rounds
          if (allocated(answer%gap)) call move_alloc(answer%gap, st%gap)
          if (allocated(answer%plastic)) call move_alloc(answer%plastic, st%plastic)
          st%contacts = count(contact)

@@ -94,7 +94,7 @@ contains
          search%used_fft = choose_fft(state, options)
          if (search%used_fft) then
             call fft_search(search, state, options)
-            state%res%fft_steps = state%res%fft_steps + 1
+            state%checks%fft_steps = state%checks%fft_steps + 1
          else
             do
                tie = options%tie_tolerance*(total + max(search%lam_best, 0.0_dp))
@@ -136,7 +136,7 @@ contains
             call merge_sort_index(real(search%joiners(1:search%njoin), dp), order)
             search%joiners(1:search%njoin) = search%joiners(order)
          end if
-         state%res%missed_during_run = state%res%missed_during_run + &
+         state%checks%missed_during_run = state%checks%missed_during_run + &
             count(search%gap_eval(1:search%neval) < -options%tie_tolerance*state%path%approach)
          ! The plastic events of this step: every one within the tie tolerance of lam_best.
          search%ncap = 0
@@ -196,7 +196,7 @@ contains
             max(search%lam_best, 0.0_dp)*state%open_max
          if (reach < 0) cycle
          call state%evaluate(state%plastic_pix(q), gap, rate)
-         state%res%evaluations = state%res%evaluations + 1
+         state%checks%evaluations = state%checks%evaluations + 1
          state%plastic_key(q) = min(gap, 0.0_dp) - state%psi
          if (rate < 0) then
             search%lam_open(q) = min(gap, 0.0_dp)/rate
@@ -214,7 +214,7 @@ contains
       integer, intent(in) :: pixel
       real(dp) :: gp, rp
       call state%evaluate(pixel, gp, rp)
-      state%res%evaluations = state%res%evaluations + 1
+      state%checks%evaluations = state%checks%evaluations + 1
       search%neval = search%neval + 1
       associate(q => search%neval)
          search%eval_pix(q) = pixel

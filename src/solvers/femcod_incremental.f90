@@ -245,6 +245,7 @@ contains
       end associate
       if (state%fmax > 0) call plastic_displacements(state)
       res = state%res
+      allocate(res%diagnostics, source=state%checks)
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
    end subroutine finish_events
@@ -312,7 +313,7 @@ contains
       call convolution_apply(conv, field, disp)
       call convolution_free(conv)
       worst = 0
-      state%res%missed_final_check = 0
+      state%checks%missed_final_check = 0
       ! Round-off allowance: the tie tolerance of the approach plus the FFT's round-off
       ! on the height scale.
       allowance = options%tie_tolerance*max(state%path%approach, tiny(1.0_dp)) + 1.0e-12_dp*maxval(abs(state%g0))
@@ -321,10 +322,10 @@ contains
          iq = (qq - 1)/np + 1
          jq = qq - (iq - 1)*np
          gq = state%g0(qq) - state%path%approach + state%c*disp(iq, jq)
-         if (gq < -allowance) state%res%missed_final_check = state%res%missed_final_check + 1
+         if (gq < -allowance) state%checks%missed_final_check = state%checks%missed_final_check + 1
          worst = min(worst, gq)
       end do
-      state%res%max_penetration = max(0.0_dp, -worst)
+      state%checks%max_penetration = max(0.0_dp, -worst)
       ! F = A M^-1 1 - M^-1 g0_C, A from 1'F = P (O(n^2)).
       associate(n => state%n, u => state%u, ld => state%ld)
          w = state%g0(state%pix(1:n))
@@ -334,7 +335,7 @@ contains
          call dtrsv("U", "N", "N", n, u, ld, state%x, 1)
          aex = (state%path%total - state%nplastic*state%fmax + sum(w))/sum(state%x(1:n))
          fex = aex*state%x(1:n) - w
-         state%res%final_check_difference = max(abs(aex - state%path%approach)/max(abs(aex), tiny(1.0_dp)), &
+         state%checks%final_check_difference = max(abs(aex - state%path%approach)/max(abs(aex), tiny(1.0_dp)), &
             maxval(abs(fex - state%ftot(1:n)))/max(maxval(abs(fex)), tiny(1.0_dp)))
       end associate
    end subroutine final_check

@@ -34,7 +34,7 @@ module femcod_incremental_state
    use femcod_state_visitor, only: state_visitor, visitable
    use femcod_solver_options, only: contact_options, &
       BOUNDARY_PERIODIC
-   use femcod_contact_result, only: contact_result, visit_result
+   use femcod_contact_result, only: contact_result, visit_result, event_path_diagnostics, visit_event_checks
    use femcod_event_path, only: load_path
    use femcod_interface_law, only: interface_law, make_interface_law
    implicit none
@@ -99,6 +99,8 @@ module femcod_incremental_state
       integer :: last_neval = 0
       !> The results so far.
       type(contact_result) :: res
+      !> What the event path found and counted (the result's diagnostics at the end).
+      type(event_path_diagnostics) :: checks
    contains
       procedure :: init
       procedure :: visit
@@ -219,6 +221,7 @@ contains
       call visitor%real_prefix("heap_key", self%heap%key, self%heap%size)
       call visitor%integer_prefix("heap_item", self%heap%item, self%heap%size)
       call visit_result(self%res, visitor)
+      call visit_event_checks(self%checks, visitor)
       if (self%fmax > 0) then
          ! The plastic set (runs without the cap store nothing more, as before it).
          call visitor%group("plastic")
@@ -352,7 +355,7 @@ contains
             wq(1:n) = self%wc(1:n, sq)
             self%cslot(pixel) = 0
             self%cpix(sq) = 0
-            self%res%cache_hits = self%res%cache_hits + 1
+            self%checks%cache_hits = self%checks%cache_hits + 1
          else
             ! l = U^-T m and w = U^-1 l = M^-1 m by two triangular solves.
             do kk = 1, n
@@ -361,7 +364,7 @@ contains
             if (n > 0) call dtrsv("U", "T", "N", n, u, self%ld, col, 1)
             wq(1:n) = col(1:n)
             if (n > 0) call dtrsv("U", "N", "N", n, u, self%ld, wq, 1)
-            self%res%cache_misses = self%res%cache_misses + 1
+            self%checks%cache_misses = self%checks%cache_misses + 1
          end if
          d2 = self%self - sum(col(1:n)**2)
          if (.not. d2 > epsilon(1.0_dp)*self%self) then
@@ -435,7 +438,7 @@ contains
       self%slot(self%pix(krm)) = 0
       call heap_push(self%heap, self%phi, self%pix(krm))
       call remove_contact(self, krm, status)
-      self%res%releases = self%res%releases + 1
+      self%checks%releases = self%checks%releases + 1
    end subroutine release_contact
 
    !> Contact k has reached the cap fmax = H d^2: it leaves the elastic set (the factor
@@ -625,8 +628,8 @@ contains
          do b = 1, nfresh
             self%wc(1:n, self%cslot(fresh(b))) = block(:, b)
          end do
-         self%res%cache_refills = self%res%cache_refills + 1
-         self%res%cache_columns = self%res%cache_columns + nfresh
+         self%checks%cache_refills = self%checks%cache_refills + 1
+         self%checks%cache_columns = self%checks%cache_columns + nfresh
       end associate
    end subroutine refill_cache
 end module femcod_incremental_state

@@ -10,7 +10,8 @@ module femcod_solver
    use femcod_problem, only: contact_problem
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
-   use femcod_contact_result, only: contact_result
+   use femcod_contact_result, only: contact_result, load_state, cg_diagnostics, cg_state_diagnostics, &
+      event_path_diagnostics, legacy_diagnostics
    use femcod_solver_options, only: contact_options, validate_options, by_gap_variables, run_shear_model, &
       refuse_beyond_memory, &
       SOLVER_INCREMENTAL, SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, law_name
@@ -258,18 +259,18 @@ contains
    end function solver_notes
 
    !> What the solver did and checked, for the summary: the model notes, then the
-   !> solver's own lines, labelled.
+   !> solver's own lines, labelled, from the diagnostics it returned (its own type).
    function report_lines(problem, options, res) result(lines)
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       type(contact_result), intent(in) :: res
       type(report_line), allocatable :: lines(:)
       type(string_type), allocatable :: model(:)
-      character(len=:), allocatable :: rounds
       integer :: k
       allocate(lines(0))
-      select case (options%solver)
-      case (SOLVER_CG)
+      if (.not. allocated(res%diagnostics)) return
+      select type (d => res%diagnostics)
+      type is (cg_diagnostics)
          model = model_notes(problem, options)
          do k = 1, size(model)
             call add("model", model(k)%s)
@@ -279,21 +280,9 @@ contains
                "every load one elastic solve, with no plastic bookkeeping")
          end if
          do k = 1, size(res%states)
-            if (by_gap_variables(options)) then
-               call add("cg", "approach "//sig_str(res%states(k)%approach, 6)//" nm: "// &
-                  int_str(res%states(k)%iterations)//" iterations, residual "//sig_str(res%states(k)%residual, 2)// &
-                  " (force balance, as a gap over the height range)")
-               cycle
-            end if
-            rounds = ""
-            if (options%plastic) rounds = ", in "//int_str(res%states(k)%plastic_rounds)//" round"// &
-               trim(merge("s", " ", res%states(k)%plastic_rounds /= 1))//" of the plastic set"
-            call add("cg", "load "//sig_str(res%states(k)%load, 6)//" nN: "// &
-               int_str(res%states(k)%iterations)//" iterations, residual "//sig_str(res%states(k)%residual, 2)// &
-               ", penetration "//sig_str(res%states(k)%penetration, 2)//" nm, |gap| on contact "// &
-               sig_str(res%states(k)%contact_gap, 2)//" nm, load error "//sig_str(res%states(k)%load_error, 2)//rounds)
+            call add("cg", cg_line(res%states(k), d%states(k)))
          end do
-      case (SOLVER_INCREMENTAL)
+      type is (event_path_diagnostics)
          model = model_notes(problem, options)
          do k = 1, size(model)
             call add("model", model(k)%s)
@@ -303,21 +292,21 @@ contains
                "the elastic path with one more comparison per contact and step")
          end if
          call add("checked", "every pixel by FFT convolution at the end: "// &
-            int_str(res%missed_final_check)//" penetrating (deepest "//sig_str(res%max_penetration, 2)// &
-            " nm); "//int_str(res%releases)//" releases; "//int_str(res%evaluations)// &
-            " exact pixel evaluations; exact re-solve differs by "//sig_str(res%final_check_difference, 2))
-         call add("search", int_str(res%fft_steps)//" of "//int_str(res%nsteps)// &
+            int_str(d%missed_final_check)//" penetrating (deepest "//sig_str(d%max_penetration, 2)// &
+            " nm); "//int_str(d%releases)//" releases; "//int_str(d%evaluations)// &
+            " exact pixel evaluations; exact re-solve differs by "//sig_str(d%final_check_difference, 2))
+         call add("search", int_str(d%fft_steps)//" of "//int_str(res%nsteps)// &
             " steps by full-field FFT, the others by the gap bound (--event-search "//trim(options%event_search)//")")
-         call add("cache", int_str(res%cache_hits)//" contacts bordered from the candidate "// &
-            "cache, "//int_str(res%cache_misses)//" by their own triangular solves; "//int_str(res%cache_refills)// &
-            " refills ("//int_str(res%cache_columns)//" columns by BLAS-3 solves)")
-      case default
-         call add("checked", int_str(res%missed_during_run)//" contacts found late by the candidate search, "// &
-            int_str(res%missed_final_check)//" found by the final check of all pixels; exact re-solve differs by "// &
-            sig_str(res%final_check_difference, 2))
-         call add("TRFACT", "condition estimate "//sig_str(res%condition, 2)// &
-            " (LAPACK dlacn2): relative errors up to about "//sig_str(epsilon(1.0_dp)*res%condition, 1))
-         if (epsilon(1.0_dp)*res%condition > 1.0e-8_dp) call add("warning", "the stiff springs and rigid body cost "// &
+         call add("cache", int_str(d%cache_hits)//" contacts bordered from the candidate "// &
+            "cache, "//int_str(d%cache_misses)//" by their own triangular solves; "//int_str(d%cache_refills)// &
+            " refills ("//int_str(d%cache_columns)//" columns by BLAS-3 solves)")
+      type is (legacy_diagnostics)
+         call add("checked", int_str(d%missed_during_run)//" contacts found late by the candidate search, "// &
+            int_str(d%missed_final_check)//" found by the final check of all pixels; exact re-solve differs by "// &
+            sig_str(d%final_check_difference, 2))
+         call add("TRFACT", "condition estimate "//sig_str(d%condition, 2)// &
+            " (LAPACK dlacn2): relative errors up to about "//sig_str(epsilon(1.0_dp)*d%condition, 1))
+         if (epsilon(1.0_dp)*d%condition > 1.0e-8_dp) call add("warning", "the stiff springs and rigid body cost "// &
             "the legacy solver digits; the incremental solver is immune (doc/stability.md)")
       end select
    contains
@@ -325,5 +314,23 @@ contains
          character(len=*), intent(in) :: label, text
          lines = [lines, report_line(label, text)]
       end subroutine add
+
+      !> One state's line of the cg solver's work: by approach in the gap variables, by
+      !> load otherwise (with the plastic rounds under the cap).
+      function cg_line(st, work) result(text)
+         type(load_state), intent(in) :: st
+         type(cg_state_diagnostics), intent(in) :: work
+         character(len=:), allocatable :: text
+         if (by_gap_variables(options)) then
+            text = "approach "//sig_str(st%approach, 6)//" nm: "//int_str(work%iterations)//" iterations, residual "// &
+               sig_str(work%residual, 2)//" (force balance, as a gap over the height range)"
+            return
+         end if
+         text = "load "//sig_str(st%load, 6)//" nN: "//int_str(work%iterations)//" iterations, residual "// &
+            sig_str(work%residual, 2)//", penetration "//sig_str(work%penetration, 2)//" nm, |gap| on contact "// &
+            sig_str(work%contact_gap, 2)//" nm, load error "//sig_str(work%load_error, 2)
+         if (options%plastic) text = text//", in "//int_str(work%plastic_rounds)//" round"// &
+            trim(merge("s", " ", work%plastic_rounds /= 1))//" of the plastic set"
+      end function cg_line
    end function report_lines
 end module femcod_solver
