@@ -4,6 +4,7 @@ module test_deck
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
    use femcod_deck, only: read_deck, write_deck
+   use femcod_deck_stream, only: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, format_real, format_reals, int_str, parse_real
    use femcod_cli, only: run_femcod
@@ -62,7 +63,8 @@ contains
          new_unittest("a deck above 2 GiB less 64 KiB is refused before it is read", test_huge_deck), &
          new_unittest("a deck beyond the writer's limit is refused and not written", test_deck_limit), &
          new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck), &
-         new_unittest("a UTF-8 byte order mark is not part of the label", test_bom) &
+         new_unittest("a UTF-8 byte order mark is not part of the label", test_bom), &
+         new_unittest("streamed in slabs (femcod-mpi): the same heights and messages, cut anywhere", test_stream) &
          ]
    end subroutine collect_deck
 
@@ -917,4 +919,103 @@ contains
       if (allocated(error)) return
       call check(error, deck%label, "with a BOM")
    end subroutine test_bom
+   !> The streamed reader (femcod_deck_stream: femcod-mpi's rank 0 reads a text deck in
+   !> slabs) read in chunks of 1, 13 and 4096 bytes and the default, and in slabs of 7
+   !> values, so that tokens, CR LF pairs and lines are cut at every place:
+   !> - a 40 x 40 deck of random values between random separators (blanks, tabs, commas,
+   !>   LF, CR LF) gives exactly the values Fortran's READ gives the same strings, and its
+   !>   header as written;
+   !> - the input/ decks give what read_deck gives, bit for bit;
+   !> - each of bad_case's 22 decks is refused as read_deck is: status 3, the message
+   !>   naming the file and the line bad_case states, what was expected and what found.
+   subroutine test_stream(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: np = 40, chunks(4) = [1, 13, 4096, 0]
+      character(len=*), parameter :: separators(5) = [character(len=2) :: " ", achar(9), ",", nl, achar(13)//nl]
+      character(len=*), parameter :: decks(3) = [character(len=32) :: "input/sphere_d1.deck", &
+         "input/rough_selfaffine_32.deck", "input/square_punch_n27.deck"]
+      type(contact_problem) :: deck, whole
+      type(status_type) :: status
+      character(len=:), allocatable :: path, text, name, where, expected
+      character(len=25) :: t
+      real(dp), allocatable :: values(:), got(:)
+      real(dp) :: u
+      integer :: k, c, sep, d
+      path = scratch_path("stream.deck")
+      allocate(values(2*np*np))
+      text = "streamed"//nl//"40 2.5 100"//nl//"200 0.3"//nl//"150 0.25"//nl//"1e7 0.25"//nl
+      do k = 1, size(values)
+         call random_number(u)
+         write(t, "(es25.16e3)") (u - 0.5_dp)*10.0_dp**(mod(k, 9) - 4)
+         read(t, *) values(k)
+         call random_number(u)
+         sep = 1 + int(u*size(separators))
+         text = text//trim(adjustl(t))//trim(separators(sep))
+         if (sep == 1 .or. sep == 2) text = text//" "
+      end do
+      call write_text(path, text)
+      do c = 1, size(chunks)
+         call stream_all(path, chunks(c), deck, got, status)
+         call check(error, status%code, 0, "chunks of "//to_string(chunks(c))//": "//status%message)
+         if (allocated(error)) return
+         call check(error, deck%np == np .and. deck%pixel == 2.5_dp .and. deck%maxcont == 100 .and. &
+            deck%young(2) == 150 .and. deck%poisson(3) == 0.25_dp .and. deck%label == "streamed", "the header")
+         if (allocated(error)) return
+         call check(error, all(got == values), "chunks of "//to_string(chunks(c))//": heights differ from READ's")
+         if (allocated(error)) return
+      end do
+      do d = 1, size(decks)
+         call read_deck(trim(decks(d)), whole, status)
+         do c = 1, size(chunks)
+            call stream_all(trim(decks(d)), chunks(c), deck, got, status)
+            call check(error, status%code, 0, trim(decks(d))//": "//status%message)
+            if (allocated(error)) return
+            call check(error, all(got == [reshape(transpose(whole%lower), [whole%np**2]), &
+               reshape(transpose(whole%upper), [whole%np**2])]), trim(decks(d))//": not read_deck's heights")
+            if (allocated(error)) return
+         end do
+      end do
+      do k = 1, 22
+         call bad_case(k, name, text, where, expected)
+         call write_text(path, text)
+         do c = 1, size(chunks)
+            call stream_all(path, chunks(c), deck, got, status)
+            call check(error, status%code, 3, name//", chunks of "//to_string(chunks(c))//": status "// &
+               to_string(status%code)//" "//status%message)
+            if (allocated(error)) return
+            call check(error, contains_text(status%message, path//where) .and. contains_text(status%message, &
+               expected) .and. contains_text(status%message, "found"), name//", chunks of "//to_string(chunks(c))// &
+               ": the message "//status%message//" should name "//where//" and "//expected)
+            if (allocated(error)) return
+         end do
+      end do
+   contains
+      !> The header, and all 2 NP^2 heights in slabs of 7 values (file order).
+      subroutine stream_all(file, chunk, header, heights, st)
+         character(len=*), intent(in) :: file
+         integer, intent(in) :: chunk
+         type(contact_problem), intent(out) :: header
+         real(dp), allocatable, intent(out) :: heights(:)
+         type(status_type), intent(out) :: st
+         type(deck_stream) :: stream
+         integer :: at, n
+         allocate(heights(0))
+         if (chunk > 0) then
+            call open_deck_stream(file, stream, header, st, chunk_bytes=chunk)
+         else
+            call open_deck_stream(file, stream, header, st)
+         end if
+         if (st%code /= 0) return
+         deallocate(heights)
+         allocate(heights(2*header%np**2))
+         at = 0
+         do while (at < size(heights))
+            n = min(7, size(heights) - at)
+            call read_deck_heights(stream, heights(at + 1:at + n), st)
+            if (st%code /= 0) exit
+            at = at + n
+         end do
+         call close_deck_stream(stream)
+      end subroutine stream_all
+   end subroutine test_stream
 end module test_deck

@@ -26,7 +26,7 @@ module femcod_deck
    !$ use omp_lib, only: omp_get_max_threads
    implicit none
    private
-   public :: read_deck, write_deck
+   public :: read_deck, write_deck, read_deck_header
 
 
    character(len=*), parameter :: material_names(3) = [character(len=26) :: &
@@ -96,6 +96,24 @@ contains
       end if
       call read_height_tokens(t, deck, status)
    end subroutine read_deck
+
+   !> The header of a text deck, `text` (its lines 1 to 5 with their line ends, or the
+   !> whole file when it has fewer), checked and read as read_deck reads it: the label,
+   !> NP PIXEL MAXCONT and the three materials, with read_deck's messages; no heights.
+   !> For a reader that takes the heights in slabs (femcod_deck_stream).
+   subroutine read_deck_header(path, text, deck, status)
+      character(len=*), intent(in) :: path, text
+      type(contact_problem), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      type(deck_tokens) :: t
+      t%path = path
+      t%text = text
+      call check_text(path, t%text, status)
+      if (status%code /= 0) return
+      call tokenize(t%text, t%n, t%first, t%last, t%line, t%last_line)
+      deck%label = label_of(t%text)
+      call read_header_values(t, deck, status)
+   end subroutine read_deck_header
 
    !> Lines 2 to 5: exactly the named values (NP PIXEL MAXCONT, then each material's E
    !> and NU), each within its range.

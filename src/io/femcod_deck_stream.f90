@@ -1,0 +1,373 @@
+!> A text deck read in slabs: its header as read_deck reads it (femcod_deck's
+!> read_deck_header), then its 2 NP^2 heights in file order, as many at a time as the
+!> caller asks for, through a buffer of CHUNK_BYTES: the file is never held whole, so a
+!> deck larger than the 2 GiB that read_file takes (8192^2 and up) is read too. femcod-mpi
+!> streams a text deck this way on rank 0 and scatters each slab (mpi/src/femcod_mpi_input).
+!>
+!> Every message is read_deck's: the file, the line, what was expected and what was
+!> found (a value that is not a finite number, or beyond 1e12 nm, with its row and
+!> column; too few or too many heights; a binary control character).
+module femcod_deck_stream
+   use femcod_kinds, only: dp, i8
+   use femcod_problem, only: contact_problem, MAX_HEIGHT
+   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
+   use femcod_deck, only: read_deck_header
+   use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens
+   use femcod_strings, only: int_str, parse_real
+   use femcod_files, only: path_exists, path_is_directory, os_error_text, clear_write_error
+   implicit none
+   private
+   public :: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream, CHUNK_BYTES
+
+   !> Bytes read from the file at a time (the buffer holds one chunk and the part of a
+   !> token cut at its end).
+   integer, parameter :: CHUNK_BYTES = 4*1024*1024
+   !> The header (lines 1 to 5) is looked for in the file's first bytes.
+   integer, parameter :: HEADER_BYTES = 1024*1024
+
+   !> An open text deck, positioned at its next height.
+   type :: deck_stream
+      character(len=:), allocatable :: path
+      integer :: unit = -1
+      !> The file's size and the next byte to read (1-based).
+      integer(i8) :: size = 0, next = 1
+      !> NP, and the heights handed out so far (of 2 NP^2).
+      integer :: np = 0
+      integer(i8) :: delivered = 0
+      !> The current chunk: its text, its tokens' bounds and lines, the values they read
+      !> as (huge where a token is not a height), and how many were handed out.
+      character(len=:), allocatable :: text, carry
+      integer, allocatable :: first(:), last(:), line(:)
+      real(dp), allocatable :: value(:)
+      integer :: ntok = 0, used = 0
+      !> The line at the start of the next chunk; the last line that holds anything.
+      integer :: line0 = 1, last_line = 1
+      !> The file's byte at text(1:1).
+      integer(i8) :: text_start = 1
+      !> Bytes read at a time (CHUNK_BYTES unless the caller chose).
+      integer :: chunk = CHUNK_BYTES
+      logical :: at_end = .false.
+   end type deck_stream
+
+contains
+
+   !> Open the text deck `path` and read its header into `deck` (no heights); the
+   !> stream then stands at the first height. `chunk_bytes`: read that many bytes at a
+   !> time (CHUNK_BYTES by default; the tests take a few, to cut tokens and lines).
+   subroutine open_deck_stream(path, stream, deck, status, chunk_bytes)
+      character(len=*), intent(in) :: path
+      type(deck_stream), intent(out) :: stream
+      type(contact_problem), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      integer, intent(in), optional :: chunk_bytes
+      character(len=:), allocatable :: head
+      integer :: ios, k, at, header_end
+      stream%path = path
+      if (present(chunk_bytes)) stream%chunk = max(1, chunk_bytes)
+      ! read_file's messages (femcod_files) for what is not a readable file.
+      if (path_is_directory(path)) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected a deck file, found a directory")
+         return
+      end if
+      if (.not. path_exists(path)) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected a deck file, found no such file")
+         return
+      end if
+      call clear_write_error()
+      open(newunit=stream%unit, file=path, access="stream", form="unformatted", action="read", status="old", &
+         iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected a deck file, cannot open it ("// &
+            os_error_text()//")")
+         stream%unit = -1
+         return
+      end if
+      inquire(unit=stream%unit, size=stream%size)
+      if (stream%size <= 0) then
+         call set_error(status, STATUS_BAD_INPUT, path//":1: expected a label line, found an empty file")
+         call close_deck_stream(stream)
+         return
+      end if
+      allocate(character(len=int(min(stream%size, int(HEADER_BYTES, i8)))) :: head)
+      read(stream%unit, pos=1, iostat=ios) head
+      if (ios /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot read it")
+         call close_deck_stream(stream)
+         return
+      end if
+      ! Lines 1 to 5 with their line ends; the heights start after the fifth.
+      header_end = len(head)
+      at = 0
+      do k = 1, 5
+         ios = index(head(at + 1:), new_line("a"))
+         if (ios == 0) exit
+         at = at + ios
+         if (k == 5) header_end = at
+      end do
+      call read_deck_header(path, head(1:header_end), deck, status)
+      if (status%code /= 0) then
+         call close_deck_stream(stream)
+         return
+      end if
+      stream%np = deck%np
+      stream%next = header_end + 1
+      stream%line0 = 1 + count_line_ends(head(1:header_end))
+      stream%last_line = last_line_of(head(1:header_end), stream%line0)
+      stream%carry = ""
+      stream%text = ""
+      stream%at_end = stream%next > stream%size
+   end subroutine open_deck_stream
+
+   !> The next size(values) heights (nm) in file order: the lower surface's NP^2 row by
+   !> row, then the upper's. After the last of the 2 NP^2, the rest of the file must be
+   !> blank (else: "expected the end of the deck ...").
+   subroutine read_deck_heights(stream, values, status)
+      type(deck_stream), intent(inout) :: stream
+      real(dp), intent(out) :: values(:)
+      type(status_type), intent(inout) :: status
+      integer(i8) :: total
+      integer :: filled, take, k
+      total = 2*int(stream%np, i8)**2
+      filled = 0
+      do while (filled < size(values))
+         if (stream%used == stream%ntok) then
+            call next_chunk(stream, status)
+            if (status%code /= 0) return
+            if (stream%ntok == 0) then
+               call set_error(status, STATUS_BAD_INPUT, stream%path//":"//int_str(stream%last_line)//": expected "// &
+                  int_str(total)//" heights (NP**2 = "//int_str(int(stream%np, i8)**2)//" lower, then as many "// &
+                  "upper), found "//int_str(stream%delivered)//" before the end of the file")
+               return
+            end if
+         end if
+         take = min(size(values) - filled, stream%ntok - stream%used)
+         do k = 1, take
+            if (stream%value(stream%used + k) == huge(1.0_dp)) then
+               call refuse_height(stream, stream%used + k, stream%delivered + k, status)
+               return
+            end if
+         end do
+         values(filled + 1:filled + take) = stream%value(stream%used + 1:stream%used + take)
+         filled = filled + take
+         stream%used = stream%used + take
+         stream%delivered = stream%delivered + take
+      end do
+      if (stream%delivered == total) call expect_end(stream, status)
+   end subroutine read_deck_heights
+
+   !> The file closed (it may be closed twice).
+   subroutine close_deck_stream(stream)
+      type(deck_stream), intent(inout) :: stream
+      if (stream%unit >= 0) close(stream%unit)
+      stream%unit = -1
+   end subroutine close_deck_stream
+
+   !> The next chunk of the file that holds a token (ntok = 0: the end of the file).
+   subroutine next_chunk(stream, status)
+      type(deck_stream), intent(inout) :: stream
+      type(status_type), intent(inout) :: status
+      do
+         call load_chunk(stream, status)
+         if (status%code /= 0 .or. stream%ntok > 0) return
+         if (stream%at_end .and. len(stream%carry) == 0) return
+      end do
+   end subroutine next_chunk
+
+   !> The next chunk of the file: cut after its last separator (the rest carried to the
+   !> next one), refused if it holds a control byte, tokenized with the lines of its
+   !> tokens, and each token read as a height, on all threads.
+   subroutine load_chunk(stream, status)
+      type(deck_stream), intent(inout) :: stream
+      type(status_type), intent(inout) :: status
+      character(len=:), allocatable :: bytes
+      integer :: n, ios, cut, bad, count, ends, k
+      stream%ntok = 0
+      stream%used = 0
+      if (stream%at_end .and. len(stream%carry) == 0) return
+      n = int(min(int(stream%chunk, i8), stream%size - stream%next + 1))
+      allocate(character(len=max(n, 0)) :: bytes)
+      if (n > 0) then
+         read(stream%unit, pos=stream%next, iostat=ios) bytes
+         if (ios /= 0) then
+            call set_error(status, STATUS_IO, stream%path//": cannot read it past byte "//int_str(stream%next))
+            return
+         end if
+         stream%next = stream%next + n
+      end if
+      stream%at_end = stream%next > stream%size
+      stream%text_start = stream%next - n - len(stream%carry)
+      stream%text = stream%carry//bytes
+      deallocate(bytes)
+      cut = len(stream%text)
+      if (.not. stream%at_end) then
+         do while (cut > 0)
+            if (iachar(stream%text(cut:cut)) < 33 .or. stream%text(cut:cut) == ",") exit
+            cut = cut - 1
+         end do
+      end if
+      stream%carry = stream%text(cut + 1:)
+      stream%text = stream%text(1:cut)
+      bad = first_control(stream%text)
+      if (bad > 0) then
+         call set_error(status, STATUS_BAD_INPUT, stream%path//":"//int_str(stream%line0 + &
+            count_line_ends(stream%text(1:bad - 1)))//": expected a text deck, found a binary control character "// &
+            "(code "//int_str(iachar(stream%text(bad:bad)))//") at byte "//int_str(stream%text_start + bad - 1))
+         return
+      end if
+      call scan_all(stream%text, 0, stream%line0, count, ends)
+      if (allocated(stream%first)) deallocate(stream%first, stream%last, stream%line, stream%value)
+      allocate(stream%first(count), stream%last(count), stream%line(count), stream%value(count))
+      call scan_all(stream%text, 0, stream%line0, count, ends, stream%first, stream%last, stream%line)
+      stream%line0 = stream%line0 + ends
+      if (len(stream%text) > 0) stream%last_line = last_line_of(stream%text, stream%line0)
+      stream%ntok = count
+      !$omp parallel do schedule(static)
+      do k = 1, count
+         call read_height(stream%text(stream%first(k):stream%last(k)), stream%value(k))
+      end do
+      !$omp end parallel do
+   end subroutine load_chunk
+
+   !> A token as a height: its value, or huge when it is not a finite number within
+   !> MAX_HEIGHT.
+   subroutine read_height(token, value)
+      character(len=*), intent(in) :: token
+      real(dp), intent(out) :: value
+      logical :: ok
+      call parse_real(token, value, ok)
+      if (ok) ok = abs(value) <= MAX_HEIGHT
+      if (.not. ok) value = huge(1.0_dp)
+   end subroutine read_height
+
+   !> read_deck's message for token k of the chunk, height number m (1-based, in file
+   !> order): not a number, or beyond 1e12 nm, with its surface, row and column.
+   subroutine refuse_height(stream, k, m, status)
+      type(deck_stream), intent(in) :: stream
+      integer, intent(in) :: k
+      integer(i8), intent(in) :: m
+      type(status_type), intent(inout) :: status
+      integer(i8) :: per_surface, index
+      character(len=:), allocatable :: what, where, token
+      real(dp) :: v
+      logical :: ok
+      per_surface = int(stream%np, i8)**2
+      index = m - 1
+      what = "a lower-surface height"
+      if (index >= per_surface) then
+         index = index - per_surface
+         what = "an upper-surface height"
+      end if
+      where = "(row "//int_str(index/stream%np + 1)//", column "//int_str(mod(index, int(stream%np, i8)) + 1)//")"
+      token = stream%text(stream%first(k):min(stream%last(k), stream%first(k) + 39))
+      token = "'"//token//"'"
+      if (stream%last(k) - stream%first(k) > 39) token = token//"..."
+      call parse_real(stream%text(stream%first(k):stream%last(k)), v, ok)
+      if (.not. ok) then
+         call set_error(status, STATUS_BAD_INPUT, stream%path//":"//int_str(stream%line(k))//": expected "//what// &
+            " in nm "//where//" (a finite number), found "//token)
+      else
+         call set_error(status, STATUS_BAD_INPUT, stream%path//":"//int_str(stream%line(k))//": expected a height "// &
+            "within 1e12 nm "//where//", found "//token)
+      end if
+   end subroutine refuse_height
+
+   !> After the last height: nothing but separators to the end of the file.
+   subroutine expect_end(stream, status)
+      type(deck_stream), intent(inout) :: stream
+      type(status_type), intent(inout) :: status
+      integer :: k
+      character(len=:), allocatable :: token
+      do while (stream%used == stream%ntok)
+         call next_chunk(stream, status)
+         if (status%code /= 0) return
+         if (stream%ntok == 0) return
+      end do
+      k = stream%used + 1
+      token = "'"//stream%text(stream%first(k):min(stream%last(k), stream%first(k) + 39))//"'"
+      if (stream%last(k) - stream%first(k) > 39) token = token//"..."
+      call set_error(status, STATUS_BAD_INPUT, stream%path//":"//int_str(stream%line(k))//": expected the end of "// &
+         "the deck after the "//int_str(2*int(stream%np, i8)**2)//" heights, found "//token)
+   end subroutine expect_end
+
+   !> The tokens of text (separated by blanks, tabs, CR, LF, FF and commas) and its line
+   !> ends, counted, and with `first` recorded from token k0 + 1 and line ln0 on.
+   subroutine scan_all(text, k0, ln0, count, ends, first, last, line)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: k0, ln0
+      integer, intent(out) :: count, ends
+      integer, intent(inout), optional :: first(:), last(:), line(:)
+      integer :: i, k, ln, c
+      logical :: inside
+      if (words_little_endian()) then
+         if (present(first)) then
+            call scan_tokens(text, 1, len(text), k0, ln0, count, ends, first, last, line)
+         else
+            call scan_tokens(text, 1, len(text), k0, ln0, count, ends)
+         end if
+         return
+      end if
+      ! Byte by byte where words are not little-endian.
+      k = k0
+      ln = ln0
+      inside = .false.
+      do i = 1, len(text)
+         c = iachar(text(i:i))
+         if (c < 33 .or. c == 44) then
+            if (inside .and. present(first)) last(k) = i - 1
+            inside = .false.
+            if (c == 10) ln = ln + 1
+         else if (.not. inside) then
+            inside = .true.
+            k = k + 1
+            if (present(first)) then
+               first(k) = i
+               line(k) = ln
+            end if
+         end if
+      end do
+      if (inside .and. present(first)) last(k) = len(text)
+      count = k - k0
+      ends = ln - ln0
+   end subroutine scan_all
+
+   !> The first byte of text that is a control character but TAB, LF, FF and CR (or
+   !> DEL); 0 when there is none.
+   integer function first_control(text) result(at)
+      character(len=*), intent(in) :: text
+      integer :: i, c
+      at = 0
+      if (words_little_endian()) then
+         at = first_control_byte(text)
+         if (at == huge(at)) at = 0
+         return
+      end if
+      do i = 1, len(text)
+         c = iachar(text(i:i))
+         if ((c < 32 .and. c /= 9 .and. c /= 10 .and. c /= 12 .and. c /= 13) .or. c == 127) then
+            at = i
+            return
+         end if
+      end do
+   end function first_control
+
+   !> The number of the last line of a text that ends on line `line` (one past its
+   !> last LF): that line, or the one before when the text ends with its LF.
+   pure integer function last_line_of(text, line) result(last)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: line
+      last = line
+      if (len(text) > 0) then
+         if (text(len(text):len(text)) == new_line("a")) last = line - 1
+      end if
+   end function last_line_of
+
+   !> The LF bytes of text.
+   pure integer function count_line_ends(text) result(n)
+      character(len=*), intent(in) :: text
+      integer :: i
+      n = 0
+      do i = 1, len(text)
+         if (text(i:i) == new_line("a")) n = n + 1
+      end do
+   end function count_line_ends
+end module femcod_deck_stream
