@@ -27,9 +27,8 @@ program femcod_mpi
    use femcod_mpi_generate, only: generate_columns
    use femcod_run, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
-   use femcod_deck, only: read_deck
    use femcod_deck_h5, only: is_hdf5_file, read_deck_h5_header
-   use femcod_mpi_input, only: read_deck_columns
+   use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, read_text_deck_header, slab_rows
    use femcod_heights, only: load_scene, height_file_path
    use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_files, only: path_exists, remove_file, atomic_rename, write_file, acquire_lock, release_lock, &
@@ -69,7 +68,7 @@ program femcod_mpi
    integer(i8) :: estimated_rank_bytes
    type(state_maps), allocatable :: figures(:)
    integer :: provided, rank, ranks, np, block, code, k, figure
-   logical :: locked, slab_input, generating
+   logical :: locked, slab_input, hdf5_input, generating
    character(len=:), allocatable :: fftw_message
    type(scene_spec) :: generated
 
@@ -123,7 +122,8 @@ program femcod_mpi
          ! An HDF5 deck: its header here, its heights by every rank below.
          call read_deck_h5_header(settings%decks(1)%s, problem, status)
       else
-         call read_deck(settings%decks(1)%s, problem, status)
+         ! A text deck: its header here, its heights streamed below.
+         call read_text_deck_header(settings%decks(1)%s, problem, status)
       end if
       ! femcod's rule for every file it writes: an input is never an output, and an
       ! existing file is replaced only with --force and only if femcod wrote it.
@@ -141,18 +141,25 @@ program femcod_mpi
    call agree(status, MPI_COMM_WORLD)
    if (status%code /= 0) call finish(status%code, status%message)
 
-   slab_input = .false.
-   if (settings%decks(1)%s /= "" .and. .not. generating) slab_input = is_hdf5_file(settings%decks(1)%s)
+   slab_input = settings%decks(1)%s /= "" .and. .not. generating
+   hdf5_input = .false.
+   if (slab_input) hdf5_input = is_hdf5_file(settings%decks(1)%s)
    if (generating) then
       ! Each rank makes its own columns of the surface (FFTW-MPI).
       call generate_columns(generated, MPI_COMM_WORLD, settings%solve%cg, header, local, constants, block, status)
       call agree(status, MPI_COMM_WORLD)
       if (rank == 0) problem = header
       if (status%code /= 0) call finish(status%code, status%message)
-   else if (slab_input) then
+   else if (hdf5_input) then
       ! Each rank reads its own columns of the HDF5 deck (parallel HDF5, collective).
       call read_deck_columns(settings%decks(1)%s, MPI_COMM_WORLD, settings%solve%cg, header, local, constants, &
          block, status)
+      if (rank == 0) problem = header
+      if (status%code /= 0) call finish(status%code, status%message)
+   else if (slab_input) then
+      ! Rank 0 streams the text deck in slabs of rows, each scattered to the ranks' columns.
+      call read_text_deck_columns(settings%decks(1)%s, MPI_COMM_WORLD, settings%solve%cg, header, local, &
+         constants, block, status)
       if (rank == 0) problem = header
       if (status%code /= 0) call finish(status%code, status%message)
    else
@@ -340,8 +347,11 @@ contains
       if (generating) then
          text = "made on the ranks: "//generated%kind//", NP "//int_str(generated%np)//", seed "// &
             int_str(generated%seed)
-      else if (slab_input) then
+      else if (hdf5_input) then
          text = "HDF5 deck, each rank its own columns"
+      else if (slab_input) then
+         text = "text deck, streamed by rank 0 in slabs of "//int_str(slab_rows(np, ranks))//" row"// &
+            trim(merge("s", " ", slab_rows(np, ranks) /= 1))
       else
          text = "rank 0 reads, sends columns"
       end if
