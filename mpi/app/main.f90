@@ -28,7 +28,8 @@ program femcod_mpi
    use femcod_run, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
    use femcod_deck_h5, only: is_hdf5_file, read_deck_h5_header
-   use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, read_text_deck_header, slab_rows
+   use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, read_text_deck_header, slab_rows, &
+      is_dataset_scene, read_dataset_header, read_dataset_columns
    use femcod_heights, only: load_scene, height_file_path
    use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_files, only: path_exists, remove_file, atomic_rename, write_file, acquire_lock, release_lock, &
@@ -68,7 +69,7 @@ program femcod_mpi
    integer(i8) :: estimated_rank_bytes
    type(state_maps), allocatable :: figures(:)
    integer :: provided, rank, ranks, np, block, code, k, figure
-   logical :: locked, slab_input, hdf5_input, generating
+   logical :: locked, slab_input, hdf5_input, dataset_input, generating
    character(len=:), allocatable :: fftw_message
    type(scene_spec) :: generated
 
@@ -111,6 +112,9 @@ program femcod_mpi
       if (generating) then
          ! Made on the ranks below: nothing to read.
          problem%label = generated%label
+      else if (settings%decks(1)%s == "" .and. is_dataset_scene(settings%scene)) then
+         ! HDF5 datasets: their sizes here, their columns read by every rank below.
+         call read_dataset_header(settings%scene, problem, status)
       else if (settings%decks(1)%s == "") then
          call load_scene(settings%scene, problem, status, warnings=warnings)
          if (allocated(warnings)) then
@@ -144,11 +148,24 @@ program femcod_mpi
    slab_input = settings%decks(1)%s /= "" .and. .not. generating
    hdf5_input = .false.
    if (slab_input) hdf5_input = is_hdf5_file(settings%decks(1)%s)
+   dataset_input = .false.
+   if (settings%decks(1)%s == "" .and. .not. generating) dataset_input = is_dataset_scene(settings%scene)
    if (generating) then
       ! Each rank makes its own columns of the surface (FFTW-MPI).
       call generate_columns(generated, MPI_COMM_WORLD, settings%solve%cg, header, local, constants, block, status)
       call agree(status, MPI_COMM_WORLD)
       if (rank == 0) problem = header
+      if (status%code /= 0) call finish(status%code, status%message)
+   else if (dataset_input) then
+      ! Each rank reads its own columns of the height datasets (parallel HDF5, collective).
+      call read_dataset_columns(settings%scene, MPI_COMM_WORLD, settings%solve%cg, header, local, constants, &
+         block, status, warnings)
+      if (rank == 0) then
+         problem = header
+         do k = 1, size(warnings)
+            write(error_unit, '(a)') "femcod-mpi: warning: "//warnings(k)%s
+         end do
+      end if
       if (status%code /= 0) call finish(status%code, status%message)
    else if (hdf5_input) then
       ! Each rank reads its own columns of the HDF5 deck (parallel HDF5, collective).
@@ -347,6 +364,8 @@ contains
       if (generating) then
          text = "made on the ranks: "//generated%kind//", NP "//int_str(generated%np)//", seed "// &
             int_str(generated%seed)
+      else if (dataset_input) then
+         text = "HDF5 height datasets, each rank its own columns"
       else if (hdf5_input) then
          text = "HDF5 deck, each rank its own columns"
       else if (slab_input) then

@@ -3,8 +3,12 @@
 !> a text deck streamed by rank 0 (femcod_deck_stream) in slabs of rows, each slab
 !> scattered to the ranks' columns as it is read. The composite gaps are formed on the
 !> ranks (femcod_scene's initial gaps, element by element, with the two maxima over all
-!> ranks): no rank holds more than its columns, and rank 0 one slab besides. The height
-!> files go through rank 0 (femcod_mpi_cg's scatter_problem).
+!> ranks): no rank holds more than its columns, and rank 0 one slab besides. A height
+!> file that is an HDF5 dataset (`--lower FILE.h5:/DATASET`, and `--upper` likewise) is
+!> read by every rank, its own columns, with the height file's rules computed over the
+!> ranks (units, finite values, the least-squares plane: removed with --remove-plane,
+!> its tilt reported without). Other height files go through rank 0 (femcod_mpi_cg's
+!> scatter_problem).
 !>
 !> No I/O but the reading of the deck, no stop: errors come back in a status, the same on
 !> every rank.
@@ -15,17 +19,22 @@ module femcod_mpi_input
       h5fopen_f, h5fclose_f, h5screate_simple_f, h5sselect_hyperslab_f, h5sclose_f, h5dopen_f, h5dread_f, &
       h5dclose_f, h5dget_space_f, H5P_FILE_ACCESS_F, H5P_DATASET_XFER_F, H5FD_MPIO_COLLECTIVE_F, H5F_ACC_RDONLY_F, &
       H5S_SELECT_SET_F, H5T_NATIVE_DOUBLE
-   use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO, STATUS_USAGE
    use femcod_problem, only: contact_problem, MAX_HEIGHT
-   use femcod_deck_h5, only: read_deck_h5_header
+   use femcod_deck_h5, only: read_deck_h5_header, is_hdf5_file
    use femcod_deck_stream, only: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream
+   use femcod_generate, only: scene_spec, scene_header
+   use femcod_heights, only: unit_in_nm
+   use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_rank_and_dims
+   use femcod_strings, only: string_type, int_str, sig_str, format_real
    use femcod_solver_options, only: cg_settings
    use femcod_mpi_cg, only: column_split, coarse_factor, problem_constants
    use femcod_mpi_results, only: agree
    implicit none
    private
    public :: read_deck_columns, read_text_deck_columns, read_text_deck_header, slab_rows
+   public :: is_dataset_scene, read_dataset_header, read_dataset_columns
 
    !> A text deck's slab: at most this many bytes of heights (and at most an eighth of a
    !> rank's columns, so that rank 0 holds within 1/8 of what every rank holds).
@@ -196,60 +205,300 @@ contains
    end subroutine composite_gaps
 
    !> Columns j0 + 1 .. j0 + nj (all NP rows) of /lower and /upper, each rank its own
-   !> hyperslab, collectively. The datasets are C order [row][column]: in HDF5's Fortran
-   !> view (column, row), so a rank's columns are one contiguous block of the first index.
+   !> hyperslab, collectively (read_dataset_part).
    subroutine read_columns(path, comm, np, j0, nj, lower, upper, status)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: np, j0, nj
       real(dp), allocatable, intent(out) :: lower(:, :), upper(:, :)
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: fapl, dxpl, fid
-      integer :: error
       allocate(lower(np, nj), upper(np, nj))
+      call read_dataset_part(path, "/lower", comm, np, j0, nj, lower, status)
+      if (status%code == 0) call read_dataset_part(path, "/upper", comm, np, j0, nj, upper, status)
+   end subroutine read_columns
+   !> Whether a scene is read by the ranks from HDF5 datasets: height files (a "matrix"
+   !> scene) whose first, and second if any, is FILE.h5:/DATASET of an HDF5 file.
+   logical function is_dataset_scene(spec) result(yes)
+      type(scene_spec), intent(in) :: spec
+      yes = .false.
+      if (.not. allocated(spec%kind)) return
+      if (spec%kind /= "matrix") return
+      yes = is_dataset(spec%matrix_file)
+      if (yes .and. allocated(spec%second_file)) then
+         if (spec%second_file /= "") yes = is_dataset(spec%second_file)
+      end if
+   contains
+      logical function is_dataset(path)
+         character(len=*), intent(in) :: path
+         integer :: colon
+         colon = index(path, ":/", back=.true.)
+         is_dataset = .false.
+         if (colon > 1) is_dataset = is_hdf5_file(path(1:colon - 1))
+      end function is_dataset
+   end function is_dataset_scene
+
+   !> Rank 0's look at a dataset scene before anything is read: each dataset two-
+   !> dimensional and square (the second the first's size), a pixel given (--pixel: a
+   !> dataset carries none), MAXCONT within NP^2; the problem's header (no heights) in
+   !> `problem`, as femcod run's load_scene would make it.
+   subroutine read_dataset_header(spec, problem, status)
+      type(scene_spec), intent(in) :: spec
+      type(contact_problem), intent(out) :: problem
+      type(status_type), intent(inout) :: status
+      integer :: np, other
+      call dataset_side(spec%matrix_file, np, status)
+      if (status%code /= 0) return
+      if (allocated(spec%second_file)) then
+         if (spec%second_file /= "") then
+            call dataset_side(spec%second_file, other, status)
+            if (status%code /= 0) return
+            if (other /= np) then
+               call set_error(status, STATUS_BAD_INPUT, spec%matrix_file//" has "//int_str(np)//" x "// &
+                  int_str(np)//" heights, "//spec%second_file//" has "//int_str(other)//" x "//int_str(other)// &
+                  ": the two surfaces must share one grid (femcod does not resample)")
+               return
+            end if
+         end if
+      end if
+      if (.not. spec%pixel > 0) then
+         call set_error(status, STATUS_USAGE, spec%matrix_file//" does not give its pixel size: give --pixel D (nm)")
+         return
+      end if
+      if (spec%maxcont > np**2) then
+         call set_error(status, STATUS_USAGE, "--maxcont "//int_str(spec%maxcont)//" is above the "// &
+            int_str(np**2)//" pixels of "//spec%matrix_file//" (NP^2, the most contacts there are)")
+         return
+      end if
+      call scene_header(spec, np, 0, problem, status)
+   contains
+      !> The side of the square dataset FILE:/DATASET (a message naming it otherwise).
+      subroutine dataset_side(path, side, st)
+         character(len=*), intent(in) :: path
+         integer, intent(out) :: side
+         type(status_type), intent(inout) :: st
+         type(h5_file) :: file
+         integer(i8) :: dims(7)
+         integer :: colon, rank
+         side = 0
+         colon = index(path, ":/", back=.true.)
+         call h5_open(path(1:colon - 1), file, st, STATUS_BAD_INPUT)
+         call h5_rank_and_dims(file, path(colon + 1:), rank, dims, st, STATUS_BAD_INPUT)
+         call h5_close(file, st)
+         if (st%code /= 0) return
+         if (rank /= 2) then
+            call set_error(st, STATUS_BAD_INPUT, path//": expected a two-dimensional dataset of heights, found "// &
+               int_str(rank)//" dimensions")
+         else if (dims(1) /= dims(2)) then
+            call set_error(st, STATUS_BAD_INPUT, path//": expected a square matrix of heights, found "// &
+               int_str(int(dims(1)))//" rows of "//int_str(int(dims(2)))//" values")
+         else if (dims(1) < 2 .or. dims(1) > 65536) then
+            call set_error(st, STATUS_BAD_INPUT, path//": expected 2 to 65536 rows and columns, found "// &
+               int_str(int(dims(1))))
+         else
+            side = int(dims(1))
+         end if
+      end subroutine dataset_side
+   end subroutine read_dataset_header
+
+   !> A dataset scene on the ranks of `comm`, as read_deck_columns gives an HDF5 deck:
+   !> every rank reads its columns of each dataset (collective MPI-IO) and applies the
+   !> height file's rules over all ranks: heights in --height-unit (nm by default),
+   !> finite and within 1e12 nm; the least-squares plane removed with --remove-plane, its
+   !> tilt reported without (more than 10 times the rms roughness about it, as femcod
+   !> run); each surface from its lowest point; the other surface flat where there is no
+   !> second dataset (--shape-on says which is which). `problem` (rank 0) is the header,
+   !> `warnings` (rank 0) what femcod run would warn of. Collective.
+   subroutine read_dataset_columns(spec, comm, how, problem, local, constants, block, status, warnings)
+      type(scene_spec), intent(in) :: spec
+      type(MPI_Comm), intent(in) :: comm
+      type(cg_settings), intent(in) :: how
+      type(contact_problem), intent(out) :: problem
+      real(dp), allocatable, intent(out) :: local(:, :)
+      real(dp), intent(out) :: constants(4)
+      integer, intent(out) :: block
+      type(status_type), intent(inout) :: status
+      type(string_type), allocatable, intent(out) :: warnings(:)
+      integer, allocatable :: first(:), count(:)
+      real(dp), allocatable :: shape(:, :), other(:, :)
+      integer :: rank, ranks, np
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_size(comm, ranks)
+      allocate(local(0, 0), warnings(0))
+      constants = 0
+      block = 1
+      call read_dataset_header(spec, problem, status)
+      call agree(status, comm)
+      if (status%code /= 0) return
+      np = problem%np
+      constants = problem_constants(problem)
+      block = coarse_factor(np, ranks, how)
+      call column_split(np, ranks, block, first, count)
+      call dataset_surface(spec, spec%matrix_file, comm, np, first(rank), count(rank), .true., shape, warnings, &
+         status)
+      if (status%code /= 0) return
+      allocate(other(np, count(rank)))
+      other = 0
+      if (allocated(spec%second_file)) then
+         if (spec%second_file /= "") call dataset_surface(spec, spec%second_file, comm, np, first(rank), &
+            count(rank), .false., other, warnings, status)
+      end if
+      if (status%code /= 0) return
+      if (spec%shape_on == "upper") then
+         call composite_gaps(other, shape, comm, local)
+      else
+         call composite_gaps(shape, other, comm, local)
+      end if
+   end subroutine read_dataset_columns
+
+   !> One dataset's columns j0 + 1 .. j0 + nj as a surface (nm, from its lowest point over
+   !> all ranks), with the height file's checks over all ranks (femcod_heights'
+   !> read_height_map and load_scene); the tilt is told of the first file only.
+   !> Collective.
+   subroutine dataset_surface(spec, path, comm, np, j0, nj, first_file, z, warnings, status)
+      type(scene_spec), intent(in) :: spec
+      character(len=*), intent(in) :: path
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: np, j0, nj
+      logical, intent(in) :: first_file
+      real(dp), allocatable, intent(inout) :: z(:, :)
+      type(string_type), allocatable, intent(inout) :: warnings(:)
+      type(status_type), intent(inout) :: status
+      real(dp) :: scale, v(3), rise, roughness
+      integer :: colon, bad
+      colon = index(path, ":/", back=.true.)
+      if (allocated(z)) deallocate(z)
+      allocate(z(np, nj))
+      call read_dataset_part(path(1:colon - 1), path(colon + 1:), comm, np, j0, nj, z, status)
+      call agree(status, comm)
+      if (status%code /= 0) return
+      scale = 1
+      if (spec%height_unit /= "") scale = unit_in_nm(spec%height_unit)
+      if (abs(scale - 1) > 0) z = z*scale
+      bad = 0
+      if (.not. all(ieee_is_finite(z))) bad = 1
+      call MPI_Allreduce(MPI_IN_PLACE, bad, 1, MPI_INTEGER, MPI_MAX, comm)
+      if (bad == 1) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected finite heights (nm), found NaN or Inf")
+         return
+      end if
+      ! v: the largest |z|, the largest z, minus the smallest z, over all ranks.
+      v = -huge(1.0_dp)
+      if (size(z) > 0) v = [maxval(abs(z)), maxval(z), -minval(z)]
+      call MPI_Allreduce(MPI_IN_PLACE, v, 3, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      if (v(1) > MAX_HEIGHT) then
+         call set_error(status, STATUS_BAD_INPUT, path//": expected heights within 1e12 nm (1 km), found "// &
+            format_real(v(1))//" nm (heights in other units: --height-unit)")
+         return
+      end if
+      if (v(2) + v(3) > 0 .and. v(2) + v(3) < 1.0e-3_dp) warnings = [warnings, string_type(path// &
+         ": the heights span only "//format_real(v(2) + v(3))//" nm; if the file holds metres, give --height-unit m")]
+      if (first_file .and. .not. spec%plane) then
+         call distributed_plane(z, np, j0, comm, .false., rise, roughness)
+         if (rise > 10*roughness .and. roughness > 0) then
+            warnings = [warnings, string_type(path//": its least-squares plane rises "//sig_str(rise, 3)// &
+               " nm across the scan, "//sig_str(rise/roughness, 3)//" times the roughness about it ("// &
+               sig_str(roughness, 3)//" nm rms): give --remove-plane if the tilt is the mounting, not the surface")]
+         else if (rise > 0 .and. roughness == 0) then
+            warnings = [warnings, string_type(path//": its heights are a tilted plane (rising "//sig_str(rise, 3)// &
+               " nm across the scan) with no roughness about it")]
+         end if
+      end if
+      if (spec%plane) call distributed_plane(z, np, j0, comm, .true., rise, roughness)
+      v(1) = huge(1.0_dp)
+      if (size(z) > 0) v(1) = minval(z)
+      call MPI_Allreduce(MPI_IN_PLACE, v(1), 1, MPI_DOUBLE_PRECISION, MPI_MIN, comm)
+      z = z - v(1)
+   end subroutine dataset_surface
+
+   !> femcod_surfaces' least-squares plane z = mz + b (i - mi) + c (j - mj) of the whole
+   !> NP x NP grid, from this rank's columns j0 + 1 .. and sums over the ranks:
+   !> subtracted (`remove`), or its rise across the grid and the rms about it (nm).
+   !> Collective.
+   subroutine distributed_plane(z, np, j0, comm, remove, rise, roughness)
+      real(dp), intent(inout) :: z(:, :)
+      integer, intent(in) :: np, j0
+      type(MPI_Comm), intent(in) :: comm
+      logical, intent(in) :: remove
+      real(dp), intent(out) :: rise, roughness
+      real(dp) :: sums(3), mi, mj, mz, b, c, deviations, r(1)
+      integer :: i, j
+      mi = (np + 1)/2.0_dp
+      mj = (np + 1)/2.0_dp
+      sums = [sum(z), 0.0_dp, 0.0_dp]
+      call MPI_Allreduce(MPI_IN_PLACE, sums(1:1), 1, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      mz = sums(1)/real(np, dp)**2
+      do j = 1, size(z, 2)
+         do i = 1, np
+            sums(2) = sums(2) + (z(i, j) - mz)*(i - mi)
+            sums(3) = sums(3) + (z(i, j) - mz)*(j0 + j - mj)
+         end do
+      end do
+      call MPI_Allreduce(MPI_IN_PLACE, sums(2:3), 2, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      ! The squared deviations of i (or j) over the full grid: NP columns of NP (NP^2 - 1)/12.
+      deviations = real(np, dp)**2*(real(np, dp)**2 - 1)/12
+      b = sums(2)/deviations
+      c = sums(3)/deviations
+      rise = abs(b)*(np - 1) + abs(c)*(np - 1)
+      r = 0
+      do j = 1, size(z, 2)
+         do i = 1, np
+            if (remove) then
+               z(i, j) = z(i, j) - mz - b*(i - mi) - c*(j0 + j - mj)
+            else
+               r(1) = r(1) + (z(i, j) - mz - b*(i - mi) - c*(j0 + j - mj))**2
+            end if
+         end do
+      end do
+      roughness = 0
+      if (.not. remove) then
+         call MPI_Allreduce(MPI_IN_PLACE, r, 1, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+         roughness = sqrt(r(1)/real(np, dp)**2)
+      end if
+   end subroutine distributed_plane
+
+   !> Columns j0 + 1 .. j0 + nj (all NP rows) of the dataset `name` of `path`, each rank
+   !> its own hyperslab, collectively, as map(row, column) (the dataset in C order
+   !> [row][column]). Collective.
+   subroutine read_dataset_part(path, name, comm, np, j0, nj, map, status)
+      character(len=*), intent(in) :: path, name
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: np, j0, nj
+      real(dp), intent(out) :: map(:, :)
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: fapl, dxpl, fid, dset, fspace, mspace
+      integer(hsize_t) :: block(2), offset(2)
+      real(dp), allocatable :: stored(:, :)
+      integer :: error, e(5)
       call h5open_f(error)
       call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, error)
       call h5pset_fapl_mpio_f(fapl, comm%MPI_VAL, MPI_INFO_NULL%MPI_VAL, error)
       call h5fopen_f(path, H5F_ACC_RDONLY_F, fid, error, access_prp=fapl)
       call h5pclose_f(fapl, error)
       if (error /= 0) then
-         call set_error(status, STATUS_IO, path//": cannot open the deck on every rank (MPI-IO)")
+         call set_error(status, STATUS_IO, path//": cannot open it on every rank (MPI-IO)")
          return
       end if
       call h5pcreate_f(H5P_DATASET_XFER_F, dxpl, error)
       call h5pset_dxpl_mpio_f(dxpl, H5FD_MPIO_COLLECTIVE_F, error)
-      call read_map("/lower", lower)
-      call read_map("/upper", upper)
+      block = [integer(hsize_t) :: nj, np]
+      offset = [integer(hsize_t) :: j0, 0]
+      allocate(stored(nj, np))
+      e = 0
+      call h5dopen_f(fid, name, dset, e(1))
+      if (e(1) == 0) call h5dget_space_f(dset, fspace, e(2))
+      if (all(e == 0)) call h5sselect_hyperslab_f(fspace, H5S_SELECT_SET_F, offset, block, e(3))
+      if (all(e == 0)) call h5screate_simple_f(2, block, mspace, e(4))
+      if (all(e == 0)) call h5dread_f(dset, H5T_NATIVE_DOUBLE, stored, block, e(5), mem_space_id=mspace, &
+         file_space_id=fspace, xfer_prp=dxpl)
+      call h5sclose_f(mspace, error)
+      call h5sclose_f(fspace, error)
+      call h5dclose_f(dset, error)
       call h5pclose_f(dxpl, error)
       call h5fclose_f(fid, error)
-   contains
-      !> This rank's columns of one map, as map(row, column).
-      subroutine read_map(name, map)
-         character(len=*), intent(in) :: name
-         real(dp), intent(out) :: map(:, :)
-         integer(hid_t) :: dset, fspace, mspace
-         integer(hsize_t) :: block(2), offset(2)
-         real(dp), allocatable :: stored(:, :)
-         integer :: e(5)
-         if (status%code /= 0) return
-         block = [integer(hsize_t) :: nj, np]
-         offset = [integer(hsize_t) :: j0, 0]
-         allocate(stored(nj, np))
-         e = 0
-         call h5dopen_f(fid, name, dset, e(1))
-         if (e(1) == 0) call h5dget_space_f(dset, fspace, e(2))
-         if (all(e == 0)) call h5sselect_hyperslab_f(fspace, H5S_SELECT_SET_F, offset, block, e(3))
-         if (all(e == 0)) call h5screate_simple_f(2, block, mspace, e(4))
-         if (all(e == 0)) call h5dread_f(dset, H5T_NATIVE_DOUBLE, stored, block, e(5), mem_space_id=mspace, &
-            file_space_id=fspace, xfer_prp=dxpl)
-         call h5sclose_f(mspace, error)
-         call h5sclose_f(fspace, error)
-         call h5dclose_f(dset, error)
-         if (any(e /= 0)) then
-            call set_error(status, STATUS_IO, path//":"//name//": cannot read this rank's columns")
-            return
-         end if
-         map = transpose(stored)
-      end subroutine read_map
-   end subroutine read_columns
+      if (any(e /= 0)) then
+         call set_error(status, STATUS_IO, path//":"//name//": cannot read this rank's columns")
+         return
+      end if
+      map = transpose(stored)
+   end subroutine read_dataset_part
 end module femcod_mpi_input
