@@ -7,6 +7,8 @@ module test_heights
    use femcod_status, only: status_type
    use femcod_strings, only: string_type
    use femcod_heights, only: height_map, read_height_map, is_height_file
+   use femcod_deck, only: read_deck
+   use femcod_problem, only: contact_problem
    use femcod_cli, only: run_femcod
    use test_support, only: scratch_path, write_text, read_text, file_exists, contains_text
    use test_results, only: self_command
@@ -29,7 +31,9 @@ contains
          new_unittest("Gwyddion exports, English and German: metres to nm, width and height", test_gwyddion), &
          new_unittest("run with a Gwyddion export: pixel from the width, units from the header", test_gwyddion_run), &
          new_unittest("--height-unit for plain matrices; refused against a file's own unit", test_height_unit), &
-         new_unittest("a tilt far above the roughness is reported; --remove-plane silences it", test_tilt_warning) &
+         new_unittest("a tilt far above the roughness is reported; --remove-plane silences it", test_tilt_warning), &
+         new_unittest("mkdeck matrix --average N: block means by hand, N times the pixel; a remainder refused", &
+            test_average) &
          ]
    end subroutine collect_heights
 
@@ -281,4 +285,50 @@ contains
       call check(error, code == 0 .and. .not. contains_text(read_text(dir//"/c.err"), "plane rises"), &
          "no tilt: no warning: "//read_text(dir//"/c.err"))
    end subroutine test_tilt_warning
+   !> `femcod mkdeck matrix --file F --pixel 2 --average 3` on a 6 x 6 matrix of heights
+   !> h(i, j) = 10 i + j (nm): a 2 x 2 deck of 6 nm pixels, each the mean of its 3 x 3
+   !> block, 10 (3 I - 1) + (3 J - 1) for block (I, J) (the mean of i is the block's middle
+   !> row, by hand), less the smallest (mkdeck's rough surfaces start at 0): 0, 30, 3, 33
+   !> as rows 1-2, columns 1-2. --average 4 on 6 x 6 is refused (exit 2), no deck written.
+   subroutine test_average(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(status_type) :: status
+      character(len=:), allocatable :: dir, text
+      character(len=8) :: buf
+      integer :: i, j, code
+      dir = scratch_path("average")
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      text = ""
+      do i = 1, 6
+         do j = 1, 6
+            write(buf, '(i0)') 10*i + j
+            text = text//" "//trim(buf)
+         end do
+         text = text//new_line("a")
+      end do
+      call write_text(dir//"/h.txt", text)
+      call run_femcod([string_type("mkdeck"), string_type("matrix"), string_type("--file"), &
+         string_type(dir//"/h.txt"), string_type("--pixel"), string_type("2"), string_type("--average"), &
+         string_type("3"), string_type("-o"), string_type(dir//"/a.deck")], code)
+      call check(error, code, 0, "mkdeck matrix --average 3")
+      if (allocated(error)) return
+      call read_deck(dir//"/a.deck", deck, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, deck%np == 2 .and. deck%pixel == 6, "NP "//to_string(deck%np)//", pixel "// &
+         to_string(deck%pixel)//"; expected 2 and 6 nm")
+      if (allocated(error)) return
+      ! mkdeck puts a height file's surface on the upper body (--shape-on upper).
+      call check(error, all(abs(deck%upper - reshape([0.0_dp, 30.0_dp, 3.0_dp, 33.0_dp], [2, 2])) < 1.0e-12_dp), &
+         "block means "//to_string(deck%upper(1, 1))//" "//to_string(deck%upper(2, 1))//" "// &
+         to_string(deck%upper(1, 2))//" "//to_string(deck%upper(2, 2)))
+      if (allocated(error)) return
+      call run_femcod([string_type("mkdeck"), string_type("matrix"), string_type("--file"), &
+         string_type(dir//"/h.txt"), string_type("--pixel"), string_type("2"), string_type("--average"), &
+         string_type("4"), string_type("-o"), string_type(dir//"/b.deck")], code)
+      call check(error, code, 2, "--average 4 of 6 x 6 heights")
+      if (allocated(error)) return
+      call check(error, .not. file_exists(dir//"/b.deck"), "a refused --average wrote a deck")
+   end subroutine test_average
 end module test_heights

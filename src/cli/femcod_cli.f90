@@ -223,7 +223,9 @@ contains
             mode="self-affine"), &
          real_option("--rms", "S", "rms height in nm (default 1)", lower=0.0_dp, closed="()", mode="self-affine"), &
          text_option("--file", "FILE", "heights: an ASCII matrix (one row per line, '#' comments, Gwyddion export) "// &
-            "or FILE.h5:/dataset (square, C order)", mode="matrix")]
+            "or FILE.h5:/dataset (square, C order)", mode="matrix"), &
+         integer_option("--average", "N", "average N x N blocks of heights into one pixel, as a tip N pixels wide "// &
+            "sees them (section 4.5): NP/N pixels of N times the size (default 1: none)", lower=1, mode="matrix")]
    end function mkdeck_table
 
    subroutine mkdeck_help()
@@ -318,6 +320,7 @@ contains
       end if
       call get_option(parsed, "--label", spec%label)
       call get_option(parsed, "--file", spec%matrix_file)
+      call get_option(parsed, "--average", spec%average)
       text = ""
       call get_option(parsed, "--shape-on", text)
       if (text /= "") spec%shape_on = text

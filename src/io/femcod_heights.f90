@@ -17,7 +17,7 @@ module femcod_heights
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_USAGE
    use femcod_strings, only: string_type, int_str, parse_real, parse_integer, format_real, append_string, sig_str, &
       next_line
-   use femcod_surfaces, only: plane_tilt
+   use femcod_surfaces, only: plane_tilt, block_average
    use femcod_files, only: path_exists, path_is_directory, read_file
    use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close, h5_rank_and_dims
    use femcod_memory, only: physical_memory, memory_text
@@ -283,6 +283,20 @@ contains
       end if
       if (used%pixel < 1.0e-3_dp) call append_string(warned, "a pixel of "//format_real(used%pixel)// &
          " nm: if that is metres, give the size in nm")
+      ! --average N: N x N blocks into one pixel, both surfaces alike.
+      if (spec%average > 1) then
+         if (mod(size(first%z, 1), spec%average) /= 0) then
+            call set_error(status, STATUS_USAGE, "--average "//int_str(spec%average)//": the "// &
+               int_str(size(first%z, 1))//" x "//int_str(size(first%z, 1))//" heights of "//spec%matrix_file// &
+               " are not a whole number of "//int_str(spec%average)//" x "//int_str(spec%average)//" blocks")
+            return
+         end if
+         first%z = block_average(first%z, spec%average)
+         if (size(second) > 0) second = block_average(second, spec%average)
+         used%pixel = used%pixel*spec%average
+         call append_string(lines, int_str(spec%average)//" x "//int_str(spec%average)//" blocks averaged: "// &
+            int_str(size(first%z, 1))//" x "//int_str(size(first%z, 1))//" pixels of "//format_real(used%pixel)//" nm")
+      end if
       ! A tilt far above the roughness is most often the scan's mounting: say so.
       if (.not. spec%plane) then
          call plane_tilt(first%z, rise, roughness)

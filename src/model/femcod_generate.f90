@@ -56,6 +56,8 @@ module femcod_generate
       !> Weierstrass-Mandelbrot eq. (3.6).
       real(dp) :: ds = 2.4_dp, g = 1.36e-2_dp, gamma = 1.5_dp, lmax = 1000, lmin = 1
       logical :: plane = .false.
+      !> Height files: N x N blocks of heights averaged into one pixel (1: none).
+      integer :: average = 1
    end type scene_spec
 
 contains

@@ -13,6 +13,7 @@ module femcod_surfaces
    implicit none
    private
    public :: circle_punch, square_punch, sphere_cap, sinusoid_surface, weierstrass_mandelbrot, wm_terms
+   public :: block_average
    public :: self_affine_surface, self_affine_spectrum, remove_plane, rms_height, downsample_subsample, &
       downsample_average, plane_tilt
 
@@ -362,6 +363,23 @@ contains
       real(dp), allocatable :: w(:, :)
       w = z(1::2, 1::2)
    end function downsample_subsample
+
+   !> Average n x n blocks: an m x m grid (m a multiple of n) -> m/n x m/n, the pixel n
+   !> times larger (an AFM tip of n pixels' width; section 4.5's averaging for any n).
+   pure function block_average(z, n) result(w)
+      real(dp), intent(in) :: z(:, :)
+      integer, intent(in) :: n
+      real(dp), allocatable :: w(:, :)
+      integer :: i, j, m1, m2
+      m1 = size(z, 1)/n
+      m2 = size(z, 2)/n
+      allocate(w(m1, m2))
+      do j = 1, m2
+         do i = 1, m1
+            w(i, j) = sum(z(n*(i - 1) + 1:n*i, n*(j - 1) + 1:n*j))/real(n, dp)**2
+         end do
+      end do
+   end function block_average
 
    !> Average 2 x 2 blocks: NP -> NP/2 (NP even), pixel doubles (section 4.5).
    pure function downsample_average(z) result(w)
