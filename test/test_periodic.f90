@@ -23,6 +23,7 @@ module test_periodic
    use femcod_status, only: STATUS_BAD_INPUT, STATUS_USAGE
    use test_support, only: scratch_path, read_text, file_exists, remove_scratch, missed_final_check_of
    use test_incremental, only: events
+   use test_cg, only: rough_scene
    use oracles, only: event_path
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -49,6 +50,7 @@ contains
             test_event_path), &
          new_unittest("--plastic on a periodic cell, both solvers: capped at H, the load carried, area >= P/H", &
             test_plastic_periodic), &
+         new_unittest("mean gap on a periodic cell: mean(g0) - approach (zero-mean displacements)", test_mean_gap), &
          new_unittest("--approach on the periodic cell: Westergaard's load at the closed-form approach, both; "// &
             "beyond full contact refused", &
             test_approach_westergaard), &
@@ -667,4 +669,35 @@ contains
       call check(error, status%code == STATUS_USAGE .and. index(status%message, "full contact") > 0, &
          "approach 1.01 h0: exit "//to_string(status%code)//", "//status%message)
    end subroutine test_approach_westergaard
+   !> The mean gap cg reports on a periodic cell (summary.json's mean_gap_nm, from its gap
+   !> map). Reference, from the kernel's definition: the periodic Love kernel has no zero-
+   !> frequency term, so the displacements have zero mean over the cell and the mean gap
+   !> is mean(g0) - A exactly, g0 the initial gaps (femcod_scene, summed here) and A the
+   !> approach; to 1e-9 of the height range at --tol 1e-10 (the gaps' error bound).
+   subroutine test_mean_gap(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(status_type) :: status
+      real(dp), allocatable :: g0(:)
+      integer :: k
+      call rough_scene(32, 4, deck)
+      options%solver = SOLVER_CG
+      options%boundary = BOUNDARY_PERIODIC
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-10_dp
+      options%loads = [200.0_dp, 2000.0_dp]
+      call solve_contact(deck, options, res, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      g0 = initial_gaps(deck%lower, deck%upper)
+      do k = 1, 2
+         call check(error, abs(res%states(k)%mean_gap - (sum(g0)/size(g0) - res%states(k)%approach)) <= &
+            1.0e-9_dp*(maxval(g0) - minval(g0)), "load "//to_string(options%loads(k))//": mean gap "// &
+            to_string(res%states(k)%mean_gap)//", mean(g0) - A = "//to_string(sum(g0)/size(g0) - &
+            res%states(k)%approach))
+         if (allocated(error)) return
+      end do
+   end subroutine test_mean_gap
 end module test_periodic

@@ -537,9 +537,9 @@ contains
                int_str(st%cg%convolutions)//', "residual": '//json_number(st%cg%residual)//', "time_s": '// &
                json_number(st%seconds)//', "transform_s": '//json_number(st%transform_seconds)// &
                ', "communication_s": '//json_number(st%communication_seconds)
+            text = text//', "mean_gap_nm": '//json_number(st%mean_gap)
             if (settings%solve%adhesion /= LAW_HARD_WALL) text = text//', "attractive_pixels": '//int_str(st%attractive)// &
-               ', "attractive_load_nN": '//json_number(st%attractive_load)//', "mean_gap_nm": '// &
-               json_number(st%mean_gap)//', "jump": '//int_str(st%jump)
+               ', "attractive_load_nN": '//json_number(st%attractive_load)//', "jump": '//int_str(st%jump)
             if (settings%solve%shear) text = text//', "friction_nN": '//json_number(st%friction)// &
                ', "friction_coefficient": '//json_number(friction_coefficient(st%friction, st%load, st%contacts))
             text = text//'}'

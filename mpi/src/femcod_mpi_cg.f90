@@ -851,7 +851,7 @@ contains
       real(dp), intent(in) :: hardness
       type(shear_model), intent(in) :: shear
       type(distributed_state), intent(inout) :: st
-      real(dp) :: total(5), top(1)
+      real(dp) :: total(6), top(1)
       logical, allocatable :: contact(:, :)
       st%load = answer%load
       st%approach = answer%approach
@@ -888,7 +888,10 @@ contains
       total(1) = count(contact)
       total(2) = count(session%p/grid%pixel**2 > hardness)
       total(5) = friction_force(shear, pack(session%p, contact), grid%pixel)
+      total(6) = sum(st%gap)
       call grid%sum_over_grid(total)
+      ! The mean gap over the grid (nm): the gap variables' own where they ran.
+      if (.not. answer%by_gaps) st%mean_gap = total(6)/real(grid%np, dp)**2
       st%friction = total(5)
       st%contacts = nint(total(1))
       st%above_hardness = nint(total(2))

@@ -737,9 +737,11 @@ contains
                json_number(stick_count(s)*area_pixel)//', "gross_sliding": '//trim(merge("true ", "false", s%sliding))
             if (s%reached .and. info%friction) loads = loads//', "friction_nN": '//json_number(s%friction)// &
                ', "friction_coefficient": '//json_number(friction_coefficient(s%friction, s%load, s%contacts))
+            if (s%reached .and. (has_adhesion(info) .or. info%solver == "cg")) loads = loads//', "mean_gap_nm": '// &
+               json_number(s%mean_gap)
             if (s%reached .and. has_adhesion(info)) loads = loads//', "attractive_pixels": '// &
                int_str(s%attractive)//', "attractive_load_nN": '//json_number(s%attractive_load)// &
-               ', "mean_gap_nm": '//json_number(s%mean_gap)//', "jump": '//int_str(s%jump)
+               ', "jump": '//int_str(s%jump)
             loads = loads//'}'//trim(merge(",", " ", k < size(res%states)))//nl
          end associate
       end do

@@ -355,6 +355,8 @@ contains
          work%split_corrections = answer%rep%split_corrections
          work%plastic_rounds = answer%plastic_rounds
          if (allocated(answer%gap)) call move_alloc(answer%gap, st%gap)
+         ! The mean gap over the grid (nm): the gap variables' own where they ran.
+         if (.not. answer%by_gaps .and. allocated(st%gap)) st%mean_gap = sum(st%gap)/real(size(st%gap), dp)
          if (allocated(answer%plastic)) call move_alloc(answer%plastic, st%plastic)
          st%contacts = count(contact)
          st%max_pressure = 0
@@ -366,7 +368,7 @@ contains
          end if
          st%attractive = answer%attractive
          st%attractive_load = answer%attractive_load
-         st%mean_gap = answer%mean_gap
+         if (answer%by_gaps) st%mean_gap = answer%mean_gap
          call gather_contacts(st, contact, p)
          st%friction = friction_force(run_shear_model(options), st%force, pixel)
          call append_step(res, st%contacts, st%n_above_hardness, st%load, st%approach, seconds, st%friction)
