@@ -12,7 +12,7 @@ module femcod_bench_common
    use femcod_options, only: option_spec, parsed_options, parse_options
    use femcod_analytic, only: segedin_sphere
    use femcod_scene, only: initial_gaps
-   use femcod_files, only: path_exists, canonical_path
+   use femcod_files, only: path_exists, canonical_path, path_is_directory, make_directories
    use femcod_solver_options, only: contact_options, validate_options, requested_states
    use femcod_output_guard, only: guard_outputs
    implicit none
@@ -190,23 +190,18 @@ contains
    subroutine prepare_directory(dir, command, code)
       character(len=*), intent(in) :: dir, command
       integer, intent(inout) :: code
-      integer :: ios
-      logical :: is_dir
+      type(status_type) :: status
       if (code /= 0) return
-      if (path_exists(dir)) then
-         call execute_command_line("test -d '"//dir//"'", exitstat=ios)
-         is_dir = ios == 0
-         if (.not. is_dir) then
-            write(error_unit, '(a)') "femcod bench "//command//": --dir "//dir//": exists and is not a directory"
-            code = 2
-         end if
+      if (path_exists(dir) .and. .not. path_is_directory(dir)) then
+         write(error_unit, '(a)') "femcod bench "//command//": --dir "//dir//": exists and is not a directory"
+         code = 2
          return
       end if
-      call execute_command_line("mkdir -p -- '"//dir//"' 2> /dev/null", exitstat=ios)
-      if (ios /= 0) then
-         write(error_unit, '(a)') "femcod bench "//command//": --dir "//dir//": cannot make the directory"
-         code = 5
-      end if
+      ! femcod_files' make_directories: the OS's reason when a part cannot be made.
+      call make_directories(dir, status)
+      if (status%code == 0) return
+      write(error_unit, '(a)') "femcod bench "//command//": --dir "//status%message
+      code = status%code
    end subroutine prepare_directory
 
    !> The files a bench is about to write (each of kind `kind`, OUTPUT_* of
