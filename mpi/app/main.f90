@@ -28,8 +28,9 @@ program femcod_mpi
    use femcod_run, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
    use femcod_deck_h5, only: is_hdf5_file, read_deck_h5_header
-   use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, read_text_deck_header, slab_rows, &
-      is_dataset_scene, read_dataset_header, read_dataset_columns
+   use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, slab_rows, is_dataset_scene, &
+      read_dataset_header, read_dataset_columns
+   use femcod_deck_stream, only: read_text_deck_header
    use femcod_heights, only: load_scene, height_file_path
    use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_files, only: path_exists, remove_file, atomic_rename, write_file, acquire_lock, release_lock, &

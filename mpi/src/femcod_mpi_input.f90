@@ -33,7 +33,7 @@ module femcod_mpi_input
    use femcod_mpi_results, only: agree
    implicit none
    private
-   public :: read_deck_columns, read_text_deck_columns, read_text_deck_header, slab_rows
+   public :: read_deck_columns, read_text_deck_columns, slab_rows
    public :: is_dataset_scene, read_dataset_header, read_dataset_columns
 
    !> A text deck's slab: at most this many bytes of heights (and at most an eighth of a
@@ -157,17 +157,6 @@ contains
          end do
       end subroutine scatter_surface
    end subroutine read_text_deck_columns
-
-   !> A text deck's header (label, NP, pixel, MAXCONT, materials; no heights), with
-   !> read_deck's checks and messages: its first lines only are read.
-   subroutine read_text_deck_header(path, problem, status)
-      character(len=*), intent(in) :: path
-      type(contact_problem), intent(out) :: problem
-      type(status_type), intent(inout) :: status
-      type(deck_stream) :: stream
-      call open_deck_stream(path, stream, problem, status)
-      call close_deck_stream(stream)
-   end subroutine read_text_deck_header
 
    !> The rows of a text deck's slab on `ranks` ranks: at most SLAB_BYTES of heights and
    !> at most an eighth of one rank's columns (NP / (8 ranks) rows), at least one row.

@@ -17,7 +17,7 @@ module femcod_deck_stream
    use femcod_files, only: path_exists, path_is_directory, os_error_text, clear_write_error
    implicit none
    private
-   public :: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream, CHUNK_BYTES
+   public :: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream, read_text_deck_header, CHUNK_BYTES
 
    !> Bytes read from the file at a time (the buffer holds one chunk and the part of a
    !> token cut at its end).
@@ -40,6 +40,8 @@ module femcod_deck_stream
       integer, allocatable :: first(:), last(:), line(:)
       real(dp), allocatable :: value(:)
       integer :: ntok = 0, used = 0
+      !> The chunk's first token that is not a height (huge: none).
+      integer :: first_bad = huge(0)
       !> The line at the start of the next chunk; the last line that holds anything.
       integer :: line0 = 1, last_line = 1
       !> The file's byte at text(1:1).
@@ -141,12 +143,11 @@ contains
             end if
          end if
          take = min(size(values) - filled, stream%ntok - stream%used)
-         do k = 1, take
-            if (stream%value(stream%used + k) == huge(1.0_dp)) then
-               call refuse_height(stream, stream%used + k, stream%delivered + k, status)
-               return
-            end if
-         end do
+         if (stream%first_bad <= stream%used + take) then
+            k = stream%first_bad - stream%used
+            call refuse_height(stream, stream%first_bad, stream%delivered + k, status)
+            return
+         end if
          values(filled + 1:filled + take) = stream%value(stream%used + 1:stream%used + take)
          filled = filled + take
          stream%used = stream%used + take
@@ -154,6 +155,17 @@ contains
       end do
       if (stream%delivered == total) call expect_end(stream, status)
    end subroutine read_deck_heights
+
+   !> A text deck's header (label, NP, pixel, MAXCONT, materials; no heights), with
+   !> read_deck's checks and messages: only its first lines are read.
+   subroutine read_text_deck_header(path, deck, status)
+      character(len=*), intent(in) :: path
+      type(contact_problem), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      type(deck_stream) :: stream
+      call open_deck_stream(path, stream, deck, status)
+      call close_deck_stream(stream)
+   end subroutine read_text_deck_header
 
    !> The file closed (it may be closed twice).
    subroutine close_deck_stream(stream)
@@ -182,6 +194,7 @@ contains
       character(len=:), allocatable :: bytes
       integer :: n, ios, cut, bad, count, ends, k
       stream%ntok = 0
+      stream%first_bad = huge(0)
       stream%used = 0
       if (stream%at_end .and. len(stream%carry) == 0) return
       n = int(min(int(stream%chunk, i8), stream%size - stream%next + 1))
@@ -221,11 +234,14 @@ contains
       stream%line0 = stream%line0 + ends
       if (len(stream%text) > 0) stream%last_line = last_line_of(stream%text, stream%line0)
       stream%ntok = count
-      !$omp parallel do schedule(static)
+      bad = huge(0)
+      !$omp parallel do schedule(static) reduction(min: bad)
       do k = 1, count
          call read_height(stream%text(stream%first(k):stream%last(k)), stream%value(k))
+         if (stream%value(k) == huge(1.0_dp)) bad = min(bad, k)
       end do
       !$omp end parallel do
+      stream%first_bad = bad
    end subroutine load_chunk
 
    !> A token as a height: its value, or huge when it is not a finite number within
