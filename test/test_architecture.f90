@@ -1,5 +1,5 @@
 !> The shape of src/ (doc/architecture.md): the layers core < model < legacy < solvers <
-!> io < studies < cli, each a folder; a module uses only its own layer and those below.
+!> io < studies < cli < capi, each a folder; a module uses only its own layer and those below.
 !> femcod-mpi's modules (mpi/src, built apart with MPI) are one more layer on top, and the
 !> programs with their benchmarks (app/, mpi/app/) the last: nothing below uses them.
 !> The numerical core keeps no state between calls (no module-level save variables) and
@@ -13,8 +13,8 @@ module test_architecture
    private
    public :: collect_architecture
 
-   character(len=*), parameter :: LAYERS(9) = [character(len=7) :: "core", "model", "legacy", "solvers", "io", &
-      "studies", "cli", "mpi", "app"]
+   character(len=*), parameter :: LAYERS(10) = [character(len=7) :: "core", "model", "legacy", "solvers", "io", &
+      "studies", "cli", "capi", "mpi", "app"]
 
    !> The longest a routine may be (lines, from its first line to its end statement, its
    !> contained procedures included).

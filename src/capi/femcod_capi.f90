@@ -1,0 +1,598 @@
+!> femcod as a C library (libfemcod.so, header capi/femcod.h): the top layer, over the run
+!> options (cli), the deck readers and writers (io) and the one solver interface
+!> (solvers/femcod_solver). A caller makes a session, gives it a problem (height arrays
+!> and materials, or a deck file), sets `femcod run`'s options by name, solves, and
+!> copies the results into arrays it owns. Nothing here prints or stops: every function
+!> returns a status code with the exit codes' meanings (0 ok, 2 usage, 3 bad input,
+!> 4 numerical failure or memory, 5 I/O, 6 stopped by the progress callback) and keeps
+!> the message of the last failure in the session (femcod_message).
+!>
+!> Arrays cross in C order, as in the HDF5 files: `a[i*np + j]` is row i, column j.
+!> Heights in nm, pixel in nm, moduli in GPa, loads in nN.
+!>
+!> A session is an opaque C pointer to a Fortran object: C holds no Fortran type, and a
+!> pointer is the one way to hand an object's address across (femcod_create allocates
+!> it, femcod_destroy frees it).
+module femcod_capi
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double, c_char, c_ptr, c_funptr, c_null_ptr, &
+      c_null_char, c_null_funptr, c_loc, c_f_pointer, c_f_procpointer, c_associated, c_size_t
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT
+   use femcod_strings, only: string_type, int_str
+   use femcod_about, only: VERSION_TEXT => FEMCOD_VERSION
+   use femcod_problem, only: contact_problem, validate_problem
+   use femcod_generate, only: scene_spec, build_problem
+   use femcod_deck, only: read_deck, write_deck
+   use femcod_heights, only: load_scene
+   use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
+   !$ use omp_lib, only: omp_set_num_threads
+   use femcod_library_session, only: library_session, solve_session, state_value, state_value_names, &
+      history_column, HISTORY_COLUMNS, map_of, map_names
+   implicit none
+   private
+   public :: femcod_create, femcod_destroy, femcod_version, femcod_message, femcod_set_heights, femcod_set_problem, &
+      femcod_read_deck, femcod_write_deck, femcod_problem_size, femcod_get_problem, femcod_get_label, &
+      femcod_set_option, femcod_clear_options, femcod_solve, femcod_state_count, femcod_state_value, &
+      femcod_value_names, femcod_state_map, femcod_history_length, femcod_history, femcod_set_threads, &
+      femcod_read_heights, femcod_warnings
+
+   !> Longest C string read from a caller (a path, an option's value).
+   integer, parameter :: MAX_C_STRING = 1048576
+
+contains
+
+   !> A new session, or NULL when there is no memory for it.
+   function femcod_create() result(handle) bind(C, name="femcod_create")
+      type(c_ptr) :: handle
+      type(library_session), pointer :: session
+      integer :: stat
+      allocate(session, stat=stat)
+      handle = c_null_ptr
+      if (stat /= 0) return
+      session%message = ""
+      allocate(session%args(0))
+      handle = c_loc(session)
+   end function femcod_create
+
+   !> Free a session and everything it holds (NULL: nothing).
+   subroutine femcod_destroy(handle) bind(C, name="femcod_destroy")
+      type(c_ptr), value :: handle
+      type(library_session), pointer :: session
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      deallocate(session)
+   end subroutine femcod_destroy
+
+   !> femcod's version into `text` (`length` bytes with the terminating NUL).
+   integer(c_int) function femcod_version(text, length) bind(C, name="femcod_version")
+      character(kind=c_char), intent(out) :: text(*)
+      integer(c_size_t), value :: length
+      femcod_version = copy_out(VERSION_TEXT, text, length)
+   end function femcod_version
+
+   !> The message of the session's last failure ("" after a success).
+   integer(c_int) function femcod_message(handle, text, length) bind(C, name="femcod_message")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(out) :: text(*)
+      integer(c_size_t), value :: length
+      type(library_session), pointer :: session
+      femcod_message = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      femcod_message = copy_out(session%message, text, length)
+   end function femcod_message
+
+   !> The problem of `femcod run --lower L [--upper U] --pixel D --young E --poisson NU`:
+   !> the surface given alone is the elastic body's (lower), the other body rigid and
+   !> flat; with `upper` (not NULL) both are rough. Each surface is taken from its
+   !> lowest point. MAXCONT <= 0: 5 % of NP^2.
+   integer(c_int) function femcod_set_heights(handle, np, pixel, lower, upper, young, poisson, maxcont) &
+      bind(C, name="femcod_set_heights")
+      type(c_ptr), value :: handle
+      integer(c_int), value :: np, maxcont
+      real(c_double), value :: pixel, young, poisson
+      real(c_double), intent(in) :: lower(*)
+      type(c_ptr), value :: upper
+      type(library_session), pointer :: session
+      type(scene_spec) :: spec
+      type(status_type) :: st
+      real(c_double), pointer :: top(:)
+      femcod_set_heights = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      call forget_problem(session)
+      if (np <= 0) call set_error(st, STATUS_BAD_INPUT, "np must be positive, found "//int_str(int(np)))
+      if (st%code == 0) then
+         spec%kind = "matrix"
+         spec%label = "femcod library"
+         spec%pixel = pixel
+         spec%young = young
+         spec%poisson = poisson
+         spec%maxcont = max(0, int(maxcont))
+         spec%matrix_file = "the lower heights"
+         spec%second_file = ""
+         spec%shape_on = "lower"
+         if (c_associated(upper)) then
+            call c_f_pointer(upper, top, [int(np)*int(np)])
+            spec%matrix_file = "the upper heights"
+            spec%second_file = "the lower heights"
+            spec%shape_on = "upper"
+            call build_problem(spec, session%problem, st, c_order(top, int(np)), c_order(lower, int(np)))
+         else
+            call build_problem(spec, session%problem, st, c_order(lower, int(np)))
+         end if
+      end if
+      femcod_set_heights = finish_problem(session, st)
+   end function femcod_set_heights
+
+   !> A problem as a deck gives it: both height maps, the three moduli and Poisson's
+   !> ratios (lower, upper, contact elements), MAXCONT and a one-line label.
+   integer(c_int) function femcod_set_problem(handle, np, pixel, lower, upper, young, poisson, maxcont, label) &
+      bind(C, name="femcod_set_problem")
+      type(c_ptr), value :: handle
+      integer(c_int), value :: np, maxcont
+      real(c_double), value :: pixel
+      real(c_double), intent(in) :: lower(*), upper(*), young(3), poisson(3)
+      character(kind=c_char), intent(in) :: label(*)
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      femcod_set_problem = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      call forget_problem(session)
+      if (np <= 0) then
+         call set_error(st, STATUS_BAD_INPUT, "np must be positive, found "//int_str(int(np)))
+      else
+         associate(p => session%problem)
+            p%label = from_c(label)
+            p%np = np
+            p%pixel = pixel
+            p%maxcont = maxcont
+            p%young = young
+            p%poisson = poisson
+            p%lower = c_order(lower, int(np))
+            p%upper = c_order(upper, int(np))
+         end associate
+         call validate_problem(session%problem, st)
+      end if
+      femcod_set_problem = finish_problem(session, st)
+   end function femcod_set_problem
+
+   !> The problem of a deck file (text or HDF5), read with femcod run's checks.
+   integer(c_int) function femcod_read_deck(handle, path) bind(C, name="femcod_read_deck")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(in) :: path(*)
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      femcod_read_deck = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      call forget_problem(session)
+      call read_deck(from_c(path), session%problem, st)
+      femcod_read_deck = finish_problem(session, st)
+   end function femcod_read_deck
+
+   !> The problem of `femcod run --lower PATH [--pixel D] [--remove-plane] --young E
+   !> --poisson NU`: a height file (an ASCII matrix or Gwyddion export, FILE.h5:/DATASET,
+   !> a NanoScope file FILE[:CHANNEL]) on an elastic body against a rigid flat. pixel <= 0:
+   !> the file's own. What run warns of (a tilt, a guessed unit) is in femcod_warnings.
+   integer(c_int) function femcod_read_heights(handle, path, pixel, remove_plane, young, poisson) &
+      bind(C, name="femcod_read_heights")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(in) :: path(*)
+      real(c_double), value :: pixel, young, poisson
+      integer(c_int), value :: remove_plane
+      type(library_session), pointer :: session
+      type(scene_spec) :: spec
+      type(status_type) :: st
+      type(string_type), allocatable :: notes(:), warnings(:)
+      integer :: k
+      femcod_read_heights = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      call forget_problem(session)
+      spec%kind = "matrix"
+      spec%matrix_file = from_c(path)
+      spec%second_file = ""
+      spec%shape_on = "lower"
+      spec%label = "femcod library: "//spec%matrix_file
+      spec%pixel = max(0.0_dp, pixel)
+      spec%plane = remove_plane /= 0
+      spec%young = young
+      spec%poisson = poisson
+      call load_scene(spec, session%problem, st, notes, warnings)
+      session%warnings = ""
+      if (allocated(warnings)) then
+         do k = 1, size(warnings)
+            session%warnings = session%warnings//warnings(k)%s//new_line("a")
+         end do
+      end if
+      femcod_read_heights = finish_problem(session, st)
+   end function femcod_read_heights
+
+   !> What the last read of heights warned of, one warning per line ("": nothing).
+   integer(c_int) function femcod_warnings(handle, text, length) bind(C, name="femcod_warnings")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(out) :: text(*)
+      integer(c_size_t), value :: length
+      type(library_session), pointer :: session
+      femcod_warnings = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      if (.not. allocated(session%warnings)) session%warnings = ""
+      femcod_warnings = copy_out(session%warnings, text, length)
+   end function femcod_warnings
+
+   !> Write the session's problem as a deck (a name ending in .h5: the HDF5 deck),
+   !> atomically. An existing file is replaced only with `force` /= 0, and only if femcod
+   !> wrote it (femcod mkdeck's rule).
+   integer(c_int) function femcod_write_deck(handle, path, force) bind(C, name="femcod_write_deck")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_int), value :: force
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      character(len=:), allocatable :: name
+      femcod_write_deck = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      name = from_c(path)
+      if (.not. session%has_problem) call set_error(st, STATUS_USAGE, "no problem to write: set one first")
+      call guard_outputs([string_type(name)], [string_type :: ], force /= 0, OUTPUT_DECK, st)
+      if (st%code == 0) call write_deck(name, session%problem, st)
+      femcod_write_deck = finish(session, st)
+   end function femcod_write_deck
+
+   !> NP of the session's problem (0: none).
+   integer(c_int) function femcod_problem_size(handle, np) bind(C, name="femcod_problem_size")
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: np
+      type(library_session), pointer :: session
+      np = 0
+      femcod_problem_size = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      if (session%has_problem) np = session%problem%np
+      femcod_problem_size = 0
+   end function femcod_problem_size
+
+   !> The session's problem into caller arrays: pixel, MAXCONT, the three moduli and
+   !> ratios, and the NP x NP heights (C order).
+   integer(c_int) function femcod_get_problem(handle, pixel, maxcont, young, poisson, lower, upper) &
+      bind(C, name="femcod_get_problem")
+      type(c_ptr), value :: handle
+      real(c_double), intent(out) :: pixel, young(3), poisson(3), lower(*), upper(*)
+      integer(c_int), intent(out) :: maxcont
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      integer :: n
+      femcod_get_problem = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      if (.not. session%has_problem) then
+         call set_error(st, STATUS_USAGE, "no problem: set one or read a deck first")
+      else
+         associate(p => session%problem)
+            n = p%np
+            pixel = p%pixel
+            maxcont = p%maxcont
+            young = p%young
+            poisson = p%poisson
+            call to_c_order(p%lower, lower(1:n*n))
+            call to_c_order(p%upper, upper(1:n*n))
+         end associate
+      end if
+      femcod_get_problem = finish(session, st)
+   end function femcod_get_problem
+
+   !> The problem's label into `text`.
+   integer(c_int) function femcod_get_label(handle, text, length) bind(C, name="femcod_get_label")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(out) :: text(*)
+      integer(c_size_t), value :: length
+      type(library_session), pointer :: session
+      femcod_get_label = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      if (.not. session%has_problem) return
+      femcod_get_label = copy_out(session%problem%label, text, length)
+   end function femcod_get_label
+
+   !> Add one of `femcod run`'s options by its name ("--solver") and value ("cg"; "" for
+   !> a flag such as "--plastic"). The rules between options are checked at the solve,
+   !> by run's own parser, before any work.
+   integer(c_int) function femcod_set_option(handle, name, value) bind(C, name="femcod_set_option")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(in) :: name(*), value(*)
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      character(len=:), allocatable :: key, text
+      femcod_set_option = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      key = from_c(name)
+      text = from_c(value)
+      session%args = [session%args, string_type(key)]
+      if (len(text) > 0) session%args = [session%args, string_type(text)]
+      femcod_set_option = finish(session, st)
+   end function femcod_set_option
+
+   !> Forget every option set.
+   integer(c_int) function femcod_clear_options(handle) bind(C, name="femcod_clear_options")
+      type(c_ptr), value :: handle
+      type(library_session), pointer :: session
+      femcod_clear_options = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      session%args = [string_type :: ]
+      femcod_clear_options = 0
+   end function femcod_clear_options
+
+   !> Solve the session's problem with its options. `progress` (may be NULL) is called
+   !> after every step or state and, while the solver iterates, at least every 0.1 s:
+   !> int progress(int step, int contacts, double load_nN, double seconds, void *user);
+   !> a non-zero return stops the solve, which then returns 6 and keeps no result.
+   integer(c_int) function femcod_solve(handle, progress, user) bind(C, name="femcod_solve")
+      type(c_ptr), value :: handle
+      type(c_funptr), value :: progress
+      type(c_ptr), value :: user
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      femcod_solve = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      call solve_session(session, progress, user, st)
+      femcod_solve = finish(session, st)
+   end function femcod_solve
+
+   !> The threads of the solvers and FFTW for the whole process (OpenMP's
+   !> omp_set_num_threads; the default is OMP_NUM_THREADS or every core).
+   integer(c_int) function femcod_set_threads(threads) bind(C, name="femcod_set_threads")
+      integer(c_int), value :: threads
+      femcod_set_threads = STATUS_USAGE
+      if (threads < 1) return
+      !$ call omp_set_num_threads(int(threads))
+      femcod_set_threads = 0
+   end function femcod_set_threads
+
+   !> The number of states of the last solve (one per load or approach asked; for the
+   !> event solvers without --loads, the last step).
+   integer(c_int) function femcod_state_count(handle, count) bind(C, name="femcod_state_count")
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: count
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      count = 0
+      femcod_state_count = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      if (.not. session%solved) then
+         call set_error(st, STATUS_USAGE, "no result: solve first")
+      else if (allocated(session%res%states)) then
+         count = size(session%res%states)
+      end if
+      femcod_state_count = finish(session, st)
+   end function femcod_state_count
+
+   !> The names (comma-separated) of what the last solve has: `kind` 0 the state values
+   !> (femcod_state_value), 1 the maps (femcod_state_map), 2 the history columns.
+   integer(c_int) function femcod_value_names(handle, kind, text, length) bind(C, name="femcod_value_names")
+      type(c_ptr), value :: handle
+      integer(c_int), value :: kind
+      character(kind=c_char), intent(out) :: text(*)
+      integer(c_size_t), value :: length
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      femcod_value_names = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      if (.not. session%solved) then
+         call set_error(st, STATUS_USAGE, "no result: solve first")
+         femcod_value_names = finish(session, st)
+         return
+      end if
+      select case (kind)
+      case (0)
+         femcod_value_names = copy_out(state_value_names(session), text, length)
+      case (1)
+         femcod_value_names = copy_out(map_names(session), text, length)
+      case (2)
+         femcod_value_names = copy_out(HISTORY_COLUMNS, text, length)
+      case default
+         call set_error(st, STATUS_USAGE, "kind must be 0 (state values), 1 (maps) or 2 (history)")
+         femcod_value_names = finish(session, st)
+      end select
+   end function femcod_value_names
+
+   !> One number of state k (1-based) by name (femcod_value_names 0; counts as reals).
+   integer(c_int) function femcod_state_value(handle, k, name, value) bind(C, name="femcod_state_value")
+      type(c_ptr), value :: handle
+      integer(c_int), value :: k
+      character(kind=c_char), intent(in) :: name(*)
+      real(c_double), intent(out) :: value
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      value = 0
+      femcod_state_value = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      call check_state(session, int(k), st)
+      if (st%code == 0) call state_value(session, int(k), from_c(name), value, st)
+      femcod_state_value = finish(session, st)
+   end function femcod_state_value
+
+   !> One NP x NP map of state k by name ("pressure" GPa, "gap" nm, "plastic_displacement"
+   !> nm) into `out` (C order, `size` doubles, which must be NP^2).
+   integer(c_int) function femcod_state_map(handle, k, name, out, size) bind(C, name="femcod_state_map")
+      type(c_ptr), value :: handle
+      integer(c_int), value :: k
+      character(kind=c_char), intent(in) :: name(*)
+      integer(c_int64_t), value :: size
+      real(c_double), intent(out) :: out(*)
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      real(dp), allocatable :: map(:, :)
+      integer :: n
+      femcod_state_map = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      call check_state(session, int(k), st)
+      if (st%code == 0) then
+         n = session%problem%np
+         if (size /= int(n, c_int64_t)**2) then
+            call set_error(st, STATUS_USAGE, "the map needs NP^2 = "//int_str(n*n)//" doubles")
+         else
+            call map_of(session, int(k), from_c(name), map, st)
+            if (st%code == 0) call to_c_order(map, out(1:n*n))
+         end if
+      end if
+      femcod_state_map = finish(session, st)
+   end function femcod_state_map
+
+   !> The number of steps in the history of the last solve.
+   integer(c_int) function femcod_history_length(handle, steps) bind(C, name="femcod_history_length")
+      type(c_ptr), value :: handle
+      integer(c_int), intent(out) :: steps
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      steps = 0
+      femcod_history_length = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      if (.not. session%solved) call set_error(st, STATUS_USAGE, "no result: solve first")
+      if (st%code == 0) steps = session%res%nsteps
+      femcod_history_length = finish(session, st)
+   end function femcod_history_length
+
+   !> One column of the history (femcod_value_names 2) into `out` (`size` doubles, the
+   !> history's length).
+   integer(c_int) function femcod_history(handle, name, out, size) bind(C, name="femcod_history")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(in) :: name(*)
+      integer(c_int64_t), value :: size
+      real(c_double), intent(out) :: out(*)
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      real(dp), allocatable :: column(:)
+      femcod_history = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      if (.not. session%solved) call set_error(st, STATUS_USAGE, "no result: solve first")
+      if (st%code == 0) call history_column(session, from_c(name), column, st)
+      if (st%code == 0) then
+         if (size /= int(session%res%nsteps, c_int64_t)) then
+            call set_error(st, STATUS_USAGE, "the history has "//int_str(session%res%nsteps)//" steps")
+         else
+            out(1:session%res%nsteps) = column
+         end if
+      end if
+      femcod_history = finish(session, st)
+   end function femcod_history
+
+   ! ---- helpers ----
+
+   !> A state index within the last solve.
+   subroutine check_state(session, k, st)
+      type(library_session), intent(in) :: session
+      integer, intent(in) :: k
+      type(status_type), intent(inout) :: st
+      if (.not. session%solved) then
+         call set_error(st, STATUS_USAGE, "no result: solve first")
+      else if (k < 1 .or. k > size(session%res%states)) then
+         call set_error(st, STATUS_USAGE, "state "//int_str(k)//" does not exist (1 to "// &
+            int_str(size(session%res%states))//")")
+      end if
+   end subroutine check_state
+
+   !> A new problem makes the last result stale.
+   subroutine forget_problem(session)
+      type(library_session), intent(inout) :: session
+      type(contact_problem) :: none
+      session%has_problem = .false.
+      session%solved = .false.
+      session%problem = none
+   end subroutine forget_problem
+
+   integer(c_int) function finish_problem(session, st)
+      type(library_session), intent(inout) :: session
+      type(status_type), intent(in) :: st
+      session%has_problem = st%code == 0
+      finish_problem = finish(session, st)
+   end function finish_problem
+
+   !> The status as a return code, its message kept in the session.
+   integer(c_int) function finish(session, st)
+      type(library_session), intent(inout) :: session
+      type(status_type), intent(in) :: st
+      finish = st%code
+      session%message = ""
+      if (st%code /= 0) session%message = st%message
+   end function finish
+
+   !> A NUL-terminated C string as Fortran text (at most MAX_C_STRING characters).
+   function from_c(text) result(s)
+      character(kind=c_char), intent(in) :: text(*)
+      character(len=:), allocatable :: s
+      integer :: n, k
+      n = 0
+      do while (n < MAX_C_STRING)
+         if (text(n + 1) == c_null_char) exit
+         n = n + 1
+      end do
+      allocate(character(len=n) :: s)
+      do k = 1, n
+         s(k:k) = text(k)
+      end do
+   end function from_c
+
+   !> Copy `s` into a C buffer of `length` bytes, NUL-terminated; 2 (usage) when it does
+   !> not fit (the buffer then holds as much as fits).
+   integer(c_int) function copy_out(s, text, length)
+      character(len=*), intent(in) :: s
+      character(kind=c_char), intent(out) :: text(*)
+      integer(c_size_t), intent(in) :: length
+      integer :: n, k
+      copy_out = 0
+      if (length < 1) then
+         copy_out = STATUS_USAGE
+         return
+      end if
+      n = len(s)
+      if (int(n, c_size_t) >= length) then
+         n = int(length) - 1
+         copy_out = STATUS_USAGE
+      end if
+      do k = 1, n
+         text(k) = s(k:k)
+      end do
+      text(n + 1) = c_null_char
+   end function copy_out
+
+   !> A C-order NP x NP array (a[i*np + j] is row i, column j) as the map (i, j): the one
+   !> copy of a caller's heights into the problem.
+   function c_order(a, np) result(map)
+      real(c_double), intent(in) :: a(*)
+      integer, intent(in) :: np
+      real(dp), allocatable :: map(:, :)
+      integer :: i, j
+      allocate(map(np, np))
+      do i = 1, np
+         do j = 1, np
+            map(i, j) = a((i - 1)*np + j)
+         end do
+      end do
+   end function c_order
+
+   !> The map (i, j) into a C-order array.
+   subroutine to_c_order(map, a)
+      real(dp), intent(in) :: map(:, :)
+      real(c_double), intent(out) :: a(:)
+      integer :: i, j, np
+      np = size(map, 1)
+      do i = 1, np
+         do j = 1, np
+            a((i - 1)*np + j) = map(i, j)
+         end do
+      end do
+   end subroutine to_c_order
+end module femcod_capi

@@ -1,0 +1,317 @@
+!> What a library caller holds between calls (capi/femcod_capi): the problem, the
+!> options given by name, and the result of the last solve with its maps. The solve goes
+!> through `femcod run`'s own parser and rules (cli/femcod_run's parse_run_arguments) and
+!> the one solver interface, so a combination the command refuses is refused here with
+!> the same words, and an answer is the command's to the last bit.
+module femcod_library_session
+   use, intrinsic :: iso_c_binding, only: c_int, c_double, c_ptr, c_funptr, c_null_ptr, c_associated, &
+      c_f_procpointer
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_INTERRUPTED
+   use femcod_strings, only: string_type, int_str
+   use femcod_clock, only: wall_clock
+   use femcod_memory, only: available_memory
+   use femcod_problem, only: contact_problem
+   use femcod_contact_result, only: contact_result, cg_work, cg_state_diagnostics
+   use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL
+   use femcod_shear_model, only: friction_coefficient
+   use femcod_observer, only: solver_observer
+   use femcod_solver, only: solve_contact
+   use femcod_maps, only: load_maps, state_maps
+   use femcod_options, only: option_spec, FLAG
+   use femcod_run, only: run_table, run_settings, parse_run_arguments
+   implicit none
+   private
+   public :: library_session, solve_session, state_value, state_value_names, map_of, map_names, history_column, &
+      HISTORY_COLUMNS, LIBRARY_OPTIONS
+
+   !> `femcod run`'s options that a library call takes: the solver's. The others name
+   !> files, the run's printing or its checkpoints, or build the scene from files (the
+   !> library's caller gives the arrays).
+   character(len=*), parameter :: LIBRARY_OPTIONS(*) = [character(len=20) :: "--solver", "--loads", "--approach", &
+      "--hardness", "--boundary", "--plastic", "--max-contacts", "--no-final-check", "--event-search", "--tol", &
+      "--max-iterations", "--kernel-radius", "--adhesion", "--work", "--range", "--shear-strength", &
+      "--shear-slope", "--tangential", "--slip", "--friction"]
+   !> The history's columns (femcod_history).
+   character(len=*), parameter :: HISTORY_COLUMNS = "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,"// &
+      "n_above_hardness"
+   !> The least interval between two calls of the caller's progress function while a
+   !> solver iterates (s).
+   real(dp), parameter :: CALLBACK_INTERVAL = 0.1_dp
+
+   !> One caller's problem, options and last result.
+   type :: library_session
+      type(contact_problem) :: problem
+      logical :: has_problem = .false.
+      !> The options as `femcod run` takes them: names and values in order.
+      type(string_type), allocatable :: args(:)
+      !> The last solve: its options, result and maps (solved: they hold one).
+      type(contact_options) :: options
+      type(contact_result) :: res
+      type(state_maps), allocatable :: maps(:)
+      logical :: solved = .false.
+      !> The message of the last failure; what the last read of heights warned of.
+      character(len=:), allocatable :: message, warnings
+   end type library_session
+
+   abstract interface
+      !> The caller's progress function: non-zero stops the solve.
+      integer(c_int) function progress_function(step, contacts, load, seconds, user) bind(C)
+         import :: c_int, c_double, c_ptr
+         integer(c_int), value :: step, contacts
+         real(c_double), value :: load, seconds
+         type(c_ptr), value :: user
+      end function progress_function
+   end interface
+
+   !> Hands the solver's progress to the caller's function, which may ask it to stop.
+   type, extends(solver_observer) :: library_observer
+      procedure(progress_function), pointer, nopass :: callback => null()
+      type(c_ptr) :: user = c_null_ptr
+      integer :: step = 0, contacts = 0
+      real(dp) :: load = 0, started = 0, last_call = 0
+      logical :: stopped = .false.
+   contains
+      procedure :: progress => tell_progress
+      procedure :: stop_requested => caller_stops
+      procedure :: call_back
+   end type library_observer
+
+contains
+
+   !> Solve the session's problem with its options; the result and its maps replace the
+   !> last ones (none are kept after a failure).
+   subroutine solve_session(session, progress, user, st)
+      type(library_session), intent(inout) :: session
+      type(c_funptr), intent(in) :: progress
+      type(c_ptr), intent(in) :: user
+      type(status_type), intent(inout) :: st
+      type(run_settings) :: settings
+      type(library_observer) :: observer
+      type(contact_options) :: options
+      type(contact_result) :: empty
+      session%solved = .false.
+      session%res = empty
+      if (allocated(session%maps)) deallocate(session%maps)
+      if (.not. session%has_problem) then
+         call set_error(st, STATUS_USAGE, "no problem: set one or read a deck first")
+         return
+      end if
+      call refuse_file_options(session%args, st)
+      if (st%code /= 0) return
+      ! run's parser wants a deck: a stand-in name, never opened.
+      call parse_run_arguments([session%args, string_type("arrays")], settings, st)
+      if (st%code /= 0) return
+      options = settings%solve
+      options%checkpoint_interval = -1
+      options%memory_available = available_memory()
+      if (c_associated(progress)) call c_f_procpointer(progress, observer%callback)
+      observer%user = user
+      call wall_clock(observer%started)
+      observer%last_call = observer%started
+      call solve_contact(session%problem, options, session%res, st, observer)
+      if (observer%stopped .and. st%code == STATUS_INTERRUPTED) st%message = "stopped by the progress function"
+      if (st%code /= 0) then
+         session%res = empty
+         return
+      end if
+      call load_maps(session%problem, session%res%states, session%maps, options%boundary == BOUNDARY_PERIODIC)
+      session%options = options
+      session%solved = .true.
+   end subroutine solve_session
+
+   !> Refuse run's options that are not the solver's (LIBRARY_OPTIONS), with the reason.
+   subroutine refuse_file_options(args, st)
+      type(string_type), intent(in) :: args(:)
+      type(status_type), intent(inout) :: st
+      type(option_spec), allocatable :: table(:)
+      integer :: i, k
+      table = run_table()
+      i = 1
+      do while (i <= size(args))
+         do k = 1, size(table)
+            if (args(i)%s == table(k)%name) exit
+            if (allocated(table(k)%alias)) then
+               if (table(k)%alias /= "" .and. args(i)%s == table(k)%alias) exit
+            end if
+         end do
+         if (k <= size(table)) then
+            if (.not. any(LIBRARY_OPTIONS == table(k)%name)) then
+               call set_error(st, STATUS_USAGE, table(k)%name//" is an option of the femcod command, not of the "// &
+                  "library: the caller gives the arrays and keeps the results (library options: "// &
+                  joined_options()//")")
+               return
+            end if
+            if (table(k)%kind /= FLAG) i = i + 1
+         end if
+         i = i + 1
+      end do
+   end subroutine refuse_file_options
+
+   function joined_options() result(text)
+      character(len=:), allocatable :: text
+      integer :: k
+      text = trim(LIBRARY_OPTIONS(1))
+      do k = 2, size(LIBRARY_OPTIONS)
+         text = text//" "//trim(LIBRARY_OPTIONS(k))
+      end do
+   end function joined_options
+
+   !> The names of the state values the last solve has (comma-separated).
+   function state_value_names(session) result(names)
+      type(library_session), intent(in) :: session
+      character(len=:), allocatable :: names
+      names = "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
+         "plastic_volume_nm3,reached"
+      associate(o => session%options)
+         if (o%adhesion /= LAW_HARD_WALL) names = names//",attractive_pixels,attractive_load_nN,jump"
+         if (o%solver == SOLVER_CG) names = names//",mean_gap_nm,cg_iterations,cg_residual,cg_penetration_nm,"// &
+            "cg_contact_gap_nm,cg_load_error,approach_error_bound_nm"
+         if (o%shear) names = names//",friction_nN,friction_coefficient"
+         if (o%tangential) names = names//",tangential_force_nN,tangential_force_y_nN,tangential_shift_nm,"// &
+            "tangential_shift_y_nm,gross_sliding,tangential_iterations"
+      end associate
+   end function state_value_names
+
+   !> State k's value `name` (as femcod run's loads.csv and PREFIX.h5 compute it).
+   subroutine state_value(session, k, name, value, st)
+      type(library_session), intent(in) :: session
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      real(c_double), intent(out) :: value
+      type(status_type), intent(inout) :: st
+      real(dp) :: area_pixel, region
+      type(cg_state_diagnostics) :: work
+      value = 0
+      if (index(","//state_value_names(session)//",", ","//name//",") == 0) then
+         call set_error(st, STATUS_USAGE, "no state value '"//name//"' in this result (it has: "// &
+            state_value_names(session)//")")
+         return
+      end if
+      area_pixel = session%problem%pixel**2
+      region = session%problem%np**2*area_pixel
+      work = cg_work(session%res, k)
+      associate(s => session%res%states(k))
+         select case (name)
+         case ("load_nN"); value = s%load
+         case ("approach_nm"); value = s%approach
+         case ("contacts"); value = s%contacts
+         case ("area_nm2"); value = s%contacts*area_pixel
+         case ("area_fraction"); value = s%contacts*area_pixel/region
+         case ("max_pressure_GPa"); value = s%max_pressure
+         case ("n_above_hardness"); value = s%n_above_hardness
+         case ("n_plastic"); value = s%n_plastic
+         case ("plastic_volume_nm3"); value = s%plastic_volume
+         case ("reached"); value = merge(1, 0, s%reached)
+         case ("attractive_pixels"); value = s%attractive
+         case ("attractive_load_nN"); value = s%attractive_load
+         case ("mean_gap_nm"); value = s%mean_gap
+         case ("jump"); value = s%jump
+         case ("friction_nN"); value = s%friction
+         case ("friction_coefficient"); value = friction_coefficient(s%friction, s%load, s%contacts)
+         case ("tangential_force_nN"); value = s%tangential_force(1)
+         case ("tangential_force_y_nN"); value = s%tangential_force(2)
+         case ("tangential_shift_nm"); value = s%tangential_shift(1)
+         case ("tangential_shift_y_nm"); value = s%tangential_shift(2)
+         case ("gross_sliding"); value = merge(1, 0, s%sliding)
+         case ("tangential_iterations"); value = s%tangential_iterations
+         case ("cg_iterations"); value = work%iterations
+         case ("cg_residual"); value = work%residual
+         case ("cg_penetration_nm"); value = work%penetration
+         case ("cg_contact_gap_nm"); value = work%contact_gap
+         case ("cg_load_error"); value = work%load_error
+         case ("approach_error_bound_nm"); value = work%approach_bound
+         end select
+      end associate
+   end subroutine state_value
+
+   !> The names of the maps the last solve has.
+   function map_names(session) result(names)
+      type(library_session), intent(in) :: session
+      character(len=:), allocatable :: names
+      names = "pressure,gap"
+      if (session%options%plastic) names = names//",plastic_displacement"
+   end function map_names
+
+   !> State k's map `name` (NP x NP, (i, j) row i column j).
+   subroutine map_of(session, k, name, map, st)
+      type(library_session), intent(in) :: session
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      real(dp), allocatable, intent(out) :: map(:, :)
+      type(status_type), intent(inout) :: st
+      if (.not. session%res%states(k)%reached) then
+         call set_error(st, STATUS_USAGE, "state "//int_str(k)//" was not reached: it has no maps")
+         return
+      end if
+      select case (name)
+      case ("pressure")
+         map = session%maps(k)%pressure
+      case ("gap")
+         map = session%maps(k)%gap
+      case ("plastic_displacement")
+         if (allocated(session%res%states(k)%plastic)) map = session%res%states(k)%plastic
+      end select
+      if (.not. allocated(map)) call set_error(st, STATUS_USAGE, "no map '"//name//"' in this result (it has: "// &
+         map_names(session)//")")
+   end subroutine map_of
+
+   !> A column of the history by name (HISTORY_COLUMNS), as femcod run's history.csv.
+   subroutine history_column(session, name, column, st)
+      type(library_session), intent(in) :: session
+      character(len=*), intent(in) :: name
+      real(dp), allocatable, intent(out) :: column(:)
+      type(status_type), intent(inout) :: st
+      integer :: n, k
+      real(dp) :: area_pixel, region
+      n = session%res%nsteps
+      area_pixel = session%problem%pixel**2
+      region = session%problem%np**2*area_pixel
+      associate(r => session%res)
+         select case (name)
+         case ("step"); column = [(real(k, dp), k = 1, n)]
+         case ("contacts"); column = real(r%step_contacts(1:n), dp)
+         case ("load_nN"); column = r%step_load(1:n)
+         case ("approach_nm"); column = r%step_approach(1:n)
+         case ("area_nm2"); column = r%step_contacts(1:n)*area_pixel
+         case ("area_fraction"); column = r%step_contacts(1:n)*area_pixel/region
+         case ("n_above_hardness"); column = real(r%step_above_hardness(1:n), dp)
+         case default
+            call set_error(st, STATUS_USAGE, "no history column '"//name//"' (columns: "//HISTORY_COLUMNS//")")
+         end select
+      end associate
+   end subroutine history_column
+
+   ! ---- the observer ----
+
+   subroutine tell_progress(self, step, contacts, load, elapsed)
+      class(library_observer), intent(inout) :: self
+      integer, intent(in) :: step, contacts
+      real(dp), intent(in) :: load, elapsed
+      self%step = step
+      self%contacts = contacts
+      self%load = load
+      call self%call_back()
+   end subroutine tell_progress
+
+   logical function caller_stops(self)
+      class(library_observer), intent(inout) :: self
+      real(dp) :: now
+      if (.not. self%stopped .and. associated(self%callback)) then
+         call wall_clock(now)
+         if (now - self%last_call >= CALLBACK_INTERVAL) call self%call_back()
+      end if
+      caller_stops = self%stopped
+   end function caller_stops
+
+   !> Call the caller's function with the last progress; a non-zero answer stops.
+   subroutine call_back(self)
+      class(library_observer), intent(inout) :: self
+      real(dp) :: now
+      if (.not. associated(self%callback)) return
+      call wall_clock(now)
+      self%last_call = now
+      if (self%callback(int(self%step, c_int), int(self%contacts, c_int), real(self%load, c_double), &
+         real(now - self%started, c_double), self%user) /= 0) self%stopped = .true.
+   end subroutine call_back
+end module femcod_library_session
