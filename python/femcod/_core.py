@@ -1,0 +1,451 @@
+"""femcod.solve, read_deck and write_deck over libfemcod.so (src/capi/femcod.h).
+
+Axis convention, once for all of femcod: a height or result map ``a[i, j]`` is row i,
+column j of the grid, as in femcod's decks and HDF5 files (C order). Units: heights and
+pixel nm, moduli GPa, loads nN, pressures GPa.
+
+Copies: an input array that is already C-ordered float64 is passed as it is (otherwise
+numpy converts it once); the library copies the heights once into its problem. Each map
+of the result is copied once, from the library into a new numpy array.
+"""
+import ctypes
+import math
+import signal
+import threading
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _library
+from ._library import PROGRESS, STOPPED
+
+
+class FemcodError(RuntimeError):
+    """A failure the library reported; ``code`` is the femcod command's exit code for it
+    (2 usage, 3 bad input, 4 numerical failure or memory, 5 I/O, 6 stopped)."""
+
+    def __init__(self, code, message):
+        super().__init__(f"femcod: {message} (code {code})")
+        self.code = code
+        self.message = message
+
+
+class Stopped(FemcodError):
+    """The progress function asked the solve to stop."""
+
+
+@dataclass
+class Deck:
+    """A contact problem as a deck holds it (doc/deck-format.md): heights ``lower`` and
+    ``upper`` (nm, NP x NP, [i, j] row i column j), the pixel (nm), the moduli (GPa) and
+    Poisson's ratios of the lower body, the upper body and the contact elements, MAXCONT
+    and a one-line label."""
+    lower: np.ndarray
+    upper: np.ndarray
+    pixel: float
+    young: tuple = (200.0, 2.0e12, 2.0e12)
+    poisson: tuple = (0.25, 0.25, 0.25)
+    maxcont: int = 0
+    label: str = "femcod deck"
+    #: NP where the heights are not held (a femcod-mpi result set does not store them).
+    size: int = 0
+
+    @property
+    def np(self):
+        return self.lower.shape[0] if self.lower is not None else self.size
+
+
+@dataclass
+class State:
+    """The contact state at one requested load or approach."""
+    values: dict
+    maps: dict = field(default_factory=dict)
+
+    def __getattr__(self, name):
+        short = {"load": "load_nN", "approach": "approach_nm", "area": "area_nm2",
+                 "max_pressure": "max_pressure_GPa", "plastic_volume": "plastic_volume_nm3"}
+        values = self.__dict__.get("values", {})
+        maps = self.__dict__.get("maps", {})
+        key = short.get(name, name)
+        if key in values:
+            v = values[key]
+            if key in ("contacts", "n_above_hardness", "n_plastic", "attractive_pixels", "jump", "cg_iterations",
+                       "tangential_iterations"):
+                return int(v)
+            if key in ("reached", "gross_sliding"):
+                return bool(v)
+            return v
+        if name in maps:
+            return maps[name]
+        raise AttributeError(name)
+
+    @property
+    def pressure(self):
+        return self.maps.get("pressure")
+
+    @property
+    def gap(self):
+        return self.maps.get("gap")
+
+
+@dataclass
+class Result:
+    """A solve's answer, or a femcod run result set read back (femcod.load): the states
+    (one per load or approach asked), the step history (arrays by column), the problem
+    and the run's description."""
+    states: list
+    history: dict
+    deck: Deck
+    solver: str
+    options: dict = field(default_factory=dict)
+    summary: dict = None
+
+    def column(self, name):
+        """One value of every state as an array (``result.column("area_nm2")``)."""
+        return np.array([s.values.get(name, math.nan) for s in self.states])
+
+    @property
+    def loads(self):
+        return self.column("load_nN")
+
+    @property
+    def approaches(self):
+        return self.column("approach_nm")
+
+    @property
+    def areas(self):
+        return self.column("area_nm2")
+
+    def to_xarray(self):
+        """The result as an xarray.Dataset (xarray must be installed): the maps over
+        (state, i, j) with x, y in nm, the state values over (state)."""
+        try:
+            import xarray as xr
+        except ImportError as e:  # optional, never required
+            raise ImportError("to_xarray needs xarray (pip install xarray)") from e
+        n = self.deck.np
+        reached = [s for s in self.states if s.values.get("reached", 1)]
+        coords = {"state": np.arange(1, len(reached) + 1), "i": np.arange(n), "j": np.arange(n),
+                  "y_nm": ("i", np.arange(n) * self.deck.pixel), "x_nm": ("j", np.arange(n) * self.deck.pixel)}
+        data = {}
+        for name in (reached[0].maps if reached else {}):
+            data[name] = (("state", "i", "j"), np.stack([s.maps[name] for s in reached]))
+        for name in (reached[0].values if reached else {}):
+            data[name] = (("state",), np.array([s.values[name] for s in reached]))
+        return xr.Dataset(data, coords=coords, attrs={"solver": self.solver, "pixel_nm": self.deck.pixel})
+
+
+class _Session:
+    """One libfemcod session (freed with the object)."""
+
+    def __init__(self):
+        self.lib = _library.lib()
+        self.handle = self.lib.femcod_create()
+        if not self.handle:
+            raise MemoryError("femcod: no memory for a session")
+
+    def __del__(self):
+        if getattr(self, "handle", None):
+            self.lib.femcod_destroy(self.handle)
+            self.handle = None
+
+    def message(self):
+        buf = ctypes.create_string_buffer(65536)
+        self.lib.femcod_message(self.handle, buf, len(buf))
+        return buf.value.decode("utf-8", "replace")
+
+    def check(self, code):
+        if code != 0:
+            cls = Stopped if code == STOPPED else FemcodError
+            raise cls(code, self.message())
+
+    def text(self, function, *args):
+        buf = ctypes.create_string_buffer(1 << 16)
+        self.check(function(self.handle, *args, buf, len(buf)))
+        return buf.value.decode("utf-8", "replace")
+
+
+def _pointer(a):
+    return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+
+def heights_array(a, name="heights"):
+    """A real square array as C-ordered float64 (converted once when it is not), with a
+    clear exception for what femcod cannot take."""
+    if hasattr(a, "heights") and callable(a.heights):
+        a = a.heights()  # a SurfaceTopography Topography: see femcod.from_topography for its pixel
+    a = np.asarray(a)
+    if a.dtype.kind == "c":
+        raise TypeError(f"{name}: complex heights; give the real part (np.real) if that is what is meant")
+    if a.dtype.kind not in "iuf":
+        raise TypeError(f"{name}: heights must be real numbers, found dtype {a.dtype}")
+    if a.ndim != 2:
+        raise ValueError(f"{name}: a 2-D height map is needed, found {a.ndim} dimensions {a.shape}")
+    if a.shape[0] != a.shape[1] or a.shape[0] == 0:
+        raise ValueError(f"{name}: femcod's grids are square (NP x NP), found {a.shape[0]} x {a.shape[1]}")
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    if not np.isfinite(a).all():
+        bad = np.argwhere(~np.isfinite(a))[0]
+        raise ValueError(f"{name}: heights must be finite, found {a[tuple(bad)]} at [{bad[0]}, {bad[1]}] "
+                         f"(and {int((~np.isfinite(a)).sum()) - 1} more)")
+    return a
+
+
+def _positive(x, name):
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a number, found {x!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{name} must be a positive size in nm, found {x!r}")
+    return v
+
+
+def _number_text(x):
+    """A number as text that reads back to the same double (repr is the shortest such)."""
+    return repr(float(x))
+
+
+def _option_list(values, name):
+    values = np.atleast_1d(np.asarray(values, dtype=np.float64))
+    if values.ndim != 1 or values.size == 0:
+        raise ValueError(f"{name}: give a number or a list of numbers")
+    return ",".join(_number_text(v) for v in values)
+
+
+#: Keyword arguments of solve that are femcod run's options (--kebab-case).
+_VALUE_OPTIONS = ("hardness", "boundary", "tol", "max_iterations", "kernel_radius", "max_contacts", "event_search",
+                  "work", "range", "shear_strength", "shear_slope", "tangential", "slip", "friction")
+
+
+def _options(solver, loads, approach, plastic, adhesion, final_check, extra):
+    opts = [("--solver", solver)]
+    if loads is not None:
+        opts.append(("--loads", _option_list(loads, "loads")))
+    if approach is not None:
+        opts.append(("--approach", _option_list(approach, "approach")))
+    if plastic is not None and plastic is not False:
+        opts.append(("--plastic", ""))
+        if plastic is not True:
+            opts.append(("--hardness", _number_text(plastic)))
+    if adhesion is not None:
+        opts.append(("--adhesion", str(adhesion)))
+    if not final_check:
+        opts.append(("--no-final-check", ""))
+    for key, value in extra.items():
+        if key not in _VALUE_OPTIONS:
+            raise TypeError(f"solve() got an unexpected keyword argument {key!r} (options: {', '.join(_VALUE_OPTIONS)})")
+        if value is None:
+            continue
+        if isinstance(value, str):
+            text = value
+        elif isinstance(value, (int, np.integer)) and key in ("max_iterations", "max_contacts"):
+            text = str(int(value))
+        else:
+            text = _number_text(value)
+        opts.append(("--" + key.replace("_", "-"), text))
+    return opts
+
+
+def _set_problem(session, lower, pixel, upper, young, poisson, maxcont):
+    """The problem into the session; returns the arrays it was given (kept alive)."""
+    lib = session.lib
+    if isinstance(lower, Deck):
+        deck = lower
+        if upper is not None or pixel is not None:
+            raise TypeError("solve(deck): the deck gives the pixel and both surfaces")
+        lo = heights_array(deck.lower, "deck.lower")
+        up = heights_array(deck.upper, "deck.upper")
+        if up.shape != lo.shape:
+            raise ValueError(f"deck: lower {lo.shape} and upper {up.shape} differ")
+        young3 = (ctypes.c_double * 3)(*[float(v) for v in deck.young])
+        poisson3 = (ctypes.c_double * 3)(*[float(v) for v in deck.poisson])
+        session.check(lib.femcod_set_problem(session.handle, lo.shape[0], _positive(deck.pixel, "pixel"),
+                                             _pointer(lo), _pointer(up), young3, poisson3, int(deck.maxcont),
+                                             str(deck.label).encode()))
+        return lo, up
+    if pixel is None:
+        raise TypeError("solve(heights, pixel=...): the pixel size in nm is needed")
+    lo = heights_array(lower, "lower")
+    up = None
+    if upper is not None:
+        up = heights_array(upper, "upper")
+        if up.shape != lo.shape:
+            raise ValueError(f"upper {up.shape} and lower {lo.shape} must be the same grid")
+    if np.ndim(young) == 1 and len(young) == 3:
+        blank = up if up is not None else np.zeros_like(lo)
+        return _set_problem(session, Deck(lo, blank, pixel, tuple(young), tuple(np.broadcast_to(poisson, 3)),
+                                          int(maxcont or max(1, lo.size // 20)), "femcod python"),
+                            None, None, None, None, None)
+    session.check(lib.femcod_set_heights(session.handle, lo.shape[0], _positive(pixel, "pixel"), _pointer(lo),
+                                         _pointer(up) if up is not None else None, float(young), float(poisson),
+                                         int(maxcont or 0)))
+    return lo, up
+
+
+def _solve_session(session, progress):
+    """femcod_solve with the GIL released (ctypes does so), Ctrl-C turned into a stop
+    through the progress function, and the user's progress function called."""
+    interrupted = []
+    failure = []
+
+    def on_sigint(signum, frame):
+        interrupted.append(True)
+
+    def callback(step, contacts, load, seconds, user):
+        if interrupted:
+            return 1
+        if progress is None:
+            return 0
+        try:
+            return 1 if progress(step, contacts, load, seconds) is True else 0
+        except BaseException as e:  # an error in the user's function stops the solve and is raised
+            failure.append(e)
+            return 1
+
+    c_callback = PROGRESS(callback)
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, on_sigint) if main else None
+    try:
+        code = session.lib.femcod_solve(session.handle, c_callback, None)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
+    if interrupted:
+        raise KeyboardInterrupt("femcod: the solve was stopped (Ctrl-C); nothing was kept")
+    if failure:
+        raise failure[0]
+    session.check(code)
+
+
+def _result(session, solver, options):
+    lib = session.lib
+    count = ctypes.c_int()
+    session.check(lib.femcod_state_count(session.handle, ctypes.byref(count)))
+    value_names = [n for n in session.text(lib.femcod_value_names, 0).split(",") if n]
+    map_names = [n for n in session.text(lib.femcod_value_names, 1).split(",") if n]
+    columns = [n for n in session.text(lib.femcod_value_names, 2).split(",") if n]
+    deck = _get_deck(session)
+    n = deck.np
+    states = []
+    value = ctypes.c_double()
+    for k in range(1, count.value + 1):
+        values = {}
+        for name in value_names:
+            session.check(lib.femcod_state_value(session.handle, k, name.encode(), ctypes.byref(value)))
+            values[name] = value.value
+        maps = {}
+        if values["reached"]:
+            for name in map_names:
+                m = np.empty((n, n), dtype=np.float64)
+                session.check(lib.femcod_state_map(session.handle, k, name.encode(), _pointer(m), n * n))
+                maps[name] = m
+        states.append(State(values, maps))
+    steps = ctypes.c_int()
+    session.check(lib.femcod_history_length(session.handle, ctypes.byref(steps)))
+    history = {}
+    for name in columns:
+        h = np.empty(steps.value, dtype=np.float64)
+        session.check(lib.femcod_history(session.handle, name.encode(), _pointer(h), steps.value))
+        history[name] = h
+    return Result(states, history, deck, solver, dict(options))
+
+
+def _get_deck(session):
+    lib = session.lib
+    np_ = ctypes.c_int()
+    session.check(lib.femcod_problem_size(session.handle, ctypes.byref(np_)))
+    n = np_.value
+    lower = np.empty((n, n), dtype=np.float64)
+    upper = np.empty((n, n), dtype=np.float64)
+    pixel = ctypes.c_double()
+    maxcont = ctypes.c_int()
+    young = (ctypes.c_double * 3)()
+    poisson = (ctypes.c_double * 3)()
+    session.check(lib.femcod_get_problem(session.handle, ctypes.byref(pixel), ctypes.byref(maxcont), young, poisson,
+                                         _pointer(lower), _pointer(upper)))
+    label = session.text(lib.femcod_get_label)
+    return Deck(lower, upper, pixel.value, tuple(young), tuple(poisson), maxcont.value, label)
+
+
+def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=200.0, poisson=0.25, boundary="free",
+          plastic=None, adhesion=None, approach=None, maxcont=None, final_check=True, threads=None, progress=None,
+          **options):
+    """Solve a contact problem; returns a Result.
+
+    lower      the heights (nm, NP x NP, [i, j] row i column j; any real array), or a
+               Deck (femcod.read_deck), which then gives the pixel, both surfaces and
+               the materials.
+    pixel      the pixel size (nm).
+    loads      total loads (nN) at which to report the state; or approach= (nm).
+    solver     "cg" (default), "incremental" (event-exact) or "legacy" (Appendix B).
+    upper      the other surface's heights (default: flat).
+    young, poisson  the elastic body's modulus (GPa) and ratio, the other body rigid, as
+               `femcod run --lower` (or three values each: lower, upper, contact elements).
+    boundary   "free" or "periodic".
+    plastic    None, True (hardness 11 GPa), or the hardness in GPa.
+    adhesion   None, "dugdale" or "exponential", with work= (J/m^2) and range= (nm).
+    threads    OpenMP threads for this and later solves (default: OMP_NUM_THREADS or all).
+    progress   f(step, contacts, load_nN, seconds), called after each step or state and
+               every 0.1 s while iterating; returning True stops the solve (femcod.Stopped).
+    Further keywords are femcod run's options: hardness, tol, max_iterations,
+    kernel_radius, max_contacts, event_search, work, range, shear_strength, shear_slope,
+    tangential, slip, friction. Ctrl-C stops the solve and raises KeyboardInterrupt.
+    """
+    extra = dict(options)
+    if boundary != "free":
+        extra["boundary"] = boundary
+    opts = _options(solver, loads, approach, plastic, adhesion, final_check, extra)
+    session = _Session()
+    if threads is not None:
+        if int(threads) < 1:
+            raise ValueError(f"threads must be at least 1, found {threads}")
+        session.check(session.lib.femcod_set_threads(int(threads)))
+    kept = _set_problem(session, lower, pixel, upper, young, poisson, maxcont)
+    for name, value in opts:
+        session.check(session.lib.femcod_set_option(session.handle, name.encode(), str(value).encode()))
+    _solve_session(session, progress)
+    del kept
+    return _result(session, solver, opts)
+
+
+def read_deck(path):
+    """A deck file (text or HDF5) as a Deck, read by femcod's own reader with its checks."""
+    session = _Session()
+    session.check(session.lib.femcod_read_deck(session.handle, str(path).encode()))
+    return _get_deck(session)
+
+
+def read_heights(path, pixel=None, remove_plane=False, young=200.0, poisson=0.25):
+    """A height file as `femcod run --lower PATH` reads it, as a Deck: an ASCII matrix or
+    Gwyddion export (with its units and width), FILE.h5:/DATASET, or a NanoScope file
+    FILE[:CHANNEL]; the surface on an elastic body (young GPa, poisson) against a rigid
+    flat, from its lowest point. pixel (nm): needed when the file does not give it.
+    What femcod run warns of (a tilt, a guessed unit) is issued as a Python warning."""
+    session = _Session()
+    session.check(session.lib.femcod_read_heights(session.handle, str(path).encode(), float(pixel or 0),
+                                                  1 if remove_plane else 0, float(young), float(poisson)))
+    for line in session.text(session.lib.femcod_warnings).splitlines():
+        warnings.warn(f"femcod: {line}", stacklevel=2)
+    return _get_deck(session)
+
+
+def write_deck(path, deck, force=False):
+    """Write a Deck to `path` (a name ending in .h5: the HDF5 deck), atomically. An
+    existing file is replaced only with force=True, and only if femcod wrote it."""
+    session = _Session()
+    _set_problem(session, deck, None, None, None, None, None)
+    session.check(session.lib.femcod_write_deck(session.handle, str(path).encode(), 1 if force else 0))
+
+
+def set_threads(threads):
+    """OpenMP threads of the solvers for the whole process."""
+    session = _Session()
+    session.check(session.lib.femcod_set_threads(int(threads)))
+
+
+def version():
+    buf = ctypes.create_string_buffer(256)
+    _library.lib().femcod_version(buf, len(buf))
+    return buf.value.decode()
