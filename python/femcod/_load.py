@@ -15,9 +15,6 @@ import numpy as np
 
 from ._core import Deck, Result, State, read_deck
 
-#: /loads/<kkk> attributes that are counts.
-_COUNTS = {"index", "contacts", "n_above_hardness", "n_plastic", "cg_iterations", "attractive_pixels", "jump",
-           "stick_contacts", "gross_sliding", "tangential_iterations"}
 #: History datasets and the names femcod.solve gives the same columns.
 _HISTORY = {"step": "step", "contacts": "contacts", "load": "load_nN", "approach": "approach_nm", "area": "area_nm2",
             "area_fraction": "area_fraction", "n_above_hardness": "n_above_hardness", "n_plastic": "n_plastic",

@@ -146,3 +146,31 @@ def test_to_xarray_where_installed():
     r = femcod.solve(paraboloid(16, 1.0, 50.0), pixel=1.0, loads=[50.0, 100.0])
     ds = r.to_xarray()
     assert isinstance(ds, xr.Dataset) and ds["pressure"].shape == (2, 16, 16)
+
+
+class StandInTopography:
+    """The part of SurfaceTopography's Topography that from_topography reads (heights(),
+    nb_grid_pts, physical_sizes, unit), for machines without that package."""
+
+    def __init__(self, heights, physical_sizes, unit):
+        self._h = heights
+        self.nb_grid_pts = heights.shape
+        self.physical_sizes = physical_sizes
+        self.unit = unit
+
+    def heights(self):
+        return self._h
+
+
+def test_topography_adapter():
+    h = np.random.default_rng(0).standard_normal((32, 32))
+    try:  # the real package where it is installed, the stand-in elsewhere
+        from SurfaceTopography import Topography
+        t = Topography(h, physical_sizes=(0.064, 0.064), unit="um", periodic=True)
+    except ImportError:
+        t = StandInTopography(h, (0.064, 0.064), "um")
+    kw = femcod.from_topography(t)
+    assert kw["pixel"] == pytest.approx(2.0) and np.allclose(kw["lower"], h * 1000)
+    assert femcod.solve(**kw, loads=[1000.0], boundary="periodic").states[0].contacts >= 1
+    with pytest.raises(ValueError, match="square"):
+        femcod.from_topography(StandInTopography(np.zeros((8, 4)), (8.0, 4.0), "nm"))
