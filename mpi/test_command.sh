@@ -43,11 +43,15 @@ for x, y in zip(a, b):
     assert x["contacts"] == y["contacts"], ("contacts", x["contacts"], y["contacts"])
 PY
 then echo "  passed   the serial solver's approaches and contacts"; else echo "  FAILED   the serial solver's approaches and contacts"; failed=1; fi
-# loads.csv: the serial writer's header, the same contact counts; one figure per load.
+# loads.csv: the serial writer's header, the same contact counts and contact patches
+# (the last two columns: 4- and 8-connected, joined across the ranks' slabs); one figure
+# per load.
 if [ "$(head -1 "$work/mpi.loads.csv")" = "$(head -1 "$work/serial.loads.csv")" ] && \
    [ "$(cut -d, -f3 "$work/mpi.loads.csv")" = "$(cut -d, -f3 "$work/serial.loads.csv")" ] && \
+   [ "$(awk -F, '{print $(NF-1), $NF}' "$work/mpi.loads.csv")" = \
+     "$(awk -F, '{print $(NF-1), $NF}' "$work/serial.loads.csv")" ] && \
    [ -s "$work/mpi.pressure_1.svg" ] && [ -s "$work/mpi.pressure_3.svg" ]; then
-  echo "  passed   loads.csv as the serial one's, a pressure figure per load"
+  echo "  passed   loads.csv as the serial one's (contacts, patches), a pressure figure per load"
 else
   echo "  FAILED   loads.csv or the figures"; failed=1
 fi

@@ -487,13 +487,14 @@ contains
       integer :: s
       text = "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
          "plastic_volume_nm3"//trim(merge(",friction_nN,friction_coefficient", "                                 ", &
-         settings%solve%shear))//new_line('a')
+         settings%solve%shear))//",patches_4,patches_8"//new_line('a')
       do s = 1, size(states)
          associate(st => states(s))
             text = text//format_real(st%load)//","//format_real(st%approach)//","//int_str(st%contacts)//","// &
                format_real(st%contacts*grid%pixel**2)//","//format_real(real(st%contacts, dp)/real(np, dp)**2)//","// &
                format_real(st%max_pressure)//","//int_str(st%above_hardness)//","//int_str(st%n_plastic)//","// &
-               format_real(st%plastic_volume)//friction_fields(st)//new_line('a')
+               format_real(st%plastic_volume)//friction_fields(st)//","//int_str(st%patches_4)//","// &
+               int_str(st%patches_8)//new_line('a')
          end associate
       end do
    end function loads_csv
@@ -538,7 +539,8 @@ contains
                int_str(st%cg%convolutions)//', "residual": '//json_number(st%cg%residual)//', "time_s": '// &
                json_number(st%seconds)//', "transform_s": '//json_number(st%transform_seconds)// &
                ', "communication_s": '//json_number(st%communication_seconds)
-            text = text//', "mean_gap_nm": '//json_number(st%mean_gap)
+            text = text//', "mean_gap_nm": '//json_number(st%mean_gap)//', "patches_4": '//int_str(st%patches_4)// &
+               ', "patches_8": '//int_str(st%patches_8)
             if (settings%solve%adhesion /= LAW_HARD_WALL) text = text//', "attractive_pixels": '//int_str(st%attractive)// &
                ', "attractive_load_nN": '//json_number(st%attractive_load)//', "jump": '//int_str(st%jump)
             if (settings%solve%shear) text = text//', "friction_nN": '//json_number(st%friction)// &

@@ -45,6 +45,7 @@ module femcod_mpi_cg
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
+   use femcod_mpi_patches, only: count_patches_on_ranks
    use femcod_love_periodic, only: periodic_love_spectrum_rows
    use femcod_spring, only: spring_stiffness
    use femcod_problem, only: contact_problem
@@ -148,6 +149,8 @@ module femcod_mpi_cg
       !> With the shear model (--shear-strength, --shear-slope): the friction force (nN)
       !> over all ranks, femcod_shear_model's sum over the contact pixels.
       real(dp) :: friction = 0
+      !> The contact patches over all ranks, 4- and 8-connected (femcod_mpi_patches).
+      integer :: patches_4 = 0, patches_8 = 0
    end type distributed_state
 
 contains
@@ -885,6 +888,8 @@ contains
          total(3) = count(session%capped)
          total(4) = sum(st%plastic)*grid%pixel**2
       end if
+      call count_patches_on_ranks(grid%comm, grid%ranks, grid%rank, grid%count, contact, grid%periodic, &
+         st%patches_4, st%patches_8)
       total(1) = count(contact)
       total(2) = count(session%p/grid%pixel**2 > hardness)
       total(5) = friction_force(shear, pack(session%p, contact), grid%pixel)

@@ -69,6 +69,8 @@ contains
                call h5_attribute(file, g, "n_above_hardness", s%above_hardness, status)
                call h5_attribute(file, g, "n_plastic", s%n_plastic, status)
                call h5_attribute(file, g, "plastic_volume_nm3", s%plastic_volume, status)
+               call h5_attribute(file, g, "patches_4", s%patches_4, status)
+               call h5_attribute(file, g, "patches_8", s%patches_8, status)
                if (info%friction) then
                   call h5_attribute(file, g, "friction_nN", s%friction, status)
                   call h5_attribute(file, g, "friction_coefficient", &

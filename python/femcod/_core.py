@@ -71,7 +71,7 @@ class State:
         if key in values:
             v = values[key]
             if key in ("contacts", "n_above_hardness", "n_plastic", "attractive_pixels", "jump", "cg_iterations",
-                       "tangential_iterations"):
+                       "tangential_iterations", "patches_4", "patches_8"):
                 return int(v)
             if key in ("reached", "gross_sliding"):
                 return bool(v)

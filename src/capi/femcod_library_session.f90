@@ -162,7 +162,7 @@ contains
       type(library_session), intent(in) :: session
       character(len=:), allocatable :: names
       names = "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
-         "plastic_volume_nm3,reached"
+         "plastic_volume_nm3,reached,patches_4,patches_8"
       associate(o => session%options)
          if (o%adhesion /= LAW_HARD_WALL) names = names//",attractive_pixels,attractive_load_nN,jump"
          if (o%solver == SOLVER_CG) names = names//",mean_gap_nm,cg_iterations,cg_residual,cg_penetration_nm,"// &
@@ -203,6 +203,8 @@ contains
          case ("n_plastic"); value = s%n_plastic
          case ("plastic_volume_nm3"); value = s%plastic_volume
          case ("reached"); value = merge(1, 0, s%reached)
+         case ("patches_4"); value = session%maps(k)%patches%count4
+         case ("patches_8"); value = session%maps(k)%patches%count8
          case ("attractive_pixels"); value = s%attractive
          case ("attractive_load_nN"); value = s%attractive_load
          case ("mean_gap_nm"); value = s%mean_gap

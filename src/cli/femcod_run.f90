@@ -33,11 +33,12 @@ module femcod_run
    use femcod_incremental_state, only: incremental_state
    use femcod_solver, only: solve_contact, model_notes, report_lines, report_line
    use femcod_maps, only: load_maps, state_maps
+   use femcod_patches, only: contact_patches, perimeter_area_fit
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_output_guard, only: guard_outputs, OUTPUT_WISDOM, OUTPUT_RESULT
    use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, HISTORY_HEADER, LOADS_HEADER, &
-      CONTACTS_HEADER, FRICTION_COLUMNS
+      CONTACTS_HEADER, FRICTION_COLUMNS, PATCH_COLUMNS
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
@@ -197,8 +198,9 @@ contains
          "         PREFIX.contacts.csv, at the largest requested load or the last step:", &
          "           "//CONTACTS_HEADER, &
          "         PREFIX.loads.csv, one row per requested load or approach:", &
-         "           "//LOADS_HEADER, &
-         "         with --shear-strength/--shear-slope both end in "//FRICTION_COLUMNS(2:), &
+         "           "//LOADS_HEADER//PATCH_COLUMNS, &
+         "         (patches_4, patches_8: the contact patches, 4- and 8-connected; --shear-strength", &
+         "         and --shear-slope add "//FRICTION_COLUMNS(2:)//", a tangential step its own, before them),", &
          "         PREFIX.h5 (everything, with the pressure and gap", &
          "         maps at each requested load; doc/results.md), PREFIX.xdmf (the maps on a mesh for", &
          "         ParaView and meshio), PREFIX.summary.json (the summary as numbers with units),", &
@@ -821,7 +823,7 @@ contains
                end if
             end if
          end do
-         if (.not. settings%quiet) call print_summary(deck_path, prefix, problem, options, res)
+         if (.not. settings%quiet) call print_summary(deck_path, prefix, problem, options, res, maps)
       end associate
    end subroutine run_locked
 
@@ -928,11 +930,12 @@ contains
 
    !> The summary on standard output: the scene, the steps, the states at the requested
    !> loads, the wall time, then what the solver left out and checked.
-   subroutine print_summary(deck_path, prefix, problem, options, res)
+   subroutine print_summary(deck_path, prefix, problem, options, res, maps)
       character(len=*), intent(in) :: deck_path, prefix
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       type(contact_result), intent(in) :: res
+      type(state_maps), intent(in) :: maps(:)
       type(report_line), allocatable :: lines(:)
       type(cg_state_diagnostics) :: work
       integer :: k, last
@@ -966,6 +969,7 @@ contains
             int_str(res%states(k)%contacts)//" contacts ("// &
             sig_str(res%states(k)%contacts*problem%pixel**2, 4)//" nm^2), max pressure "// &
             sig_str(res%states(k)%max_pressure, 4)//" GPa"
+         call print_patches(maps(k)%patches)
          if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
             " of them plastic (at the hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "// &
             sig_str(res%states(k)%plastic_volume, 4)//" nm^3"
@@ -1003,6 +1007,20 @@ contains
             lines(k)%text
       end do
    end subroutine print_summary
+
+   !> The patches line of the summary: the 4- and 8-connected counts, the largest patch
+   !> and the perimeter-area exponent.
+   subroutine print_patches(patches)
+      type(contact_patches), intent(in) :: patches
+      real(dp) :: exponent, prefactor
+      character(len=:), allocatable :: fit
+      call perimeter_area_fit(patches%area4, patches%perimeter4, exponent, prefactor)
+      fit = ""
+      if (exponent == exponent) fit = ", perimeter ~ area^"//sig_str(exponent, 3)
+      write(output_unit, '(a)') "              patches "//int_str(patches%count4)//" (4-connected), "// &
+         int_str(patches%count8)//" (8-connected), the largest "//int_str(maxval([0, patches%area8]))// &
+         " pixels"//fit
+   end subroutine print_patches
 
    !> A state's tangential step in the summary: the force and shift along x, the stick
    !> area, or gross sliding.

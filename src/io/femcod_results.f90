@@ -21,13 +21,14 @@ module femcod_results
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
       h5_read_string_attribute, h5_flat_view
    use femcod_maps, only: state_maps
+   use femcod_patches, only: contact_patches, perimeter_area_fit
    use femcod_svg, only: svg_plot, svg_pressure_map
    use femcod_richardson, only: power_law_fit
    use femcod_shear_model, only: friction_coefficient
    implicit none
    private
    public :: write_results, run_info, result_files, write_file_set, stored_fingerprint, load_group
-   public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, TANGENTIAL_COLUMNS
+   public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, TANGENTIAL_COLUMNS, PATCH_COLUMNS
 
    !> The CSV files' header lines (the help prints them from here).
    character(len=*), parameter :: HISTORY_HEADER = &
@@ -35,6 +36,9 @@ module femcod_results
    character(len=*), parameter :: LOADS_HEADER = "load_nN,approach_nm,contacts,area_nm2,area_fraction,"// &
       "max_pressure_GPa,n_above_hardness,n_plastic,plastic_volume_nm3"
    character(len=*), parameter :: CONTACTS_HEADER = "i,j,step,force_nN,pressure_GPa"
+   !> The columns every loads file ends with: the contact patches, 4- and 8-connected
+   !> (model/femcod_patches).
+   character(len=*), parameter :: PATCH_COLUMNS = ",patches_4,patches_8"
    !> The columns the shear model adds to the history and loads files.
    character(len=*), parameter :: FRICTION_COLUMNS = ",friction_nN,friction_coefficient"
    !> The maps of a tangential step in each load group (and on the mesh).
@@ -123,7 +127,7 @@ contains
       call write_text(temps(size(temps))%s, contacts_csv(deck, res), status)
       if (size(res%states) > 0) then
          call add(".loads.csv")
-         call write_text(temps(size(temps))%s, loads_csv(deck, res, info%friction, info%tangential), status)
+         call write_text(temps(size(temps))%s, loads_csv(deck, res, maps, info%friction, info%tangential), status)
       end if
       call add(".xdmf")
       call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res, info%tangential), status)
@@ -142,7 +146,7 @@ contains
       end do
       call wall_clock(t2)
       call add(".summary.json")
-      call write_text(temps(size(temps))%s, summary_json(prefix, deck, res, info, [hdf5_seconds, t2 - t1]), status)
+      call write_text(temps(size(temps))%s, summary_json(prefix, deck, res, maps, info, [hdf5_seconds, t2 - t1]), status)
       call add(".h5")
       call commit_set(names, temps, status)
    contains
@@ -324,9 +328,10 @@ contains
 
    !> PREFIX.loads.csv: the states at the requested loads that were reached; with
    !> `friction`, the shear model's columns.
-   function loads_csv(deck, res, friction, tangential) result(text)
+   function loads_csv(deck, res, maps, friction, tangential) result(text)
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
+      type(state_maps), intent(in) :: maps(:)
       logical, intent(in) :: friction, tangential
       character(len=:), allocatable :: text
       type(text_builder) :: b
@@ -335,7 +340,7 @@ contains
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
       call add_line(b, LOADS_HEADER//trim(merge(FRICTION_COLUMNS, repeat(" ", len(FRICTION_COLUMNS)), friction))// &
-         trim(merge(TANGENTIAL_COLUMNS, repeat(" ", len(TANGENTIAL_COLUMNS)), tangential)))
+         trim(merge(TANGENTIAL_COLUMNS, repeat(" ", len(TANGENTIAL_COLUMNS)), tangential))//PATCH_COLUMNS)
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          associate(s => res%states(k))
@@ -343,7 +348,8 @@ contains
                int_str(s%contacts)//","//format_real(s%contacts*area_pixel)//","// &
                format_real(s%contacts*area_pixel/region)//","//format_real(s%max_pressure)//","// &
                int_str(s%n_above_hardness)//","//int_str(s%n_plastic)//","//format_real(s%plastic_volume)// &
-               friction_fields(friction, s%friction, s%load, s%contacts)//tangential_fields(s, tangential))
+               friction_fields(friction, s%friction, s%load, s%contacts)//tangential_fields(s, tangential)// &
+               ","//int_str(maps(k)%patches%count4)//","//int_str(maps(k)%patches%count8))
          end associate
       end do
       text = built_text(b)
@@ -439,6 +445,7 @@ contains
                call h5_attribute(file, g, "mean_gap_nm", s%mean_gap, local)
                call h5_attribute(file, g, "jump", s%jump, local)
             end if
+            call write_patches(file, g, maps(k)%patches, local)
             call h5_write(file, g//"/pressure", maps(k)%pressure, "GPa", local, &
                compress=mostly_zero(maps(k)%pressure))
             call h5_write(file, g//"/gap", maps(k)%gap, "nm", local, compress=mostly_zero(maps(k)%gap))
@@ -700,10 +707,11 @@ contains
 
    !> PREFIX.summary.json: what the summary prints, as numbers whose names carry their
    !> units, for scripts; the solver's own counters last.
-   function summary_json(prefix, deck, res, info, write_seconds) result(j)
+   function summary_json(prefix, deck, res, maps, info, write_seconds) result(j)
       character(len=*), intent(in) :: prefix
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
+      type(state_maps), intent(in) :: maps(:)
       type(run_info), intent(in) :: info
       !> Seconds of writing PREFIX.h5 and of the text files and figures before this one.
       real(dp), intent(in) :: write_seconds(2)
@@ -728,6 +736,7 @@ contains
                ', "n_above_hardness": '//int_str(s%n_above_hardness)//', "n_plastic": '// &
                int_str(s%n_plastic)//', "plastic_volume_nm3": '//json_number(s%plastic_volume)//', "hdf5_group": '// &
                json_string(load_group(k, size(res%states)))
+            if (s%reached) loads = loads//patch_fields(maps(k)%patches)
             work = cg_work(res, k)
             if (s%reached .and. work%approach_bound >= 0) loads = loads//', "approach_error_bound_nm": '// &
                json_number(work%approach_bound)
@@ -811,6 +820,16 @@ contains
          end select
       end function solver_details
 
+      !> The patches of a state: counts, the largest, the perimeter-area exponent.
+      function patch_fields(patches) result(t)
+         type(contact_patches), intent(in) :: patches
+         character(len=:), allocatable :: t
+         real(dp) :: e, p
+         call perimeter_area_fit(patches%area4, patches%perimeter4, e, p)
+         t = ', "patches_4": '//int_str(patches%count4)//', "patches_8": '//int_str(patches%count8)// &
+            ', "largest_patch_pixels": '//int_str(maxval([0, patches%area8]))// &
+            ', "patch_perimeter_exponent": '//json_number(e)
+      end function patch_fields
       function text_or_empty(t) result(r)
          character(len=:), allocatable, intent(in) :: t
          character(len=:), allocatable :: r
@@ -822,6 +841,28 @@ contains
    !> /run's datasets of the solver's checks: the event path's (zeros for cg) and the
    !> legacy solver's conditioning (its defaults, pivot loss 1 and condition 0, for the
    !> others), the same datasets for every solver.
+   !> A load group's contact patches: the counts and the perimeter-area fit as attributes,
+   !> each patch's area and perimeter as datasets (when there are patches).
+   subroutine write_patches(file, g, patches, local)
+      type(h5_file), intent(inout) :: file
+      character(len=*), intent(in) :: g
+      type(contact_patches), intent(in) :: patches
+      type(status_type), intent(inout) :: local
+      real(dp) :: exponent, prefactor
+      call h5_attribute(file, g, "patches_4", patches%count4, local)
+      call h5_attribute(file, g, "patches_8", patches%count8, local)
+      call perimeter_area_fit(patches%area4, patches%perimeter4, exponent, prefactor)
+      call h5_attribute(file, g, "patch_perimeter_exponent", exponent, local)
+      if (patches%count4 > 0) then
+         call h5_write(file, g//"/patch_area_4", patches%area4, "pixels", local)
+         call h5_write(file, g//"/patch_perimeter_4", patches%perimeter4, "pixel sides", local)
+      end if
+      if (patches%count8 > 0) then
+         call h5_write(file, g//"/patch_area_8", patches%area8, "pixels", local)
+         call h5_write(file, g//"/patch_perimeter_8", patches%perimeter8, "pixel sides", local)
+      end if
+   end subroutine write_patches
+
    subroutine write_run_checks(file, res, local)
       type(h5_file), intent(inout) :: file
       type(contact_result), intent(in) :: res

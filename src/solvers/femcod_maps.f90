@@ -1,4 +1,4 @@
-!> Pressure and gap maps of the recorded load states (no I/O).
+!> Pressure and gap maps of the recorded load states, and their contact patches (no I/O).
 module femcod_maps
    use femcod_kinds, only: dp
    use femcod_problem, only: contact_problem
@@ -8,13 +8,15 @@ module femcod_maps
    use femcod_spring, only: spring_stiffness
    use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: load_state
+   use femcod_patches, only: contact_patches, find_patches
    implicit none
    private
    public :: load_maps, state_maps
 
-   !> The maps of one load state.
+   !> The maps of one load state, and its contact patches (model/femcod_patches).
    type :: state_maps
       real(dp), allocatable :: pressure(:, :), gap(:, :)
+      type(contact_patches) :: patches
    end type state_maps
 
 contains
@@ -42,15 +44,16 @@ contains
       allocate(maps(size(states)))
       if (.not. any(states%reached)) return
       np = problem%np
+      cyclic = .false.
+      if (present(periodic)) cyclic = periodic
       handed = allocated_gap(states)
       do s = 1, size(states)
          if (.not. states(s)%reached) cycle
          maps(s)%pressure = pressure_map(states(s))
+         call find_patches(np, states(s)%i, states(s)%j, cyclic, maps(s)%patches)
          if (handed(s)) call move_alloc(states(s)%gap, maps(s)%gap)
       end do
       if (all(handed .or. .not. states%reached)) return
-      cyclic = .false.
-      if (present(periodic)) cyclic = periodic
       allocate(force(np, np), disp(np, np), table(0:np - 1, 0:np - 1))
       if (cyclic) then
          table(:, :) = periodic_offset_table(np)
