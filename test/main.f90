@@ -29,6 +29,7 @@ program tester
    use test_friction, only: collect_friction
    use test_tangential, only: collect_tangential
    use test_patches, only: collect_patches
+   use test_refine, only: collect_refine
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
    use femcod_strings, only: string_type, parse_integer
@@ -57,6 +58,7 @@ program tester
       new_testsuite("friction", collect_friction), &
       new_testsuite("tangential", collect_tangential), &
       new_testsuite("patches", collect_patches), &
+      new_testsuite("refine", collect_refine), &
       new_testsuite("studies", collect_studies), &
       new_testsuite("options", collect_options), &
       new_testsuite("heights", collect_heights), &

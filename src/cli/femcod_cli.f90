@@ -18,6 +18,7 @@ module femcod_cli
    use femcod_run, only: run_command
    use femcod_process, only: SIGINT, SIGTERM, SIGUSR1
    use femcod_studies, only: resolution_command, summits_command, multiscale_command
+   use femcod_refine_command, only: refine_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
    use femcod_help, only: help_requested, print_lines
@@ -86,6 +87,8 @@ contains
          call summits_command(args(2:), code)
       case ("multiscale")
          call multiscale_command(args(2:), code)
+      case ("refine")
+         call refine_command(args(2:), code)
       case ("verify")
          call verify_command(args(2:), code)
       case default
@@ -106,6 +109,7 @@ contains
          "  resolution DECK [options] the resolution study of section 4.5 (femcod resolution --help)", &
          "  summits FILE [options]    summit search, PSD and structure function of chapter 3", &
          "  multiscale FILE [options] the multiscale Hertz model of section 3.3", &
+         "  refine DECK --loads ...   the contact area below the pixel: the thesis' third model (section 5.3)", &
          "  workspace NP MAXCONT      print the Appendix B memory map (Tables B.1, B.2)", &
          "  verify [-o FILE]          recompute the thesis checks, write doc/verification.md", &
          "  bench [--full]            speed against error, one table (use the release build)", &

@@ -34,7 +34,7 @@ module femcod_studies
       option_given, refuse_options
    implicit none
    private
-   public :: resolution_command, summits_command, multiscale_command, resolution_table, surface_table
+   public :: resolution_command, summits_command, multiscale_command, resolution_table, surface_table, check_outputs
 
    !> Options shared by `summits` and `multiscale`.
    type :: surface_options

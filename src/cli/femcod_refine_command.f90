@@ -1,0 +1,207 @@
+!> `femcod refine DECK --loads F1,...`: the thesis' third model (section 5.3,
+!> studies/femcod_refine): the real area fraction against magnification, from the pixel
+!> down to --down-to, by the refinement below the pixel, beside Richardson's
+!> extrapolation (section 4.5) and Persson's theory on the same PSD.
+module femcod_refine_command
+   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE
+   use femcod_strings, only: string_type, int_str, sig_str, format_real, text_builder, add_line, built_text
+   use femcod_memory, only: available_memory
+   use femcod_problem, only: contact_problem
+   use femcod_deck, only: read_deck
+   use femcod_heights, only: is_height_file, looks_like_height_matrix
+   use femcod_solver_options, only: contact_options, validate_options, SOLVER_CG, boundary_from_name, &
+      BOUNDARY_PERIODIC
+   use femcod_options, only: option_spec, parsed_options, parse_options, option_help, flag_option, real_option, &
+      text_option, choice_option, real_list_option, get_option, option_given
+   use femcod_help, only: help_requested, print_lines
+   use femcod_results, only: write_file_set
+   use femcod_svg, only: svg_series, add_series, svg_multi_plot
+   use femcod_files, only: default_prefix
+   use femcod_studies, only: check_outputs
+   use femcod_refine_study, only: refine_answer, refine_contact
+   implicit none
+   private
+   public :: refine_command, refine_table
+
+   !> The default cut-off (nm): about the spacing of atoms, below which a continuum's
+   !> spectrum has no meaning.
+   real(dp), parameter :: ATOMIC_CUTOFF = 0.25_dp
+
+contains
+
+   function refine_table() result(table)
+      type(option_spec), allocatable :: table(:)
+      table = [ &
+         real_list_option("--loads", "F1,...", "total loads in nN (required)", lower=0.0_dp, closed="()"), &
+         real_option("--down-to", "LENGTH", "refine down to this length in nm (default 0.25, about the spacing "// &
+            "of atoms; it must be below the pixel)", lower=0.0_dp, closed="()"), &
+         choice_option("--boundary", "free|periodic", "the solve's boundary (default free; periodic for a cell)"), &
+         real_option("--tol", "T", "the cg solver's tolerance (default 1e-8)", lower=0.0_dp, closed="()"), &
+         text_option("--output", "PREFIX", "output prefix (default: the deck's name)", alias="-o"), &
+         flag_option("--force", "replace the outputs of an earlier refine"), &
+         flag_option("--quiet", "no summary", alias="-q")]
+   end function refine_table
+
+   subroutine refine_help()
+      write(output_unit, '(a)') &
+         "usage: femcod refine DECK --loads F1,... [--down-to LENGTH] [--boundary free|periodic] [-o PREFIX]", &
+         "", &
+         "The thesis' third model (section 5.3): the deck solved at its resolution (cg), the surface's PSD", &
+         "fitted by a power law over 4 q_L .. q_d/2, and each contact pixel refined below the pixel by", &
+         "Persson's theory of its own mean pressure over the roughness the power law continues (doc/studies.md).", &
+         "Beside it: Richardson's extrapolation from solves at 2d and 4d (section 4.5) and Persson's theory", &
+         "of the whole surface. A surface whose PSD is not a power law (no scaling range) is refused.", ""
+      call print_lines(option_help(refine_table(), ""))
+      write(output_unit, '(a)') "", &
+         "outputs: PREFIX.refine.csv  load_nN,magnification,pixel_nm,area_fraction_solve,area_fraction_refined,", &
+         "                            area_fraction_richardson,area_fraction_persson,", &
+         "                            area_fraction_refined_sqrt2 (Persson's constant in place of kappa),kappa", &
+         "         PREFIX.refine.svg  area fraction against magnification, one curve per method and load"
+   end subroutine refine_help
+
+   subroutine refine_command(args, code)
+      type(string_type), intent(in) :: args(:)
+      integer, intent(out) :: code
+      type(parsed_options) :: parsed
+      type(status_type) :: status
+      type(contact_problem) :: problem
+      type(contact_options) :: options
+      type(refine_answer) :: answer
+      type(string_type), allocatable :: names(:), texts(:)
+      character(len=:), allocatable :: prefix, deck, boundary
+      real(dp) :: down_to
+      logical :: force, quiet
+      code = 0
+      if (help_requested(args)) then
+         call refine_help()
+         return
+      end if
+      call parse_options(refine_table(), args, parsed, status)
+      if (status%code == 0 .and. size(parsed%positional) /= 1) call set_error(status, STATUS_USAGE, &
+         "refine needs one DECK")
+      if (status%code == 0 .and. .not. option_given(parsed, "--loads")) call set_error(status, STATUS_USAGE, &
+         "refine needs --loads F1,... (nN)")
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod refine: "//status%message//" (femcod refine --help)"
+         code = status%code
+         return
+      end if
+      deck = parsed%positional(1)%s
+      prefix = default_prefix(deck)
+      down_to = ATOMIC_CUTOFF
+      force = .false.
+      quiet = .false.
+      boundary = "free"
+      call get_option(parsed, "--output", prefix)
+      call get_option(parsed, "--down-to", down_to)
+      call get_option(parsed, "--force", force)
+      call get_option(parsed, "--quiet", quiet)
+      call get_option(parsed, "--boundary", boundary)
+      options%solver = SOLVER_CG
+      options%boundary = boundary_from_name(boundary)
+      allocate(options%approaches(0))
+      call get_option(parsed, "--loads", options%loads)
+      call get_option(parsed, "--tol", options%cg%tol)
+      call validate_options(options, status)
+      if (status%code == 0 .and. is_height_file(deck)) call set_error(status, STATUS_USAGE, deck// &
+         " is a height file: make a deck of it first (femcod mkdeck matrix --file ... --shape-on lower)")
+      names = [string_type(prefix//".refine.csv"), string_type(prefix//".refine.svg")]
+      if (status%code == 0) call check_outputs(names, deck, force, status)
+      if (status%code == 0) then
+         call read_deck(deck, problem, status)
+         if (status%code /= 0 .and. looks_like_height_matrix(deck)) then
+            status%code = STATUS_USAGE
+            status%message = deck//" reads as a matrix of heights, not as a deck: make a deck of it first "// &
+               "(femcod mkdeck matrix --file "//deck//" --pixel D --shape-on lower -o DECK)"
+         end if
+      end if
+      options%memory_available = available_memory()
+      if (status%code == 0) call refine_contact(problem, options, down_to, answer, status)
+      if (status%code == 0) then
+         allocate(texts(2))
+         texts(1)%s = refine_csv(answer, problem%pixel)
+         texts(2)%s = refine_svg(answer, problem)
+         call write_file_set(names, texts, status)
+      end if
+      if (status%code /= 0) then
+         write(error_unit, '(a)') "femcod refine: "//status%message
+         code = status%code
+         return
+      end if
+      if (.not. quiet) call print_refine(deck, prefix, problem, options, down_to, answer)
+   end subroutine refine_command
+
+   function refine_csv(answer, pixel) result(text)
+      type(refine_answer), intent(in) :: answer
+      real(dp), intent(in) :: pixel
+      character(len=:), allocatable :: text
+      type(text_builder) :: b
+      integer :: k, z
+      call add_line(b, "load_nN,magnification,pixel_nm,area_fraction_solve,area_fraction_refined,"// &
+         "area_fraction_richardson,area_fraction_persson,area_fraction_refined_sqrt2,kappa")
+      do k = 1, size(answer%loads)
+         do z = 1, size(answer%zeta)
+            call add_line(b, format_real(answer%loads(k))//","//format_real(answer%zeta(z))//","// &
+               format_real(pixel/answer%zeta(z))//","//format_real(answer%coarse(1, k))//","// &
+               format_real(answer%refined(z, k))//","//format_real(answer%richardson(z, k))//","// &
+               format_real(answer%persson(z, k))//","//format_real(answer%theory(z, k))//","// &
+               format_real(answer%kappa(k)))
+         end do
+      end do
+      text = built_text(b)
+   end function refine_csv
+
+   function refine_svg(answer, problem) result(svg)
+      type(refine_answer), intent(in) :: answer
+      type(contact_problem), intent(in) :: problem
+      character(len=:), allocatable :: svg
+      type(svg_series), allocatable :: series(:)
+      integer :: k
+      allocate(series(0))
+      do k = 1, size(answer%loads)
+         call add_series(series, "refined, "//sig_str(answer%loads(k), 4)//" nN", answer%zeta, answer%refined(:, k))
+         if (all(answer%richardson(:, k) == answer%richardson(:, k))) call add_series(series, "Richardson, "// &
+            sig_str(answer%loads(k), 4)//" nN", answer%zeta, answer%richardson(:, k), dashed=.true., markers=.false.)
+         call add_series(series, "Persson, "//sig_str(answer%loads(k), 4)//" nN", answer%zeta, answer%persson(:, k), &
+            dashed=.true., markers=.false.)
+      end do
+      svg = svg_multi_plot("femcod refine: "//problem%label, "magnification (pixel "//format_real(problem%pixel)// &
+         " nm / length)", "real area fraction", series, .true., .true.)
+   end function refine_svg
+
+   subroutine print_refine(deck, prefix, problem, options, down_to, answer)
+      character(len=*), intent(in) :: deck, prefix
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      real(dp), intent(in) :: down_to
+      type(refine_answer), intent(in) :: answer
+      integer :: k, last
+      character(len=:), allocatable :: bnd
+      last = size(answer%zeta)
+      bnd = "free"
+      if (options%boundary == BOUNDARY_PERIODIC) bnd = "periodic"
+      write(output_unit, '(a)') "femcod refine "//deck//" (cg, "//bnd//"): NP = "//int_str(problem%np)//", d = "// &
+         format_real(problem%pixel)//" nm, E* = "//sig_str(answer%estar, 5)//" GPa"
+      associate(s => answer%spectrum)
+         write(output_unit, '(a)') "  spectrum  : C(q) = "//sig_str(s%prefactor, 4)//" q^-(2+2H), H = "// &
+            sig_str(s%hurst, 3)//", fitted from "//sig_str(s%q_low, 3)//" to "//sig_str(s%q_high, 3)// &
+            " 1/nm ("//int_str(s%points)//" bins, r^2 "//sig_str(s%r_squared, 4)//"); rms slope of the image "// &
+            sig_str(sqrt(s%slope_variance), 4)
+      end associate
+      write(output_unit, '(a)') "  down to   : "//format_real(down_to)//" nm, magnification "// &
+         sig_str(answer%zeta(last), 4)
+      do k = 1, size(answer%loads)
+         write(output_unit, '(a)') "  at load   : "//sig_str(answer%loads(k), 6)//" nN: the solve "// &
+            sig_str(100*answer%coarse(1, k), 4)//" %; refined "//sig_str(100*answer%refined(last, k), 4)// &
+            " %, Richardson "//sig_str(100*answer%richardson(last, k), 4)//" %, Persson "// &
+            sig_str(100*answer%persson(last, k), 4)//" % at "//format_real(down_to)//" nm (kappa "// &
+            sig_str(answer%kappa(k), 4)//", Persson's sqrt(2) gives "//sig_str(100*answer%theory(last, k), 4)//" %)"
+      end do
+      write(output_unit, '(a)') "  cost      : the solve "//sig_str(answer%solve_seconds, 3)//" s; spectrum, fit "// &
+         "and refinement "//sig_str(answer%refine_seconds, 3)//" s; the solves at 2d and 4d (Richardson) "// &
+         sig_str(answer%richardson_seconds, 3)//" s"
+      write(output_unit, '(a)') "  written   : "//prefix//".refine.csv, .refine.svg"
+   end subroutine print_refine
+end module femcod_refine_command

@@ -1,0 +1,208 @@
+!> `femcod refine` without its I/O: the solve at the deck's resolution (and at 2d and 4d
+!> for Richardson), the spectrum and its fit, and the area fraction against magnification
+!> by the refinement (femcod_refine), Richardson's extrapolation and Persson's theory.
+module femcod_refine_study
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+   use femcod_kinds, only: dp
+   use femcod_status, only: status_type, set_error, STATUS_USAGE
+   use femcod_strings, only: format_real
+   use femcod_clock, only: wall_clock
+   use femcod_problem, only: contact_problem
+   use femcod_scene, only: initial_gap_map
+   use femcod_surfaces, only: block_average
+   use femcod_contact_result, only: contact_result
+   use femcod_solver_options, only: contact_options, SOLVER_CG
+   use femcod_solver, only: solve_contact
+   use femcod_refine, only: surface_spectrum, surface_spectrum_of, fit_spectrum, subpixel_slope_variance, &
+      refined_fraction, persson_fraction, richardson_area, magnifications, calibrate_kappa
+   implicit none
+   private
+   public :: refine_answer, refine_contact, composite_modulus
+
+   real(dp), parameter :: PI = acos(-1.0_dp)
+
+   !> A pressure map (GPa), one per load.
+   type :: pressure_set
+      real(dp), allocatable :: p(:, :)
+   end type pressure_set
+
+   !> Everything `femcod refine` reports.
+   type :: refine_answer
+      type(surface_spectrum) :: spectrum
+      !> E* (GPa) of the two bodies.
+      real(dp) :: estar = 0
+      !> The loads (nN) and the magnifications (1 = the pixel).
+      real(dp), allocatable :: loads(:), zeta(:)
+      !> Area fractions: the solve at d, 2d, 4d per load; by each method per magnification
+      !> and load (zeta, load).
+      real(dp), allocatable :: coarse(:, :)
+      real(dp), allocatable :: refined(:, :), richardson(:, :), persson(:, :)
+      !> The refinement with Persson's own constant sqrt(2) in place of the measured one
+      !> (zeta, load), and the measured constant kappa per load.
+      real(dp), allocatable :: theory(:, :), kappa(:)
+      !> Wall seconds: the solve at d; the solves at 2d and 4d; the spectrum, fit and refinement.
+      real(dp) :: solve_seconds = 0, richardson_seconds = 0, refine_seconds = 0
+   end type refine_answer
+
+contains
+
+   !> E* of the two bodies (GPa): 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2.
+   pure real(dp) function composite_modulus(problem) result(estar)
+      type(contact_problem), intent(in) :: problem
+      estar = 1/((1 - problem%poisson(1)**2)/problem%young(1) + (1 - problem%poisson(2)**2)/problem%young(2))
+   end function composite_modulus
+
+   !> Refine `problem` at options%loads down to the length `down_to` (nm, below the pixel).
+   subroutine refine_contact(problem, options, down_to, answer, status)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      real(dp), intent(in) :: down_to
+      type(refine_answer), intent(out) :: answer
+      type(status_type), intent(inout) :: status
+      type(pressure_set), allocatable :: at_d(:), at_2d(:), none(:)
+      real(dp) :: t0, t1, t2
+      if (status%code /= 0) return
+      if (options%solver /= SOLVER_CG .or. size(options%loads) == 0) then
+         call set_error(status, STATUS_USAGE, "refine solves with the cg solver at given loads (--loads)")
+         return
+      end if
+      if (.not. (down_to > 0 .and. down_to < problem%pixel)) then
+         call set_error(status, STATUS_USAGE, "--down-to "//format_real(down_to)//" nm: the refinement goes below the "// &
+            "pixel, "//format_real(problem%pixel)//" nm")
+         return
+      end if
+      answer%estar = composite_modulus(problem)
+      answer%loads = options%loads
+      answer%zeta = magnifications(problem%pixel/down_to)
+      call wall_clock(t0)
+      call surface_spectrum_of(initial_gap_map(problem%lower, problem%upper), problem%pixel, answer%spectrum)
+      call fit_spectrum(answer%spectrum, status)
+      if (status%code /= 0) return
+      call wall_clock(t1)
+      allocate(answer%coarse(3, size(answer%loads)))
+      answer%coarse = ieee_value(1.0_dp, ieee_quiet_nan)
+      call solve_level(problem, options, 1, answer%coarse(1, :), at_d, status)
+      call wall_clock(t2)
+      answer%solve_seconds = t2 - t1
+      answer%refine_seconds = t1 - t0
+      if (status%code /= 0) return
+      if (modulo(problem%np, 4) == 0 .and. problem%np >= 16) then
+         call solve_level(problem, options, 2, answer%coarse(2, :), at_2d, status)
+         allocate(none(0))
+         if (status%code == 0) call solve_level(problem, options, 4, answer%coarse(3, :), none, status)
+         call wall_clock(t0)
+         answer%richardson_seconds = t0 - t2
+         if (status%code /= 0) return
+      end if
+      call wall_clock(t0)
+      call refine_states(problem, answer, at_d, at_2d)
+      call wall_clock(t1)
+      answer%refine_seconds = answer%refine_seconds + (t1 - t0)
+   end subroutine refine_contact
+
+   !> The refinement, Persson and Richardson at every load and magnification.
+   subroutine refine_states(problem, answer, at_d, at_2d)
+      type(contact_problem), intent(in) :: problem
+      type(refine_answer), intent(inout) :: answer
+      type(pressure_set), intent(in) :: at_d(:)
+      type(pressure_set), allocatable, intent(in) :: at_2d(:)
+      real(dp) :: q_d, m2, p0, side
+      integer :: k, z, nz, nl
+      nz = size(answer%zeta)
+      nl = size(answer%loads)
+      allocate(answer%refined(nz, nl), answer%theory(nz, nl), answer%persson(nz, nl), answer%richardson(nz, nl), &
+         answer%kappa(nl))
+      answer%refined = ieee_value(1.0_dp, ieee_quiet_nan)
+      answer%theory = answer%refined
+      answer%persson = answer%refined
+      answer%richardson = answer%refined
+      answer%kappa = sqrt(2.0_dp)
+      q_d = PI/problem%pixel
+      side = problem%np*problem%pixel
+      ! The one constant of the refinement, from the step 2d -> d the image resolves.
+      if (allocated(at_2d)) answer%kappa = calibrated(answer, at_2d, subpixel_slope_variance(answer%spectrum, &
+         q_d/2, q_d))
+      do k = 1, nl
+         if (.not. allocated(at_d(k)%p)) cycle
+         p0 = answer%loads(k)/side**2
+         do z = 1, nz
+            m2 = subpixel_slope_variance(answer%spectrum, q_d, answer%zeta(z)*q_d)
+            answer%refined(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, answer%kappa(k))
+            answer%theory(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, sqrt(2.0_dp))
+            answer%persson(z, k) = persson_fraction(p0, answer%estar, answer%spectrum%slope_variance + m2)
+            answer%richardson(z, k) = richardson_area(answer%coarse(1, k), answer%coarse(2, k), answer%coarse(3, k), &
+               problem%pixel, problem%pixel/answer%zeta(z))
+         end do
+      end do
+   end subroutine refine_states
+
+   !> kappa over the loads reached at both d and 2d (sqrt 2, Persson's, when none is).
+   function calibrated(answer, at_2d, m2) result(kappa)
+      type(refine_answer), intent(in) :: answer
+      type(pressure_set), intent(in) :: at_2d(:)
+      real(dp), intent(in) :: m2
+      real(dp) :: kappa
+      real(dp), allocatable :: p(:, :, :)
+      logical :: both(size(at_2d))
+      integer :: k, m, n
+      kappa = sqrt(2.0_dp)
+      do k = 1, size(at_2d)
+         both(k) = allocated(at_2d(k)%p) .and. answer%coarse(1, k) == answer%coarse(1, k)
+      end do
+      if (.not. any(both)) return
+      n = size(at_2d(findloc(both, .true., 1))%p, 1)
+      allocate(p(n, n, count(both)))
+      m = 0
+      do k = 1, size(at_2d)
+         if (.not. both(k)) cycle
+         m = m + 1
+         p(:, :, m) = at_2d(k)%p
+      end do
+      kappa = calibrate_kappa(p, answer%estar, m2, pack(answer%coarse(1, :), both))
+   end function calibrated
+
+   !> The solve with both surfaces averaged in blocks of `block` x `block` pixels (1: as
+   !> given; the resolution study's averaging): each load's area fraction and, when
+   !> `pressures` has room, its pressure map.
+   subroutine solve_level(problem, options, block, fraction, pressures, status)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      integer, intent(in) :: block
+      real(dp), intent(inout) :: fraction(:)
+      type(pressure_set), allocatable, intent(inout) :: pressures(:)
+      type(status_type), intent(inout) :: status
+      type(contact_problem) :: level
+      type(contact_result) :: res
+      integer :: k
+      level = problem
+      if (block > 1) then
+         level%np = problem%np/block
+         level%pixel = problem%pixel*block
+         level%maxcont = level%np**2
+         level%lower = block_average(problem%lower, block)
+         level%upper = block_average(problem%upper, block)
+      end if
+      call solve_contact(level, options, res, status)
+      if (status%code /= 0) return
+      if (.not. allocated(pressures)) allocate(pressures(size(fraction)))
+      do k = 1, size(fraction)
+         if (.not. res%states(k)%reached) cycle
+         fraction(k) = real(res%states(k)%contacts, dp)/real(level%np, dp)**2
+         if (size(pressures) > 0) pressures(k)%p = pressure_map(level%np, res, k, level%pixel)
+      end do
+   end subroutine solve_level
+
+   !> State k's pressure map (GPa).
+   function pressure_map(np, res, k, pixel) result(p)
+      integer, intent(in) :: np, k
+      type(contact_result), intent(in) :: res
+      real(dp), intent(in) :: pixel
+      real(dp), allocatable :: p(:, :)
+      integer :: m
+      allocate(p(np, np))
+      p = 0
+      do m = 1, size(res%states(k)%force)
+         p(res%states(k)%i(m), res%states(k)%j(m)) = res%states(k)%force(m)/pixel**2
+      end do
+   end function pressure_map
+end module femcod_refine_study
