@@ -12,6 +12,7 @@ module femcod_bench
    use femcod_bench_frontier, only: bench_frontier
    use femcod_bench_adhesion, only: bench_adhesion
    use femcod_bench_tangential, only: bench_tangential
+   use femcod_bench_refine, only: bench_refine
    implicit none
    private
    public :: bench_command
@@ -49,6 +50,9 @@ contains
             return
          case ("mpi")
             call bench_mpi(args(2:), code)
+            return
+         case ("refine")
+            call bench_refine(args(2:), code)
             return
          end select
       end if

@@ -49,6 +49,7 @@ contains
             "       femcod bench adhesion [--full]  (--help for more)", &
             "       femcod bench tangential [--full] [--figure FILE] [--peers PYTHON]  (--help for more)", &
             "       femcod bench mpi [--np LIST] [--ranks LIST]  (--help for more; needs femcod-mpi)", &
+            "       femcod bench refine [--np N] [--coarse LIST] [--hurst LIST] [--svg FILE]  (--help for more)", &
             "Times the solvers and prints one table: problem, NP, contacts, solver, wall time, time per", &
             "event, peak memory (resident, per case), error against the reference. The rough surface:", &
             "self-affine, H = 0.8, rms 3 nm, 5 um square, 512 x 512, E = 200 GPa, nu = 0.25, against a", &
