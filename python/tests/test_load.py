@@ -1,6 +1,6 @@
 """femcod.load reads what every femcod command writes: run's PREFIX.h5 (with its
 summary.json) into the Result femcod.solve returns, mkdeck's decks (text and HDF5) into a
-Deck, and the CSV tables of resolution, summits and multiscale into dicts of columns;
+Deck, and the CSV tables of resolution, summits, multiscale and refine into dicts of columns;
 femcod-mpi's PREFIX.h5 too where femcod-mpi is installed (setup.sh --mpi)."""
 import csv
 import os
@@ -66,6 +66,7 @@ def test_decks(rough):
     ("resolution", ["--levels", "64,32"]),
     ("summits", []),
     ("multiscale", []),
+    ("refine", ["--loads", "1e4,1e5", "--down-to", "1"]),
 ])
 def test_study_tables(rough, command, args):
     d, deck = rough
