@@ -6,7 +6,7 @@ solver=S, loads=...) answers in memory: every state value the file holds, every 
 every history column must be the same doubles. The loads are 5, 15 and 30 % of the load
 at which the deck's full incremental history ends (the legacy solver's cost grows as the
 fourth power of the contacts). Further cases pass the other physics through (periodic,
-plastic, adhesion, friction).
+plastic, adhesion, friction, a tangential step).
 """
 import glob
 import os
@@ -80,6 +80,8 @@ PHYSICS = [
      dict(solver="cg", plastic=5, approach=[1, 3])),
     ("incremental friction", ["--shear-strength", "0.1", "--shear-slope", "0.2", "--loads", "3000"],
      dict(solver="incremental", shear_strength=0.1, shear_slope=0.2, loads=[3000])),
+    ("cg tangential", ["--solver", "cg", "--loads", "3000,8000", "--tangential", "300", "--friction", "0.3"],
+     dict(solver="cg", loads=[3000, 8000], tangential=300, friction=0.3)),
 ]
 
 

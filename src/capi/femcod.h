@@ -77,6 +77,8 @@ int femcod_state_count(femcod_session *s, int *count);
 int femcod_value_names(femcod_session *s, int kind, char *text, size_t length);
 /* k from 1. */
 int femcod_state_value(femcod_session *s, int k, const char *name, double *value);
+/* Maps: pressure (GPa), gap (nm); with --plastic plastic_displacement (nm); with a tangential
+ * step shear_x, shear_y (GPa), stick, slip (1 where the contact sticks, or slips). */
 int femcod_state_map(femcod_session *s, int k, const char *name, double *out, int64_t size);
 int femcod_history_length(femcod_session *s, int *steps);
 int femcod_history(femcod_session *s, const char *name, double *out, int64_t size);

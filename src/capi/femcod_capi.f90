@@ -422,7 +422,8 @@ contains
    end function femcod_state_value
 
    !> One NP x NP map of state k by name ("pressure" GPa, "gap" nm, "plastic_displacement"
-   !> nm) into `out` (C order, `size` doubles, which must be NP^2).
+   !> nm; with a tangential step "shear_x", "shear_y" GPa, "stick", "slip") into `out` (C
+   !> order, `size` doubles, which must be NP^2).
    integer(c_int) function femcod_state_map(handle, k, name, out, size) bind(C, name="femcod_state_map")
       type(c_ptr), value :: handle
       integer(c_int), value :: k

@@ -17,7 +17,7 @@ module femcod_library_session
    use femcod_shear_model, only: friction_coefficient
    use femcod_observer, only: solver_observer
    use femcod_solver, only: solve_contact
-   use femcod_maps, only: load_maps, state_maps
+   use femcod_maps, only: load_maps, state_maps, tangential_step_maps
    use femcod_options, only: option_spec, FLAG
    use femcod_run, only: run_table, run_settings, parse_run_arguments
    implicit none
@@ -169,7 +169,7 @@ contains
             "cg_contact_gap_nm,cg_load_error,approach_error_bound_nm"
          if (o%shear) names = names//",friction_nN,friction_coefficient"
          if (o%tangential) names = names//",tangential_force_nN,tangential_force_y_nN,tangential_shift_nm,"// &
-            "tangential_shift_y_nm,gross_sliding,tangential_iterations"
+            "tangential_shift_y_nm,gross_sliding,tangential_iterations,tangential_residual,stick_contacts,stick_area_nm2"
       end associate
    end function state_value_names
 
@@ -182,6 +182,7 @@ contains
       type(status_type), intent(inout) :: st
       real(dp) :: area_pixel, region
       type(cg_state_diagnostics) :: work
+      real(dp), allocatable :: stick(:, :, :)
       value = 0
       if (index(","//state_value_names(session)//",", ","//name//",") == 0) then
          call set_error(st, STATUS_USAGE, "no state value '"//name//"' in this result (it has: "// &
@@ -217,6 +218,12 @@ contains
          case ("tangential_shift_y_nm"); value = s%tangential_shift(2)
          case ("gross_sliding"); value = merge(1, 0, s%sliding)
          case ("tangential_iterations"); value = s%tangential_iterations
+         case ("tangential_residual"); value = s%tangential_residual
+         case ("stick_contacts", "stick_area_nm2")
+            ! As femcod run's PREFIX.h5 has them: from the stick map.
+            stick = tangential_step_maps(session%problem%np, session%problem%pixel, s)
+            value = int(sum(stick(:, :, 3)))
+            if (name == "stick_area_nm2") value = sum(stick(:, :, 3))*session%problem%pixel**2
          case ("cg_iterations"); value = work%iterations
          case ("cg_residual"); value = work%residual
          case ("cg_penetration_nm"); value = work%penetration
@@ -233,6 +240,7 @@ contains
       character(len=:), allocatable :: names
       names = "pressure,gap"
       if (session%options%plastic) names = names//",plastic_displacement"
+      if (session%options%tangential) names = names//",shear_x,shear_y,stick,slip"
    end function map_names
 
    !> State k's map `name` (NP x NP, (i, j) row i column j).
@@ -253,9 +261,21 @@ contains
          map = session%maps(k)%gap
       case ("plastic_displacement")
          if (allocated(session%res%states(k)%plastic)) map = session%res%states(k)%plastic
+      case ("shear_x", "shear_y", "stick", "slip")
+         if (session%options%tangential) map = tangential_map(findloc(["shear_x", "shear_y", "stick  ", &
+            "slip   "], name, 1))
       end select
       if (.not. allocated(map)) call set_error(st, STATUS_USAGE, "no map '"//name//"' in this result (it has: "// &
          map_names(session)//")")
+   contains
+      !> One of the tangential step's maps, as femcod run's PREFIX.h5 has it.
+      function tangential_map(which) result(m)
+         integer, intent(in) :: which
+         real(dp), allocatable :: m(:, :)
+         real(dp), allocatable :: all(:, :, :)
+         all = tangential_step_maps(session%problem%np, session%problem%pixel, session%res%states(k))
+         m = all(:, :, which)
+      end function tangential_map
    end subroutine map_of
 
    !> A column of the history by name (HISTORY_COLUMNS), as femcod run's history.csv.

@@ -20,7 +20,7 @@ module femcod_results
       legacy_diagnostics, cg_diagnostics, cg_state_diagnostics, event_checks, legacy_checks, cg_work
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
       h5_read_string_attribute, h5_flat_view
-   use femcod_maps, only: state_maps
+   use femcod_maps, only: state_maps, tangential_step_maps
    use femcod_patches, only: contact_patches, perimeter_area_fit
    use femcod_svg, only: svg_plot, svg_pressure_map
    use femcod_richardson, only: power_law_fit
@@ -608,15 +608,7 @@ contains
       type(load_state), intent(in) :: s
       type(status_type), intent(inout) :: status
       real(dp), allocatable :: map(:, :, :)
-      integer :: k
-      allocate(map(deck%np, deck%np, 4))
-      map = 0
-      if (allocated(s%stick)) then
-         do k = 1, size(s%stick)
-            map(s%i(k), s%j(k), :) = [s%shear_x(k)/deck%pixel**2, s%shear_y(k)/deck%pixel**2, &
-               merge(1.0_dp, 0.0_dp, s%stick(k)), merge(0.0_dp, 1.0_dp, s%stick(k))]
-         end do
-      end if
+      map = tangential_step_maps(deck%np, deck%pixel, s)
       call h5_attribute(file, g, "tangential_force_nN", s%tangential_force(1), status)
       call h5_attribute(file, g, "tangential_force_y_nN", s%tangential_force(2), status)
       call h5_attribute(file, g, "tangential_shift_nm", s%tangential_shift(1), status)

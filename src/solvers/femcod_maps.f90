@@ -11,7 +11,7 @@ module femcod_maps
    use femcod_patches, only: contact_patches, find_patches
    implicit none
    private
-   public :: load_maps, state_maps
+   public :: load_maps, state_maps, tangential_step_maps
 
    !> The maps of one load state, and its contact patches (model/femcod_patches).
    type :: state_maps
@@ -110,4 +110,21 @@ contains
          allocated_gap = allocated(state%gap)
       end function allocated_gap
    end subroutine load_maps
+
+   !> A state's tangential step as four NP x NP maps: the tangential traction along x and
+   !> y (GPa), 1 where the contact sticks, 1 where it slips (all 0 off contact, and
+   !> without a tangential step).
+   pure function tangential_step_maps(np, pixel, s) result(map)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: pixel
+      type(load_state), intent(in) :: s
+      real(dp) :: map(np, np, 4)
+      integer :: k
+      map = 0
+      if (.not. allocated(s%stick)) return
+      do k = 1, size(s%stick)
+         map(s%i(k), s%j(k), :) = [s%shear_x(k)/pixel**2, s%shear_y(k)/pixel**2, merge(1.0_dp, 0.0_dp, s%stick(k)), &
+            merge(0.0_dp, 1.0_dp, s%stick(k))]
+      end do
+   end function tangential_step_maps
 end module femcod_maps
