@@ -50,7 +50,8 @@ contains
          "", &
          "The thesis' third model (section 5.3): the deck solved at its resolution (cg), the surface's PSD", &
          "fitted by a power law over 4 q_L .. q_d/2, and each contact pixel refined below the pixel by", &
-         "Persson's theory of its own mean pressure over the roughness the power law continues (doc/studies.md).", &
+         "Persson's erf of its own mean pressure over the roughness the power law continues, with one", &
+         "constant (kappa) measured on the octave from 2d to d that the image resolves (doc/studies.md).", &
          "Beside it: Richardson's extrapolation from solves at 2d and 4d (section 4.5) and Persson's theory", &
          "of the whole surface. A surface whose PSD is not a power law (no scaling range) is refused.", ""
       call print_lines(option_help(refine_table(), ""))
