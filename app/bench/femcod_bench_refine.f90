@@ -14,7 +14,8 @@ module femcod_bench_refine
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_solver, only: solve_contact
-   use femcod_refine_study, only: refine_answer, refine_contact, composite_modulus
+   use femcod_refine_study, only: refine_answer, refine_contact
+   use femcod_resolution, only: composite_modulus
    use femcod_strings, only: string_type, int_str, fixed_str, sig_str
    use femcod_help, only: help_requested
    use femcod_options, only: option_spec, parsed_options, integer_option, real_list_option, integer_list_option, &
@@ -154,7 +155,7 @@ contains
       real(dp) :: loads(size(fractions)), slope2
       slope2 = sum(((cshift(p%lower, 1, 1) - cshift(p%lower, -1, 1))/(2*p%pixel))**2 + &
          ((cshift(p%lower, 1, 2) - cshift(p%lower, -1, 2))/(2*p%pixel))**2)/size(p%lower)
-      loads = real(nint(fractions*composite_modulus(p)*sqrt(slope2)/2*(p%np*p%pixel)**2/100)*100, dp)
+      loads = real(nint(fractions*composite_modulus(p%young(1:2), p%poisson(1:2))*sqrt(slope2)/2*(p%np*p%pixel)**2/100)*100, dp)
    end function loads_for
 
    subroutine print_rows(hurst, np, truth, answer, fine_seconds)

@@ -51,12 +51,13 @@ contains
 
    !> Label the connected groups of `mask` 1, 2, ... in the order of their first pixel in
    !> column order (0 off contact): a flood fill with an explicit stack, O(NP^2).
-   subroutine label_patches(mask, periodic, diagonal, labels, count, wrap_columns)
+   subroutine label_patches(mask, periodic, diagonal, labels, found, wrap_columns)
       logical, intent(in) :: mask(:, :)
       !> The grid wraps (a periodic cell); corners connect too (8-connected).
       logical, intent(in) :: periodic, diagonal
       integer, intent(out) :: labels(:, :)
-      integer, intent(out) :: count
+      !> The number of patches.
+      integer, intent(out) :: found
       !> Whether the columns wrap too (default: as `periodic`; a slab of columns of a
       !> periodic cell wraps in its rows only).
       logical, intent(in), optional :: wrap_columns
@@ -68,13 +69,13 @@ contains
       n1 = size(mask, 1)
       n2 = size(mask, 2)
       labels = 0
-      count = 0
-      allocate(stack(max(1, count_true(mask))))
+      found = 0
+      allocate(stack(max(1, count(mask))))
       do j = 1, n2
          do i = 1, n1
             if (.not. mask(i, j) .or. labels(i, j) /= 0) cycle
-            count = count + 1
-            labels(i, j) = count
+            found = found + 1
+            labels(i, j) = found
             top = 1
             stack(1) = (j - 1)*n1 + i
             do while (top > 0)
@@ -92,7 +93,7 @@ contains
                      if (wrap_j) qj = modulo(qj - 1, n2) + 1
                      if (qi < 1 .or. qi > n1 .or. qj < 1 .or. qj > n2) cycle
                      if (.not. mask(qi, qj) .or. labels(qi, qj) /= 0) cycle
-                     labels(qi, qj) = count
+                     labels(qi, qj) = found
                      top = top + 1
                      stack(top) = (qj - 1)*n1 + qi
                   end do
@@ -101,11 +102,6 @@ contains
          end do
       end do
    end subroutine label_patches
-
-   pure integer function count_true(mask)
-      logical, intent(in) :: mask(:, :)
-      count_true = count(mask)
-   end function count_true
 
    !> Each labelled patch's area (pixels) and perimeter (pixel sides facing no contact).
    pure subroutine patch_measures(mask, labels, count, periodic, area, perimeter)

@@ -11,7 +11,7 @@ module femcod_maps
    use femcod_patches, only: contact_patches, find_patches
    implicit none
    private
-   public :: load_maps, state_maps, tangential_step_maps
+   public :: load_maps, state_maps, tangential_step_maps, state_pressure_map
 
    !> The maps of one load state, and its contact patches (model/femcod_patches).
    type :: state_maps
@@ -49,7 +49,7 @@ contains
       handed = allocated_gap(states)
       do s = 1, size(states)
          if (.not. states(s)%reached) cycle
-         maps(s)%pressure = pressure_map(states(s))
+         maps(s)%pressure = state_pressure_map(np, problem%pixel, states(s))
          call find_patches(np, states(s)%i, states(s)%j, cyclic, maps(s)%patches)
          if (handed(s)) call move_alloc(states(s)%gap, maps(s)%gap)
       end do
@@ -89,27 +89,30 @@ contains
       end do
       call convolution_free(conv)
    contains
-      !> Pressure (GPa) of a state's contact forces.
-      function pressure_map(state) result(pressure)
-         type(load_state), intent(in) :: state
-         real(dp), allocatable :: pressure(:, :)
-         integer :: m, j
-         allocate(pressure(np, np))
-         ! Zeroed on all threads: most of the time is the first touch of fresh pages.
-         !$omp parallel do schedule(static)
-         do j = 1, np
-            pressure(:, j) = 0
-         end do
-         !$omp end parallel do
-         do m = 1, size(state%force)
-            pressure(state%i(m), state%j(m)) = state%force(m)/problem%pixel**2
-         end do
-      end function pressure_map
       elemental logical function allocated_gap(state)
          type(load_state), intent(in) :: state
          allocated_gap = allocated(state%gap)
       end function allocated_gap
    end subroutine load_maps
+
+   !> A state's pressure map (GPa): its contact forces over the pixel's area, 0 elsewhere.
+   function state_pressure_map(np, pixel, state) result(pressure)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: pixel
+      type(load_state), intent(in) :: state
+      real(dp), allocatable :: pressure(:, :)
+      integer :: m, j
+      allocate(pressure(np, np))
+      ! Zeroed on all threads: most of the time is the first touch of fresh pages.
+      !$omp parallel do schedule(static)
+      do j = 1, np
+         pressure(:, j) = 0
+      end do
+      !$omp end parallel do
+      do m = 1, size(state%force)
+         pressure(state%i(m), state%j(m)) = state%force(m)/pixel**2
+      end do
+   end function state_pressure_map
 
    !> A state's tangential step as four NP x NP maps: the tangential traction along x and
    !> y (GPa), 1 where the contact sticks, 1 where it slips (all 0 off contact, and

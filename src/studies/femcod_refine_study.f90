@@ -10,6 +10,8 @@ module femcod_refine_study
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
    use femcod_surfaces, only: block_average
+   use femcod_resolution, only: composite_modulus
+   use femcod_maps, only: state_pressure_map
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options, SOLVER_CG
    use femcod_solver, only: solve_contact
@@ -17,7 +19,7 @@ module femcod_refine_study
       refined_fraction, persson_fraction, richardson_area, magnifications, calibrate_kappa
    implicit none
    private
-   public :: refine_answer, refine_contact, composite_modulus
+   public :: refine_answer, refine_contact
 
    real(dp), parameter :: PI = acos(-1.0_dp)
 
@@ -46,12 +48,6 @@ module femcod_refine_study
 
 contains
 
-   !> E* of the two bodies (GPa): 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2.
-   pure real(dp) function composite_modulus(problem) result(estar)
-      type(contact_problem), intent(in) :: problem
-      estar = 1/((1 - problem%poisson(1)**2)/problem%young(1) + (1 - problem%poisson(2)**2)/problem%young(2))
-   end function composite_modulus
-
    !> Refine `problem` at options%loads down to the length `down_to` (nm, below the pixel).
    subroutine refine_contact(problem, options, down_to, answer, status)
       type(contact_problem), intent(in) :: problem
@@ -71,7 +67,7 @@ contains
             "pixel, "//format_real(problem%pixel)//" nm")
          return
       end if
-      answer%estar = composite_modulus(problem)
+      answer%estar = composite_modulus(problem%young(1:2), problem%poisson(1:2))
       answer%loads = options%loads
       answer%zeta = magnifications(problem%pixel/down_to)
       call wall_clock(t0)
@@ -188,21 +184,8 @@ contains
       do k = 1, size(fraction)
          if (.not. res%states(k)%reached) cycle
          fraction(k) = real(res%states(k)%contacts, dp)/real(level%np, dp)**2
-         if (size(pressures) > 0) pressures(k)%p = pressure_map(level%np, res, k, level%pixel)
+         if (size(pressures) > 0) pressures(k)%p = state_pressure_map(level%np, level%pixel, res%states(k))
       end do
    end subroutine solve_level
 
-   !> State k's pressure map (GPa).
-   function pressure_map(np, res, k, pixel) result(p)
-      integer, intent(in) :: np, k
-      type(contact_result), intent(in) :: res
-      real(dp), intent(in) :: pixel
-      real(dp), allocatable :: p(:, :)
-      integer :: m
-      allocate(p(np, np))
-      p = 0
-      do m = 1, size(res%states(k)%force)
-         p(res%states(k)%i(m), res%states(k)%j(m)) = res%states(k)%force(m)/pixel**2
-      end do
-   end function pressure_map
 end module femcod_refine_study
