@@ -80,6 +80,22 @@ def test_refused_combinations_come_back_as_exceptions():
         femcod.solve(h, pixel=1e9, loads=[10.0])
 
 
+def test_the_library_refuses_the_commands_own_options_and_stray_values():
+    """Through the C interface: run's file options are refused with the reason, and a
+    value after a flag is named (femcod_set_option)."""
+    from femcod._core import _Session, _set_problem
+    for args, words in ((("--output", "x"), "option of the femcod command"),
+                        (("--plastic", "11"), "follows no option"),
+                        (("--nosuch", ""), "nosuch")):
+        s = _Session()
+        _set_problem(s, paraboloid(16, 1.0, 50.0), 1.0, None, 200.0, 0.25, None)
+        s.check(s.lib.femcod_set_option(s.handle, b"--loads", b"10"))
+        s.check(s.lib.femcod_set_option(s.handle, args[0].encode(), args[1].encode()))
+        with pytest.raises(femcod.FemcodError, match=words) as e:
+            s.check(s.lib.femcod_solve(s.handle, femcod._library.PROGRESS(0), None))
+        assert e.value.code == 2
+
+
 def test_any_real_dtype_and_layout_gives_the_same_answer():
     h = paraboloid(32, 1.0, 50.0)
     ref = femcod.solve(h, pixel=1.0, loads=[300.0])

@@ -18,7 +18,7 @@ module femcod_library_session
    use femcod_observer, only: solver_observer
    use femcod_solver, only: solve_contact
    use femcod_maps, only: load_maps, state_maps, tangential_step_maps
-   use femcod_options, only: option_spec, FLAG
+   use femcod_options, only: parsed_options, parse_options
    use femcod_run, only: run_table, run_settings, parse_run_arguments
    implicit none
    private
@@ -120,32 +120,26 @@ contains
       session%solved = .true.
    end subroutine solve_session
 
-   !> Refuse run's options that are not the solver's (LIBRARY_OPTIONS), with the reason.
+   !> Refuse run's options that are not the solver's (LIBRARY_OPTIONS), with the reason,
+   !> and a value given where none belongs (a flag's "value": a stray argument). The
+   !> arguments are parsed by run's own parser, which reports unknown options itself.
    subroutine refuse_file_options(args, st)
       type(string_type), intent(in) :: args(:)
       type(status_type), intent(inout) :: st
-      type(option_spec), allocatable :: table(:)
-      integer :: i, k
-      table = run_table()
-      i = 1
-      do while (i <= size(args))
-         do k = 1, size(table)
-            if (args(i)%s == table(k)%name) exit
-            if (allocated(table(k)%alias)) then
-               if (table(k)%alias /= "" .and. args(i)%s == table(k)%alias) exit
-            end if
-         end do
-         if (k <= size(table)) then
-            if (.not. any(LIBRARY_OPTIONS == table(k)%name)) then
-               call set_error(st, STATUS_USAGE, table(k)%name//" is an option of the femcod command, not of the "// &
-                  "library: the caller gives the arrays and keeps the results (library options: "// &
-                  joined_options()//")")
-               return
-            end if
-            if (table(k)%kind /= FLAG) i = i + 1
+      type(parsed_options) :: parsed
+      integer :: k
+      call parse_options(run_table(), args, parsed, st)
+      if (st%code /= 0) return
+      do k = 1, size(parsed%table)
+         if (parsed%given(k) .and. .not. any(LIBRARY_OPTIONS == parsed%table(k)%name)) then
+            call set_error(st, STATUS_USAGE, parsed%table(k)%name//" is an option of the femcod command, not of the "// &
+               "library: the caller gives the arrays and keeps the results (library options: "// &
+               joined_options()//")")
+            return
          end if
-         i = i + 1
       end do
+      if (size(parsed%positional) > 0) call set_error(st, STATUS_USAGE, "'"//parsed%positional(1)%s// &
+         "' follows no option that takes a value (a flag such as --plastic takes none)")
    end subroutine refuse_file_options
 
    function joined_options() result(text)
