@@ -40,7 +40,7 @@ class Deck:
     """A contact problem as a deck holds it (doc/deck-format.md): heights ``lower`` and
     ``upper`` (nm, NP x NP, [i, j] row i column j), the pixel (nm), the moduli (GPa) and
     Poisson's ratios of the lower body, the upper body and the contact elements, MAXCONT
-    and a one-line label."""
+    (0: 5 % of NP^2, as for a rough scene) and a one-line label."""
     lower: np.ndarray
     upper: np.ndarray
     pixel: float
@@ -276,7 +276,7 @@ def _set_problem(session, lower, pixel, upper, young, poisson, maxcont):
     if np.ndim(young) == 1 and len(young) == 3:
         blank = up if up is not None else np.zeros_like(lo)
         return _set_problem(session, Deck(lo, blank, pixel, tuple(young), tuple(np.broadcast_to(poisson, 3)),
-                                          int(maxcont or max(1, lo.size // 20)), "femcod python"),
+                                          int(maxcont or 0), "femcod python"),
                             None, None, None, None, None)
     session.check(lib.femcod_set_heights(session.handle, lo.shape[0], _positive(pixel, "pixel"), _pointer(lo),
                                          _pointer(up) if up is not None else None, float(young), float(poisson),

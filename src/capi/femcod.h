@@ -50,7 +50,8 @@ int femcod_set_threads(int threads);
  * (not NULL) both are rough. maxcont <= 0: 5 % of np^2. */
 int femcod_set_heights(femcod_session *s, int np, double pixel, const double *lower, const double *upper,
                        double young, double poisson, int maxcont);
-/* A problem as a deck gives it: moduli and ratios of the lower body, upper body and contact elements. */
+/* A problem as a deck gives it: moduli and ratios of the lower body, upper body and contact elements;
+ * maxcont <= 0: 5 % of np^2. */
 int femcod_set_problem(femcod_session *s, int np, double pixel, const double *lower, const double *upper,
                        const double young[3], const double poisson[3], int maxcont, const char *label);
 int femcod_read_deck(femcod_session *s, const char *path);

@@ -21,7 +21,7 @@ module femcod_capi
    use femcod_strings, only: string_type, int_str
    use femcod_about, only: VERSION_TEXT => FEMCOD_VERSION
    use femcod_problem, only: contact_problem, validate_problem
-   use femcod_generate, only: scene_spec, build_problem
+   use femcod_generate, only: scene_spec, build_problem, rough_maxcont
    use femcod_deck, only: read_deck, write_deck
    use femcod_heights, only: load_scene
    use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
@@ -126,7 +126,8 @@ contains
    end function femcod_set_heights
 
    !> A problem as a deck gives it: both height maps, the three moduli and Poisson's
-   !> ratios (lower, upper, contact elements), MAXCONT and a one-line label.
+   !> ratios (lower, upper, contact elements), MAXCONT (<= 0: 5 % of NP^2, as for a
+   !> rough scene) and a one-line label.
    integer(c_int) function femcod_set_problem(handle, np, pixel, lower, upper, young, poisson, maxcont, label) &
       bind(C, name="femcod_set_problem")
       type(c_ptr), value :: handle
@@ -148,6 +149,7 @@ contains
             p%np = np
             p%pixel = pixel
             p%maxcont = maxcont
+            if (maxcont <= 0) p%maxcont = rough_maxcont(int(np))
             p%young = young
             p%poisson = poisson
             p%lower = c_order(lower, int(np))

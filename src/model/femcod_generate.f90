@@ -18,7 +18,7 @@ module femcod_generate
       self_affine_surface, remove_plane
    implicit none
    private
-   public :: scene_header
+   public :: scene_header, rough_maxcont
    public :: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, RIGID_FACTOR, THESIS_RIGID_FACTOR, KINDS, &
       paraboloid_problem
 
@@ -189,9 +189,7 @@ contains
       else if (spec%kind == "flat") then
          problem%maxcont = np*np
       else
-         ! 5 % of the pixels: rough contacts rarely go further, and the legacy solver's
-         ! skyline grows as MAXCONT**2.
-         problem%maxcont = max(1, np*np/20)
+         problem%maxcont = rough_maxcont(np)
       end if
       problem%young = spec%young
       problem%poisson = spec%poisson
@@ -209,6 +207,13 @@ contains
          return
       end select
    end subroutine scene_header
+
+   !> The MAXCONT of a rough scene of NP^2 pixels when none is given: 5 % of the pixels.
+   !> Rough contacts rarely go further, and the legacy solver's skyline grows as MAXCONT**2.
+   pure integer function rough_maxcont(np)
+      integer, intent(in) :: np
+      rough_maxcont = max(1, np*np/20)
+   end function rough_maxcont
 
    !> The spec of a verification deck of input/ by name; an error for an unknown name.
    subroutine verification_spec(name, spec, status)
