@@ -174,7 +174,8 @@ def heights_array(a, name="heights"):
     """A real square array as C-ordered float64 (converted once when it is not), with a
     clear exception for what femcod cannot take."""
     if hasattr(a, "heights") and callable(a.heights):
-        a = a.heights()  # a SurfaceTopography Topography: see femcod.from_topography for its pixel
+        raise TypeError(f"{name}: a SurfaceTopography Topography carries its own units and pixel: "
+                        "femcod.solve(**femcod.from_topography(t), loads=[...])")
     a = np.asarray(a)
     if a.dtype.kind == "c":
         raise TypeError(f"{name}: complex heights; give the real part (np.real) if that is what is meant")

@@ -190,3 +190,6 @@ def test_topography_adapter():
     assert femcod.solve(**kw, loads=[1000.0], boundary="periodic").states[0].contacts >= 1
     with pytest.raises(ValueError, match="square"):
         femcod.from_topography(StandInTopography(np.zeros((8, 4)), (8.0, 4.0), "nm"))
+    # Given as the heights themselves, its units would be lost: refused, with the way.
+    with pytest.raises(TypeError, match="from_topography"):
+        femcod.solve(t, pixel=2.0, loads=[1000.0])
