@@ -19,8 +19,10 @@
 !> step (refused with adhesion, as the shear model) the normal answer is the same too, and the tangential force of every
 !> state is Q = 10 nN (the multiplier's Newton solve holds sum t = Q to 1e-14 mu P).
 !> With --kernel-radius beyond the grid (cg only: the other solvers refuse it) the table
-!> is whole, so every cg path, the fixed-load and the gap variables, free and periodic,
-!> answers exactly as without it, bit for bit, and refuses exactly where it does.
+!> is whole, so every cg path of the free surface, the fixed-load and the gap variables,
+!> answers exactly as without it, bit for bit, and refuses exactly where it does; on the
+!> periodic cell it is refused (issue 47: a cut periodic kernel changes the cell's mean
+!> compliance, -28 % in the approach at R = 16 on a 32-pixel cell).
 module test_matrix
    use femcod_kinds, only: dp
    use test_support, only: scratch_path, read_text, file_exists, contains_text
@@ -88,8 +90,9 @@ contains
                         call check(error, .not. file_exists(prefix//".lock"), "femcod "//args//": a lock left behind")
                         if (allocated(error)) return
                         if (r == 5) then
-                           call check(error, (code == 0) .eqv. (SOLVERS(s) == "cg" .and. answered(s, b, p, l, m)), &
-                              "femcod "//args//": --kernel-radius beyond the grid answers only where cg does without it")
+                           call check(error, (code == 0) .eqv. (SOLVERS(s) == "cg" .and. BOUNDARIES(b) == "free" &
+                              .and. answered(s, b, p, l, m)), "femcod "//args//": --kernel-radius beyond the grid "// &
+                              "answers only where cg does without it, and on the free surface only")
                            if (allocated(error)) return
                         end if
                         if ((r == 3 .or. r == 4) .and. LAWS(l) == "none") then

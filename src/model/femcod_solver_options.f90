@@ -267,6 +267,14 @@ contains
             "gaps are sums of terms as large as the height range, each rounded to 1.1e-16 of it, so a relative "// &
             "violation below 10 machine epsilons ("//sig_str(tolerance_floor(), 2)//") cannot be shown; give "// &
             "--tol "//sig_str(tolerance_floor(), 2)//" or more")
+      else if (options%boundary == BOUNDARY_PERIODIC .and. options%cg%kernel_radius > 0) then
+         call refuse("--kernel-radius with --boundary periodic: the periodic kernel is a sum over every image "// &
+            "of the cell, and cutting it changes the cell's mean compliance (on a 32-pixel cell R = 16 gave an "// &
+            "approach 28 % short); use the whole periodic kernel, or --kernel-radius on the free surface")
+      else if (options%plastic .and. nloads > 1) then
+         if (any(options%loads(2:) < options%loads(:nloads - 1))) call refuse("--loads with --plastic: the "// &
+            "plastic interface remembers its path and the fixed-load solves only load; give the loads in "// &
+            "increasing order, or unload by displacement control (--solver cg --approach D1,D2,...)")
       else if (options%plastic .and. options%solver /= SOLVER_CG .and. napproaches > 1) then
          if (any(options%approaches(2:) < options%approaches(:napproaches - 1))) call refuse("--approach with "// &
             "--plastic and --solver "//solver_name(options%solver)//": the event path only loads; give the approaches in "// &
