@@ -12,7 +12,7 @@ module femcod_cli
    use femcod_deck, only: write_deck, read_deck
    use femcod_workspace, only: workspace_type, workspace_layout, workspace_table, MAX_WORKSPACE_CONTACTS
    use femcod_problem, only: MAX_NP
-   use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, KINDS
+   use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, KINDS, check_scene_spec
    use femcod_heights, only: load_scene, height_file_path
    use femcod_output_guard, only: guard_outputs, OUTPUT_DECK, OUTPUT_RESULT
    use femcod_run, only: run_command
@@ -306,6 +306,9 @@ contains
             return
          end if
          call refuse_options(parsed, "verification", "", status)
+         if (status%code == 0 .and. verification /= "all" .and. .not. any(VERIFICATION_DECKS == verification)) &
+            call set_error(status, STATUS_USAGE, "--verification: no deck named '"//verification//"' (names: "// &
+               verification_names()//", or all)")
          return
       end if
       if (spec%kind == "") then
@@ -355,6 +358,7 @@ contains
       call get_option(parsed, "--gamma", spec%gamma)
       call get_option(parsed, "--lmax", spec%lmax)
       call get_option(parsed, "--lmin", spec%lmin)
+      call check_scene_spec(spec, status)
       if (spec%label == "") spec%label = "femcod mkdeck "//spec%kind
    end subroutine parse_mkdeck_arguments
 
@@ -528,6 +532,16 @@ contains
       end if
       write(output_unit, '(a)') "wrote "//output
    end subroutine verify_command
+
+   !> The names of the verification decks, comma-separated.
+   function verification_names() result(text)
+      character(len=:), allocatable :: text
+      integer :: k
+      text = trim(VERIFICATION_DECKS(1))
+      do k = 2, size(VERIFICATION_DECKS)
+         text = text//", "//trim(VERIFICATION_DECKS(k))
+      end do
+   end function verification_names
 
    function kinds_list() result(s)
       character(len=:), allocatable :: s

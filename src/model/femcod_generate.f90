@@ -11,14 +11,14 @@
 !> input/ keep the thesis' THESIS_RIGID_FACTOR = 1e5 so that they are the thesis' scenes.
 module femcod_generate
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
+   use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_USAGE
    use femcod_problem, only: contact_problem, validate_problem
    use femcod_strings, only: int_str, format_real
    use femcod_surfaces, only: circle_punch, square_punch, sphere_cap, sinusoid_surface, weierstrass_mandelbrot, &
       self_affine_surface, remove_plane
    implicit none
    private
-   public :: scene_header, rough_maxcont
+   public :: scene_header, rough_maxcont, check_scene_spec
    public :: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS, RIGID_FACTOR, THESIS_RIGID_FACTOR, KINDS, &
       paraboloid_problem
 
@@ -169,6 +169,47 @@ contains
          if (value <= 0) pick = default
       end function pick
    end subroutine build_problem
+
+   !> A spec asked for on the command line, checked before anything is made or read:
+   !> every size its kind needs is given (a sphere without --radius would be a flat deck
+   !> labelled sphere), the grid suits the kind, MAXCONT fits the grid, the label is one
+   !> line, and no option is given that the kind would ignore. STATUS_USAGE (exit 2).
+   subroutine check_scene_spec(spec, status)
+      type(scene_spec), intent(in) :: spec
+      type(status_type), intent(inout) :: status
+      if (status%code /= 0) return
+      if (spec%kind /= "matrix" .and. spec%np <= 0) then
+         call refuse(spec%kind//" needs --np N (pixels per side)")
+      else if (spec%kind /= "matrix" .and. .not. spec%pixel > 0) then
+         call refuse(spec%kind//" needs --pixel D (the pixel size, nm)")
+      else if (spec%kind == "sphere" .and. .not. spec%radius > 0) then
+         call refuse("sphere needs --radius R (nm): without it the deck would be flat")
+      else if (spec%kind == "circle-punch" .and. .not. (spec%radius > 0 .or. (spec%area > 0 .and. spec%height > 0))) &
+         then
+         call refuse("circle-punch needs its size: --radius R (nm; area pi R^2, height R), or --area A "// &
+            "(nm^2) with --height H (nm); without them the deck would be flat")
+      else if (spec%kind == "circle-punch" .and. mod(spec%np, 2) /= 1) then
+         call refuse("circle-punch needs an odd --np (the punch is centred on a pixel), found "// &
+            int_str(spec%np))
+      else if (spec%kind == "square-punch" .and. mod(spec%np, 3) /= 0) then
+         call refuse("square-punch needs --np divisible by 3 (the punch is the central NP/3 x NP/3 "// &
+            "pixels), found "//int_str(spec%np))
+      else if (spec%kind /= "matrix" .and. spec%maxcont > 0 .and. int(spec%maxcont, kind(1_8)) > &
+         int(spec%np, kind(1_8))**2) then
+         call refuse("--maxcont "//int_str(spec%maxcont)//" is more than the grid's "//int_str(spec%np)//"^2 = "// &
+            int_str(spec%np*spec%np)//" pixels")
+      else if (scan(spec%label, achar(10)//achar(13)) > 0) then
+         call refuse("--label must be a single line (it is the deck's first line)")
+      else if (spec%kind /= "matrix" .and. spec%height_unit /= "") then
+         call refuse("--height-unit with mkdeck "//spec%kind//": the unit of heights read from a file (kind "// &
+            "matrix); a generated surface is in nm")
+      end if
+   contains
+      subroutine refuse(message)
+         character(len=*), intent(in) :: message
+         call set_error(status, STATUS_USAGE, message)
+      end subroutine refuse
+   end subroutine check_scene_spec
 
    !> A scene's problem without its heights: label, NP, pixel, MAXCONT (MAXCONT 0 in the
    !> spec: `npunch` for punches, NP**2 for a flat, 5 % of NP**2 otherwise) and the
