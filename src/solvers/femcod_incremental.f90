@@ -173,7 +173,10 @@ contains
             call touch_again(state, options, status)
             if (status%code /= 0) return
             if (state%n == 0) then
+               ! No pixel joined: either none is left, or MAXCONT leaves no room for it.
                state%res%stop_reason = STOP_NO_CONTACT
+               if (state%nplastic < state%npix .and. .not. state%path%room_for(state%nplastic, 1)) &
+                  state%res%stop_reason = STOP_MAXCONT
                exit
             end if
             cycle
@@ -326,7 +329,10 @@ contains
          worst = min(worst, gq)
       end do
       state%checks%max_penetration = max(0.0_dp, -worst)
-      ! F = A M^-1 1 - M^-1 g0_C, A from 1'F = P (O(n^2)).
+      ! F = A M^-1 1 - M^-1 g0_C, A from 1'F = P (O(n^2)); with every contact capped there
+      ! is no elastic set to re-solve, and nothing that could differ.
+      state%checks%final_check_difference = 0
+      if (state%n == 0) return
       associate(n => state%n, u => state%u, ld => state%ld)
          w = state%g0(state%pix(1:n))
          call dtrsv("U", "T", "N", n, u, ld, w, 1)
