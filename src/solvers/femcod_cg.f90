@@ -494,7 +494,15 @@ contains
             answer%plastic = session%path%plastic
             session%capped = session%path%cap
          end if
-         total = [sum(force), real(count(g > 0 .and. g < session%law%range), dp), sum(force, mask=g > 0), sum(g)]
+         ! Without adhesion only the contact pixels (g = 0) carry force; what the iteration
+         ! leaves elsewhere is its residual, so the load is the pressure map's sum (a state
+         ! off contact is load 0, not the residual's 1e-12 nN).
+         if (session%law%adhesive()) then
+            total(1) = sum(force)
+         else
+            total(1) = sum(force, mask=g == 0)
+         end if
+         total(2:) = [real(count(g > 0 .and. g < session%law%range), dp), sum(force, mask=g > 0), sum(g)]
          call grid%sum_over_grid(total)
          answer%load = total(1)
          answer%attractive = nint(total(2))
