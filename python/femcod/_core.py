@@ -58,7 +58,9 @@ class Deck:
 
 @dataclass
 class State:
-    """The contact state at one requested load or approach."""
+    """The contact state at one requested load or approach. A state the solve did not
+    reach (``state.reached`` False; a warning says why) keeps only what was asked, its
+    other values NaN, and no maps."""
     values: dict
     maps: dict = field(default_factory=dict)
 
@@ -102,8 +104,10 @@ class Result:
     summary: dict = None
 
     def column(self, name):
-        """One value of every state as an array (``result.column("area_nm2")``)."""
-        return np.array([s.values.get(name, math.nan) for s in self.states])
+        """One value of every state as an array (``result.column("area_nm2")``); NaN for a
+        state that was not reached (``state.reached`` False), so none is mixed in."""
+        return np.array([s.values.get(name, math.nan) if s.values.get("reached", 1) else math.nan
+                         for s in self.states])
 
     @property
     def loads(self):
@@ -254,8 +258,12 @@ def _set_problem(session, lower, pixel, upper, young, poisson, maxcont):
     lib = session.lib
     if isinstance(lower, Deck):
         deck = lower
-        if upper is not None or pixel is not None:
-            raise TypeError("solve(deck): the deck gives the pixel and both surfaces")
+        given = [name for name, v in (("pixel", pixel), ("upper", upper), ("young", young), ("poisson", poisson),
+                                      ("maxcont", maxcont)) if v is not None]
+        if given:
+            raise TypeError(f"solve(deck): the deck gives the pixel, both surfaces, the materials and MAXCONT; "
+                            f"{', '.join(given)}= would be ignored (change the Deck's fields instead, "
+                            f"dataclasses.replace(deck, young=...))")
         lo = heights_array(deck.lower, "deck.lower")
         up = heights_array(deck.upper, "deck.upper")
         if up.shape != lo.shape:
@@ -268,6 +276,8 @@ def _set_problem(session, lower, pixel, upper, young, poisson, maxcont):
         return lo, up
     if pixel is None:
         raise TypeError("solve(heights, pixel=...): the pixel size in nm is needed")
+    young = 200.0 if young is None else young
+    poisson = 0.25 if poisson is None else poisson
     lo = heights_array(lower, "lower")
     up = None
     if upper is not None:
@@ -336,6 +346,10 @@ def _result(session, solver, options):
         for name in value_names:
             session.check(lib.femcod_state_value(session.handle, k, name.encode(), ctypes.byref(value)))
             values[name] = value.value
+        if not values["reached"]:
+            # Not an answer: only what was asked (the load or the approach) is kept.
+            asked = "approach_nm" if any(o == "--approach" for o, _ in options) else "load_nN"
+            values = {name: (v if name in ("reached", asked) else math.nan) for name, v in values.items()}
         maps = {}
         if values["reached"]:
             for name in map_names:
@@ -370,7 +384,7 @@ def _get_deck(session):
     return Deck(lower, upper, pixel.value, tuple(young), tuple(poisson), maxcont.value, label)
 
 
-def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=200.0, poisson=0.25, boundary="free",
+def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=None, poisson=None, boundary="free",
           plastic=None, adhesion=None, approach=None, maxcont=None, final_check=True, threads=None, progress=None,
           **options):
     """Solve a contact problem; returns a Result.
@@ -382,8 +396,10 @@ def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=200.0, p
     loads      total loads (nN) at which to report the state; or approach= (nm).
     solver     "cg" (default), "incremental" (event-exact) or "legacy" (Appendix B).
     upper      the other surface's heights (default: flat).
-    young, poisson  the elastic body's modulus (GPa) and ratio, the other body rigid, as
-               `femcod run --lower` (or three values each: lower, upper, contact elements).
+    young, poisson  the elastic body's modulus (GPa, default 200) and ratio (default 0.25),
+               the other body rigid, as `femcod run --lower` (or three values each: lower,
+               upper, contact elements). With a Deck, these, pixel, upper and maxcont are
+               the deck's and refused here (TypeError).
     boundary   "free" or "periodic".
     plastic    None, True (hardness 11 GPa), or the hardness in GPa.
     adhesion   None, "dugdale" or "exponential", with work= (J/m^2) and range= (nm).
@@ -408,6 +424,8 @@ def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=200.0, p
         session.check(session.lib.femcod_set_option(session.handle, name.encode(), str(value).encode()))
     _solve_session(session, progress)
     del kept
+    for line in session.text(session.lib.femcod_warnings).splitlines():
+        warnings.warn(f"femcod: {line}", stacklevel=2)
     return _result(session, solver, opts)
 
 

@@ -60,6 +60,9 @@ int femcod_read_deck(femcod_session *s, const char *path);
  * pixel <= 0: the file's own. Warnings (a tilt, a guessed unit): femcod_warnings, one per line. */
 int femcod_read_heights(femcod_session *s, const char *path, double pixel, int remove_plane, double young,
                         double poisson);
+/* What the last read of heights or the last solve warned of, one warning per line ("": none):
+ * after femcod_solve, each requested state not reached (with the reason) and each tangential
+ * step at a state without contact. */
 int femcod_warnings(femcod_session *s, char *text, size_t length);
 /* A name ending in .h5 writes the HDF5 deck; an existing file is replaced only with force != 0. */
 int femcod_write_deck(femcod_session *s, const char *path, int force);

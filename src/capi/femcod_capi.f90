@@ -212,7 +212,9 @@ contains
       femcod_read_heights = finish_problem(session, st)
    end function femcod_read_heights
 
-   !> What the last read of heights warned of, one warning per line ("": nothing).
+   !> What the last read of heights or the last solve warned of, one warning per line ("":
+   !> nothing): a tilt or a guessed unit of a height file, a requested state not reached,
+   !> a tangential step at a state without contact.
    integer(c_int) function femcod_warnings(handle, text, length) bind(C, name="femcod_warnings")
       type(c_ptr), value :: handle
       character(kind=c_char), intent(out) :: text(*)

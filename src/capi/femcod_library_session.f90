@@ -16,7 +16,7 @@ module femcod_library_session
    use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL
    use femcod_shear_model, only: friction_coefficient
    use femcod_observer, only: solver_observer
-   use femcod_solver, only: solve_contact
+   use femcod_solver, only: solve_contact, run_warnings
    use femcod_maps, only: load_maps, state_maps, tangential_step_maps
    use femcod_options, only: parsed_options, parse_options
    use femcod_run, only: run_table, run_settings, parse_run_arguments
@@ -90,7 +90,10 @@ contains
       type(library_observer) :: observer
       type(contact_options) :: options
       type(contact_result) :: empty
+      type(string_type), allocatable :: warnings(:)
+      integer :: k
       session%solved = .false.
+      session%warnings = ""
       session%res = empty
       if (allocated(session%maps)) deallocate(session%maps)
       if (.not. session%has_problem) then
@@ -118,6 +121,13 @@ contains
       call load_maps(session%problem, session%res%states, session%maps, options%boundary == BOUNDARY_PERIODIC)
       session%options = options
       session%solved = .true.
+      ! What `femcod run` prints as warnings (a requested state not reached, a tangential
+      ! step without contact): femcod_warnings, one per line.
+      warnings = run_warnings(options, session%res)
+      session%warnings = ""
+      do k = 1, size(warnings)
+         session%warnings = session%warnings//warnings(k)%s//new_line("a")
+      end do
    end subroutine solve_session
 
    !> Refuse run's options that are not the solver's (LIBRARY_OPTIONS), with the reason,

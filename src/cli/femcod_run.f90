@@ -31,7 +31,7 @@ module femcod_run
    use femcod_observer, only: solver_observer
    use femcod_state_visitor, only: visitable
    use femcod_incremental_state, only: incremental_state
-   use femcod_solver, only: solve_contact, model_notes, report_lines, report_line
+   use femcod_solver, only: solve_contact, model_notes, report_lines, report_line, run_warnings
    use femcod_maps, only: load_maps, state_maps
    use femcod_patches, only: contact_patches, perimeter_area_fit
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
@@ -715,7 +715,7 @@ contains
       type(run_info) :: info
       type(shear_model) :: shear
       character(len=:), allocatable :: fingerprint, started
-      type(string_type), allocatable :: digests(:)
+      type(string_type), allocatable :: digests(:), warnings(:)
       logical :: resuming, ok, have_checkpoint, complete
       type(contact_options) :: solve_options
       integer(i8) :: held
@@ -812,16 +812,9 @@ contains
          ! The set is replaced as a whole: what an earlier run left beside it goes, and the
          ! checkpoint has served its purpose.
          call remove_stale_results(prefix, requested_states(options))
-         do k = 1, size(res%states)
-            if (.not. res%states(k)%reached) then
-               if (size(options%approaches) > 0) then
-                  write(error_unit, '(a)') "femcod: warning: approach "//format_real(res%states(k)%approach)// &
-                     " nm not reached ("//stop_reason_text(res%stop_reason)//")"
-               else
-                  write(error_unit, '(a)') "femcod: warning: load "//format_real(res%states(k)%load)// &
-                     " nN not reached ("//stop_reason_text(res%stop_reason)//")"
-               end if
-            end if
+         warnings = run_warnings(options, res)
+         do k = 1, size(warnings)
+            write(error_unit, '(a)') "femcod: warning: "//warnings(k)%s
          end do
          if (.not. settings%quiet) call print_summary(deck_path, prefix, problem, options, res, maps)
       end associate
@@ -1029,7 +1022,7 @@ contains
       real(dp), intent(in) :: pixel
       integer :: stick
       if (.not. allocated(s%stick)) then
-         write(output_unit, '(a)') "              tangential: no contact"
+         write(output_unit, '(a)') "              tangential: none (no contact carries it)"
          return
       end if
       stick = count(s%stick)

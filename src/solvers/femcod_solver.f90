@@ -11,7 +11,7 @@ module femcod_solver
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result, load_state, cg_diagnostics, cg_state_diagnostics, &
-      event_path_diagnostics, legacy_diagnostics
+      event_path_diagnostics, legacy_diagnostics, stop_reason_text
    use femcod_solver_options, only: contact_options, validate_options, by_gap_variables, run_shear_model, &
       refuse_beyond_memory, &
       SOLVER_INCREMENTAL, SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, law_name
@@ -27,7 +27,7 @@ module femcod_solver
    use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential, tangential_storage_bytes
    implicit none
    private
-   public :: solve_contact, model_notes, report_lines, report_line
+   public :: solve_contact, model_notes, report_lines, report_line, run_warnings
 
    !> A line of the summary: a label ("checked", "cg", ...) and its text.
    type :: report_line
@@ -97,6 +97,37 @@ contains
       end if
    end subroutine solve_contact
 
+   !> What a finished run must tell its user that is not an error, one line each: every
+   !> requested state not reached (with the reason the run stopped), and every reached
+   !> state where the tangential step asked for could not be applied (no contact carries
+   !> it). The command line prints them as warnings, the C library and Python return them.
+   function run_warnings(options, res) result(lines)
+      type(contact_options), intent(in) :: options
+      type(contact_result), intent(in) :: res
+      type(string_type), allocatable :: lines(:)
+      integer :: k
+      allocate(lines(0))
+      if (.not. allocated(res%states)) return
+      do k = 1, size(res%states)
+         associate(s => res%states(k))
+            if (.not. s%reached) then
+               if (allocated(options%approaches)) then
+                  if (size(options%approaches) > 0) then
+                     lines = [lines, string_type("approach "//format_real(s%approach)//" nm not reached ("// &
+                        stop_reason_text(res%stop_reason)//")")]
+                     cycle
+                  end if
+               end if
+               lines = [lines, string_type("load "//format_real(s%load)//" nN not reached ("// &
+                  stop_reason_text(res%stop_reason)//")")]
+            else if (options%tangential .and. s%contacts == 0) then
+               lines = [lines, string_type("state "//int_str(k)//" (approach "//format_real(s%approach)// &
+                  " nm) has no contact: the tangential step was not applied, and its tangential force is 0")]
+            end if
+         end associate
+      end do
+   end function run_warnings
+
    !> The tangential step (solvers/femcod_tangential) at each reached state with contacts,
    !> after its memory check: the answer into the state.
    subroutine tangential_states(problem, options, res, status, observer)
@@ -120,7 +151,8 @@ contains
       request%periodic = options%boundary == BOUNDARY_PERIODIC
       do k = 1, size(res%states)
          associate(s => res%states(k))
-            if (.not. s%reached .or. .not. allocated(s%force)) cycle
+            ! A state without contact carries no tangential force: no step (run_warnings).
+            if (.not. s%reached .or. .not. allocated(s%force) .or. s%contacts == 0) cycle
             call solve_tangential(problem, s%i, s%j, s%force, request, answer, status, observer)
             if (status%code /= 0) then
                status%message = "state "//int_str(k)//" (load "//sig_str(s%load, 6)//" nN): "//status%message
