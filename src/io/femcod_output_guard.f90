@@ -6,8 +6,9 @@
 !> Whether femcod wrote a file is read from its form, by the kind its name gives:
 !>   .h5            an HDF5 file with a `femcod_version` attribute (on / for a checkpoint,
 !>                  on /run for a result set)
-!>   .csv           a header line of two or more names joined by commas (femcod's headers;
-!>                  a line of numbers, a blank line or free text is not one)
+!>   .csv           one of femcod's tables: the name ends as femcod names it (.loads.csv,
+!>                  .history.csv, ...) and the header begins with that table's first
+!>                  columns (FEMCOD_TABLES); a user's "sample,thickness_nm" is not one
 !>   .svg           femcod's SVG preamble (XML declaration, <svg>, white background)
 !>   .json          a JSON object with a "femcod_version" member
 !>   .xdmf          an XDMF document
@@ -93,7 +94,7 @@ contains
          if (ends_with(path, ".h5")) then
             ours = is_femcod_hdf5(path, head)
          else if (ends_with(path, ".csv")) then
-            ours = is_csv_header(first_line(head))
+            ours = is_femcod_table(path, first_line(head))
          else if (ends_with(path, ".svg")) then
             ours = index(head, '<?xml version="1.0" encoding="UTF-8"?>'//new_line('a')// &
                '<svg xmlns="http://www.w3.org/2000/svg"') == 1 .and. &
@@ -138,6 +139,36 @@ contains
       end do
       ok = .true.
    end function is_deck_head
+
+   !> True when `path` is named as one of femcod's tables and `header` begins as that
+   !> table's header does: the ending of the name, then the table's first columns. Only
+   !> femcod writes these pairs (a user's table beside a deck, s.loads.csv with "sample,
+   !> thickness_nm", is not one of them).
+   pure logical function is_femcod_table(path, header) result(ours)
+      character(len=*), intent(in) :: path, header
+      character(len=*), parameter :: TABLES(2, 15) = reshape([character(len=40) :: &
+         ".loads.csv", "load_nN,approach_nm,contacts,area_nm2,", &
+         ".history.csv", "step,contacts,load_nN,approach_nm,", &
+         ".contacts.csv", "i,j,step,force_nN,pressure_GPa", &
+         ".resolution.csv", "np,method,load_nN,approach_nm,area_nm2", &
+         ".powerlaw.csv", "np,exponent,prefactor", &
+         ".estimates.csv", "np,model,load_nN,area_nm2", &
+         ".hardness.csv", "np,step,area_fraction,contacts,", &
+         ".hardness_capped.csv", "np,step,load_nN,area_fraction,contacts,", &
+         ".summits.csv", "box_nm,n,density_per_um2,", &
+         ".summit_exponents.csv", "quantity,exponent,prefactor", &
+         ".psd.csv", "frequency_per_nm,power_nm3", &
+         ".structure.csv", "tau_nm,structure_nm2", &
+         ".fractal.csv", "method,profile_dimension,", &
+         ".multiscale.csv", "s,constraint,scale,length_nm,", &
+         ".refine.csv", "load_nN,magnification,pixel_nm,"], [2, 15])
+      integer :: k
+      ours = .false.
+      if (.not. is_csv_header(header)) return
+      do k = 1, size(TABLES, 2)
+         if (ends_with(path, trim(TABLES(1, k))) .and. index(header, trim(TABLES(2, k))) == 1) ours = .true.
+      end do
+   end function is_femcod_table
 
    !> femcod's CSV header: two or more names of letters, digits and '_' (not starting with
    !> a digit) joined by commas, such as "step,contacts,load_nN,...".
