@@ -14,7 +14,7 @@ module femcod_bench_io
    use femcod_files, only: write_file
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
    use femcod_svg, only: svg_pressure_map
-   use femcod_output_guard, only: OUTPUT_DECK
+   use femcod_output_guard, only: OUTPUT_DECK, OUTPUT_RESULT
    use femcod_bench_common, only: prepare_directory, guard_bench_files, &
       bench_arguments, benchmark_surface, linear_law, self_path, json_value, &
       read_text_file, BENCH_LENGTH
@@ -73,6 +73,9 @@ contains
          decks(n)%s = dir//"/io_"//int_str(sizes(n))//".deck"
       end do
       call guard_bench_files(decks, OUTPUT_DECK, "io", code)
+      ! The figure written again here, and each run's outputs, are replaced only where femcod
+      ! wrote them (the runs' own guard, with --force, checks theirs).
+      call guard_bench_files([string_type(dir//"/figure.svg")], OUTPUT_RESULT, "io", code)
       if (code /= 0) return
       write(output_unit, '(a)') "| NP | deck write s (values/s) | deck read s (values/s) | femcod run s | solver s "// &
          "| outside the solver s (% of solve, s/Mpixel) | read / digests / maps / h5 / text s | figure s "// &
@@ -107,7 +110,10 @@ contains
          t_run = t1 - t0
          if (ios /= 0) then
             write(error_unit, '(a)') "femcod bench io: "//command//" ended with exit code "//int_str(ios)
+            ! The run's own cause (2 usage, 3 input, 4 numerical, 5 I/O, 6 stopped) is this
+            ! command's; anything else (a signal, a shell's 127) counts as a failure, 4.
             code = 4
+            if (ios >= 2 .and. ios <= 6) code = ios
             return
          end if
          ! The solver's own time and the parts outside it, from the summary file.
