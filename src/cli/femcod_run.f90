@@ -98,7 +98,8 @@ contains
    function run_table() result(table)
       type(option_spec), allocatable :: table(:)
       table = [ &
-         text_option("--output", "PREFIX", "output prefix (default: the deck's name without .deck, here)", alias="-o"), &
+         text_option("--output", "PREFIX", "output prefix (default: the deck's name without .deck, here; its "// &
+            "directory is made if missing)", alias="-o"), &
          text_option("--outdir", "DIR", "write each deck's outputs into DIR (made if missing), named after the deck"), &
          choice_option("--solver", "incremental|legacy|cg", "the solver (default incremental; doc/solver.md)"), &
          real_list_option("--loads", "F1,...", "total loads in nN at which to report the state (PREFIX.loads.csv); "// &
@@ -387,7 +388,7 @@ contains
       type(run_settings) :: settings
       type(status_type) :: status
       type(string_type), allocatable :: failed(:)
-      integer :: d, rc
+      integer :: d, rc, k
       code = 0
       if (help_requested(args)) then
          call run_help()
@@ -413,6 +414,18 @@ contains
             return
          end if
       end if
+      ! -o out/circle in a fresh directory: out/ is made, as --outdir makes its DIR.
+      do d = 1, size(settings%prefixes)
+         k = index(settings%prefixes(d)%s, "/", back=.true.)
+         if (k <= 1) cycle
+         if (path_is_directory(settings%prefixes(d)%s(1:k - 1))) cycle
+         call make_directories(settings%prefixes(d)%s(1:k - 1), status)
+         if (status%code /= 0) then
+            write(error_unit, '(a)') "femcod: "//status%message
+            code = status%code
+            return
+         end if
+      end do
       ! A batch system's stop signals end the run between two steps, with a checkpoint.
       call catch_stop_signals()
       ! Batch: every deck runs; a failed deck is reported and the others go on.
