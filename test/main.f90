@@ -30,6 +30,7 @@ program tester
    use test_tangential, only: collect_tangential
    use test_patches, only: collect_patches
    use test_refine, only: collect_refine
+   use test_silent, only: collect_silent
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
    use femcod_strings, only: string_type, parse_integer
@@ -48,6 +49,7 @@ program tester
       new_testsuite("surfaces", collect_surfaces), &
       new_testsuite("boussinesq", collect_boussinesq), &
       new_testsuite("legacy", collect_legacy), &
+      new_testsuite("silent", collect_silent), &
       new_testsuite("incremental", collect_incremental), &
       new_testsuite("results", collect_results), &
       new_testsuite("hostile", collect_hostile), &

@@ -1,0 +1,64 @@
+"""Issue 47: the library never gives an answer silently wrong. Each test failed on the
+main before the fix (the defect it names is in its docstring)."""
+import math
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+import femcod
+
+from conftest import REPO
+
+SPHERE = os.path.join(REPO, "input", "sphere_d1.deck")
+
+
+@pytest.mark.parametrize("given", [{"young": 100}, {"poisson": 0.3}, {"young": [1, 2, 3]}, {"maxcont": 5},
+                                   {"pixel": 1.0}, {"upper": np.zeros((30, 30))}])
+def test_a_deck_refuses_what_it_already_gives(given):
+    """Before: young=, poisson= (one or three values) with a Deck were ignored, the deck's
+    values used without a word."""
+    deck = femcod.read_deck(SPHERE)
+    with pytest.raises(TypeError, match=next(iter(given)) + "="):
+        femcod.solve(deck, loads=[1e3], **given)
+
+
+def test_an_unreached_load_is_a_warning_and_not_an_answer():
+    """Before: solver='incremental', maxcont=5, loads=[1e3, 10] gave the unreached 1e3 as an
+    ordinary state, approach 0 and area 0, only values['reached'] == 0 telling. The
+    command line leaves its row out and warns; the library warns, marks the state and
+    keeps it out of column()."""
+    deck = femcod.read_deck(SPHERE)
+    deck.maxcont = 5
+    with pytest.warns(UserWarning, match=r"load 1e3 nN not reached \(maximum number of contacts reached\)"):
+        r = femcod.solve(deck, loads=[1e3, 10], solver="incremental")
+    first, second = r.states
+    assert not first.reached and second.reached
+    assert first.load == 1e3  # what was asked stays
+    assert math.isnan(first.approach) and math.isnan(first.area) and first.maps == {}
+    assert math.isnan(r.areas[0]) and math.isnan(r.loads[0])
+    # The reached state is the command line's: 10 nN on the sphere touches.
+    assert r.loads[1] == pytest.approx(10, rel=1e-12) and r.areas[1] > 0
+
+
+def test_a_tangential_step_without_contact_is_a_warning():
+    """Before: --tangential 500 --friction 0.3 at a state without contact (cg, --plastic
+    --approach 2.5,1) gave tangential force 0 and stick fraction 0 without a word, and the
+    summary printed 'NaN %'. The state's load is the pressure map's sum: exactly 0 off
+    contact (it was the residual's 3e-12 nN)."""
+    deck = femcod.read_deck(SPHERE)
+    with pytest.warns(UserWarning, match="has no contact: the tangential step was not applied"):
+        r = femcod.solve(deck, approach=[2.5, 1], plastic=11, tangential=500, friction=0.3)
+    loaded, off = r.states
+    assert off.contacts == 0 and off.load == 0.0
+    assert loaded.load == pytest.approx(loaded.pressure.sum() * deck.pixel ** 2, rel=1e-14)
+    assert loaded.tangential_force_nN == pytest.approx(500, rel=1e-12)
+
+
+def test_no_warning_when_every_state_is_answered():
+    deck = femcod.read_deck(SPHERE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = femcod.solve(deck, loads=[100, 1000])
+    assert all(s.reached for s in r.states)
