@@ -29,6 +29,14 @@ def _is_hdf5(path):
 def load(path):
     """Read what a femcod command wrote at `path` (see the module's description)."""
     path = os.fspath(path)
+    for companion in (".summary.json", ".xdmf"):
+        # A companion of PREFIX.h5 names the set: read the set (with its summary).
+        if path.endswith(companion):
+            prefix = path[:-len(companion)]
+            if os.path.isfile(prefix + ".h5"):
+                return load(prefix + ".h5")
+            raise FileNotFoundError(f"{path}: a companion file of a femcod result set; its data, {prefix}.h5, "
+                                    f"is not beside it (femcod.load reads PREFIX.h5, a deck or PREFIX.*.csv)")
     if os.path.isfile(path) and _is_hdf5(path):
         import h5py
         with h5py.File(path, "r") as f:

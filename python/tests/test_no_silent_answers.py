@@ -62,3 +62,48 @@ def test_no_warning_when_every_state_is_answered():
         warnings.simplefilter("error")
         r = femcod.solve(deck, loads=[100, 1000])
     assert all(s.reached for s in r.states)
+
+
+def test_a_summary_file_loads_its_result_set(tmp_path):
+    """Before: femcod.load('x.summary.json') read it as a deck ('x.summary.json:2:
+    expected 3 values'). Now the set beside it is read; without it, a clear error."""
+    from conftest import run_femcod
+    run_femcod("run", SPHERE, "--loads", "100", "-o", tmp_path / "s", "--quiet")
+    r = femcod.load(tmp_path / "s.summary.json")
+    assert r.states[0].load == 100 and r.summary is not None
+    (tmp_path / "s.h5").unlink()
+    with pytest.raises(FileNotFoundError, match="is not beside it"):
+        femcod.load(tmp_path / "s.summary.json")
+
+
+def test_the_c_library_refuses_null_outputs():
+    """Before: femcod_state_value(s, 1, "area_nm2", NULL) dereferenced NULL (a segfault).
+    Every output pointer is checked: exit code 2 and a message naming it."""
+    import ctypes
+    from femcod._core import _Session
+    s = _Session()
+    assert s.lib.femcod_read_deck(s.handle, SPHERE.encode()) == 0
+    assert s.lib.femcod_set_option(s.handle, b"--loads", b"100") == 0
+    keep_going = femcod._library.PROGRESS(lambda *args: 0)
+    assert s.lib.femcod_solve(s.handle, keep_going, None) == 0
+    assert s.lib.femcod_state_value(s.handle, 1, b"area_nm2", None) == 2
+    assert "NULL given where its output goes (value)" in s.message()
+    assert s.lib.femcod_state_count(s.handle, None) == 2
+    assert s.lib.femcod_problem_size(s.handle, None) == 2
+    value = ctypes.c_double()
+    assert s.lib.femcod_state_value(s.handle, 1, b"load_nN", ctypes.byref(value)) == 0 and value.value == 100
+
+
+def test_a_failed_set_keeps_the_problem_before_it():
+    """Before: a femcod_set_heights that failed (here np = 0) discarded the problem set
+    before it. A failed set of any kind changes nothing."""
+    import ctypes
+    from femcod._core import _Session
+    s = _Session()
+    assert s.lib.femcod_read_deck(s.handle, SPHERE.encode()) == 0
+    heights = np.zeros(4)
+    pointer = heights.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+    assert s.lib.femcod_set_heights(s.handle, 0, 1.0, pointer, None, 200.0, 0.25, 0) == 3
+    assert s.lib.femcod_read_deck(s.handle, b"/nonexistent.deck") == 3
+    size = ctypes.c_int()
+    assert s.lib.femcod_problem_size(s.handle, ctypes.byref(size)) == 0 and size.value == 30

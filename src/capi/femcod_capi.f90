@@ -65,21 +65,33 @@ contains
 
    !> femcod's version into `text` (`length` bytes with the terminating NUL).
    integer(c_int) function femcod_version(text, length) bind(C, name="femcod_version")
-      character(kind=c_char), intent(out) :: text(*)
       integer(c_size_t), value :: length
-      femcod_version = copy_out(VERSION_TEXT, text, length)
+      type(c_ptr), value :: text
+      character(kind=c_char), pointer :: text_out(:)
+      if (.not. all_given([text])) then
+         femcod_version = null_argument(c_null_ptr, "femcod_version", "text")
+         return
+      end if
+      call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
+      femcod_version = copy_out(VERSION_TEXT, text_out, length)
    end function femcod_version
 
    !> The message of the session's last failure ("" after a success).
    integer(c_int) function femcod_message(handle, text, length) bind(C, name="femcod_message")
       type(c_ptr), value :: handle
-      character(kind=c_char), intent(out) :: text(*)
       integer(c_size_t), value :: length
       type(library_session), pointer :: session
+      type(c_ptr), value :: text
+      character(kind=c_char), pointer :: text_out(:)
+      if (.not. all_given([text])) then
+         femcod_message = null_argument(handle, "femcod_message", "text")
+         return
+      end if
+      call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_message = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
-      femcod_message = copy_out(session%message, text, length)
+      femcod_message = copy_out(session%message, text_out, length)
    end function femcod_message
 
    !> The problem of `femcod run --lower L [--upper U] --pixel D --young E --poisson NU`:
@@ -217,14 +229,20 @@ contains
    !> a tangential step at a state without contact.
    integer(c_int) function femcod_warnings(handle, text, length) bind(C, name="femcod_warnings")
       type(c_ptr), value :: handle
-      character(kind=c_char), intent(out) :: text(*)
       integer(c_size_t), value :: length
       type(library_session), pointer :: session
+      type(c_ptr), value :: text
+      character(kind=c_char), pointer :: text_out(:)
+      if (.not. all_given([text])) then
+         femcod_warnings = null_argument(handle, "femcod_warnings", "text")
+         return
+      end if
+      call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_warnings = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
       if (.not. allocated(session%warnings)) session%warnings = ""
-      femcod_warnings = copy_out(session%warnings, text, length)
+      femcod_warnings = copy_out(session%warnings, text_out, length)
    end function femcod_warnings
 
    !> Write the session's problem as a deck (a name ending in .h5: the HDF5 deck),
@@ -250,13 +268,19 @@ contains
    !> NP of the session's problem (0: none).
    integer(c_int) function femcod_problem_size(handle, np) bind(C, name="femcod_problem_size")
       type(c_ptr), value :: handle
-      integer(c_int), intent(out) :: np
       type(library_session), pointer :: session
-      np = 0
+      type(c_ptr), value :: np
+      integer(c_int), pointer :: np_out
+      if (.not. all_given([np])) then
+         femcod_problem_size = null_argument(handle, "femcod_problem_size", "np")
+         return
+      end if
+      call c_f_pointer(np, np_out)
+      np_out = 0
       femcod_problem_size = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
-      if (session%has_problem) np = session%problem%np
+      if (session%has_problem) np_out = session%problem%np
       femcod_problem_size = 0
    end function femcod_problem_size
 
@@ -265,11 +289,29 @@ contains
    integer(c_int) function femcod_get_problem(handle, pixel, maxcont, young, poisson, lower, upper) &
       bind(C, name="femcod_get_problem")
       type(c_ptr), value :: handle
-      real(c_double), intent(out) :: pixel, young(3), poisson(3), lower(*), upper(*)
-      integer(c_int), intent(out) :: maxcont
       type(library_session), pointer :: session
       type(status_type) :: st
       integer :: n
+      type(c_ptr), value :: pixel
+      type(c_ptr), value :: young
+      type(c_ptr), value :: poisson
+      type(c_ptr), value :: lower
+      type(c_ptr), value :: upper
+      type(c_ptr), value :: maxcont
+      real(c_double), pointer :: pixel_out
+      real(c_double), pointer :: young_out(:)
+      real(c_double), pointer :: poisson_out(:)
+      real(c_double), pointer :: lower_out(:)
+      real(c_double), pointer :: upper_out(:)
+      integer(c_int), pointer :: maxcont_out
+      if (.not. all_given([pixel, young, poisson, lower, upper, maxcont])) then
+         femcod_get_problem = null_argument(handle, "femcod_get_problem", "pixel, young, poisson, lower, upper, maxcont")
+         return
+      end if
+      call c_f_pointer(pixel, pixel_out)
+      call c_f_pointer(young, young_out, [3])
+      call c_f_pointer(poisson, poisson_out, [3])
+      call c_f_pointer(maxcont, maxcont_out)
       femcod_get_problem = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
@@ -278,12 +320,14 @@ contains
       else
          associate(p => session%problem)
             n = p%np
-            pixel = p%pixel
-            maxcont = p%maxcont
-            young = p%young
-            poisson = p%poisson
-            call to_c_order(p%lower, lower(1:n*n))
-            call to_c_order(p%upper, upper(1:n*n))
+            pixel_out = p%pixel
+            maxcont_out = p%maxcont
+            young_out = p%young
+            poisson_out = p%poisson
+            call c_f_pointer(lower, lower_out, [n*n])
+            call c_f_pointer(upper, upper_out, [n*n])
+            call to_c_order(p%lower, lower_out)
+            call to_c_order(p%upper, upper_out)
          end associate
       end if
       femcod_get_problem = finish(session, st)
@@ -292,14 +336,20 @@ contains
    !> The problem's label into `text`.
    integer(c_int) function femcod_get_label(handle, text, length) bind(C, name="femcod_get_label")
       type(c_ptr), value :: handle
-      character(kind=c_char), intent(out) :: text(*)
       integer(c_size_t), value :: length
       type(library_session), pointer :: session
+      type(c_ptr), value :: text
+      character(kind=c_char), pointer :: text_out(:)
+      if (.not. all_given([text])) then
+         femcod_get_label = null_argument(handle, "femcod_get_label", "text")
+         return
+      end if
+      call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_get_label = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
       if (.not. session%has_problem) return
-      femcod_get_label = copy_out(session%problem%label, text, length)
+      femcod_get_label = copy_out(session%problem%label, text_out, length)
    end function femcod_get_label
 
    !> Add one of `femcod run`'s options by its name ("--solver") and value ("cg"; "" for
@@ -363,17 +413,23 @@ contains
    !> event solvers without --loads, the last step).
    integer(c_int) function femcod_state_count(handle, count) bind(C, name="femcod_state_count")
       type(c_ptr), value :: handle
-      integer(c_int), intent(out) :: count
       type(library_session), pointer :: session
       type(status_type) :: st
-      count = 0
+      type(c_ptr), value :: count
+      integer(c_int), pointer :: count_out
+      if (.not. all_given([count])) then
+         femcod_state_count = null_argument(handle, "femcod_state_count", "count")
+         return
+      end if
+      call c_f_pointer(count, count_out)
+      count_out = 0
       femcod_state_count = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
       if (.not. session%solved) then
          call set_error(st, STATUS_USAGE, "no result: solve first")
       else if (allocated(session%res%states)) then
-         count = size(session%res%states)
+         count_out = size(session%res%states)
       end if
       femcod_state_count = finish(session, st)
    end function femcod_state_count
@@ -383,10 +439,16 @@ contains
    integer(c_int) function femcod_value_names(handle, kind, text, length) bind(C, name="femcod_value_names")
       type(c_ptr), value :: handle
       integer(c_int), value :: kind
-      character(kind=c_char), intent(out) :: text(*)
       integer(c_size_t), value :: length
       type(library_session), pointer :: session
       type(status_type) :: st
+      type(c_ptr), value :: text
+      character(kind=c_char), pointer :: text_out(:)
+      if (.not. all_given([text])) then
+         femcod_value_names = null_argument(handle, "femcod_value_names", "text")
+         return
+      end if
+      call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_value_names = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
@@ -397,11 +459,11 @@ contains
       end if
       select case (kind)
       case (0)
-         femcod_value_names = copy_out(state_value_names(session), text, length)
+         femcod_value_names = copy_out(state_value_names(session), text_out, length)
       case (1)
-         femcod_value_names = copy_out(map_names(session), text, length)
+         femcod_value_names = copy_out(map_names(session), text_out, length)
       case (2)
-         femcod_value_names = copy_out(HISTORY_COLUMNS, text, length)
+         femcod_value_names = copy_out(HISTORY_COLUMNS, text_out, length)
       case default
          call set_error(st, STATUS_USAGE, "kind must be 0 (state values), 1 (maps) or 2 (history)")
          femcod_value_names = finish(session, st)
@@ -413,15 +475,21 @@ contains
       type(c_ptr), value :: handle
       integer(c_int), value :: k
       character(kind=c_char), intent(in) :: name(*)
-      real(c_double), intent(out) :: value
       type(library_session), pointer :: session
       type(status_type) :: st
-      value = 0
+      type(c_ptr), value :: value
+      real(c_double), pointer :: value_out
+      if (.not. all_given([value])) then
+         femcod_state_value = null_argument(handle, "femcod_state_value", "value")
+         return
+      end if
+      call c_f_pointer(value, value_out)
+      value_out = 0
       femcod_state_value = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
       call check_state(session, int(k), st)
-      if (st%code == 0) call state_value(session, int(k), from_c(name), value, st)
+      if (st%code == 0) call state_value(session, int(k), from_c(name), value_out, st)
       femcod_state_value = finish(session, st)
    end function femcod_state_value
 
@@ -433,11 +501,17 @@ contains
       integer(c_int), value :: k
       character(kind=c_char), intent(in) :: name(*)
       integer(c_int64_t), value :: size
-      real(c_double), intent(out) :: out(*)
       type(library_session), pointer :: session
       type(status_type) :: st
       real(dp), allocatable :: map(:, :)
       integer :: n
+      type(c_ptr), value :: out
+      real(c_double), pointer :: out_out(:)
+      if (.not. all_given([out])) then
+         femcod_state_map = null_argument(handle, "femcod_state_map", "out")
+         return
+      end if
+      call c_f_pointer(out, out_out, [max(1_c_int64_t, size)])
       femcod_state_map = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
@@ -448,7 +522,7 @@ contains
             call set_error(st, STATUS_USAGE, "the map needs NP^2 = "//int_str(n*n)//" doubles")
          else
             call map_of(session, int(k), from_c(name), map, st)
-            if (st%code == 0) call to_c_order(map, out(1:n*n))
+            if (st%code == 0) call to_c_order(map, out_out(1:n*n))
          end if
       end if
       femcod_state_map = finish(session, st)
@@ -457,15 +531,21 @@ contains
    !> The number of steps in the history of the last solve.
    integer(c_int) function femcod_history_length(handle, steps) bind(C, name="femcod_history_length")
       type(c_ptr), value :: handle
-      integer(c_int), intent(out) :: steps
       type(library_session), pointer :: session
       type(status_type) :: st
-      steps = 0
+      type(c_ptr), value :: steps
+      integer(c_int), pointer :: steps_out
+      if (.not. all_given([steps])) then
+         femcod_history_length = null_argument(handle, "femcod_history_length", "steps")
+         return
+      end if
+      call c_f_pointer(steps, steps_out)
+      steps_out = 0
       femcod_history_length = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
       if (.not. session%solved) call set_error(st, STATUS_USAGE, "no result: solve first")
-      if (st%code == 0) steps = session%res%nsteps
+      if (st%code == 0) steps_out = session%res%nsteps
       femcod_history_length = finish(session, st)
    end function femcod_history_length
 
@@ -475,10 +555,16 @@ contains
       type(c_ptr), value :: handle
       character(kind=c_char), intent(in) :: name(*)
       integer(c_int64_t), value :: size
-      real(c_double), intent(out) :: out(*)
       type(library_session), pointer :: session
       type(status_type) :: st
       real(dp), allocatable :: column(:)
+      type(c_ptr), value :: out
+      real(c_double), pointer :: out_out(:)
+      if (.not. all_given([out])) then
+         femcod_history = null_argument(handle, "femcod_history", "out")
+         return
+      end if
+      call c_f_pointer(out, out_out, [max(1_c_int64_t, size)])
       femcod_history = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
@@ -488,13 +574,35 @@ contains
          if (size /= int(session%res%nsteps, c_int64_t)) then
             call set_error(st, STATUS_USAGE, "the history has "//int_str(session%res%nsteps)//" steps")
          else
-            out(1:session%res%nsteps) = column
+            out_out(1:session%res%nsteps) = column
          end if
       end if
       femcod_history = finish(session, st)
    end function femcod_history
 
    ! ---- helpers ----
+
+   !> True when no address in `addresses` is NULL.
+   logical function all_given(addresses)
+      type(c_ptr), intent(in) :: addresses(:)
+      integer :: k
+      all_given = .true.
+      do k = 1, size(addresses)
+         if (.not. c_associated(addresses(k))) all_given = .false.
+      end do
+   end function all_given
+
+   !> A call with a NULL where an output goes: STATUS_USAGE, and the session's message
+   !> (where there is a session) names the function and its outputs.
+   integer(c_int) function null_argument(handle, function_name, outputs)
+      type(c_ptr), intent(in) :: handle
+      character(len=*), intent(in) :: function_name, outputs
+      type(library_session), pointer :: session
+      null_argument = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      session%message = function_name//": NULL given where its output goes ("//outputs//"); nothing was written"
+   end function null_argument
 
    !> A state index within the last solve.
    subroutine check_state(session, k, st)
@@ -513,6 +621,9 @@ contains
    subroutine forget_problem(session)
       type(library_session), intent(inout) :: session
       type(contact_problem) :: none
+      session%previous = session%problem
+      session%had_problem = session%has_problem
+      session%was_solved = session%solved
       session%has_problem = .false.
       session%solved = .false.
       session%problem = none
@@ -521,7 +632,15 @@ contains
    integer(c_int) function finish_problem(session, st)
       type(library_session), intent(inout) :: session
       type(status_type), intent(in) :: st
+      type(contact_problem) :: none
       session%has_problem = st%code == 0
+      if (st%code /= 0) then
+         ! The failed set changes nothing: the problem before it, and its result, stay.
+         session%problem = session%previous
+         session%has_problem = session%had_problem
+         session%solved = session%was_solved
+      end if
+      session%previous = none
       finish_problem = finish(session, st)
    end function finish_problem
 

@@ -43,6 +43,10 @@ module femcod_library_session
    type :: library_session
       type(contact_problem) :: problem
       logical :: has_problem = .false.
+      !> The problem (and whether a result went with it) while a new one is being set: a
+      !> set that fails puts it back, so a bad call loses nothing.
+      type(contact_problem) :: previous
+      logical :: had_problem = .false., was_solved = .false.
       !> The options as `femcod run` takes them: names and values in order.
       type(string_type), allocatable :: args(:)
       !> The last solve: its options, result and maps (solved: they hold one).

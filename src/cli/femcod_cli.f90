@@ -171,9 +171,14 @@ contains
             call set_error(status, STATUS_USAGE, "NP "//int_str(np)//": expected 1 to "//int_str(MAX_NP)// &
                " (the largest grid a deck may hold)")
          else if (maxcont < 1 .or. int(maxcont, i8) > int(np, i8)**2 .or. maxcont > MAX_WORKSPACE_CONTACTS) then
-            call set_error(status, STATUS_USAGE, "MAXCONT "//int_str(maxcont)//": expected 1 to NP^2 = "// &
-               int_str(min(int(np, i8)**2, int(MAX_WORKSPACE_CONTACTS, i8)))//" (and at most "// &
-               int_str(MAX_WORKSPACE_CONTACTS)//", where MAXNODE = 4 MAXCONT + 2 still fits an integer word)")
+            if (int(np, i8)**2 <= MAX_WORKSPACE_CONTACTS) then
+               call set_error(status, STATUS_USAGE, "MAXCONT "//int_str(maxcont)//": expected 1 to NP^2 = "// &
+                  int_str(int(np, i8)**2))
+            else
+               call set_error(status, STATUS_USAGE, "MAXCONT "//int_str(maxcont)//": expected 1 to "// &
+                  int_str(MAX_WORKSPACE_CONTACTS)//", where MAXNODE = 4 MAXCONT + 2 still fits an integer word "// &
+                  "(below NP^2 = "//int_str(int(np, i8)**2)//")")
+            end if
          end if
       end if
       if (status%code /= 0) then

@@ -22,8 +22,8 @@ module femcod_studies
    use femcod_resolution_study, only: resolution_level, solve_level, extrapolate_levels
    use femcod_summits, only: summit_statistics, summit_search, summits_of_size, default_sizes, profile_psd, summit_power_laws, &
       structure_function, psd_dimension, structure_dimension, summits_storage_bytes
-   use femcod_memory, only: available_memory, memory_text
-   use femcod_multiscale, only: roughness_template, multiscale_result, multiscale_hertz
+   use femcod_memory, only: available_memory, memory_text, usable_text
+   use femcod_multiscale, only: roughness_template, multiscale_result, multiscale_hertz, check_growth
    use femcod_scene, only: flip_upper
    use femcod_surfaces, only: remove_plane
    use femcod_richardson, only: power_law_fit
@@ -699,7 +699,7 @@ contains
          if (may > 0 .and. need > may) call set_error(status, STATUS_NUMERICAL, opts%input//": the analysis of "// &
             int_str(size(z, 1))//" x "//int_str(size(z, 2))//" heights needs about "//memory_text(need)// &
             " besides them (box maxima, summit lists, the structure function's differences), this run may use "// &
-            memory_text(may))
+            usable_text(may))
       end if
       if (status%code /= 0) then
          call fail_with("summits", status, code)

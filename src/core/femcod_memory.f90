@@ -11,7 +11,7 @@ module femcod_memory
    use femcod_kinds, only: i8
    implicit none
    private
-   public :: physical_memory, memory_text, resident_bytes, peak_resident_bytes, available_memory
+   public :: physical_memory, memory_text, usable_text, resident_bytes, peak_resident_bytes, available_memory
    public :: memory_setting, MEMORY_VARIABLE
 
    !> The environment variable that caps the memory femcod may use.
@@ -163,6 +163,19 @@ contains
 
    !> "N bytes (X.Y UNIT)", UNIT the largest of KiB, MiB, GiB and TiB that X is at least
    !> 1 of (bytes alone below 1 KiB).
+   !> The memory a run may still use, as text: memory_text, or "nothing" where the
+   !> process already holds more than it may use (available_memory's 1 byte).
+   function usable_text(bytes) result(text)
+      integer(i8), intent(in) :: bytes
+      character(len=:), allocatable :: text
+      if (bytes <= 1) then
+         text = "nothing (the process already holds more than the memory it may use: FEMCOD_MEMORY, the job's "// &
+            "limit or the machine's)"
+      else
+         text = memory_text(bytes)
+      end if
+   end function usable_text
+
    function memory_text(bytes) result(text)
       integer(i8), intent(in) :: bytes
       character(len=:), allocatable :: text

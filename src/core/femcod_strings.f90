@@ -8,6 +8,7 @@ module femcod_strings
    use femcod_bytes, only: eight_digits
    implicit none
    private
+   public :: count_text
    public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, add_lines, add_text, built_text
    public :: without_trailing_zeros, xml_escape, json_string, json_number, sig_str, next_line
    public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, format_reals, is_digit, &
@@ -134,6 +135,15 @@ contains
    end function built_text
 
    !> An integer without blanks.
+   !> "1 value", "2 values": a count with its noun, plural where the count is not 1.
+   pure function count_text(n, noun) result(text)
+      integer, intent(in) :: n
+      character(len=*), intent(in) :: noun
+      character(len=:), allocatable :: text
+      text = int_str(n)//" "//noun
+      if (n /= 1) text = text//"s"
+   end function count_text
+
    pure function int_str_default(i) result(s)
       integer, intent(in) :: i
       character(len=:), allocatable :: s

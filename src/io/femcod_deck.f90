@@ -21,7 +21,7 @@ module femcod_deck
    use femcod_files, only: write_file, read_file, MAX_TEXT_BYTES
    use femcod_deck_h5, only: read_deck_h5, write_deck_h5, is_hdf5_file
    use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens, count_tokens
-   use femcod_strings, only: int_str, parse_real, parse_integer, format_real, format_reals, is_digit, text_builder, &
+   use femcod_strings, only: count_text, int_str, parse_real, parse_integer, format_real, format_reals, is_digit, text_builder, &
       add_line, add_text, built_text
    !$ use omp_lib, only: omp_get_max_threads
    implicit none
@@ -251,7 +251,7 @@ contains
          call set_error(status, STATUS_BAD_INPUT, t%path//":"//int_str(line)//": expected "//int_str(n)// &
             " values ("//what//"), found the end of the file")
       else
-         call refuse_found(t, line, int_str(n)//" values ("//what//")", int_str(t%count(line))//" values", status)
+         call refuse_found(t, line, int_str(n)//" values ("//what//")", count_text(t%count(line), "value"), status)
       end if
    end subroutine expect_count
 

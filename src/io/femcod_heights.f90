@@ -11,7 +11,7 @@
 !> Every size is checked before anything is allocated, every value before it is used.
 !> Heights come back in nm, row 1 at the top of the image.
 module femcod_heights
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use, intrinsic :: iso_fortran_env, only: int16, int32
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_USAGE
@@ -20,7 +20,7 @@ module femcod_heights
    use femcod_surfaces, only: plane_tilt, block_average
    use femcod_files, only: path_exists, path_is_directory, read_file
    use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close, h5_rank_and_dims
-   use femcod_memory, only: physical_memory, memory_text
+   use femcod_memory, only: physical_memory, memory_text, usable_text
    use femcod_problem, only: contact_problem, MAX_NP
    use femcod_generate, only: scene_spec, build_problem
    implicit none
@@ -165,6 +165,7 @@ contains
       character(len=*), intent(in), optional :: height_unit
       character(len=:), allocatable :: file, channel, given
       real(dp) :: scale
+      integer :: bad(2)
       allocate(map%warnings(0))
       map%channel = ""
       map%instrument = ""
@@ -200,7 +201,10 @@ contains
          if (abs(scale - 1) > 0) map%z = map%z*scale
       end if
       if (.not. all(ieee_is_finite(map%z))) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected finite heights (nm), found NaN or Inf")
+         bad = findloc(ieee_is_finite(map%z), .false.)
+         call set_error(status, STATUS_BAD_INPUT, path//": expected finite heights (nm), found "// &
+            trim(merge("NaN", "Inf", ieee_is_nan(map%z(bad(1), bad(2)))))//" at row "//int_str(bad(1))// &
+            ", column "//int_str(bad(2))//" (the first of "//int_str(count(.not. ieee_is_finite(map%z)))//")")
          return
       end if
       if (maxval(abs(map%z)) > 1.0e12_dp) then
@@ -433,12 +437,15 @@ contains
       integer(i8), intent(in) :: rows, cols
       type(status_type), intent(inout) :: status
       if (status%code /= 0) return
-      if (rows < 1 .or. cols < 1 .or. rows > MAX_NP .or. cols > MAX_NP) then
+      if (rows < 1 .or. cols < 1) then
+         call set_error(status, STATUS_BAD_INPUT, path//": the dataset is empty ("//i8_text(rows)//" x "// &
+            i8_text(cols)//"): expected a matrix of heights, at least 1 x 1")
+      else if (rows > MAX_NP .or. cols > MAX_NP) then
          call set_error(status, STATUS_BAD_INPUT, path//": expected at most "//int_str(MAX_NP)//" x "// &
             int_str(MAX_NP)//" heights, found "//i8_text(rows)//" x "//i8_text(cols))
       else if (physical_memory() > 0 .and. 16*rows*cols > physical_memory()) then
          call set_error(status, STATUS_BAD_INPUT, path//": "//i8_text(rows)//" x "//i8_text(cols)//" heights need "// &
-            memory_text(16*rows*cols)//", this run may use "//memory_text(physical_memory()))
+            memory_text(16*rows*cols)//", this run may use "//usable_text(physical_memory()))
       end if
    end subroutine check_size
 
@@ -468,7 +475,12 @@ contains
       call read_file(path, "a height-matrix file", text, status)
       if (status%code /= 0) return
       if (index(text, achar(0)) > 0) then
-         call set_error(status, STATUS_BAD_INPUT, path//": expected a text matrix of heights, found binary content")
+         if (index(text, achar(137)//"HDF") == 1) then
+            call set_error(status, STATUS_BAD_INPUT, path//": an HDF5 file: name the dataset of heights, "// &
+               path//":/PATH (for example "//path//":/heights)")
+         else
+            call set_error(status, STATUS_BAD_INPUT, path//": expected a text matrix of heights, found binary content")
+         end if
          return
       end if
       allocate(values(1024))

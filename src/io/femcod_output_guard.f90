@@ -40,14 +40,15 @@ contains
 
    !> Check the files `names` that a command is about to write, each of the kind `kind`
    !> (OUTPUT_*), against its `inputs` and what exists. STATUS_USAGE (exit 2) when an
-   !> output names an input or a directory; STATUS_IO (exit 5) when a file exists and
-   !> --force was not given, or when it was but femcod did not write the file.
+   !> output names an input or a directory; STATUS_IO (exit 5) when an output's directory
+   !> does not exist, when a file exists and --force was not given, or when it was but
+   !> femcod did not write the file.
    subroutine guard_outputs(names, inputs, force, kind, status)
       type(string_type), intent(in) :: names(:), inputs(:)
       logical, intent(in) :: force
       integer, intent(in) :: kind
       type(status_type), intent(inout) :: status
-      integer :: m, i
+      integer :: m, i, slash
       character(len=:), allocatable :: full
       if (status%code /= 0) return
       do m = 1, size(names)
@@ -61,6 +62,14 @@ contains
          end do
       end do
       do m = 1, size(names)
+         slash = index(names(m)%s, "/", back=.true.)
+         if (slash > 1) then
+            if (.not. path_is_directory(names(m)%s(1:slash - 1))) then
+               call set_error(status, STATUS_IO, names(m)%s(1:slash - 1)//": no such directory for "// &
+                  names(m)%s//"; make it first (nothing was computed)")
+               return
+            end if
+         end if
          if (path_is_directory(names(m)%s)) then
             call set_error(status, STATUS_USAGE, names(m)%s//": is a directory; give a file name for the output")
             return

@@ -12,7 +12,7 @@
 !>  - MPSTIF is the skyline size of femcod's equation numbering at MAXCONT
 !>    contacts, (7*MAXCONT + 2)*(MAXCONT + 1)/2 words (see `skyline_words`).
 module femcod_workspace
-   use femcod_memory, only: memory_text
+   use femcod_memory, only: memory_text, usable_text
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_BAD_INPUT
    use femcod_strings, only: int_str
@@ -191,7 +191,7 @@ contains
       if (present(memory_available)) budget = memory_available
       if (budget > 0 .and. 8*ws%mpend + 4*ws%ipend > budget) then
          call set_error(status, STATUS_NUMERICAL, "workspace: needs "//memory_text(8*ws%mpend + 4*ws%ipend)// &
-            ", this run may use "//memory_text(budget))
+            ", this run may use "//usable_text(budget))
          return
       end if
       allocate(ws%ra(ws%mpend), ws%ia(ws%ipend), stat=stat)

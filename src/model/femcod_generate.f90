@@ -198,6 +198,8 @@ contains
          int(spec%np, kind(1_8))**2) then
          call refuse("--maxcont "//int_str(spec%maxcont)//" is more than the grid's "//int_str(spec%np)//"^2 = "// &
             int_str(spec%np*spec%np)//" pixels")
+      else if (spec%kind == "matrix" .and. spec%matrix_file == "") then
+         call refuse("matrix needs --file FILE (an ASCII matrix of heights, a Gwyddion export or FILE.h5:/DATASET)")
       else if (scan(spec%label, achar(10)//achar(13)) > 0) then
          call refuse("--label must be a single line (it is the deck's first line)")
       else if (spec%kind /= "matrix" .and. spec%height_unit /= "") then

@@ -4,7 +4,7 @@
 !> dispatches on `solver`.
 module femcod_solver_options
    use femcod_kinds, only: dp, i8
-   use femcod_memory, only: memory_text
+   use femcod_memory, only: memory_text, usable_text
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL
    use femcod_strings, only: format_real, int_str, sig_str
    use femcod_interface_law, only: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
@@ -379,7 +379,7 @@ contains
       integer(i8), intent(in) :: need, available
       type(status_type), intent(inout) :: status
       if (available > 0 .and. need > available) call set_error(status, STATUS_NUMERICAL, what//" needs about "// &
-         memory_text(need)//" for the solver's arrays, this run may give it "//memory_text(available)// &
+         memory_text(need)//" for the solver's arrays, this run may give it "//usable_text(available)// &
          " (the memory it may use less what it holds); femcod-mpi splits a grid over nodes")
    end subroutine refuse_beyond_memory
 

@@ -85,7 +85,7 @@ module femcod_cg
       BOUNDARY_PERIODIC
    use femcod_observer, only: solver_observer
    use femcod_shear_model, only: friction_force
-   use femcod_strings, only: int_str, sig_str, format_real
+   use femcod_strings, only: count_text, int_str, sig_str, format_real
    use femcod_clock, only: wall_clock
    implicit none
    private
@@ -288,12 +288,12 @@ contains
       character(len=:), allocatable :: message
       if (by_gaps) then
          message = "adhesion: approach "//format_real(target)//" nm: residual "//sig_str(residual, 2)//" after "// &
-            int_str(iterations)//" iterations, above --tol "//sig_str(tol, 2)// &
+            count_text(iterations, "iteration")//", above --tol "//sig_str(tol, 2)// &
             " (raise --max-iterations, or refine the pixel: adhesion_convexity in the summary)"
       else
          message = "cg: "//trim(merge("approach", "load    ", by_approach))//" "//format_real(target)// &
             trim(merge(" nm", " nN", by_approach))//": residual "//sig_str(residual, 2)//" after "// &
-            int_str(iterations)//" iterations, above --tol "//sig_str(tol, 2)//" (raise --max-iterations)"
+            count_text(iterations, "iteration")//", above --tol "//sig_str(tol, 2)//" (raise --max-iterations)"
       end if
    end function unconverged_message
 

@@ -18,7 +18,7 @@ module femcod_constrained_cg
    use femcod_elastic_operator, only: elastic_operator
    use femcod_solver_options, only: cg_settings
    use femcod_observer, only: solver_observer
-   use femcod_strings, only: int_str
+   use femcod_strings, only: count_text, int_str
    !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
    implicit none
    private
@@ -125,8 +125,8 @@ contains
       call iteration_start(st, grid, how, p, total_load)
       do
          if (grid%any_over_grid(observer%stop_requested())) then
-            call set_error(status, STATUS_INTERRUPTED, "stopped after "//int_str(st%it)//" iterations on the "// &
-               int_str(st%np)//" x "//int_str(st%np)//" grid; the cg solver keeps no checkpoint")
+            call set_error(status, STATUS_INTERRUPTED, "stopped after "//count_text(st%it, "iteration")//" on the "// &
+               int_str(st%np)//" x "//int_str(st%np)//" grid")
             return
          end if
          if (st%fresh) then

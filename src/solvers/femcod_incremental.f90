@@ -26,7 +26,7 @@ module femcod_incremental
    use femcod_observer, only: solver_observer
    use femcod_event_path, only: first_touch_limit, NO_EVENT
    use femcod_incremental_state, only: incremental_state, REFILL_EVERY, factor_peak_bytes
-   use femcod_memory, only: memory_text
+   use femcod_memory, only: memory_text, usable_text
    use femcod_event_search, only: event_search
    use femcod_clock, only: wall_clock
    implicit none
@@ -78,7 +78,7 @@ contains
          if (may > 0 .and. need > may) call set_error(st, STATUS_NUMERICAL, "incremental: "//int_str(target)// &
             " contacts (MAXCONT or --max-contacts) need "//memory_text(need)//" for the factor of their "// &
             "compliance (8 bytes x "//int_str(target)//"^2, and the one it grows from), this run may use "// &
-            memory_text(may)//"; lower MAXCONT or --max-contacts (the run still stops at its loads), or use "// &
+            usable_text(may)//"; lower MAXCONT or --max-contacts (the run still stops at its loads), or use "// &
             "--solver cg")
       end subroutine check_memory
    end subroutine solve_incremental

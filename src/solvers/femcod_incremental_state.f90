@@ -30,7 +30,7 @@ module femcod_incremental_state
    use femcod_condensed, only: gap_and_rate
    use femcod_heap, only: min_heap, heap_build, heap_push
    use femcod_sort, only: merge_sort_index
-   use femcod_memory, only: memory_text
+   use femcod_memory, only: memory_text, usable_text
    use femcod_state_visitor, only: state_visitor, visitable
    use femcod_solver_options, only: contact_options, &
       BOUNDARY_PERIODIC
@@ -339,7 +339,7 @@ contains
          if (self%memory_available > 0 .and. 8*grown**2 > self%memory_available) then
             call set_error(status, STATUS_NUMERICAL, "incremental: the factor for "// &
                int_str(int(grown))//" contacts needs "//memory_text(8*grown**2)//", this run may use "// &
-               memory_text(self%memory_available)//"; lower MAXCONT or --max-contacts")
+               usable_text(self%memory_available)//"; lower MAXCONT or --max-contacts")
             return
          end if
          call resize_factor(self, int(grown), .true., status)

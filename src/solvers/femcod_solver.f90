@@ -6,7 +6,7 @@
 module femcod_solver
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE
-   use femcod_strings, only: string_type, int_str, sig_str, format_real
+   use femcod_strings, only: count_text, string_type, int_str, sig_str, format_real
    use femcod_problem, only: contact_problem
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
@@ -354,11 +354,11 @@ contains
          type(cg_state_diagnostics), intent(in) :: work
          character(len=:), allocatable :: text
          if (by_gap_variables(options)) then
-            text = "approach "//sig_str(st%approach, 6)//" nm: "//int_str(work%iterations)//" iterations, residual "// &
+            text = "approach "//sig_str(st%approach, 6)//" nm: "//count_text(work%iterations, "iteration")//", residual "// &
                sig_str(work%residual, 2)//" (force balance, as a gap over the height range)"
             return
          end if
-         text = "load "//sig_str(st%load, 6)//" nN: "//int_str(work%iterations)//" iterations, residual "// &
+         text = "load "//sig_str(st%load, 6)//" nN: "//count_text(work%iterations, "iteration")//", residual "// &
             sig_str(work%residual, 2)//", penetration "//sig_str(work%penetration, 2)//" nm, |gap| on contact "// &
             sig_str(work%contact_gap, 2)//" nm, load error "//sig_str(work%load_error, 2)
          if (options%plastic) text = text//", in "//int_str(work%plastic_rounds)//" round"// &

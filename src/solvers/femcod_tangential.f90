@@ -33,7 +33,7 @@ module femcod_tangential
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED
    use femcod_observer, only: solver_observer
-   use femcod_strings, only: int_str, sig_str
+   use femcod_strings, only: count_text, int_str, sig_str
    use femcod_problem, only: contact_problem
    use femcod_cerruti, only: tangential_tables, periodic_tangential_spectra
    use femcod_convolution, only: shear_transform, shear_transform_setup, shear_transform_setup_periodic, &
@@ -199,7 +199,7 @@ contains
       do it = 1, request%max_iterations
          if (mod(it, 10) == 0) then
             if (observer%stop_requested()) then
-               call set_error(status, STATUS_INTERRUPTED, "stopped after "//int_str(it)//" iterations of the "// &
+               call set_error(status, STATUS_INTERRUPTED, "stopped after "//count_text(it, "iteration")//" of the "// &
                   "tangential step")
                return
             end if
@@ -245,7 +245,7 @@ contains
       answer%shift = shift
       call classify(st, t, shift, answer)
       if (answer%residual > 10*request%tol) call set_error(status, STATUS_NUMERICAL, "tangential: residual "// &
-         sig_str(answer%residual, 2)//" after "//int_str(answer%iterations)//" iterations, above 10 x --tol "// &
+         sig_str(answer%residual, 2)//" after "//count_text(answer%iterations, "iteration")//", above 10 x --tol "// &
          sig_str(request%tol, 2))
    end subroutine projected_gradients
 
