@@ -21,7 +21,7 @@ module stability_cases
    private
    public :: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, single_pixel, &
       first_spike_event, identical_surfaces, height_offset, length_scaling, poisson_limit, love_precision, &
-      solve_precision, long_run_drift, solve, STIFFNESS_RATIOS, INCOMPRESSIBLE_GAP
+      solve_precision, long_run_drift, solve, STIFFNESS_RATIOS, INCOMPRESSIBLE_GAP, legacy_condition
 
    !> Penalty/interface stiffness over the substrate's, swept by stiffness_sweep.
    real(dp), parameter :: STIFFNESS_RATIOS(6) = [1.0e2_dp, 1.0e4_dp, 1.0e6_dp, 1.0e8_dp, 1.0e10_dp, 1.0e12_dp]

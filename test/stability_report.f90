@@ -10,9 +10,10 @@ module stability_report
    use stability_cases, only: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, &
       single_pixel, first_spike_event, identical_surfaces, height_offset, length_scaling, poisson_limit, &
       love_precision, solve_precision, long_run_drift, STIFFNESS_RATIOS, INCOMPRESSIBLE_GAP
+   use degenerate_cases, only: degenerate_row, degenerate_family
    implicit none
    private
-   public :: write_stability_report
+   public :: write_stability_report, degenerate_table
 
 contains
 
@@ -174,6 +175,8 @@ contains
          call add_lines(b, "| ("//int_str(offsets(1, k))//", "//int_str(offsets(2, k))//") | "//sci(femcod)//" | "// &
             sci(corners)//" | "//trim(merge("n/a     ", sci(far)//"", k == 1))//" |")
       end do
+      call step("degenerate inputs")
+      call degenerate_table(b)
       call add_lines(b, "", "Regenerate with `fpm test --profile release -- --stability-report doc/stability.md`.")
       call write_file(path, built_text(b), status)
    contains
@@ -182,6 +185,35 @@ contains
          if (progress) write(output_unit, '(a)') "stability: "//what
       end subroutine step
    end subroutine write_stability_report
+
+   !> Issue 47's degenerate family (test/degenerate_cases) as a section of the report.
+   subroutine degenerate_table(b)
+      type(text_builder), intent(inout) :: b
+      type(degenerate_row), allocatable :: rows(:)
+      character(len=:), allocatable :: answer
+      integer :: k
+      call degenerate_family(rows)
+      call add_lines(b, "", "## Degenerate inputs", "", &
+         "A flat surface, one peak pixel, two equal peaks, heights within 1e-300, 1e-12 nm and a peak of", &
+         "1e6 nm, a tilted plane, loads of 1e-300 and 1e300 nN, moduli times 1e-6 and 1e6 (16 x 16 pixels of", &
+         "1 nm on a rigid flat, E = 200 GPa, nu = 0.25, unless named). Each answer is the relative error of", &
+         "the approach against the reference named (the dense solve of test/oracles with the contact set", &
+         "the analysis gives, a closed form, or an invariance), within the bound the `stability` suite", &
+         "asserts; or the solver's refusal with its exit code. cg runs at --tol 1e-10.", "", &
+         "| input | solver | reference | answer (relative error, bound) |", "|---|---|---|---|")
+      do k = 1, size(rows)
+         associate(r => rows(k))
+            if (r%code > 0) then
+               answer = "refused, exit "//int_str(r%code)//": "//r%message
+            else if (r%code < 0) then
+               answer = r%message
+            else
+               answer = sci(r%error)//" (bound "//sci(r%bound)//")"
+            end if
+            call add_lines(b, "| "//r%scene//" | "//r%solver//" | "//r%reference//" | "//answer//" |")
+         end associate
+      end do
+   end subroutine degenerate_table
 
    function spike_note(l) result(note)
       integer, intent(in) :: l

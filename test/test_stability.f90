@@ -12,6 +12,7 @@ module test_stability
    use stability_cases, only: stiffness_row, stiffness_sweep, symmetry_defect, symmetric_scene, flat_on_flat, &
       single_pixel, first_spike_event, identical_surfaces, height_offset, length_scaling, poisson_limit, &
       love_precision, solve_precision, long_run_drift, solve, STIFFNESS_RATIOS
+   use degenerate_cases, only: degenerate_row, degenerate_family
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -27,6 +28,7 @@ contains
          new_unittest("stiff springs: 1/ratio model error, round-off within eps x condition", test_stiffness), &
          new_unittest("symmetry: sphere on a centre and a corner, square punch, sinusoid", test_symmetry), &
          new_unittest("flat on flat: all pixels at once, equal to a dense solve", test_flat), &
+         new_unittest("degenerate inputs: every solver answers to its bound or refuses", test_degenerate), &
          new_unittest("NP = 1, nu = 0.25 and nu = 0: closed form", test_single_pixel), &
          new_unittest("requested loads of zero, negative and beyond MAXCONT", test_loads), &
          new_unittest("a spike 1000 times the rms: first event in closed form", test_spike), &
@@ -117,6 +119,32 @@ contains
       if (allocated(error)) return
       call check(error, d <= eps*condition, "legacy vs dense solve "//to_string(d)//" within eps x condition")
    end subroutine test_flat
+
+   !> Issue 47's degenerate family (test/degenerate_cases): each row is an answer within
+   !> its bound of the reference from analysis or the dense solve, or a refusal with an
+   !> exit code and a message. Before the fix cg failed the flat scenes (exit 4 after
+   !> 2000 iterations, "residual 2.9e+299": the residual was measured against a height
+   !> range of 0).
+   subroutine test_degenerate(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(degenerate_row), allocatable :: rows(:)
+      integer :: k
+      call degenerate_family(rows)
+      call check(error, size(rows) >= 30, "the family has "//to_string(size(rows))//" rows")
+      if (allocated(error)) return
+      do k = 1, size(rows)
+         associate(r => rows(k))
+            if (r%code /= 0) then
+               call check(error, r%code >= 2 .and. r%code <= 4 .and. len_trim(r%message) > 0, r%scene//", "// &
+                  r%solver//": neither an answer nor a refusal with its reason (code "//to_string(r%code)//")")
+            else
+               call check(error, r%error <= r%bound, r%scene//", "//r%solver//": relative error "// &
+                  to_string(r%error)//" above "//to_string(r%bound))
+            end if
+            if (allocated(error)) return
+         end associate
+      end do
+   end subroutine test_degenerate
 
    !> One pixel: approach = P (c I(0,0) + 3/k) (femcod_stability%single_pixel).
    subroutine test_single_pixel(error)

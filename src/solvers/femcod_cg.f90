@@ -561,7 +561,7 @@ contains
       integer, parameter :: MAX_SOLVES = 100
       real(dp) :: lo, alo, hi, ahi, trial, accuracy, total(1)
       integer :: solve, side
-      accuracy = how%tol*grid%scale
+      accuracy = how%tol*max(grid%scale, abs(target))
       if (target <= 0) then
          answer%load = 0
          call solve_load(grid, problem, session, 0.0_dp, how, answer, status, observer)
@@ -702,7 +702,7 @@ contains
          force = merge(fmax, p, capped)
          call grid%displace(force, w)
          gap = g0 - session%approach + w + grid%s*force
-         call session%law%plastic_round(p, gap, how%tol*grid%scale, capped, grow, release)
+         call session%law%plastic_round(p, gap, how%tol*max(grid%scale, abs(session%approach)), capped, grow, release)
          if (.not. grid%any_over_grid(any(grow) .or. any(release))) exit
          ! A released pixel starts from the force it had.
          where (release) p = fmax

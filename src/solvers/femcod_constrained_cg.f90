@@ -83,6 +83,11 @@ module femcod_constrained_cg
       !> An entering pixel's share of a lone pixel's preconditioned step; the forces' sum.
       real(dp) :: entry = 1, psum = 0
       real(dp) :: residual = 0, contact_gap = 0, penetration = 0
+      !> The length (nm) the residual is measured against: the height range, or the
+      !> contacts' largest elastic displacement where that is larger (a flat or nearly
+      !> flat surface, whose height range is 0 or below the round-off of the
+      !> displacements: issue 47's degenerate family).
+      real(dp) :: scale = 1
       !> The error bound (nm) of the split corrections since the last fresh convolution.
       real(dp) :: split_error = 0
       integer :: it = 0
@@ -151,7 +156,7 @@ contains
          ! The split corrections' error bound stays below split_tolerance times the
          ! residual: once the residual has fallen to it, the displacements afresh and new
          ! directions.
-         if (st%split_error > how%split_tolerance*st%residual*grid%scale) then
+         if (st%split_error > how%split_tolerance*st%residual*st%scale) then
             st%fresh = .true.
             st%restart = .true.
             cycle
@@ -234,7 +239,7 @@ contains
       class(elastic_operator), intent(inout) :: grid
       real(dp), intent(in) :: p(:, :)
       type(status_type), intent(inout) :: status
-      real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, s, sums(2)
+      real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, s, sums(2), lift
       integer :: q, i, j, nc
       logical :: take_old
       nc = size(st%contact, 2)
@@ -265,10 +270,12 @@ contains
       big_g = 0
       cross = 0
       contact_gap = 0
-      !$omp parallel do private(i, j, gij) reduction(+:big_g, cross) reduction(max:contact_gap)
+      lift = 0
+      !$omp parallel do private(i, j, gij) reduction(+:big_g, cross) reduction(max:contact_gap, lift)
       do q = 1, nc
          i = st%contact(1, q)
          j = st%contact(2, q)
+         lift = max(lift, abs(alpha*(st%w(i, j) + s*p(i, j))))
          gij = grid%g0(i, j) + alpha*(st%w(i, j) + s*p(i, j)) - gbar
          if (take_old) st%g_old(q) = st%gm(i, j)
          big_g = big_g + gij**2
@@ -281,12 +288,14 @@ contains
       call grid%sum_over_grid(sums)
       st%big_g = sums(1)
       st%cross = sums(2)
-      sums(1) = contact_gap
-      call grid%max_over_grid(sums(1:1))
+      sums = [contact_gap, lift]
+      call grid%max_over_grid(sums)
       st%contact_gap = sums(1)
+      st%scale = max(grid%scale, sums(2))
    end subroutine contact_gaps
 
-   !> The relative residual max(contact gap, penetration) / height range, with the
+   !> The relative residual max(contact gap, penetration) / scale (the height range, or
+   !> the contacts' largest displacement where larger), with the
    !> penetration off the contacts evaluated only where a decision depends on it.
    subroutine measure_residual(st, grid, tol, max_iterations, how)
       type(cg_iteration), intent(inout) :: st
@@ -297,14 +306,14 @@ contains
       real(dp) :: threshold, depth(1)
       threshold = tol
       if (st%single) threshold = max(tol, how%single_until)
-      if (st%contact_gap/grid%scale < threshold .or. st%it >= max_iterations .or. st%stalled) then
+      if (st%contact_gap/st%scale < threshold .or. st%it >= max_iterations .or. st%stalled) then
          depth(1) = deepest_overlap(st, grid)
          call grid%max_over_grid(depth)
          st%penetration = depth(1)
       else
          st%penetration = 0
       end if
-      st%residual = max(st%contact_gap, st%penetration)/grid%scale
+      st%residual = max(st%contact_gap, st%penetration)/st%scale
    end subroutine measure_residual
 
    !> The next search direction t on the contacts (the preconditioned gaps with beta by
@@ -466,7 +475,7 @@ contains
       if (st%nchanged > 0 .and. st%nchanged <= st%capacity) call sort_changes(st, st%nchanged)
       if (st%nchanged_all > st%limit .and. st%nchanged_all <= st%split_limit) then
          call grid%split_correct(st%w, st%changed, st%delta, st%nchanged, how, &
-            how%split_tolerance*st%residual*grid%scale, st%split_error, applied)
+            how%split_tolerance*st%residual*st%scale, st%split_error, applied)
          if (applied) then
             rep%split_corrections = rep%split_corrections + 1
             st%fresh_double = .false.

@@ -281,7 +281,8 @@ contains
       bottom(1) = minval(g0)
       call op%max_over_grid(top)
       call op%min_over_grid(bottom)
-      it%scale = max(top(1) - bottom(1), tiny(1.0_dp))
+      ! The height range, or the approach where larger (a flat or nearly flat surface).
+      it%scale = max(top(1) - bottom(1), abs(a), tiny(1.0_dp))
       g = g0 - a + x(1:np, 1:nj)
       call project(op, it, cap, g)
       x(1:np, 1:nj) = g - g0 + a

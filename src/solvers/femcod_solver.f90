@@ -8,6 +8,7 @@ module femcod_solver
    use femcod_status, only: status_type, set_error, STATUS_USAGE
    use femcod_strings, only: count_text, string_type, int_str, sig_str, format_real
    use femcod_problem, only: contact_problem
+   use femcod_scene, only: initial_gap_map
    use femcod_love, only: surface_compliance, love_influence
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result, load_state, cg_diagnostics, cg_state_diagnostics, &
@@ -61,6 +62,9 @@ contains
             end if
          end if
       end if
+      call refuse_periodic_full_contact(problem, options, status)
+      call refuse_beyond_float32(problem, options, status)
+      if (status%code /= 0) return
       if (present(resume) .and. options%solver /= SOLVER_INCREMENTAL) then
          call set_error(status, STATUS_USAGE, "only the incremental solver continues from a stored state")
          return
@@ -96,6 +100,51 @@ contains
          end if
       end if
    end subroutine solve_contact
+
+   !> The cg iteration keeps its gradient in float32 (and transforms in it while far from
+   !> the answer): a load whose displacements, between P c I(0,0) on one pixel and that
+   !> over NP^2 spread on all, leave float32's range (1e-38 to 3e38) cannot be solved by
+   !> it (a load of 1e-300 or 1e300 nN on a flat: 2000 iterations, residual 0.25).
+   !> Refused (exit 2) before any work; the event solvers, in double throughout, take it.
+   subroutine refuse_beyond_float32(problem, options, status)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(status_type), intent(inout) :: status
+      real(dp), parameter :: SMALLEST = 1.0e-30_dp, LARGEST = 1.0e30_dp
+      real(dp) :: unit, low, high
+      if (status%code /= 0 .or. options%solver /= SOLVER_CG) return
+      if (.not. allocated(options%loads)) return
+      if (size(options%loads) == 0) return
+      unit = (surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
+         surface_compliance(problem%young(2), problem%poisson(2), problem%pixel))*love_influence(0, 0)
+      low = minval(abs(options%loads), mask=options%loads /= 0)*unit/real(problem%np, dp)**2
+      high = maxval(abs(options%loads))*unit
+      if (any(options%loads /= 0) .and. (low < SMALLEST .or. high > LARGEST)) call set_error(status, STATUS_USAGE, &
+         "--solver cg at loads from "//sig_str(minval(abs(options%loads), mask=options%loads /= 0), 3)//" to "// &
+         sig_str(maxval(abs(options%loads)), 3)//" nN: displacements from "//sig_str(low, 2)//" to "// &
+         sig_str(high, 2)//" nm, outside the 1e-30 to 1e30 nm that its float32 gradient holds; use --solver "// &
+         "incremental (double throughout), or units that bring the loads nearer 1")
+   end subroutine refuse_beyond_float32
+
+   !> The event solvers on a periodic cell: an approach at or beyond the mean initial gap
+   !> puts the cell in full contact, where the approach no longer determines the load
+   !> (the elastic displacements have no mean; only the interface springs' stiffness
+   !> would answer, 6.5e13 nN for 0.01 nm into a flat 64^2 cell). Refused, as the cg
+   !> solver refuses it on its grid (femcod_cg's refuse_beyond_full_contact).
+   subroutine refuse_periodic_full_contact(problem, options, status)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(status_type), intent(inout) :: status
+      real(dp) :: mean_gap
+      if (options%boundary /= BOUNDARY_PERIODIC .or. options%solver == SOLVER_CG) return
+      if (.not. allocated(options%approaches)) return
+      if (size(options%approaches) == 0) return
+      mean_gap = sum(initial_gap_map(problem%lower, problem%upper))/real(problem%np, dp)**2
+      if (maxval(options%approaches) >= mean_gap) call set_error(status, STATUS_USAGE, "--approach "// &
+         format_real(maxval(options%approaches))//" nm reaches the periodic cell's mean gap ("// &
+         format_real(mean_gap)//" nm): full contact, where the approach no longer determines the load; give "// &
+         "--loads for loads beyond full contact")
+   end subroutine refuse_periodic_full_contact
 
    !> What a finished run must tell its user that is not an error, one line each: every
    !> requested state not reached (with the reason the run stopped), and every reached
