@@ -12,7 +12,7 @@ module femcod_run
    use femcod_kinds, only: dp, i8
    use femcod_memory, only: available_memory, resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
-   use femcod_strings, only: sig_str, string_type, int_str, format_real, append_string
+   use femcod_strings, only: sig_str, string_type, int_str, format_real, append_string, count_text
    use femcod_files, only: remove_file, path_exists, path_is_directory, default_prefix, file_part, canonical_path, &
       acquire_lock, release_lock, make_directories
    use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
@@ -22,7 +22,7 @@ module femcod_run
    use femcod_deck, only: read_deck
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, height_file_path, is_height_file, looks_like_height_matrix
-   use femcod_contact_result, only: contact_result, load_state, stop_reason_text, cg_state_diagnostics, cg_work
+   use femcod_contact_result, only: contact_result, load_state, stop_reason_text, STOP_INTERRUPTED, cg_state_diagnostics, cg_work
    use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options, &
       SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, solver_name, boundary_name, law_name, &
       solver_from_name, boundary_from_name, law_from_name, run_shear_model
@@ -37,8 +37,8 @@ module femcod_run
    use femcod_checkpoint, only: write_checkpoint, read_checkpoint
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_output_guard, only: guard_outputs, OUTPUT_WISDOM, OUTPUT_RESULT
-   use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, HISTORY_HEADER, LOADS_HEADER, &
-      CONTACTS_HEADER, FRICTION_COLUMNS, PATCH_COLUMNS
+   use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, pressure_figure_wanted, &
+      HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, PATCH_COLUMNS
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
@@ -57,6 +57,8 @@ module femcod_run
       !> wisdom file ("": none).
       character(len=:), allocatable :: prefix, outdir, wisdom
       logical :: quiet = .false., force = .false., restart = .false.
+      !> Which states get a pressure figure (--figures all|last|none|auto).
+      character(len=:), allocatable :: figures
       !> The scene of --lower/--upper (kind "matrix").
       type(scene_spec) :: scene
       logical :: from_files = .false.
@@ -91,6 +93,10 @@ module femcod_run
       procedure :: stop_requested => signal_arrived
    end type run_observer
 
+   !> Appended to the fingerprint of a partial run (a stop signal between two requested
+   !> states of cg or legacy): --restart runs it again rather than calling it complete.
+   character(len=*), parameter :: PARTIAL_MARK = " (partial)"
+
 contains
 
    !> The options of `femcod run`. Modes: "heights" (--lower/--upper given), the solver's
@@ -116,6 +122,9 @@ contains
             "a capped pixel carries H d^2 and interpenetrates (its plastic displacement, in PREFIX.h5)", &
             mode="cg|incremental"), &
          flag_option("--quiet", "no summary on standard output, no progress lines on standard error", alias="-q"), &
+         choice_option("--figures", "auto|all|last|none", "which states get a pressure figure PREFIX.pressure_<k>.svg "// &
+            "(default auto: every state up to 20 asked, beyond that the last reached one only; the maps are in "// &
+            "PREFIX.h5 either way)"), &
          flag_option("--force", "replace existing results as a whole set, and a checkpoint of an interrupted run "// &
             "(otherwise both are kept and the deck fails with exit code 5 before it is solved); an input file is "// &
             "never an output"), &
@@ -131,7 +140,8 @@ contains
          flag_option("--restart", "continue from PREFIX.ckpt.h5 if it exists (refused if it belongs to another deck "// &
             "or other options); the run ends exactly as an uninterrupted one. Complete results of the same inputs "// &
             "and options: nothing to do; of others: refused. With a solver that keeps no checkpoint (cg, legacy) "// &
-            "the run starts afresh, so a resubmitted job array runs with every solver"), &
+            "the run starts afresh, so a resubmitted job array runs with every solver; a partial set they left on a "// &
+            "stop signal (the states finished before it, summary 'stopped': 'interrupted') is run again"), &
          real_option("--tol", "T", "stop when the gap violations over the height range are below T (default 1e-8; "// &
             "with --adhesion the force-balance violations times a pixel's compliance)", &
             lower=0.0_dp, closed="()", mode="cg"), &
@@ -279,6 +289,8 @@ contains
       call get_option(parsed, "--outdir", settings%outdir)
       call get_option(parsed, "--fftw-wisdom", settings%wisdom)
       call get_option(parsed, "--quiet", settings%quiet)
+      settings%figures = "auto"
+      call get_option(parsed, "--figures", settings%figures)
       call get_option(parsed, "--force", settings%force)
       call get_option(parsed, "--restart", settings%restart)
       call solve_options_from(parsed, settings%solve)
@@ -628,24 +640,30 @@ contains
       type(status_type), intent(inout) :: st
       character(len=:), allocatable :: stored
       type(string_type), allocatable :: names(:), none(:), checkpoint(:)
+      logical :: partial
       complete = .false.
       have_checkpoint = path_exists(prefix//".ckpt.h5")
       ! With --restart, result files are leftovers of the interrupted run while its
       ! checkpoint exists, or while PREFIX.h5 (renamed last) does not. A complete set
       ! without a checkpoint means the run had finished: nothing to do, if it is the
       ! run of these inputs and options.
+      partial = .false.
       if (settings%restart .and. .not. settings%force .and. .not. have_checkpoint .and. &
          path_exists(prefix//".h5")) then
          stored = stored_fingerprint(prefix//".h5")
+         ! The partial set of an interrupted cg or legacy run: --restart runs it again.
+         partial = stored == fingerprint//PARTIAL_MARK
          if (stored == fingerprint) then
             if (.not. settings%quiet) write(error_unit, '(a)') "femcod: "//prefix//".h5: the run of "// &
                deck_label(deck_path)//" is complete; nothing to restart"
             complete = .true.
             return
          end if
-         call set_error(st, STATUS_IO, prefix//".h5 holds the results of other inputs or options; "// &
-            "--force replaces them, or give another -o")
-         return
+         if (.not. partial) then
+            call set_error(st, STATUS_IO, prefix//".h5 holds the results of other inputs or options; "// &
+               "--force replaces them, or give another -o")
+            return
+         end if
       end if
       if (have_checkpoint .and. .not. settings%restart .and. .not. settings%force) then
          call set_error(st, STATUS_IO, prefix//".ckpt.h5: the checkpoint of an interrupted run; continue it "// &
@@ -654,7 +672,7 @@ contains
       end if
       call check_writable(prefix, st)
       if (st%code == 0 .and. .not. settings%force) then
-         if (.not. (settings%restart .and. (have_checkpoint .or. .not. path_exists(prefix//".h5")))) &
+         if (.not. (settings%restart .and. (have_checkpoint .or. partial .or. .not. path_exists(prefix//".h5")))) &
             call refuse_overwrite(prefix, requested_states(settings%solve), st)
       end if
       ! What is replaced (with --force, or as a restart's leftovers) must be femcod's; a
@@ -729,7 +747,8 @@ contains
       type(shear_model) :: shear
       character(len=:), allocatable :: fingerprint, started
       type(string_type), allocatable :: digests(:), warnings(:)
-      logical :: resuming, ok, have_checkpoint, complete
+      logical :: resuming, ok, have_checkpoint, complete, interrupted
+      type(status_type) :: stopped
       type(contact_options) :: solve_options
       integer(i8) :: held
       real(dp) :: t0, t1, digest_seconds
@@ -778,13 +797,18 @@ contains
             call solve_contact(problem, solve_options, res, st, observer)
          end if
          if (res%estimated_peak_bytes > 0) res%estimated_peak_bytes = res%estimated_peak_bytes + held
-         if (st%code == STATUS_INTERRUPTED) then
+         interrupted = st%code == STATUS_INTERRUPTED
+         if (interrupted) then
             if (path_exists(observer%checkpoint_path) .and. observer%stored) then
                st%message = st%message//"; the state is in "//observer%checkpoint_path//" (continue with --restart)"
-            else
+               return
+            else if (res%stop_reason /= STOP_INTERRUPTED .or. .not. any(res%states%reached)) then
                st%message = st%message//"; nothing was written"
+               return
             end if
-            return
+            ! The requested states finished before the signal are written, as a partial run.
+            stopped = st
+            st = status_type()
          end if
          if (st%code == 0 .and. options%solver == SOLVER_CG .and. len(settings%wisdom) > 0) &
             call save_wisdom(settings%wisdom, st)
@@ -806,6 +830,7 @@ contains
             info%shear_cap = shear%tau_max
          end if
          info%options = settings%command_line
+         info%figures = settings%figures
          info%command_line = "femcod run "//settings%command_line
          info%host = host_name()
          info%started = started
@@ -813,6 +838,8 @@ contains
          info%scene = model_notes(problem, options)
          info%inputs = inputs
          info%fingerprint = fingerprint
+         ! A partial run is not the run asked for: --restart runs it again.
+         if (interrupted) info%fingerprint = fingerprint//PARTIAL_MARK
          info%digests = digests
          info%read_seconds = read_seconds
          info%digest_seconds = digest_seconds
@@ -824,21 +851,35 @@ contains
          if (st%code /= 0) return
          ! The set is replaced as a whole: what an earlier run left beside it goes, and the
          ! checkpoint has served its purpose.
-         call remove_stale_results(prefix, requested_states(options))
+         call remove_stale_results(prefix, res, settings%figures)
          warnings = run_warnings(options, res)
          do k = 1, size(warnings)
             write(error_unit, '(a)') "femcod: warning: "//warnings(k)%s
          end do
          if (.not. settings%quiet) call print_summary(deck_path, prefix, problem, options, res, maps)
+         if (interrupted) then
+            st = stopped
+            st%message = st%message//"; the "//count_text(count(res%states%reached), "requested state")// &
+               " finished before it are in "//prefix//".h5 and its companions (a partial run)"
+         end if
       end associate
    end subroutine run_locked
 
-   !> Remove what an earlier run of this prefix left beside the new set: pressure maps of
-   !> loads beyond the new ones, a loads file when none were asked, the checkpoint.
-   subroutine remove_stale_results(prefix, nloads)
+   !> Remove what an earlier run of this prefix left beside the new set: pressure maps this
+   !> run did not write (unreached states, --figures) or of loads beyond the new ones, a
+   !> loads file when none were asked, the checkpoint.
+   subroutine remove_stale_results(prefix, res, figures)
       character(len=*), intent(in) :: prefix
-      integer, intent(in) :: nloads
-      integer :: k
+      type(contact_result), intent(in) :: res
+      character(len=*), intent(in) :: figures
+      integer :: k, nloads
+      nloads = 0
+      if (allocated(res%states)) nloads = size(res%states)
+      ! The figures this run did not write (an unreached state, --figures), and those of
+      ! states beyond its own.
+      do k = 1, nloads
+         if (.not. pressure_figure_wanted(res, k, figures)) call remove_file(prefix//".pressure_"//int_str(k)//".svg")
+      end do
       k = nloads + 1
       do while (path_exists(prefix//".pressure_"//int_str(k)//".svg"))
          call remove_file(prefix//".pressure_"//int_str(k)//".svg")

@@ -8,6 +8,7 @@
 !>   PREFIX.summary.json  what the summary prints, as numbers with units
 !>   PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg
 module femcod_results
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use femcod_kinds, only: dp, i8
    use femcod_clock, only: wall_clock
    use femcod_memory, only: peak_resident_bytes
@@ -28,6 +29,7 @@ module femcod_results
    implicit none
    private
    public :: write_results, run_info, result_files, write_file_set, stored_fingerprint, load_group
+   public :: pressure_figure_wanted, FIGURES_AUTO_LIMIT
    public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, TANGENTIAL_COLUMNS, PATCH_COLUMNS
 
    !> The CSV files' header lines (the help prints them from here).
@@ -49,8 +51,16 @@ module femcod_results
       "stick_fraction"
 
    !> What the run was, for /run in the HDF5 file.
+   !> With --figures auto (the default) a pressure figure of every state up to this many
+   !> requested states, beyond it of the last reached one only (1001 loads wrote 17 MB of
+   !> figures).
+   integer, parameter :: FIGURES_AUTO_LIMIT = 20
+
    type :: run_info
       character(len=:), allocatable :: version, solver, options
+      !> Which states get a pressure figure (--figures): "all", "last", "none", or "auto"
+      !> (unallocated too: all up to FIGURES_AUTO_LIMIT states, else the last).
+      character(len=:), allocatable :: figures
       !> The lateral boundary, "free" or "periodic" (--boundary).
       character(len=:), allocatable :: boundary
       !> The adhesion law (--adhesion: "dugdale" or "exponential"; unallocated or "none":
@@ -99,6 +109,27 @@ contains
       end do
    end function result_files
 
+   !> Whether state k gets its pressure figure PREFIX.pressure_<k>.svg under --figures
+   !> `figures` (all, last, none, auto): only a reached state has one; "last" is the last
+   !> reached state in the order asked; "auto" is all up to FIGURES_AUTO_LIMIT requested
+   !> states, else last.
+   pure logical function pressure_figure_wanted(res, k, figures) result(wanted)
+      type(contact_result), intent(in) :: res
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: figures
+      character(len=:), allocatable :: rule
+      wanted = .false.
+      if (.not. res%states(k)%reached) return
+      rule = figures
+      if (rule == "auto") rule = trim(merge("all ", "last", size(res%states) <= FIGURES_AUTO_LIMIT))
+      select case (rule)
+      case ("all")
+         wanted = .true.
+      case ("last")
+         wanted = .not. any(res%states(k + 1:)%reached)
+      end select
+   end function pressure_figure_wanted
+
    !> Write every result file for `prefix`; on failure none is left behind and
    !> existing files of that name are untouched. Each file is renamed into place when
    !> all are written, PREFIX.h5 last, so its presence marks a complete set.
@@ -111,10 +142,13 @@ contains
       type(run_info), intent(in) :: info
       type(status_type), intent(inout) :: status
       type(string_type), allocatable :: names(:), temps(:)
+      character(len=:), allocatable :: figures
       real(dp) :: t0, t1, t2, hdf5_seconds
       integer :: k
       if (status%code /= 0) return
       allocate(names(0), temps(0))
+      figures = "auto"
+      if (allocated(info%figures)) figures = info%figures
       ! PREFIX.h5 is written first and renamed last (when it exists, the whole set is
       ! complete); the summary is written last, so that it holds the writing's times.
       call wall_clock(t0)
@@ -137,7 +171,7 @@ contains
       call add(".area_load.svg")
       call write_text(temps(size(temps))%s, area_load_svg(deck, res), status)
       do k = 1, size(res%states)
-         if (.not. res%states(k)%reached) cycle
+         if (.not. pressure_figure_wanted(res, k, figures)) cycle
          call add(".pressure_"//int_str(k)//".svg")
          call write_text(temps(size(temps))%s, svg_pressure_map("contact pressure at "// &
             sig_str(res%states(k)%load, 6)//" nN (approach "//sig_str(res%states(k)%approach, 4)//" nm, "// &
@@ -497,14 +531,15 @@ contains
    end subroutine write_hdf5
 
    !> area = prefactor * load^exponent, least squares in log-log over the steps with
-   !> positive load (0, 0 when fewer than two).
+   !> positive load; NaN for both when fewer than two (no fit: null in the summary file,
+   !> where 0, 0 read as a fit).
    subroutine area_fit(deck, res, exponent, prefactor)
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       real(dp), intent(out) :: exponent, prefactor
       logical, allocatable :: keep(:)
-      exponent = 0
-      prefactor = 0
+      exponent = ieee_value(exponent, ieee_quiet_nan)
+      prefactor = exponent
       if (res%nsteps < 2) return
       keep = res%step_load(1:res%nsteps) > 0
       if (count(keep) < 2) return
@@ -902,7 +937,7 @@ contains
       type(status_type) :: local
       hex = ""
       call h5_open(path, file, local, STATUS_IO)
-      call h5_read_string_attribute(file, "/run", "fingerprint", 64, hex, local, STATUS_IO)
+      call h5_read_string_attribute(file, "/run", "fingerprint", 80, hex, local, STATUS_IO)
       call h5_close(file, local)
       if (local%code /= 0) hex = ""
    end function stored_fingerprint

@@ -40,7 +40,8 @@ module femcod_legacy
    use femcod_trfact, only: trfact, trfact_condition, TRFACT_FACTOR, TRFACT_SOLVE
    use femcod_postp, only: candidate_count, postp_search, in_contact_at
    use femcod_condensed, only: solve_active_set, gap_at
-   use femcod_contact_result, only: contact_result, STOP_MAXCONT, STOP_NO_CONTACT, finish_contacts, legacy_diagnostics
+   use femcod_contact_result, only: contact_result, STOP_MAXCONT, STOP_NO_CONTACT, STOP_INTERRUPTED, finish_contacts, &
+      legacy_diagnostics
    use femcod_solver_options, only: contact_options
    use femcod_observer, only: solver_observer
    use femcod_event_path, only: load_path, first_touch_limit, NO_EVENT
@@ -131,9 +132,11 @@ contains
          step = 0
          do
             if (observer%stop_requested()) then
+               ! The states reached so far are kept (a partial run, written by the caller).
                call set_error(status, STATUS_INTERRUPTED, "stopped at step "//int_str(step)//" ("//int_str(n)// &
-                  " contacts); the legacy solver keeps no checkpoint")
-               return
+                  " contacts)")
+               res%stop_reason = STOP_INTERRUPTED
+               exit
             end if
             step = step + 1
             call wall_clock(t0)
@@ -173,10 +176,10 @@ contains
             end do
          end do
 
-         if (options%final_check) call final_check(ws, at, n, cstep, step, table, csum, mat, problem, options, &
-            path, res, checks, status)
+         if (options%final_check .and. status%code == 0) call final_check(ws, at, n, cstep, step, table, csum, mat, &
+            problem, options, path, res, checks, status)
          allocate(res%diagnostics, source=checks)
-         if (status%code /= 0) return
+         if (status%code /= 0 .and. status%code /= STATUS_INTERRUPTED) return
          call contact_rows_cols(ws, n, ic, jc)
          call finish_contacts(res, ic, jc, cstep(1:n), ws%ra(at%force:at%force + n - 1), path%total)
       end associate

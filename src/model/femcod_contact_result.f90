@@ -14,10 +14,12 @@ module femcod_contact_result
    public :: contact_result, load_state, append_step, visit_result, record_approach_states
    public :: solver_diagnostics, event_path_diagnostics, legacy_diagnostics, cg_diagnostics, cg_state_diagnostics, &
       event_checks, legacy_checks, cg_work, visit_event_checks, cg_iterations_in_all, largest_cg_residual
-   public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, stop_reason_text, record_load_states, finish_contacts, &
+   public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, STOP_INTERRUPTED, stop_reason_text, record_load_states, finish_contacts, &
       gather_contacts
 
-   integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3
+   !> STOP_INTERRUPTED: a stop signal ended the run between two requested states; the
+   !> states before it are kept (a partial run), the others not reached.
+   integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3, STOP_INTERRUPTED = 4
 
    !> The contact state at one requested load.
    type :: load_state
@@ -419,6 +421,8 @@ contains
          text = "all requested loads reached"
       case (STOP_NO_CONTACT)
          text = "no further pixel can come into contact"
+      case (STOP_INTERRUPTED)
+         text = "interrupted by a stop signal: a partial run"
       case default
          text = "not run"
       end select

@@ -69,7 +69,7 @@
 !> approach by exactly eps.
 module femcod_cg
    use femcod_kinds, only: dp, i8
-   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_USAGE
+   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_USAGE, STATUS_INTERRUPTED
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
    use femcod_split_correction, only: split_hand_over
@@ -78,7 +78,7 @@ module femcod_cg
    use femcod_constrained_cg, only: constrained_cg, cg_residuals
    use femcod_gap_cg, only: gap_session, gap_session_start, gap_target, gap_solver_storage_bytes
    use femcod_interface_law, only: interface_law, make_interface_law, MAX_PLASTIC_ROUNDS
-   use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, gather_contacts, &
+   use femcod_contact_result, only: contact_result, load_state, append_step, STOP_LOADS, STOP_INTERRUPTED, gather_contacts, &
       cg_diagnostics, cg_state_diagnostics
    use femcod_solver_options, only: refuse_beyond_memory, contact_options, cg_settings, by_gap_variables, &
       requested_states, run_shear_model, &
@@ -268,6 +268,20 @@ contains
       call grid_operator_free(fine)
       allocate(res%diagnostics, source=work)
       res%stop_reason = STOP_LOADS
+      if (status%code == STATUS_INTERRUPTED .and. kk > 1) then
+         ! A stop signal between two targets: the states solved are kept (the caller
+         ! writes them as a partial run), the last of them reported in full.
+         res%stop_reason = STOP_INTERRUPTED
+         if (.not. allocated(res%contact_i)) then
+            associate(st => res%states(order(kk - 1)))
+               res%contact_i = st%i
+               res%contact_j = st%j
+               res%contact_step = [(kk - 1, i = 1, st%contacts)]
+               res%contact_force = st%force
+               res%reported_load = st%load
+            end associate
+         end if
+      end if
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
       if (status%code /= 0) return

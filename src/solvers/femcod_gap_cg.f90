@@ -233,7 +233,7 @@ contains
          if (residual <= tol .or. iterations >= max_iterations) exit
          if (op%any_over_grid(observer%stop_requested())) then
             call set_error(status, STATUS_INTERRUPTED, "stopped after "//int_str(iterations)// &
-               " iterations at the approach "//format_real(a)//" nm; the cg solver keeps no checkpoint")
+               " iterations at the approach "//format_real(a)//" nm")
             return
          end if
          iterations = iterations + 1

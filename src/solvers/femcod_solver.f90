@@ -154,27 +154,48 @@ contains
       type(contact_options), intent(in) :: options
       type(contact_result), intent(in) :: res
       type(string_type), allocatable :: lines(:)
+      logical :: by_approach
+      integer, allocatable :: missed(:), idle(:)
+      character(len=:), allocatable :: what, unit
       integer :: k
       allocate(lines(0))
       if (.not. allocated(res%states)) return
-      do k = 1, size(res%states)
-         associate(s => res%states(k))
-            if (.not. s%reached) then
-               if (allocated(options%approaches)) then
-                  if (size(options%approaches) > 0) then
-                     lines = [lines, string_type("approach "//format_real(s%approach)//" nm not reached ("// &
-                        stop_reason_text(res%stop_reason)//")")]
-                     cycle
-                  end if
-               end if
-               lines = [lines, string_type("load "//format_real(s%load)//" nN not reached ("// &
-                  stop_reason_text(res%stop_reason)//")")]
-            else if (options%tangential .and. s%contacts == 0) then
-               lines = [lines, string_type("state "//int_str(k)//" (approach "//format_real(s%approach)// &
-                  " nm) has no contact: the tangential step was not applied, and its tangential force is 0")]
-            end if
-         end associate
-      end do
+      by_approach = .false.
+      if (allocated(options%approaches)) by_approach = size(options%approaches) > 0
+      what = trim(merge("approach", "load    ", by_approach))
+      unit = trim(merge(" nm", " nN", by_approach))
+      missed = pack([(k, k = 1, size(res%states))], .not. res%states%reached)
+      idle = [integer ::]
+      if (options%tangential) idle = pack([(k, k = 1, size(res%states))], res%states%reached .and. &
+         res%states%contacts == 0)
+      ! Up to three states one by one; more as one line (a run stopped early may leave
+      ! hundreds).
+      if (size(missed) > 3) then
+         lines = [lines, string_type(count_text(size(missed), what)//" of "//int_str(size(res%states))// &
+            " not reached, from "//format_real(target(missed(1)))//" to "// &
+            format_real(target(missed(size(missed))))//unit//" ("//stop_reason_text(res%stop_reason)//")")]
+      else
+         do k = 1, size(missed)
+            lines = [lines, string_type(what//" "//format_real(target(missed(k)))//unit//" not reached ("// &
+               stop_reason_text(res%stop_reason)//")")]
+         end do
+      end if
+      if (size(idle) > 3) then
+         lines = [lines, string_type(count_text(size(idle), "state")//" (states "//int_str(idle(1))//" to "// &
+            int_str(idle(size(idle)))//") have no contact: the tangential step was not applied there, and their "// &
+            "tangential force is 0")]
+      else
+         do k = 1, size(idle)
+            lines = [lines, string_type("state "//int_str(idle(k))//" (approach "// &
+               format_real(res%states(idle(k))%approach)//" nm) has no contact: the tangential step was not "// &
+               "applied, and its tangential force is 0")]
+         end do
+      end if
+   contains
+      real(dp) function target(k)
+         integer, intent(in) :: k
+         target = merge(res%states(k)%approach, res%states(k)%load, by_approach)
+      end function target
    end function run_warnings
 
    !> The tangential step (solvers/femcod_tangential) at each reached state with contacts,
