@@ -19,7 +19,7 @@ module femcod_studies
    use femcod_results, only: write_file_set
    use femcod_svg, only: svg_series, svg_multi_plot, add_series
    use femcod_clock, only: wall_clock
-   use femcod_resolution_study, only: resolution_level, solve_level, extrapolate_levels
+   use femcod_resolution_study, only: resolution_level, solve_level, extrapolate_levels, check_levels
    use femcod_summits, only: summit_statistics, summit_search, summits_of_size, default_sizes, profile_psd, summit_power_laws, &
       structure_function, psd_dimension, structure_dimension, summits_storage_bytes
    use femcod_memory, only: available_memory, memory_text, usable_text
@@ -189,6 +189,11 @@ contains
             end if
          end do
          if (size(nps) == 0) nps = [deck%np]
+      end if
+      call check_levels(deck%np, nps, method, status)
+      if (status%code /= 0) then
+         call fail(status)
+         return
       end if
       observer%quiet = quiet
       allocate(levels(size(nps)))
@@ -472,6 +477,11 @@ contains
          call load_scene(spec, deck, status)
       else
          call read_deck(input, deck, status)
+         if (status%code /= 0 .and. looks_like_height_matrix(input)) then
+            status%code = STATUS_USAGE
+            status%message = input//" reads as a matrix of heights, not as a deck: give --pixel D (nm) to study "// &
+               "it as heights ("//status%message//")"
+         end if
       end if
    end subroutine study_deck
 
@@ -625,6 +635,7 @@ contains
       type(parsed_options), intent(out) :: parsed
       integer, intent(out) :: code
       type(status_type) :: status
+      integer :: k
       code = 0
       if (help_requested(args)) then
          code = -1
@@ -654,6 +665,23 @@ contains
       call get_option(parsed, "--force", opts%force)
       call get_option(parsed, "--quiet", opts%quiet)
       if (opts%prefix == "") opts%prefix = default_prefix(file_part(opts%input))
+      ! An option the run would ignore is refused, as run does.
+      do k = 1, size(opts%sizes)
+         if (count(opts%sizes == opts%sizes(k)) > 1) then
+            call set_error(status, STATUS_USAGE, "--sizes: "//int_str(opts%sizes(k))//" is given twice")
+            exit
+         end if
+      end do
+      if (status%code == 0 .and. opts%height_unit /= "" .and. .not. (opts%pixel > 0 .or. &
+         is_height_file(opts%input))) call set_error(status, STATUS_USAGE, "--height-unit: "//opts%input// &
+         " is a deck, whose heights are in nm; the unit is for height files")
+      if (status%code == 0 .and. option_given(parsed, "--min-length") .and. option_given(parsed, "--scales")) &
+         call set_error(status, STATUS_USAGE, "give --min-length L or --scales K, not both (the scales are K, "// &
+            "or as many as reach L)")
+      if (status%code /= 0) then
+         call usage_line(command, status%message)
+         code = status%code
+      end if
    end subroutine parse_surface_options
 
    subroutine usage_line(command, message)
@@ -910,6 +938,23 @@ contains
       template%box = (2*tsize + 1)*d
       region = real(size(z, 1) - 2*maxval(opts%sizes), dp)*(size(z, 2) - 2*maxval(opts%sizes))*d**2
       template%density = size(heights)/region
+      ! Every (s, constraint) is estimated from its first two scales before the first is
+      ! run whole: what would pass the model's limit is refused at once (exit 4).
+      do ks = 1, size(svals)
+         m = scales
+         if (m == 0) m = max(1, 1 + floor(log(template%box/min_length)/log(svals(ks))))
+         do kc = 1, 2
+            if (m < 3) cycle
+            call multiscale_hertz(template, ex(1), ex(2), ex(3), svals(ks), 2, load, estar, trim(constraints(kc)), &
+               result, status)
+            call check_growth(result%contacts(1), result%contacts(2), 2, m, status)
+            if (status%code /= 0) then
+               status%message = "s = "//sig_str(svals(ks), 3)//", "//trim(constraints(kc))//": "//status%message
+               call fail_with("multiscale", status, code)
+               return
+            end if
+         end do
+      end do
       call add_line(b, "s,constraint,scale,length_nm,load_nN,area_nm2,contacts")
       allocate(series(0))
       do ks = 1, size(svals)

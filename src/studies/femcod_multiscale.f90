@@ -17,10 +17,11 @@ module femcod_multiscale
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL, STATUS_BAD_INPUT
    use femcod_sort, only: merge_sort_index
-   use femcod_strings, only: int_str
+   use femcod_strings, only: int_str, sig_str
    implicit none
    private
-   public :: roughness_template, multiscale_result, multiscale_hertz, share_load, hertz_area, MAX_CONTACTS_PER_SCALE
+   public :: roughness_template, multiscale_result, multiscale_hertz, share_load, hertz_area, MAX_CONTACTS_PER_SCALE, &
+      check_growth
 
    real(dp), parameter :: pi = acos(-1.0_dp)
    !> Hexagonal close packing of equal circles: the covered fraction pi/(2 sqrt 3).
@@ -85,6 +86,26 @@ contains
          total = sum(4.0_dp/3*estar*sqrt(r)*max(h - h(1) + delta, 0.0_dp)**1.5_dp)
       end function total
    end subroutine share_load
+
+   !> The contacts multiply by about the same factor at every scale (the model is
+   !> self-similar): from `previous` contacts at scale k - 1 and `current` at scale k,
+   !> refuse (exit 4) a run whose last scale would pass MAX_CONTACTS_PER_SCALE, before
+   !> the hours that reaching it takes, naming the scales that fit.
+   subroutine check_growth(previous, current, k, scales, status)
+      integer, intent(in) :: previous, current, k, scales
+      type(status_type), intent(inout) :: status
+      real(dp) :: growth, projected
+      if (status%code /= 0 .or. previous <= 0 .or. current <= previous .or. scales <= k) return
+      growth = real(current, dp)/previous
+      projected = current*growth**(scales - k)
+      if (projected <= MAX_CONTACTS_PER_SCALE) return
+      call set_error(status, STATUS_NUMERICAL, "the contacts grow "//sig_str(growth, 3)//" times a scale ("// &
+         int_str(previous)//" to "//int_str(current)//" at scales "//int_str(k - 1)//" and "//int_str(k)// &
+         "): about "//sig_str(projected, 2)//" at scale "//int_str(scales)//", beyond the "// &
+         int_str(MAX_CONTACTS_PER_SCALE)//" a scale this model holds; use at most "// &
+         int_str(k + max(0, floor(log(real(MAX_CONTACTS_PER_SCALE, dp)/current)/log(growth))))// &
+         " scales (--scales) or a larger scaling constant (--s)")
+   end subroutine check_growth
 
    !> The multiscale model with length scaling constant s > 1 over `scales` scales,
    !> heights/radii/density exponents eh, eR, eN, total load `load` and modulus estar.
@@ -163,6 +184,8 @@ contains
          deallocate(nf, na)
          result%area(k) = sum(ha)
          result%contacts(k) = size(hf)
+         if (k < scales) call check_growth(result%contacts(k - 1), result%contacts(k), k, scales, status)
+         if (status%code /= 0) return
       end do
    contains
       pure subroutine grow(v, n_new)

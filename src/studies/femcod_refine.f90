@@ -130,8 +130,9 @@ contains
       spectrum%points = count(keep)
       if (spectrum%q_high/spectrum%q_low < MIN_FIT_RATIO .or. spectrum%points < 4) then
          call set_error(status, STATUS_BAD_INPUT, "no scaling range: the PSD fit needs wavenumbers from 4 q_L to "// &
-            "q_d/2 spanning a ratio of "//sig_str(MIN_FIT_RATIO, 2)//" (NP >= 32), found "// &
-            sig_str(spectrum%q_high/spectrum%q_low, 3))
+            "q_d/2 spanning a ratio of "//sig_str(MIN_FIT_RATIO, 2)//", found "// &
+            sig_str(spectrum%q_high/spectrum%q_low, 3)//" (the ratio is NP/16: NP >= "// &
+            int_str(nint(16*MIN_FIT_RATIO))//" pixels a side, found "//int_str(nint(spectrum%side/spectrum%pixel))//")")
          return
       end if
       ! Least squares in log-log, each bin weighted by its modes.

@@ -21,7 +21,7 @@ module femcod_resolution_study
    use femcod_strings, only: int_str
    implicit none
    private
-   public :: resolution_level, level_deck, solve_level, extrapolate_levels
+   public :: resolution_level, level_deck, solve_level, extrapolate_levels, check_levels
 
    !> One resolution level: its deck, femcod's history and the estimates. Loads nN,
    !> lengths nm, areas nm^2.
@@ -96,6 +96,35 @@ contains
       level%maxcont = max(1, min(np*np, nint(deck%maxcont*(real(np, dp)/deck%np)**2)))
       call validate_problem(level, status)
    end subroutine level_deck
+
+   !> Every level of a study checked before the first is solved: each reachable from NP by
+   !> the method's halving (subsample: (n + 1)/2, average: n/2, as level_deck makes them),
+   !> and none asked twice. STATUS_USAGE.
+   subroutine check_levels(np, levels, method, status)
+      integer, intent(in) :: np, levels(:)
+      character(len=*), intent(in) :: method
+      type(status_type), intent(inout) :: status
+      character(len=:), allocatable :: chain
+      integer :: k, n
+      if (status%code /= 0) return
+      do k = 1, size(levels)
+         if (count(levels == levels(k)) > 1) then
+            call set_error(status, STATUS_USAGE, "--levels: "//int_str(levels(k))//" is given twice")
+            return
+         end if
+         n = np
+         chain = int_str(n)
+         do while (n > levels(k) .and. n > 1)
+            n = merge((n + 1)/2, n/2, method == "subsample")
+            chain = chain//", "//int_str(n)
+         end do
+         if (n /= levels(k)) then
+            call set_error(status, STATUS_USAGE, "resolution level "//int_str(levels(k))//" cannot be reached "// &
+               "from NP = "//int_str(np)//" by halving ("//method//" gives "//chain//"); nothing was solved")
+            return
+         end if
+      end do
+   end subroutine check_levels
 
    !> Solve one level and compute its estimates; with `capped` true solve it a second
    !> time with the pressures capped at the hardness (the plastic events of the event
