@@ -11,7 +11,8 @@ module test_silent
    use femcod_solver_options, only: contact_options, SOLVER_INCREMENTAL, SOLVER_CG
    use femcod_solver, only: solve_contact, run_warnings
    use femcod_cli, only: run_femcod
-   use test_support, only: scratch_path, file_exists
+   use test_support, only: scratch_path, file_exists, read_text
+   use test_results, only: self_command
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -25,7 +26,8 @@ contains
          new_unittest("a plastic run stopped by MAXCONT says so, and its check is finite", test_plastic_maxcont), &
          new_unittest("a state off contact has load 0; the load is the pressures' sum", test_load_is_the_map_sum), &
          new_unittest("a tangential step without contact is a warning", test_tangential_without_contact), &
-         new_unittest("-o DIR/NAME makes DIR, as the README's first example needs", test_output_directory_made)]
+         new_unittest("-o DIR/NAME makes DIR, as the README's first example needs", test_output_directory_made), &
+         new_unittest("every solver gives the same bits on 1, 2 and 3 threads", test_thread_count)]
    end subroutine collect_silent
 
    !> README's example `run sphere_d1.deck --loads 1e4 --plastic --hardness 11` (MAXCONT
@@ -137,4 +139,54 @@ contains
       call check(error, file_exists(dir//"/out/circle.h5") .and. file_exists(dir//"/out/circle.loads.csv"), &
          "the results in the directory made for them")
    end subroutine test_output_directory_made
+
+   !> Issue 47, section 7: cg at 1e5 nN on a 128^2 deck gave approach ...3974 on 2
+   !> threads and ...3871 on 1 (OpenMP's reductions add the threads' shares in an order
+   !> that follows the split; OpenBLAS blocks its factorisations by its threads, which
+   !> follow OMP_NUM_THREADS). Every path of every solver, run as a user runs it, must
+   !> write the same PREFIX.loads.csv (17 significant digits) on 1, 2 and 3 threads.
+   subroutine test_thread_count(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: dir, rough, reference, args
+      character(len=*), parameter :: SPHERE = "input/sphere_d1.deck"
+      character(len=120), parameter :: PATHS(8) = [character(len=120) :: &
+         "--solver cg --loads 1e4,2e5", &
+         "--solver cg --boundary periodic --loads 1e4,2e5", &
+         "--solver cg --plastic --hardness 5 --approach 2,4,3", &
+         "--solver cg --adhesion exponential --work 0.05 --range 1 --approach 1,3,-1", &
+         "--solver incremental --loads 1e3,1e4 --plastic --hardness 8", &
+         "--solver cg --loads 1e4 --tangential 1000 --friction 0.3", &
+         "SPHERE --solver legacy --loads 300,1000", &
+         "SPHERE --solver cg --loads 3000 --shear-strength 0.1 --shear-slope 0.05"]
+      integer :: k, threads, code
+      dir = scratch_path("threads")
+      rough = dir//"/rough.deck"
+      call execute_command_line("rm -rf "//dir//" && mkdir -p "//dir)
+      call run_femcod([string_type("mkdeck"), string_type("self-affine"), string_type("--np"), string_type("64"), &
+         string_type("--pixel"), string_type("5"), string_type("--rms"), string_type("3"), string_type("--seed"), &
+         string_type("3"), string_type("--shape-on"), string_type("lower"), string_type("-o"), string_type(rough)], code)
+      call check(error, code, 0, "mkdeck")
+      if (allocated(error)) return
+      do k = 1, size(PATHS)
+         args = trim(PATHS(k))
+         if (index(args, "SPHERE") == 1) then
+            args = SPHERE//args(7:)
+         else
+            args = rough//" "//args
+         end if
+         do threads = 1, 3
+            call execute_command_line("OMP_NUM_THREADS="//to_string(threads)//" "//self_command()//" run "//args// &
+               " -o "//dir//"/t"//to_string(threads)//" --quiet --force > /dev/null 2>&1", exitstat=code)
+            call check(error, code, 0, "femcod run "//args//" on "//to_string(threads)//" threads")
+            if (allocated(error)) return
+            if (threads == 1) then
+               reference = read_text(dir//"/t1.loads.csv")
+            else
+               call check(error, read_text(dir//"/t"//to_string(threads)//".loads.csv") == reference, &
+                  "femcod run "//args//": "//to_string(threads)//" threads differ from 1")
+               if (allocated(error)) return
+            end if
+         end do
+      end do
+   end subroutine test_thread_count
 end module test_silent

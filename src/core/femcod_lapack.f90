@@ -1,12 +1,21 @@
 !> Explicit interfaces to the LAPACK and BLAS routines femcod calls
 !> (implicit-external is off in fpm.toml).
 module femcod_lapack
+   use, intrinsic :: iso_c_binding, only: c_int
    use femcod_kinds, only: dp
    implicit none
    private
    public :: dpotrf, dpotri, dsysv, dgesv, ddot, dgemv, dsymv, dtpsv, dpptrf, dtrsv, dlacn2, dtrsm, dsyrk, dgemm
+   public :: blas_set_threads
 
    interface
+      !> OpenBLAS's threads set to n; the number before, -1 with another BLAS
+      !> (core/femcod_blas_threads.c). Its factorisations block their work by the
+      !> threads: run on one, their bits do not depend on the thread count.
+      integer(c_int) function blas_set_threads(n) bind(C, name="femcod_blas_set_threads")
+         import :: c_int
+         integer(c_int), value :: n
+      end function blas_set_threads
       pure subroutine dpotrf(uplo, n, a, lda, info)
          import :: dp
          character(len=1), intent(in) :: uplo

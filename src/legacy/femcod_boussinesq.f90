@@ -5,7 +5,8 @@
 module femcod_boussinesq
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
-   use femcod_lapack, only: dpotrf, dpotri
+   use, intrinsic :: iso_c_binding, only: c_int
+   use femcod_lapack, only: dpotrf, dpotri, blas_set_threads
    implicit none
    private
    public :: boussinesq_flexibility, boussinesq_inverse, boussinesq_element
@@ -33,10 +34,14 @@ contains
       real(dp), intent(out) :: stiff(:, :)
       type(status_type), intent(inout) :: status
       integer :: n, info, k
+      integer(c_int) :: before
       n = size(flex, 1)
       stiff = flex
+      ! On one OpenBLAS thread: the same bits whatever the thread count.
+      before = blas_set_threads(1_c_int)
       call dpotrf("U", n, stiff, n, info)
       if (info == 0) call dpotri("U", n, stiff, n, info)
+      if (before > 0) before = blas_set_threads(before)
       if (info /= 0) then
          call set_error(status, STATUS_NUMERICAL, "BOUSSINESQ: the flexibility matrix is not positive definite")
          return

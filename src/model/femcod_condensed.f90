@@ -15,7 +15,8 @@
 module femcod_condensed
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
-   use femcod_lapack, only: dsysv
+   use, intrinsic :: iso_c_binding, only: c_int
+   use femcod_lapack, only: dsysv, blas_set_threads
    implicit none
    private
    public :: solve_active_set, gap_at, gap_and_rate
@@ -64,6 +65,7 @@ contains
       real(dp), allocatable :: a(:, :), b(:, :), work(:)
       integer, allocatable :: ipiv(:)
       integer :: n, k, l, info
+      integer(c_int) :: before
       n = size(ic)
       allocate(a(n + 1, n + 1), b(n + 1, 1), ipiv(n + 1), work(64*(n + 1)))
       do l = 1, n
@@ -77,7 +79,10 @@ contains
       a(n + 1, n + 1) = 0
       b(1:n, 1) = -g0
       b(n + 1, 1) = -load
+      ! On one OpenBLAS thread: the same bits whatever the thread count.
+      before = blas_set_threads(1_c_int)
       call dsysv("U", n + 1, 1, a, n + 1, ipiv, b, n + 1, work, size(work), info)
+      if (before > 0) before = blas_set_threads(before)
       if (info /= 0) then
          call set_error(status, STATUS_NUMERICAL, "active-set solve: singular system")
          forces = 0

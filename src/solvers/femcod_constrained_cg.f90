@@ -95,6 +95,11 @@ module femcod_constrained_cg
          keep_old = .false., kept_old = .false.
    end type cg_iteration
 
+
+   !> Sums over the contacts are taken by blocks of this many contacts, each block's sum in
+   !> list order, then the blocks' sums in order: the grouping is the same on any number
+   !> of threads, and so is every bit of the answer (issue 47).
+   integer, parameter :: SUM_BLOCK = 4096
 contains
 
    !> Polonsky-Keer constrained CG on the operator `grid` at total load P from the forces
@@ -240,19 +245,27 @@ contains
       real(dp), intent(in) :: p(:, :)
       type(status_type), intent(inout) :: status
       real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, s, sums(2), lift
-      integer :: q, i, j, nc
+      real(dp), allocatable :: part(:, :)
+      integer :: q, i, j, nc, b, nb
       logical :: take_old
       nc = size(st%contact, 2)
       st%nc = nc
       alpha = st%alpha
       s = st%s
-      gbar = 0
-      !$omp parallel do private(i, j) reduction(+:gbar)
-      do q = 1, nc
-         i = st%contact(1, q)
-         j = st%contact(2, q)
-         gbar = gbar + (grid%g0(i, j) + alpha*(st%w(i, j) + s*p(i, j)))
+      ! Sums over the contacts by blocks of SUM_BLOCK, then the blocks in order: the same
+      ! bits on any number of threads (the list is in column order, the blocks fixed).
+      nb = (nc + SUM_BLOCK - 1)/SUM_BLOCK
+      allocate(part(4, nb))
+      !$omp parallel do private(q, i, j)
+      do b = 1, nb
+         part(1, b) = 0
+         do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, nc)
+            i = st%contact(1, q)
+            j = st%contact(2, q)
+            part(1, b) = part(1, b) + (grid%g0(i, j) + alpha*(st%w(i, j) + s*p(i, j)))
+         end do
       end do
+      gbar = sum(part(1, :))
       sums = [gbar, real(nc, dp)]
       call grid%sum_over_grid(sums)
       st%nc_all = sums(2)
@@ -271,18 +284,23 @@ contains
       cross = 0
       contact_gap = 0
       lift = 0
-      !$omp parallel do private(i, j, gij) reduction(+:big_g, cross) reduction(max:contact_gap, lift)
-      do q = 1, nc
-         i = st%contact(1, q)
-         j = st%contact(2, q)
-         lift = max(lift, abs(alpha*(st%w(i, j) + s*p(i, j))))
-         gij = grid%g0(i, j) + alpha*(st%w(i, j) + s*p(i, j)) - gbar
-         if (take_old) st%g_old(q) = st%gm(i, j)
-         big_g = big_g + gij**2
-         if (st%keep_old .and. .not. grid%preconditioned) cross = cross + gij*real(st%g_old(q), dp)
-         contact_gap = max(contact_gap, abs(gij))
-         st%gm(i, j) = real(gij, sp)
+      !$omp parallel do private(q, i, j, gij) reduction(max:contact_gap, lift)
+      do b = 1, nb
+         part(1:2, b) = 0
+         do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, nc)
+            i = st%contact(1, q)
+            j = st%contact(2, q)
+            lift = max(lift, abs(alpha*(st%w(i, j) + s*p(i, j))))
+            gij = grid%g0(i, j) + alpha*(st%w(i, j) + s*p(i, j)) - gbar
+            if (take_old) st%g_old(q) = st%gm(i, j)
+            part(1, b) = part(1, b) + gij**2
+            if (st%keep_old .and. .not. grid%preconditioned) part(2, b) = part(2, b) + gij*real(st%g_old(q), dp)
+            contact_gap = max(contact_gap, abs(gij))
+            st%gm(i, j) = real(gij, sp)
+         end do
       end do
+      big_g = sum(part(1, :))
+      cross = sum(part(2, :))
       st%kept_old = st%keep_old
       sums = [big_g, cross]
       call grid%sum_over_grid(sums)
@@ -325,7 +343,8 @@ contains
       class(elastic_operator), intent(inout) :: grid
       type(cg_settings), intent(in) :: how
       real(dp) :: num, rt, rsum, tsum, rbar, den, beta, zbar, s, sums(4)
-      integer :: q, i, j
+      real(dp), allocatable :: part(:, :)
+      integer :: q, i, j, b, nb
       if (grid%preconditioned) then
          call grid%exchange_halo(st%gm)
          call precondition(st, grid)
@@ -342,18 +361,24 @@ contains
       st%big_g_old = st%big_g
       beta = st%beta
       zbar = st%zbar
-      num = 0
-      !$omp parallel do private(i, j) reduction(+:num)
-      do q = 1, st%nc
-         i = st%contact(1, q)
-         j = st%contact(2, q)
-         if (grid%preconditioned) then
-            st%t(i, j) = stencil_at(st, grid%taps, i, j) - zbar + beta*st%t(i, j)
-         else
-            st%t(i, j) = real(st%gm(i, j), dp) + beta*st%t(i, j)
-         end if
-         num = num + real(st%gm(i, j), dp)*st%t(i, j)
+      ! Sums by blocks of contacts, then the blocks in order (thread-count independent).
+      nb = (st%nc + SUM_BLOCK - 1)/SUM_BLOCK
+      allocate(part(3, nb))
+      !$omp parallel do private(q, i, j)
+      do b = 1, nb
+         part(1, b) = 0
+         do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, st%nc)
+            i = st%contact(1, q)
+            j = st%contact(2, q)
+            if (grid%preconditioned) then
+               st%t(i, j) = stencil_at(st, grid%taps, i, j) - zbar + beta*st%t(i, j)
+            else
+               st%t(i, j) = real(st%gm(i, j), dp) + beta*st%t(i, j)
+            end if
+            part(1, b) = part(1, b) + real(st%gm(i, j), dp)*st%t(i, j)
+         end do
       end do
+      num = sum(part(1, :))
       ! r = c (I * t): the displacements of the search direction, always in float32
       ! when float32 is on: its round-off (1e-7 of r) scales with the step, and the
       ! steps shrink with the residual, so it never limits the accuracy; the forces'
@@ -365,17 +390,20 @@ contains
       end if
       st%fresh_double = .false.
       s = st%s
-      rt = 0
-      rsum = 0
-      tsum = 0
-      !$omp parallel do private(i, j) reduction(+:rt, rsum, tsum)
-      do q = 1, st%nc
-         i = st%contact(1, q)
-         j = st%contact(2, q)
-         rt = rt + (r_at(st, i, j) + s*st%t(i, j))*st%t(i, j)
-         rsum = rsum + r_at(st, i, j) + s*st%t(i, j)
-         tsum = tsum + st%t(i, j)
+      !$omp parallel do private(q, i, j)
+      do b = 1, nb
+         part(:, b) = 0
+         do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, st%nc)
+            i = st%contact(1, q)
+            j = st%contact(2, q)
+            part(1, b) = part(1, b) + (r_at(st, i, j) + s*st%t(i, j))*st%t(i, j)
+            part(2, b) = part(2, b) + r_at(st, i, j) + s*st%t(i, j)
+            part(3, b) = part(3, b) + st%t(i, j)
+         end do
       end do
+      rt = sum(part(1, :))
+      rsum = sum(part(2, :))
+      tsum = sum(part(3, :))
       sums = [num, rt, rsum, tsum]
       call grid%sum_over_grid(sums)
       rbar = sums(3)/st%nc_all
@@ -399,28 +427,30 @@ contains
       real(dp), intent(inout) :: p(:, :)
       type(status_type), intent(inout) :: status
       real(dp) :: psum, psum_in, gij, pn, lin, alpha, tau, gbar, entry, sums(4)
-      integer :: q, i, j, thread, nchanged
+      real(dp), allocatable :: part(:, :), entered(:)
+      integer :: q, i, j, thread, nchanged, b, nb
       alpha = st%alpha
       tau = st%tau
       gbar = st%gbar
       entry = st%entry
       nchanged = 0
-      ! Each sum starts from zero in its own parallel region: how the threads' shares
-      ! are added is then the same in every run (on two threads).
-      psum_in = 0
+      ! The entering forces summed by column, then the columns in order: the same bits on
+      ! any number of threads.
+      allocate(entered(st%nj))
       st%entering%n = 0
-      !$omp parallel private(thread, i, j, gij, pn) reduction(+:psum_in)
+      !$omp parallel private(thread, i, j, gij, pn)
       thread = 0
       !$ thread = omp_get_thread_num()
       !$omp do schedule(static)
       do j = 1, st%nj
+         entered(j) = 0
          do i = 1, st%np
             if (st%touching(i, j) == 0) then
                gij = grid%g0(i, j) + alpha*st%w(i, j) - gbar
                if (gij < 0) then
                   pn = -tau*entry*gij
                   p(i, j) = pn
-                  psum_in = psum_in + pn
+                  entered(j) = entered(j) + pn
                   st%touching(i, j) = 1
                   ! Its gap now is its previous gap in the next iteration.
                   st%gm(i, j) = real(gij, sp)
@@ -433,23 +463,29 @@ contains
       end do
       !$omp end do
       !$omp end parallel
-      psum = 0
-      !$omp parallel do private(i, j, lin, pn) reduction(+:psum)
-      do q = 1, st%nc
-         i = st%contact(1, q)
-         j = st%contact(2, q)
-         lin = alpha*p(i, j) - tau*st%t(i, j)
-         pn = max(lin, 0.0_dp)
-         p(i, j) = pn
-         psum = psum + pn
-         if (.not. pn > 0) then
-            ! Leaves the contacts: no force, no direction, no contact gap.
-            st%touching(i, j) = 0
-            st%t(i, j) = 0
-            st%gm(i, j) = 0
-         end if
-         if (pn /= lin) call record_change(st, nchanged, i, j, pn - lin)
+      psum_in = sum(entered)
+      nb = (st%nc + SUM_BLOCK - 1)/SUM_BLOCK
+      allocate(part(1, nb))
+      !$omp parallel do private(q, i, j, lin, pn)
+      do b = 1, nb
+         part(1, b) = 0
+         do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, st%nc)
+            i = st%contact(1, q)
+            j = st%contact(2, q)
+            lin = alpha*p(i, j) - tau*st%t(i, j)
+            pn = max(lin, 0.0_dp)
+            p(i, j) = pn
+            part(1, b) = part(1, b) + pn
+            if (.not. pn > 0) then
+               ! Leaves the contacts: no force, no direction, no contact gap.
+               st%touching(i, j) = 0
+               st%t(i, j) = 0
+               st%gm(i, j) = 0
+            end if
+            if (pn /= lin) call record_change(st, nchanged, i, j, pn - lin)
+         end do
       end do
+      psum = sum(part(1, :))
       st%nchanged = nchanged
       sums = [psum, psum_in, real(nchanged, dp), real(sum(st%entering%n), dp)]
       call grid%sum_over_grid(sums)
@@ -714,29 +750,31 @@ contains
    subroutine precondition(st, grid)
       type(cg_iteration), intent(inout) :: st
       class(elastic_operator), intent(inout) :: grid
-      real(dp) :: zsum, gz, gsum, zo, osum, zij, sums(5)
-      integer :: k, ii, jj
+      real(dp) :: zij, sums(5)
+      real(dp), allocatable :: part(:, :)
+      integer :: k, ii, jj, b, nb
       logical :: keep_old
       keep_old = st%keep_old
-      zsum = 0
-      gz = 0
-      gsum = 0
-      zo = 0
-      osum = 0
-      !$omp parallel do private(ii, jj, zij) reduction(+:zsum, gz, gsum, zo, osum)
-      do k = 1, st%nc
-         ii = st%contact(1, k)
-         jj = st%contact(2, k)
-         zij = stencil_at(st, grid%taps, ii, jj)
-         zsum = zsum + zij
-         gz = gz + real(st%gm(ii, jj), dp)*zij
-         gsum = gsum + real(st%gm(ii, jj), dp)
-         if (keep_old) then
-            zo = zo + real(st%g_old(k), dp)*zij
-            osum = osum + real(st%g_old(k), dp)
-         end if
+      ! Sums by blocks of contacts, then the blocks in order (thread-count independent).
+      nb = (st%nc + SUM_BLOCK - 1)/SUM_BLOCK
+      allocate(part(5, nb))
+      !$omp parallel do private(k, ii, jj, zij)
+      do b = 1, nb
+         part(:, b) = 0
+         do k = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, st%nc)
+            ii = st%contact(1, k)
+            jj = st%contact(2, k)
+            zij = stencil_at(st, grid%taps, ii, jj)
+            part(1, b) = part(1, b) + zij
+            part(2, b) = part(2, b) + real(st%gm(ii, jj), dp)*zij
+            part(3, b) = part(3, b) + real(st%gm(ii, jj), dp)
+            if (keep_old) then
+               part(4, b) = part(4, b) + real(st%g_old(k), dp)*zij
+               part(5, b) = part(5, b) + real(st%g_old(k), dp)
+            end if
+         end do
       end do
-      sums = [zsum, gz, gsum, zo, osum]
+      sums = [(sum(part(k, :)), k = 1, 5)]
       call grid%sum_over_grid(sums)
       st%zbar = sums(1)/st%nc_all
       st%big_g = sums(2) - st%zbar*sums(3)

@@ -302,13 +302,15 @@ contains
       logical, intent(in) :: cap(:, :)
       type(gap_iteration), intent(inout) :: it
       real(dp) :: open_sum, open_count, t, cv, total(2)
+      real(dp), allocatable :: columns(:, :)
       integer :: i, j, np, nj
       np = op%np
       nj = op%nj
-      open_sum = 0
-      open_count = 0
-      !$omp parallel do private(i, t, cv) reduction(+:open_sum, open_count)
+      ! Sums by column, then the columns in order: the same bits on any number of threads.
+      allocate(columns(2, op%tmj))
+      !$omp parallel do private(i, t, cv)
       do j = 1, op%tmj
+         columns(:, j) = 0
          do i = 1, op%tm
             if (i <= np .and. j <= nj) then
                if (cap(i, j)) then
@@ -320,8 +322,8 @@ contains
                it%curvature(i, j) = cv
                it%r(i, j) = it%kx(i, j) + t
                if (g(i, j) > 0) then
-                  open_sum = open_sum + it%r(i, j)
-                  open_count = open_count + 1
+                  columns(1, j) = columns(1, j) + it%r(i, j)
+                  columns(2, j) = columns(2, j) + 1
                end if
             else
                it%r(i, j) = it%kx(i, j)
@@ -329,6 +331,8 @@ contains
          end do
       end do
       !$omp end parallel do
+      open_sum = sum(columns(1, :))
+      open_count = sum(columns(2, :))
       it%mu = 0
       if (.not. op%periodic) return
       total = [open_sum, open_count]
@@ -429,20 +433,21 @@ contains
    subroutine free_products(it, products)
       type(gap_iteration), intent(inout) :: it
       real(dp), intent(out) :: products(2)
-      real(dp) :: rz, rzo
+      real(dp), allocatable :: columns(:, :)
       integer :: i, j
-      rz = 0
-      rzo = 0
-      !$omp parallel do private(i) reduction(+:rz, rzo)
+      ! Sums by column, then the columns in order: the same bits on any number of threads.
+      allocate(columns(2, size(it%z, 2)))
+      !$omp parallel do private(i)
       do j = 1, size(it%z, 2)
+         columns(:, j) = 0
          do i = 1, size(it%z, 1)
             if (.not. it%free(i, j)) it%z(i, j) = 0
-            rz = rz + it%r(i, j)*it%z(i, j)
-            rzo = rzo + it%z(i, j)*it%r_old(i, j)
+            columns(1, j) = columns(1, j) + it%r(i, j)*it%z(i, j)
+            columns(2, j) = columns(2, j) + it%z(i, j)*it%r_old(i, j)
          end do
       end do
       !$omp end parallel do
-      products = [rz, rzo]
+      products = [sum(columns(1, :)), sum(columns(2, :))]
    end subroutine free_products
 
    !> d = -z + b d on the free set (0 elsewhere), with zero mean over the free set on a
@@ -452,38 +457,43 @@ contains
       type(gap_iteration), intent(inout) :: it
       real(dp), intent(in) :: b
       real(dp) :: total, nfree, shift, counts(2), rd(1)
+      real(dp), allocatable :: columns(:, :)
       integer :: i, j
-      total = 0
-      nfree = 0
-      !$omp parallel do private(i) reduction(+:total, nfree)
+      ! Sums by column, then the columns in order: the same bits on any number of threads.
+      allocate(columns(2, op%tmj))
+      !$omp parallel do private(i)
       do j = 1, op%tmj
+         columns(:, j) = 0
          do i = 1, op%tm
             if (it%free(i, j)) then
                it%d(i, j) = -it%z(i, j) + b*it%d(i, j)
-               total = total + it%d(i, j)
-               nfree = nfree + 1
+               columns(1, j) = columns(1, j) + it%d(i, j)
+               columns(2, j) = columns(2, j) + 1
             else
                it%d(i, j) = 0
             end if
          end do
       end do
       !$omp end parallel do
+      total = sum(columns(1, :))
+      nfree = sum(columns(2, :))
       shift = 0
       if (op%periodic) then
          counts = [total, nfree]
          call op%sum_over_grid(counts)
          if (counts(2) > 0) shift = counts(1)/counts(2)
       end if
-      rd(1) = 0
-      !$omp parallel do private(i) reduction(+:rd)
+      !$omp parallel do private(i)
       do j = 1, op%tmj
+         columns(1, j) = 0
          do i = 1, op%tm
             if (it%free(i, j)) it%d(i, j) = it%d(i, j) - shift
-            rd(1) = rd(1) + it%r(i, j)*it%d(i, j)
+            columns(1, j) = columns(1, j) + it%r(i, j)*it%d(i, j)
             it%r_old(i, j) = it%r(i, j)
          end do
       end do
       !$omp end parallel do
+      rd(1) = sum(columns(1, :))
       call op%sum_over_grid(rd)
       it%rd = rd(1)
    end subroutine new_direction
@@ -501,21 +511,25 @@ contains
       type(gap_iteration), intent(inout) :: it
       logical, intent(out) :: descends
       real(dp) :: curv, adhesive_curv, tau, sums(2)
+      real(dp), allocatable :: columns(:, :)
       integer :: i, j, np, nj
       logical :: clipped
       np = op%np
       nj = op%nj
       call op%apply_spectrum(SPECTRUM_STIFFNESS, it%d, it%w)
-      curv = 0
-      adhesive_curv = 0
-      !$omp parallel do private(i) reduction(+:curv, adhesive_curv)
+      ! Sums by column, then the columns in order: the same bits on any number of threads.
+      allocate(columns(2, op%tmj))
+      !$omp parallel do private(i)
       do j = 1, op%tmj
+         columns(:, j) = 0
          do i = 1, op%tm
-            curv = curv + it%d(i, j)*it%w(i, j)
-            if (i <= np .and. j <= nj) adhesive_curv = adhesive_curv + it%curvature(i, j)*it%d(i, j)**2
+            columns(1, j) = columns(1, j) + it%d(i, j)*it%w(i, j)
+            if (i <= np .and. j <= nj) columns(2, j) = columns(2, j) + it%curvature(i, j)*it%d(i, j)**2
          end do
       end do
       !$omp end parallel do
+      curv = sum(columns(1, :))
+      adhesive_curv = sum(columns(2, :))
       sums = [curv, adhesive_curv]
       call op%sum_over_grid(sums)
       curv = sums(1)
