@@ -214,7 +214,10 @@ contains
             call check(error, index(line, "use femcod_process") == 0, files(f)%s//": uses femcod_process")
             if (allocated(error)) return
             if (index(line, "use femcod_memory") == 1) then
-               call check(error, trim(line) == "use femcod_memory, only: memory_text", files(f)%s// &
+               ! Only the formatting of byte counts (memory_text, usable_text), no reading.
+               call check(error, trim(line) == "use femcod_memory, only: memory_text" .or. &
+                  trim(line) == "use femcod_memory, only: memory_text, usable_text" .or. &
+                  trim(line) == "use femcod_memory, only: usable_text", files(f)%s// &
                   ": reads the system's memory (pass it in the options): "//line)
                if (allocated(error)) return
             end if
