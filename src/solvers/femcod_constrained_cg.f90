@@ -83,10 +83,10 @@ module femcod_constrained_cg
       !> An entering pixel's share of a lone pixel's preconditioned step; the forces' sum.
       real(dp) :: entry = 1, psum = 0
       real(dp) :: residual = 0, contact_gap = 0, penetration = 0
-      !> The length (nm) the residual is measured against: the height range, or the
-      !> contacts' largest elastic displacement where that is larger (a flat or nearly
-      !> flat surface, whose height range is 0 or below the round-off of the
-      !> displacements: issue 47's degenerate family).
+      !> The length (nm) the residual is measured against: the height range, or where
+      !> larger the contacts' largest elastic displacement or a pixel's own displacement
+      !> under its force (a flat or nearly flat surface, whose height range is 0 or below
+      !> the round-off of the displacements: issue 47's degenerate family).
       real(dp) :: scale = 1
       !> The error bound (nm) of the split corrections since the last fresh convolution.
       real(dp) :: split_error = 0
@@ -244,7 +244,7 @@ contains
       class(elastic_operator), intent(inout) :: grid
       real(dp), intent(in) :: p(:, :)
       type(status_type), intent(inout) :: status
-      real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, s, sums(2), lift
+      real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, s, sums(2), lift, own
       real(dp), allocatable :: part(:, :)
       integer :: q, i, j, nc, b, nb
       logical :: take_old
@@ -275,6 +275,10 @@ contains
       end if
       gbar = sums(1)/st%nc_all
       st%gbar = gbar
+      ! A pixel's own displacement per nN: the convolution's round-off scales with the
+      ! forces, and on a periodic cell a uniform pressure displaces nothing, so the
+      ! scale holds this too (a periodic flat with 1e-12 nm ripples stalled at 1.2e-6).
+      own = alpha*(grid%c*grid%self + s)
       take_old = st%keep_old .and. .not. st%kept_old
       if (take_old) then
          if (allocated(st%g_old)) deallocate(st%g_old)
@@ -290,7 +294,7 @@ contains
          do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, nc)
             i = st%contact(1, q)
             j = st%contact(2, q)
-            lift = max(lift, abs(alpha*(st%w(i, j) + s*p(i, j))))
+            lift = max(lift, abs(alpha*(st%w(i, j) + s*p(i, j))), own*p(i, j))
             gij = grid%g0(i, j) + alpha*(st%w(i, j) + s*p(i, j)) - gbar
             if (take_old) st%g_old(q) = st%gm(i, j)
             part(1, b) = part(1, b) + gij**2
