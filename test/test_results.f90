@@ -628,14 +628,14 @@ contains
       if (allocated(error)) return
       ! An earlier femcod's table (femcod's history header, its first columns): --force may
       ! replace it, and only it (a user's table of that name is refused: the corpus).
-      call write_text(prefix//".history.csv", "step,contacts,load_nN,approach_nm"//new_line("a")//"kept,0"// &
+      call write_text(prefix//".history.csv", "step,contacts,load_nN,approach_nm,area_nm2"//new_line("a")//"kept,0"// &
          new_line("a"))
       before = read_text(prefix//".h5")
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
          string_type(prefix), string_type("--quiet")], code)
       call check(error, code, 5, "existing results: exit 5")
       if (allocated(error)) return
-      call check(error, read_text(prefix//".history.csv") == "step,contacts,load_nN,approach_nm"//new_line("a")// &
+      call check(error, read_text(prefix//".history.csv") == "step,contacts,load_nN,approach_nm,area_nm2"//new_line("a")// &
          "kept,0"//new_line("a") .and. read_text(prefix//".h5") == before, "results untouched")
       if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &

@@ -28,7 +28,6 @@ program femcod_mpi
    use femcod_run, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
    use femcod_deck_h5, only: is_hdf5_file, read_deck_h5_header
-   use femcod_hdf5, only: h5_set_probe
    use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, slab_rows, is_dataset_scene, &
       read_dataset_header, read_dataset_columns
    use femcod_deck_stream, only: read_text_deck_header
@@ -76,8 +75,6 @@ program femcod_mpi
    type(scene_spec) :: generated
 
    call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
-   ! An MPI rank must not fork: no test read of HDF5 files in a child (femcod_hdf5).
-   call h5_set_probe(.false.)
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
    call MPI_Comm_size(MPI_COMM_WORLD, ranks)
    call wall_clock(t_start)

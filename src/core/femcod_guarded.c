@@ -7,10 +7,12 @@
  * femcod_guarded(probe, arg, seconds): fork; the child runs probe(arg) under an alarm of
  * `seconds` and leaves with _exit (0: the probe succeeded). Returns 0 when the child
  * ended well, 1 when it failed or was killed by a signal, 2 when the alarm stopped it,
- * -1 when no child could be made (the caller then reads without the guard). */
+ * -1 when no child could be made, or under MPI (OMPI_COMM_WORLD_SIZE, PMI_RANK or
+ * PMIX_RANK set: a rank must not fork), and the caller then reads without the guard. */
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
+#include <stdlib.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -19,6 +21,7 @@ int femcod_guarded(int (*probe)(void *), void *arg, int seconds)
 {
     pid_t pid;
     int status = 0;
+    if (getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMI_RANK") || getenv("PMIX_RANK")) return -1;
     pid = fork();
     if (pid < 0) return -1;
     if (pid == 0) {

@@ -30,7 +30,7 @@ module femcod_hdf5
    implicit none
    private
    public :: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, h5_read, h5_exists
-   public :: h5_read_string_attribute, h5_rank_and_dims, h5_flat_view, h5_set_probe
+   public :: h5_read_string_attribute, h5_rank_and_dims, h5_flat_view
 
    !> An open HDF5 file and the name it was opened under (for messages).
    type :: h5_file
@@ -86,13 +86,12 @@ module femcod_hdf5
       end function h5d_write_chunk
    end interface
 
-   !> h5_open's test read in a child process (h5_set_probe), bounded in seconds.
-   logical, save :: probe_enabled = .true.
+   !> h5_open's test read in a child process, bounded in seconds.
    integer(c_int), parameter :: PROBE_SECONDS = 10
 
    interface
       !> core/femcod_guarded.c: probe(arg) in a child process under an alarm; 0 it ended,
-      !> 1 it failed or crashed, 2 the alarm stopped it, -1 no child.
+      !> 1 it failed or crashed, 2 the alarm stopped it, -1 no child (or under MPI).
       integer(c_int) function femcod_guarded(probe, arg, seconds) bind(C, name="femcod_guarded")
          import :: c_funptr, c_ptr, c_int
          type(c_funptr), value :: probe
@@ -149,32 +148,23 @@ contains
       ! The strings femcod reads, read first in a child process (core/femcod_guarded.c):
       ! libhdf5 can crash or loop on a corrupt file's string heap, and then only the
       ! child goes (the fuzz of issue 47: 6 of 400 mutated HDF5 decks).
-      if (probe_enabled) then
-         c_path = path//c_null_char
-         select case (femcod_guarded(c_funloc(probe_strings), c_loc(c_path), PROBE_SECONDS))
-         case (1)
-            call set_error(status, code, path//": a corrupt HDF5 file (the HDF5 library failed reading its "// &
-               "attributes in a test read); not read")
-            return
-         case (2)
-            call set_error(status, code, path//": a corrupt HDF5 file (a test read of its attributes did not end "// &
-               "in "//int_str(int(PROBE_SECONDS))//" s); not read")
-            return
-         end select
-      end if
+      c_path = path//c_null_char
+      select case (femcod_guarded(c_funloc(probe_strings), c_loc(c_path), PROBE_SECONDS))
+      case (1)
+         call set_error(status, code, path//": a corrupt HDF5 file (the HDF5 library failed reading its "// &
+            "attributes in a test read); not read")
+         return
+      case (2)
+         call set_error(status, code, path//": a corrupt HDF5 file (a test read of its attributes did not end "// &
+            "in "//int_str(int(PROBE_SECONDS))//" s); not read")
+         return
+      end select
       call h5fopen_f(path, H5F_ACC_RDONLY_F, file%id, error)
       if (error /= 0) then
          call set_error(status, code, path//": not a readable HDF5 file (missing, truncated or corrupted)")
          file%id = -1
       end if
    end subroutine h5_open
-
-   !> Whether h5_open tests a file's strings in a child process first (default on; off
-   !> in femcod-mpi, whose ranks must not fork).
-   subroutine h5_set_probe(enabled)
-      logical, intent(in) :: enabled
-      probe_enabled = enabled
-   end subroutine h5_set_probe
 
    !> The test read of h5_open, in the child: every string attribute femcod reads (the
    !> deck's, the checkpoint's and a result set's), through h5_read_string_attribute's own
