@@ -195,7 +195,7 @@ contains
       call degenerate_family(rows)
       call add_lines(b, "", "## Degenerate inputs", "", &
          "A flat surface, one peak pixel, two equal peaks, heights within 1e-300, 1e-12 nm and a peak of", &
-         "1e6 nm, a tilted plane, loads of 1e-300 and 1e300 nN, moduli times 1e-6 and 1e6 (16 x 16 pixels of", &
+         "1e6 nm, a tilted plane, loads of 1e-300 and 1e300 nN, moduli times 1e-6 and 1e6 (8 x 8 pixels of", &
          "1 nm on a rigid flat, E = 200 GPa, nu = 0.25, unless named). Each answer is the relative error of", &
          "the approach against the reference named (the dense solve of test/oracles with the contact set", &
          "the analysis gives, a closed form, or an invariance), within the bound the `stability` suite", &
