@@ -313,15 +313,15 @@ contains
          call refuse_options(parsed, "verification", "", status)
          if (status%code == 0 .and. verification /= "all" .and. .not. any(VERIFICATION_DECKS == verification)) &
             call set_error(status, STATUS_USAGE, "--verification: no deck named '"//verification//"' (names: "// &
-               verification_names()//", or all)")
+               comma_list(VERIFICATION_DECKS)//", or all)")
          return
       end if
       if (spec%kind == "") then
-         call set_error(status, STATUS_USAGE, "no KIND given (one of: "//kinds_list()//")")
+         call set_error(status, STATUS_USAGE, "no KIND given (one of: "//comma_list(KINDS)//")")
          return
       end if
       if (.not. any(KINDS == spec%kind)) then
-         call set_error(status, STATUS_USAGE, "unknown KIND '"//spec%kind//"' (one of: "//kinds_list()//")")
+         call set_error(status, STATUS_USAGE, "unknown KIND '"//spec%kind//"' (one of: "//comma_list(KINDS)//")")
          return
       end if
       call refuse_options(parsed, "kind|"//spec%kind, "verification=to --verification", status)
@@ -538,22 +538,14 @@ contains
       write(output_unit, '(a)') "wrote "//output
    end subroutine verify_command
 
-   !> The names of the verification decks, comma-separated.
-   function verification_names() result(text)
+   !> `names` without their blanks, comma-separated (the kinds, the verification decks).
+   pure function comma_list(names) result(text)
+      character(len=*), intent(in) :: names(:)
       character(len=:), allocatable :: text
       integer :: k
-      text = trim(VERIFICATION_DECKS(1))
-      do k = 2, size(VERIFICATION_DECKS)
-         text = text//", "//trim(VERIFICATION_DECKS(k))
+      text = trim(names(1))
+      do k = 2, size(names)
+         text = text//", "//trim(names(k))
       end do
-   end function verification_names
-
-   function kinds_list() result(s)
-      character(len=:), allocatable :: s
-      integer :: k
-      s = trim(KINDS(1))
-      do k = 2, size(KINDS)
-         s = s//", "//trim(KINDS(k))
-      end do
-   end function kinds_list
+   end function comma_list
 end module femcod_cli
