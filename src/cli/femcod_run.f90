@@ -38,7 +38,7 @@ module femcod_run
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_output_guard, only: guard_outputs, OUTPUT_WISDOM, OUTPUT_RESULT
    use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, pressure_figure_wanted, &
-      HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, PATCH_COLUMNS
+      FIGURES_AUTO_LIMIT, HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, PATCH_COLUMNS
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
@@ -123,7 +123,8 @@ contains
             mode="cg|incremental"), &
          flag_option("--quiet", "no summary on standard output, no progress lines on standard error", alias="-q"), &
          choice_option("--figures", "auto|all|last|none", "which states get a pressure figure PREFIX.pressure_<k>.svg "// &
-            "(default auto: every state up to 20 asked, beyond that the last reached one only; the maps are in "// &
+            "(default auto: every state up to "// &
+            int_str(FIGURES_AUTO_LIMIT)//" asked, beyond that the last reached one only; the maps are in "// &
             "PREFIX.h5 either way)"), &
          flag_option("--force", "replace existing results as a whole set, and a checkpoint of an interrupted run "// &
             "(otherwise both are kept and the deck fails with exit code 5 before it is solved); an input file is "// &
