@@ -202,7 +202,7 @@ contains
       real(dp), allocatable :: targets(:)
       integer, allocatable :: order(:)
       real(dp) :: tstart, t0, t1
-      integer :: k, kk, m, i
+      integer :: k, kk, m
       logical :: by_approach, by_gaps
       call wall_clock(tstart)
       ! Displacement control (--approach): the targets are approaches, the loads the answers.
@@ -255,15 +255,8 @@ contains
             t1 - t0)
          if (kk > 1 .and. by_gaps) call mark_jump(res%states(order(kk - 1))%contacts, res%states(k))
          call observer%progress(kk, res%states(k)%contacts, res%states(k)%load, t1 - tstart)
-         if ((by_gaps .and. kk == m) .or. (.not. by_gaps .and. targets(k) == maxval(targets))) then
-            associate(st => res%states(k))
-               res%contact_i = st%i
-               res%contact_j = st%j
-               res%contact_step = [(kk, i = 1, st%contacts)]
-               res%contact_force = st%force
-               res%reported_load = st%load
-            end associate
-         end if
+         if ((by_gaps .and. kk == m) .or. (.not. by_gaps .and. targets(k) == maxval(targets))) &
+            call report_state(res, res%states(k), kk)
       end do
       call grid_operator_free(fine)
       allocate(res%diagnostics, source=work)
@@ -272,15 +265,7 @@ contains
          ! A stop signal between two targets: the states solved are kept (the caller
          ! writes them as a partial run), the last of them reported in full.
          res%stop_reason = STOP_INTERRUPTED
-         if (.not. allocated(res%contact_i)) then
-            associate(st => res%states(order(kk - 1)))
-               res%contact_i = st%i
-               res%contact_j = st%j
-               res%contact_step = [(kk - 1, i = 1, st%contacts)]
-               res%contact_force = st%force
-               res%reported_load = st%load
-            end associate
-         end if
+         if (.not. allocated(res%contact_i)) call report_state(res, res%states(order(kk - 1)), kk - 1)
       end if
       call wall_clock(t1)
       res%wall_seconds = t1 - tstart
@@ -293,6 +278,19 @@ contains
          end if
       end do
    end subroutine solve_cg
+
+   !> The state reported in full (the contact list of the result): `st`, solved as the
+   !> `solved`-th target.
+   subroutine report_state(res, st, solved)
+      type(contact_result), intent(inout) :: res
+      type(load_state), intent(in) :: st
+      integer, intent(in) :: solved
+      res%contact_i = st%i
+      res%contact_j = st%j
+      res%contact_step = spread(solved, 1, st%contacts)
+      res%contact_force = st%force
+      res%reported_load = st%load
+   end subroutine report_state
 
    !> The message of a target whose residual stayed above --tol.
    function unconverged_message(by_approach, by_gaps, target, residual, iterations, tol) result(message)
