@@ -15,4 +15,8 @@ from ._topography import from_topography
 
 __all__ = ["solve", "load", "read_deck", "read_heights", "write_deck", "read_table", "from_topography", "set_threads", "version",
            "Deck", "Result", "State", "FemcodError", "Stopped"]
-__version__ = "0.1.0"
+try:
+    from importlib.metadata import PackageNotFoundError, version as _distribution_version
+    __version__ = _distribution_version("femcod")  # from fpm.toml at build time (python/setup.py)
+except PackageNotFoundError:  # run from the source tree, not installed
+    __version__ = version()

@@ -38,11 +38,16 @@ def _blas_environment():
 
 
 def library_path():
-    """Where libfemcod.so is: $FEMCOD_LIBRARY; else beside the installed femcod program
-    (PREFIX/lib next to PREFIX/bin/femcod, where setup.sh puts both); else the loader's."""
+    """Where libfemcod.so is: $FEMCOD_LIBRARY; else the wheel's own (femcod/_native/lib, with
+    the libraries it needs beside the package in femcod.libs); else beside the installed
+    femcod program (PREFIX/lib next to PREFIX/bin/femcod, where setup.sh puts both); else
+    the loader's."""
     given = os.environ.get("FEMCOD_LIBRARY")
     if given:
         return given
+    bundled = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_native", "lib", "libfemcod.so")
+    if os.path.exists(bundled):
+        return bundled
     program = shutil.which("femcod")
     if program:
         candidate = os.path.join(os.path.dirname(os.path.realpath(program)), os.pardir, "lib", "libfemcod.so")

@@ -18,7 +18,8 @@ from conftest import REPO, library_dirs
 def test_c_example_compiles_runs_and_gives_hertz(tmp_path):
     cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
-        pytest.fail("no C compiler (setup.sh installs gfortran, which brings gcc)")
+        # setup.sh installs gfortran, which brings gcc; a machine with only the wheel may have none.
+        pytest.skip("no C compiler on this machine")
     lib, include = library_dirs()
     exe = tmp_path / "example"
     subprocess.run([cc, os.path.join(REPO, "doc", "femcod_example.c"), f"-I{include}", f"-L{lib}", "-lfemcod",
