@@ -1,14 +1,20 @@
 #!/usr/bin/env bash
-# femcod set-up for a fresh Debian 12 machine (reaches Debian's packages and PyPI).
-# Installs only what is missing, builds femcod, installs it onto PATH and runs the main
+# femcod set-up: installs only what is missing, builds femcod, installs it and runs the main
 # job on the default deck. Idempotent and quiet: a re-run that finds everything installed
-# spends its time in the build check and the run only.
+# spends its time in the build check and the run only. Two ways to find what it needs:
+# - Debian with root (or sudo without a password): the missing Debian packages are installed;
+# - otherwise (a cluster: no root, libraries from `module load`): nothing is installed; the
+#   compilers on PATH and the libraries pkg-config, $HDF5_ROOT, $FFTW_ROOT, $OPENBLAS_ROOT
+#   (or _DIR, _HOME, EBROOT...) and the library paths show are used, and what is missing is
+#   named with the module or package to look for (doc/cluster.md, "Building on a cluster").
 #   bash setup.sh                 install + build + install femcod + run input/sphere_d1.deck
 #   bash setup.sh --no-run        the same without the run (CI)
 #   bash setup.sh --prefix DIR    install femcod into DIR/bin (default: /usr/local as root,
 #                                 ~/.local otherwise)
-#   bash setup.sh --mpi           also OpenMPI, FFTW-MPI and the OpenMPI HDF5, and femcod-mpi
-#                                 (mpi/, doc/cluster.md) next to femcod; tests: bash mpi/test.sh
+#   bash setup.sh --modules       use the environment's compilers and libraries even as root
+#   bash setup.sh --mpi           also femcod-mpi (mpi/, doc/cluster.md) next to femcod, with
+#                                 OpenMPI, FFTW-MPI and the OpenMPI HDF5 (Debian) or the
+#                                 mpifort, FFTW-MPI and parallel HDF5 found; tests: bash mpi/test.sh
 #   bash setup.sh --python        also the Python package (python/, doc/python.md) in its own
 #                                 virtual environment PREFIX/lib/femcod-python, with numpy, h5py, xarray,
 #                                 matplotlib and pytest; its interpreter is PREFIX/bin/femcod-python
@@ -22,43 +28,28 @@ cd "$(dirname "$0")"
 run_main=1
 mpi=0
 python=0
+modules=0
 if [ "$(id -u)" -eq 0 ]; then prefix=/usr/local; else prefix="$HOME/.local"; fi
 while [ $# -gt 0 ]; do
   case "$1" in
     --no-run) run_main=0; shift ;;
     --mpi) mpi=1; shift ;;
     --python) python=1; shift ;;
+    --modules) modules=1; shift ;;
     --prefix) [ $# -ge 2 ] || { echo "setup: --prefix needs a directory" >&2; exit 2; }; prefix=$2; shift 2 ;;
-    -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "setup: unknown argument $1 (setup.sh --help)" >&2; exit 2 ;;
   esac
 done
 mkdir -p "$prefix/bin"
 prefix=$(cd "$prefix" && pwd)
 
-sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
-
-debian_packages=(gfortran liblapack-dev libopenblas-dev libhdf5-dev libfftw3-dev pkg-config hdf5-tools zlib1g-dev libssl-dev
-  python3-venv)
-if [ "$mpi" -eq 1 ]; then debian_packages+=(libopenmpi-dev openmpi-bin libfftw3-mpi-dev libhdf5-openmpi-dev); fi
-missing=()
-for p in "${debian_packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "setup: installing Debian packages: ${missing[*]}"
-  export DEBIAN_FRONTEND=noninteractive
-  sudo_if_needed apt-get update -qq >/dev/null
-  sudo_if_needed apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
-
-# The serial build takes HDF5 from pkg-config's hdf5.pc. Installing libhdf5-openmpi-dev
-# switches that alternative to the MPI HDF5, which the serial build would then pick up
-# silently: point it back at the serial one (femcod-mpi finds its own, mpi/environment.sh).
-pc_dir=$(pkg-config --variable=pcfiledir hdf5-serial)
-if [ -e "$pc_dir/hdf5.pc" ] && [ "$(readlink -f "$pc_dir/hdf5.pc")" != "$(readlink -f "$pc_dir/hdf5-serial.pc")" ]; then
-  sudo_if_needed update-alternatives --set hdf5.pc "$pc_dir/hdf5-serial.pc" >/dev/null
-  echo "setup: hdf5.pc pointed at $(readlink -f "$pc_dir/hdf5.pc"); set back to the serial HDF5"
+# Debian packages when this user may install them; the environment's libraries otherwise.
+if [ "$modules" -eq 0 ] && command -v dpkg-query >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1 &&
+   { [ "$(id -u)" -eq 0 ] || sudo -n true 2>/dev/null; }; then
+  source ./packaging/debian.sh
+else
+  source ./packaging/environment.sh
 fi
 
 if ! command -v fpm >/dev/null 2>&1; then
@@ -79,10 +70,10 @@ fpm install --profile release --prefix "$prefix" --includedir include/femcod >/d
 # link makes the shared library of it, with the libraries fpm.toml links (written to a
 # temporary name, then renamed, so a program using the old one keeps it).
 if [ ! "$prefix/lib/libfemcod.so" -nt "$prefix/lib/libfemcod.a" ]; then
-  link_libraries=$(python3 -c 'import tomllib; print(" ".join("-l" + l for l in tomllib.load(open("fpm.toml", "rb"))["build"]["link"]))')
+  link_libraries=$(sed -n 's/^link *= *\[\(.*\)\]/\1/p' fpm.toml | tr -d '"' | tr ',' '\n' | sed 's/^ */-l/' | tr '\n' ' ')
   # shellcheck disable=SC2046,SC2086
-  gfortran -shared -o "$prefix/lib/libfemcod.so.tmp" -Wl,--whole-archive "$prefix/lib/libfemcod.a" \
-    -Wl,--no-whole-archive $(pkg-config --libs hdf5) -lhdf5_fortran $link_libraries -fopenmp ||
+  "${FPM_FC:-gfortran}" -shared -o "$prefix/lib/libfemcod.so.tmp" -Wl,--whole-archive "$prefix/lib/libfemcod.a" \
+    -Wl,--no-whole-archive ${FPM_LDFLAGS:-} $(pkg-config --libs hdf5) -lhdf5_fortran $link_libraries -fopenmp ||
     { echo "setup: linking libfemcod.so failed" >&2; exit 1; }
   mv -f "$prefix/lib/libfemcod.so.tmp" "$prefix/lib/libfemcod.so"
   if [ "$(id -u)" -eq 0 ]; then ldconfig; fi
