@@ -18,6 +18,9 @@
 #   bash setup.sh --python        also the Python package (python/, doc/python.md) in its own
 #                                 virtual environment PREFIX/lib/femcod-python, with numpy, h5py, xarray,
 #                                 matplotlib and pytest; its interpreter is PREFIX/bin/femcod-python
+#   bash setup.sh --wheel         build dist/femcod-VERSION-py3-none-manylinux_*.whl: the Python
+#                                 package with the femcod program, libfemcod.so and the shared
+#                                 libraries they need inside (doc/install.md); installs nothing
 # Every set-up also installs the C library: PREFIX/lib/libfemcod.so, PREFIX/include/femcod.h
 # (and the Fortran modules in PREFIX/include/femcod).
 # fpm comes from PyPI into its own virtual environment (Debian's pip refuses system
@@ -28,6 +31,7 @@ cd "$(dirname "$0")"
 run_main=1
 mpi=0
 python=0
+wheel=0
 modules=0
 if [ "$(id -u)" -eq 0 ]; then prefix=/usr/local; else prefix="$HOME/.local"; fi
 while [ $# -gt 0 ]; do
@@ -35,12 +39,16 @@ while [ $# -gt 0 ]; do
     --no-run) run_main=0; shift ;;
     --mpi) mpi=1; shift ;;
     --python) python=1; shift ;;
+    --wheel) wheel=1; shift ;;
     --modules) modules=1; shift ;;
     --prefix) [ $# -ge 2 ] || { echo "setup: --prefix needs a directory" >&2; exit 2; }; prefix=$2; shift 2 ;;
-    -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "setup: unknown argument $1 (setup.sh --help)" >&2; exit 2 ;;
   esac
 done
+if [ "$wheel" -eq 1 ] && { [ "$mpi" -eq 1 ] || [ "$python" -eq 1 ]; }; then
+  echo "setup: --wheel builds the wheel only; run it on its own (then pip install dist/femcod-*.whl)" >&2; exit 2
+fi
 mkdir -p "$prefix/bin"
 prefix=$(cd "$prefix" && pwd)
 
@@ -61,6 +69,12 @@ if ! command -v fpm >/dev/null 2>&1; then
   ln -sf "$fpm_bin" "$prefix/bin/fpm"
   export PATH="$prefix/bin:$PATH"
 fi
+if [ "$wheel" -eq 1 ]; then
+  run_main=0
+  prefix="$PWD/build/wheel/stage"
+  rm -rf build/wheel
+  mkdir -p "$prefix/bin"
+fi
 
 fpm build --profile release >/dev/null 2>build.log || { cat build.log >&2; exit 1; }
 rm -f build.log
@@ -76,15 +90,15 @@ if [ ! "$prefix/lib/libfemcod.so" -nt "$prefix/lib/libfemcod.a" ]; then
     -Wl,--no-whole-archive ${FPM_LDFLAGS:-} $(pkg-config --libs hdf5) -lhdf5_fortran $link_libraries -fopenmp ||
     { echo "setup: linking libfemcod.so failed" >&2; exit 1; }
   mv -f "$prefix/lib/libfemcod.so.tmp" "$prefix/lib/libfemcod.so"
-  if [ "$(id -u)" -eq 0 ]; then ldconfig; fi
+  if [ "$(id -u)" -eq 0 ] && [ "$wheel" -eq 0 ]; then ldconfig; fi
 fi
 mkdir -p "$prefix/include"
 cmp -s src/capi/femcod.h "$prefix/include/femcod.h" || cp src/capi/femcod.h "$prefix/include/femcod.h"
 # What the installed benchmarks need besides the program: the peers' script (--peers).
 mkdir -p "$prefix/share/femcod"
 cmp -s app/femcod_peers.py "$prefix/share/femcod/femcod_peers.py" || cp app/femcod_peers.py "$prefix/share/femcod/"
-case ":$(printenv PATH):" in
-  *":$prefix/bin:"*) ;;
+case ":$(printenv PATH):$wheel" in
+  *":$prefix/bin:"*|*:1) ;;
   *) echo "setup: femcod is installed in $prefix/bin; add it to PATH (export PATH=\"$prefix/bin:\$PATH\")" ;;
 esac
 if [ "$mpi" -eq 1 ]; then
@@ -107,4 +121,7 @@ fi
 if [ "$run_main" -eq 1 ]; then
   mkdir -p out
   "$prefix/bin/femcod" run input/sphere_d1.deck -o out/sphere_d1 --loads 100,1000,5000 --force
+fi
+if [ "$wheel" -eq 1 ]; then
+  bash packaging/wheel.sh "$prefix"
 fi
