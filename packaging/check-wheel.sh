@@ -41,6 +41,8 @@ echo "== pip install of $(basename "$wheel") with its dependencies: $(( $(date +
 as_user 'export PATH=$HOME/env/bin:$PATH && id -un && command -v femcod && femcod --version && cd femcod &&
   femcod run input/sphere_d1.deck -o out/sphere_d1 --loads 100,1000,5000 --force | tail -4 &&
   python -c "import femcod; print(\"import femcod:\", femcod.__version__, femcod._library.library_path())"'
+as_user 'cd femcod && FEMCOD_ENV=$HOME/env OUTDIR=$HOME/job bash doc/cluster/wheel.sbatch input/sphere_d2.deck --loads 100,500 &&
+  ls $HOME/job && echo "== doc/cluster/wheel.sbatch: results written"'
 start=$(date +%s)
 as_user 'export PATH=$HOME/env/bin:$PATH && cd femcod && python -m pytest -q -p no:cacheprovider python/tests 2>&1 | tail -4'
 echo "== pytest: $(( $(date +%s) - start )) s"
