@@ -163,7 +163,7 @@ export FPM_FC=$fpm_fc FPM_CC=${FPM_CC:-gcc}
 export FPM_FFLAGS="${FPM_FFLAGS:-}$flags_I" FPM_CFLAGS="${FPM_CFLAGS:-}$flags_I" FPM_LDFLAGS="${FPM_LDFLAGS:-}$flags_L"
 mkdir -p build
 {
-  echo "# written by setup.sh: the environment femcod was built in; source it before fpm test"
+  echo "# written by setup.sh: the environment femcod was built in; source it, then fpm test --profile debug"
   for v in FPM_FC FPM_CC FPM_FFLAGS FPM_CFLAGS FPM_LDFLAGS PKG_CONFIG_PATH; do printf 'export %s=%q\n' "$v" "${!v:-}"; done
 } > build/environment.sh
-echo "setup: build flags in build/environment.sh (source it before fpm test)"
+echo "setup: build flags in build/environment.sh (source it, then fpm test --profile debug)"

@@ -3,8 +3,11 @@ C library, the Python distribution (python/setup.py reads fpm.toml), femcod-mpi'
 and a result set's /run femcod_version all say the same."""
 import os
 import re
+import shutil
+import subprocess
 
 import h5py
+import pytest
 
 import femcod
 from conftest import REPO, run_femcod
@@ -34,3 +37,14 @@ def test_changelog_names_the_version():
         assert re.search(rf"^## \[?{re.escape(expected)}\]?", f.read(), re.M)
     with open(os.path.join(REPO, "CITATION.cff")) as f:
         assert re.search(rf"^version: \"?{re.escape(expected)}\"?$", f.read(), re.M)
+
+
+def test_source_tarball_holds_no_build_output():
+    """`git archive HEAD` is the source tarball: nothing generated is tracked (the build
+    directories, objects, modules, wheels, Python build files)."""
+    if shutil.which("git") is None or not os.path.isdir(os.path.join(REPO, ".git")):
+        pytest.skip("not a git checkout (a source tarball or the wheel's check)")
+    tracked = subprocess.run(["git", "ls-files"], cwd=REPO, capture_output=True, text=True, check=True).stdout.split()
+    generated = re.compile(r"(^|/)(build|dist|__pycache__|\.pytest_cache)/|\.(o|mod|smod|a|so|whl|pyc)$|\.egg-info/")
+    assert [f for f in tracked if generated.search(f)] == []
+    assert len(tracked) > 100
