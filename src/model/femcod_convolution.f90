@@ -53,7 +53,7 @@ module femcod_convolution
       inverse_kernel_taps
    public :: gap_transform, gap_transform_setup, gap_transform_apply, gap_transform_free, SPECTRUM_COMPLIANCE, &
       SPECTRUM_STIFFNESS
-   public :: inverse_half_spectrum, inverse_complex_transform, line_transform, line_transform_setup, &
+   public :: inverse_half_spectrum, inverse_complex_transform, forward_complex_transform, line_transform, line_transform_setup, &
       line_transform_apply, line_transform_free
    public :: shear_transform, shear_transform_setup, shear_transform_setup_periodic, shear_transform_apply, &
       shear_transform_free
@@ -813,6 +813,16 @@ contains
       call fftw_execute_dft(plan, spectrum, field)
       call fftw_destroy_plan(plan)
    end subroutine inverse_complex_transform
+
+   !> a = the forward (unnormalised) complex 2-D transform of `a`, in place, planned on the
+   !> caller's array (FFTW_ESTIMATE does not write it while planning).
+   subroutine forward_complex_transform(a)
+      complex(c_double_complex), intent(inout), target, contiguous :: a(:, :)
+      type(c_ptr) :: plan
+      plan = fftw_plan_dft_2d(int(size(a, 2), c_int), int(size(a, 1), c_int), a, a, FFTW_FORWARD, FFTW_ESTIMATE)
+      call fftw_execute_dft(plan, a, a)
+      call fftw_destroy_plan(plan)
+   end subroutine forward_complex_transform
 
    !> The plan of r2c transforms of `line` (n real values) into `spectrum` (n/2 + 1).
    subroutine line_transform_setup(t, line, spectrum)

@@ -27,12 +27,12 @@
 !>   fit's power law beyond;
 !> - Richardson's extrapolation of section 4.5 from solves at d, 2d and 4d.
 module femcod_refine
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_double_complex, c_int
+   use, intrinsic :: iso_c_binding, only: c_double_complex
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
    use femcod_strings, only: int_str, sig_str
-   use femcod_fftw, only: fftw_plan_dft_2d, fftw_execute_dft, fftw_destroy_plan, FFTW_FORWARD, FFTW_ESTIMATE
+   use femcod_convolution, only: forward_complex_transform
    implicit none
    private
    public :: surface_spectrum_of, fit_spectrum, subpixel_slope_variance, refined_fraction, persson_fraction, &
@@ -71,7 +71,6 @@ contains
       complex(c_double_complex), allocatable :: a(:, :)
       real(dp), allocatable :: sums(:)
       integer, allocatable :: counts(:)
-      type(c_ptr) :: plan
       integer :: n, i, j, ki, kj, b, bins
       real(dp) :: dq, qq, q_l, q_d, power
       n = size(z, 1)
@@ -82,9 +81,7 @@ contains
       q_d = PI/d
       allocate(a(n, n))
       a = cmplx(z - sum(z)/size(z), 0, kind=c_double_complex)
-      plan = fftw_plan_dft_2d(int(n, c_int), int(n, c_int), a, a, FFTW_FORWARD, FFTW_ESTIMATE)
-      call fftw_execute_dft(plan, a, a)
-      call fftw_destroy_plan(plan)
+      call forward_complex_transform(a)
       bins = max(1, ceiling(8*log(q_d/q_l)/log(2.0_dp)))
       allocate(sums(bins), counts(bins))
       sums = 0
