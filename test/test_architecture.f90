@@ -33,9 +33,48 @@ contains
          new_unittest("every use points to the same layer or one below", test_layers), &
          new_unittest("no module-level save variables, no stop in src/", test_no_state), &
          new_unittest("no routine longer than 150 lines in src/, mpi/, app/ (but the listed)", test_routine_length), &
-         new_unittest("the numerical layers (model, legacy, solvers) do no I/O", test_numerical_no_io) &
+         new_unittest("the numerical layers (model, legacy, solvers) do no I/O", test_numerical_no_io), &
+         new_unittest("doc/architecture.md names every module in its layer, and no other", test_module_table) &
          ]
    end subroutine collect_architecture
+
+   !> doc/architecture.md's table of modules: a row `| LAYER | `NAME` | ... |` for every
+   !> module of src/ and mpi/src/, in its folder's layer, and no row for a module that
+   !> does not exist.
+   subroutine test_module_table(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(string_type), allocatable :: files(:), mods(:), names(:)
+      character(len=:), allocatable :: doc, line, name
+      integer :: f, m, start, k, a, b
+      doc = read_text("doc/architecture.md")
+      files = sources()
+      allocate(names(0))
+      do f = 1, size(files)
+         call statements(read_text(files(f)%s), "module", mods)
+         do m = 1, size(mods)
+            names = [names, mods(m)]
+            call check(error, index(doc, "| "//trim(LAYERS(layer_of(files(f)%s)))//" | `"//mods(m)%s//"` |") > 0, &
+               "doc/architecture.md has no row for "//mods(m)%s//" in layer "//trim(LAYERS(layer_of(files(f)%s))))
+            if (allocated(error)) return
+         end do
+      end do
+      call check(error, size(names) > 80, "the modules are found ("//to_string(size(names))//")")
+      if (allocated(error)) return
+      start = 1
+      do k = 1, len(doc)
+         if (doc(k:k) /= new_line("a")) cycle
+         line = doc(start:k - 1)
+         start = k + 1
+         a = index(line, " | `femcod_")
+         if (index(line, "| ") /= 1 .or. a == 0) cycle
+         b = index(line(a + 4:), "`")
+         if (b == 0) cycle
+         name = line(a + 4:a + 2 + b)
+         call check(error, any([(names(m)%s == name, m = 1, size(names))]), &
+            "doc/architecture.md names "//name//", which no source defines")
+         if (allocated(error)) return
+      end do
+   end subroutine test_module_table
 
    !> The source files under src/ and mpi/src/ (one per line), from `find`; with
    !> `programs`, those of app/ and mpi/app/ too.
