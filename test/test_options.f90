@@ -13,7 +13,7 @@ module test_options
    use femcod_generate, only: scene_spec
    use test_support, only: scratch_path, read_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
-   use femcod_solver_options, only: SOLVER_CG
+   use femcod_solver_options, only: SOLVER_CG, OPTION_NAMES, OPTION_KEYS, IN_HISTORY, contact_options, history_options
    implicit none
    private
    public :: collect_options
@@ -27,6 +27,7 @@ contains
          new_unittest("ranges, choices, lists and missing values are refused with their expectation", test_refused), &
          new_unittest("an option outside its mode is refused", test_modes), &
          new_unittest("run: the arguments land in the solver options", test_run_settings), &
+         new_unittest("run: every row of the solver's option table is in run's table and history", test_option_keys), &
          new_unittest("run: scene options with a deck, cg options with another solver: exit 2", test_run_refusals), &
          new_unittest("mkdeck: a kind's options with another kind: exit 2", test_mkdeck), &
          new_unittest("help lists every option of a table", test_help) &
@@ -182,6 +183,36 @@ contains
       call check(error, settings%solve%event_search == "fft" .and. settings%solve%checkpoint_interval == 0, &
          "incremental options")
    end subroutine test_run_settings
+
+   !> The solver's option table (model/femcod_solver_options' OPTION_NAMES and OPTION_KEYS,
+   !> from which run's settings, history_options and the libraries' accepted names come):
+   !> each name is an option of `femcod run`, each key in the history a field of
+   !> history_options, once.
+   subroutine test_option_keys(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(option_spec), allocatable :: table(:)
+      type(contact_options) :: defaults
+      character(len=:), allocatable :: history
+      integer :: k, m
+      table = run_table()
+      history = "; "//history_options(defaults)
+      call check(error, size(OPTION_NAMES) == size(OPTION_KEYS) .and. size(OPTION_KEYS) == size(IN_HISTORY), &
+         "one key and one history flag per name")
+      if (allocated(error)) return
+      do k = 1, size(OPTION_NAMES)
+         if (len_trim(OPTION_NAMES(k)) > 0) then
+            call check(error, any([(table(m)%name == trim(OPTION_NAMES(k)), m = 1, size(table))]), &
+               trim(OPTION_NAMES(k))//" is an option of femcod run")
+            if (allocated(error)) return
+         end if
+         if (IN_HISTORY(k)) then
+            m = index(history, "; "//trim(OPTION_KEYS(k))//"=")
+            call check(error, m > 0 .and. index(history(m + 1:), "; "//trim(OPTION_KEYS(k))//"=") == 0, &
+               trim(OPTION_KEYS(k))//" is one field of history_options: "//history)
+            if (allocated(error)) return
+         end if
+      end do
+   end subroutine test_option_keys
 
    !> An option that does not apply to the run is a usage error (exit 2), never accepted
    !> and ignored: scene options with a deck, each solver's own with another solver.

@@ -13,7 +13,7 @@ module femcod_library_session
    use femcod_memory, only: available_memory
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result, cg_work, cg_state_diagnostics
-   use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL
+   use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, OPTION_NAMES, IN_HISTORY
    use femcod_shear_model, only: friction_coefficient
    use femcod_observer, only: solver_observer
    use femcod_solver, only: solve_contact, run_warnings
@@ -23,15 +23,8 @@ module femcod_library_session
    implicit none
    private
    public :: library_session, solve_session, state_value, state_value_names, map_of, map_names, history_column, &
-      HISTORY_COLUMNS, LIBRARY_OPTIONS
+      HISTORY_COLUMNS, library_options
 
-   !> `femcod run`'s options that a library call takes: the solver's. The others name
-   !> files, the run's printing or its checkpoints, or build the scene from files (the
-   !> library's caller gives the arrays).
-   character(len=*), parameter :: LIBRARY_OPTIONS(*) = [character(len=20) :: "--solver", "--loads", "--approach", &
-      "--hardness", "--boundary", "--plastic", "--max-contacts", "--no-final-check", "--event-search", "--tol", &
-      "--max-iterations", "--kernel-radius", "--adhesion", "--work", "--range", "--shear-strength", &
-      "--shear-slope", "--tangential", "--slip", "--friction"]
    !> The history's columns (femcod_history).
    character(len=*), parameter :: HISTORY_COLUMNS = "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,"// &
       "n_above_hardness"
@@ -134,7 +127,7 @@ contains
       end do
    end subroutine solve_session
 
-   !> Refuse run's options that are not the solver's (LIBRARY_OPTIONS), with the reason,
+   !> Refuse run's options that are not the solver's (library_options), with the reason,
    !> and a value given where none belongs (a flag's "value": a stray argument). The
    !> arguments are parsed by run's own parser, which reports unknown options itself.
    subroutine refuse_file_options(args, st)
@@ -145,10 +138,10 @@ contains
       call parse_options(run_table(), args, parsed, st)
       if (st%code /= 0) return
       do k = 1, size(parsed%table)
-         if (parsed%given(k) .and. .not. any(LIBRARY_OPTIONS == parsed%table(k)%name)) then
+         if (parsed%given(k) .and. index(" "//library_options()//" ", " "//parsed%table(k)%name//" ") == 0) then
             call set_error(st, STATUS_USAGE, parsed%table(k)%name//" is an option of the femcod command, not of the "// &
                "library: the caller gives the arrays and keeps the results (library options: "// &
-               joined_options()//")")
+               library_options()//")")
             return
          end if
       end do
@@ -156,14 +149,19 @@ contains
          "' follows no option that takes a value (a flag such as --plastic takes none)")
    end subroutine refuse_file_options
 
-   function joined_options() result(text)
+   !> `femcod run`'s options that a library call takes, separated by spaces: those that
+   !> shape the answer (IN_HISTORY). The others name files, the run's printing or its
+   !> checkpoints, or build the scene from files (the library's caller gives the arrays).
+   function library_options() result(text)
       character(len=:), allocatable :: text
       integer :: k
-      text = trim(LIBRARY_OPTIONS(1))
-      do k = 2, size(LIBRARY_OPTIONS)
-         text = text//" "//trim(LIBRARY_OPTIONS(k))
+      text = ""
+      do k = 1, size(OPTION_NAMES)
+         if (len_trim(OPTION_NAMES(k)) == 0 .or. .not. IN_HISTORY(k)) cycle
+         if (len(text) > 0) text = text//" "
+         text = text//trim(OPTION_NAMES(k))
       end do
-   end function joined_options
+   end function library_options
 
    !> The names of the state values the last solve has (comma-separated).
    function state_value_names(session) result(names)

@@ -25,7 +25,7 @@ module femcod_run
    use femcod_contact_result, only: contact_result, load_state, stop_reason_text, STOP_INTERRUPTED, cg_state_diagnostics, cg_work
    use femcod_solver_options, only: contact_options, requested_states, validate_options, history_options, &
       SOLVER_LEGACY, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, solver_name, boundary_name, law_name, &
-      solver_from_name, boundary_from_name, law_from_name, run_shear_model
+      run_shear_model, OPTION_NAMES, option_field
    use femcod_shear_model, only: shear_model, friction_coefficient
    use femcod_cerruti, only: second_dundurs_constant
    use femcod_observer, only: solver_observer
@@ -230,32 +230,16 @@ contains
    subroutine solve_options_from(parsed, o)
       type(parsed_options), intent(in) :: parsed
       type(contact_options), intent(out) :: o
+      character(len=:), allocatable :: text
+      integer :: k
       o%checkpoint_interval = 300
       allocate(o%loads(0), o%approaches(0))
-      if (option_given(parsed, "--solver")) o%solver = solver_from_name(option_value(parsed, "--solver"))
-      call get_option(parsed, "--loads", o%loads)
-      call get_option(parsed, "--approach", o%approaches)
-      call get_option(parsed, "--max-contacts", o%max_contacts)
-      call get_option(parsed, "--hardness", o%hardness)
-      call get_option(parsed, "--plastic", o%plastic)
-      if (option_given(parsed, "--boundary")) o%boundary = boundary_from_name(option_value(parsed, "--boundary"))
-      if (option_given(parsed, "--no-final-check")) o%final_check = .false.
-      if (option_given(parsed, "--event-search")) o%event_search = option_value(parsed, "--event-search")
-      call get_option(parsed, "--checkpoint-interval", o%checkpoint_interval)
-      call get_option(parsed, "--tol", o%cg%tol)
-      call get_option(parsed, "--max-iterations", o%cg%max_iterations)
-      call get_option(parsed, "--kernel-radius", o%cg%kernel_radius)
-      if (option_given(parsed, "--adhesion")) o%adhesion = law_from_name(option_value(parsed, "--adhesion"))
-      call get_option(parsed, "--work", o%work)
-      call get_option(parsed, "--range", o%range)
-      o%shear = option_given(parsed, "--shear-strength") .or. option_given(parsed, "--shear-slope")
-      call get_option(parsed, "--shear-strength", o%shear_strength)
-      call get_option(parsed, "--shear-slope", o%shear_slope)
-      o%tangential = option_given(parsed, "--tangential") .or. option_given(parsed, "--slip")
-      o%by_slip = option_given(parsed, "--slip")
-      call get_option(parsed, "--tangential", o%tangential_load)
-      call get_option(parsed, "--slip", o%slip)
-      call get_option(parsed, "--friction", o%friction)
+      do k = 1, size(OPTION_NAMES)
+         if (len_trim(OPTION_NAMES(k)) == 0) cycle
+         if (.not. option_given(parsed, trim(OPTION_NAMES(k)))) cycle
+         text = option_value(parsed, trim(OPTION_NAMES(k)))
+         call option_field(o, k, text, .true.)
+      end do
    end subroutine solve_options_from
 
    !> The text of option `name` ("" when not given).

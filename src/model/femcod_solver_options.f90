@@ -6,7 +6,7 @@ module femcod_solver_options
    use femcod_kinds, only: dp, i8
    use femcod_memory, only: memory_text, usable_text
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL
-   use femcod_strings, only: format_real, int_str, sig_str
+   use femcod_strings, only: format_real, int_str, sig_str, parse_real, parse_integer, parse_real_list
    use femcod_interface_law, only: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
    use femcod_shear_model, only: shear_model, make_shear_model
    implicit none
@@ -16,7 +16,27 @@ module femcod_solver_options
       solver_from_name, boundary_name, boundary_from_name
    public :: LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL, law_from_name, law_name
    public :: validate_options, by_gap_variables, history_options, first_difference, tolerance_floor
+   public :: OPTION_NAMES, OPTION_KEYS, IN_HISTORY, option_field
    public :: refuse_beyond_memory, run_shear_model
+
+   !> The options of a run, one row each: OPTION_NAMES(k), the option's name on `femcod
+   !> run`'s command line ("" for a field that follows from others: shear, tangential and
+   !> by_slip are set with their groups' options; tie_tolerance has none); OPTION_KEYS(k),
+   !> its field's name; IN_HISTORY(k), whether it shapes the answer (history_options
+   !> writes those fields, in this order; the C and Python libraries take those options).
+   !> option_field reads and sets each field. A new solver option is its field in
+   !> contact_options, a row here, a case in option_field, and its help row in femcod
+   !> run's table; run's settings, the history, the checkpoint's record, the fingerprint
+   !> and the libraries' names follow.
+   character(len=*), parameter :: OPTION_NAMES(*) = [character(len=21) :: "--solver", "--boundary", "--loads", &
+      "--approach", "--max-contacts", "--plastic", "--hardness", "--adhesion", "--work", "--range", "", &
+      "--no-final-check", "--event-search", "--tol", "--max-iterations", "--kernel-radius", "", "--shear-strength", &
+      "--shear-slope", "", "", "--friction", "--tangential", "--slip", "--checkpoint-interval"]
+   character(len=*), parameter :: OPTION_KEYS(*) = [character(len=19) :: "solver", "boundary", "loads", &
+      "approaches", "max_contacts", "plastic", "hardness", "adhesion", "work", "range", "tie_tolerance", &
+      "final_check", "event_search", "tol", "max_iterations", "kernel_radius", "shear", "shear_strength", &
+      "shear_slope", "tangential", "by_slip", "friction", "tangential_load", "slip", "checkpoint_interval"]
+   logical, parameter :: IN_HISTORY(*) = [spread(.true., 1, 24), .false.]
 
    !> The solvers: the event-exact incremental solver, the Appendix B program, and the
    !> fixed-load constrained conjugate gradients. An enumeration, with the names the
@@ -287,39 +307,111 @@ contains
          call set_error(status, STATUS_USAGE, message)
       end subroutine refuse
    end subroutine validate_options
-   !> The options that shape a run's answer, as "name=value" fields joined by "; ", in
-   !> one fixed order: what a checkpoint stores and --restart compares whole, and what
-   !> the run's fingerprint digests (a finished run's --restart). An option that changes
-   !> the answer is one field here; progress, checkpoint and speed settings are not.
+   !> The options that shape a run's answer, as "key=value" fields joined by "; ", in the
+   !> order of OPTION_KEYS: what a checkpoint stores and --restart compares whole, and
+   !> what the run's fingerprint digests (a finished run's --restart). Progress,
+   !> checkpoint and speed settings are not in it (IN_HISTORY false).
    function history_options(options) result(text)
       type(contact_options), intent(in) :: options
-      character(len=:), allocatable :: text
-      text = "solver="//solver_name(options%solver)//"; boundary="//boundary_name(options%boundary)// &
-         "; loads="//reals(options%loads)//"; approaches="//reals(options%approaches)// &
-         "; max_contacts="//int_str(options%max_contacts)//"; plastic="//merge("T", "F", options%plastic)// &
-         "; hardness="//format_real(options%hardness)//"; adhesion="//law_name(options%adhesion)// &
-         "; work="//format_real(options%work)//"; range="//format_real(options%range)// &
-         "; tie_tolerance="//format_real(options%tie_tolerance)//"; final_check="// &
-         merge("T", "F", options%final_check)//"; event_search="//trim(options%event_search)// &
-         "; tol="//format_real(options%cg%tol)//"; max_iterations="//int_str(options%cg%max_iterations)// &
-         "; kernel_radius="//format_real(options%cg%kernel_radius)//"; shear="//merge("T", "F", options%shear)// &
-         "; shear_strength="//format_real(options%shear_strength)//"; shear_slope="//format_real(options%shear_slope)// &
-         "; tangential="//merge("T", "F", options%tangential)//"; by_slip="//merge("T", "F", options%by_slip)// &
-         "; friction="//format_real(options%friction)//"; tangential_load="//format_real(options%tangential_load)// &
-         "; slip="//format_real(options%slip)
+      character(len=:), allocatable :: text, value
+      type(contact_options) :: copy
+      integer :: k
+      text = ""
+      copy = options
+      do k = 1, size(OPTION_KEYS)
+         if (.not. IN_HISTORY(k)) cycle
+         call option_field(copy, k, value, .false.)
+         if (len(text) > 0) text = text//"; "
+         text = text//trim(OPTION_KEYS(k))//"="//value
+      end do
+   end function history_options
+
+   !> Row k of the option table: with `set`, its field set from `text` as the command line
+   !> gives it (a flag's text is ignored: given means set; the parser checked the value);
+   !> otherwise `text` the field's value as history_options writes it.
+   subroutine option_field(o, k, text, set)
+      type(contact_options), intent(inout) :: o
+      integer, intent(in) :: k
+      character(len=:), allocatable, intent(inout) :: text
+      logical, intent(in) :: set
+      logical :: ok
+      select case (trim(OPTION_KEYS(k)))
+      case ("solver"); call choice(o%solver, SOLVER_NAMES)
+      case ("boundary"); call choice(o%boundary, BOUNDARY_NAMES)
+      case ("loads"); call real_list(o%loads)
+      case ("approaches"); call real_list(o%approaches)
+      case ("max_contacts"); call whole(o%max_contacts)
+      case ("plastic"); call flag(o%plastic, .true.)
+      case ("hardness"); call real_value(o%hardness)
+      case ("adhesion")
+         if (set) o%adhesion = law_from_name(text)
+         if (.not. set) text = law_name(o%adhesion)
+      case ("work"); call real_value(o%work)
+      case ("range"); call real_value(o%range)
+      case ("tie_tolerance"); call real_value(o%tie_tolerance)
+      case ("final_check"); call flag(o%final_check, .false.)
+      case ("event_search")
+         if (set) o%event_search = text
+         if (.not. set) text = trim(o%event_search)
+      case ("tol"); call real_value(o%cg%tol)
+      case ("max_iterations"); call whole(o%cg%max_iterations)
+      case ("kernel_radius"); call real_value(o%cg%kernel_radius)
+      case ("shear"); call flag(o%shear, .true.)
+      case ("shear_strength"); call real_value(o%shear_strength, o%shear)
+      case ("shear_slope"); call real_value(o%shear_slope, o%shear)
+      case ("tangential"); call flag(o%tangential, .true.)
+      case ("by_slip"); call flag(o%by_slip, .true.)
+      case ("friction"); call real_value(o%friction)
+      case ("tangential_load"); call real_value(o%tangential_load, o%tangential)
+      case ("slip"); call real_value(o%slip, o%tangential, o%by_slip)
+      case ("checkpoint_interval"); call real_value(o%checkpoint_interval)
+      end select
    contains
-      function reals(v) result(t)
-         real(dp), allocatable, intent(in) :: v(:)
-         character(len=:), allocatable :: t
+      !> A real; given, it also sets the group flags it implies.
+      subroutine real_value(x, implied, implied2)
+         real(dp), intent(inout) :: x
+         logical, intent(inout), optional :: implied, implied2
+         if (.not. set) then
+            text = format_real(x)
+            return
+         end if
+         call parse_real(text, x, ok)
+         if (present(implied)) implied = .true.
+         if (present(implied2)) implied2 = .true.
+      end subroutine real_value
+      subroutine whole(n)
+         integer, intent(inout) :: n
+         if (set) call parse_integer(text, n, ok)
+         if (.not. set) text = int_str(n)
+      end subroutine whole
+      !> A flag: given, the field takes `given`.
+      subroutine flag(x, given)
+         logical, intent(inout) :: x
+         logical, intent(in) :: given
+         if (set) x = given
+         if (.not. set) text = merge("T", "F", x)
+      end subroutine flag
+      subroutine choice(code, names)
+         integer, intent(inout) :: code
+         character(len=*), intent(in) :: names(:)
+         if (set) code = code_of(text, names)
+         if (.not. set) text = name_of(code, names)
+      end subroutine choice
+      subroutine real_list(v)
+         real(dp), allocatable, intent(inout) :: v(:)
          integer :: m
-         t = ""
+         if (set) then
+            call parse_real_list(text, v, ok)
+            return
+         end if
+         text = ""
          if (.not. allocated(v)) return
          do m = 1, size(v)
-            if (m > 1) t = t//","
-            t = t//format_real(v(m))
+            if (m > 1) text = text//","
+            text = text//format_real(v(m))
          end do
-      end function reals
-   end function history_options
+      end subroutine real_list
+   end subroutine option_field
 
    !> What a tangential step (`tangential`) is refused with: a friction coefficient that is
    !> not positive, a load or shift below zero, adhesion (tension in the contact: no
