@@ -3,10 +3,8 @@ module femcod_maps
    use femcod_kinds, only: dp
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
-   use femcod_love, only: offset_table, surface_compliance
-   use femcod_love_periodic, only: periodic_offset_table
-   use femcod_spring, only: spring_stiffness
-   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
+   use femcod_solver_options, only: cg_settings
+   use femcod_elastic_operator, only: grid_operator, grid_operator_setup, grid_operator_free
    use femcod_contact_result, only: load_state
    use femcod_patches, only: contact_patches, find_patches
    implicit none
@@ -23,11 +21,11 @@ contains
 
    !> For every reached state: pressure(i, j) (GPa) = contact force / pixel area;
    !> gap(i, j) (nm) = separation of the deformed surfaces, g0 - approach + c (I * F),
-   !> from one zero-padded FFT convolution (cyclic on a periodic cell), and 0 at the contacts (where the penalty
-   !> springs' compression s F is the only remaining separation). The Love table and the
-   !> FFT plans are made once for all states, and only when a state lacks the gap map its
-   !> solver already had (the cg solver's, from the same formula and its own last
-   !> double-precision convolution).
+   !> from the elastic operator's zero-padded FFT convolution (cyclic on a periodic cell),
+   !> and 0 at the contacts (where the penalty springs' compression s F is the only
+   !> remaining separation). The operator is made once for all states, and only when a
+   !> state lacks the gap map its solver already had (the cg solver's, from the same
+   !> formula and its own last double-precision convolution).
    subroutine load_maps(problem, states, maps, periodic)
       type(contact_problem), intent(in) :: problem
       !> A gap map a state holds (the cg solver's) is moved into `maps`, not copied.
@@ -36,9 +34,9 @@ contains
       !> The grid is one cell of a periodic surface (default: free).
       logical, intent(in), optional :: periodic
       logical :: cyclic
-      type(love_convolution) :: conv
-      real(dp), allocatable :: force(:, :), disp(:, :), g0(:, :), table(:, :)
-      real(dp) :: c, spring
+      type(grid_operator) :: op
+      type(cg_settings) :: plain
+      real(dp), allocatable :: force(:, :), disp(:, :)
       logical, allocatable :: handed(:)
       integer :: np, k, s
       allocate(maps(size(states)))
@@ -54,40 +52,36 @@ contains
          if (handed(s)) call move_alloc(states(s)%gap, maps(s)%gap)
       end do
       if (all(handed .or. .not. states%reached)) return
-      allocate(force(np, np), disp(np, np), table(0:np - 1, 0:np - 1))
-      if (cyclic) then
-         table(:, :) = periodic_offset_table(np)
-      else
-         table(:, :) = offset_table(np)
-      end if
-      c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
-         surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
-      spring = 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
-      ! g0 is numbered pixel by pixel along rows: p = (i - 1) np + j.
-      g0 = initial_gap_map(problem%lower, problem%upper)
-      call convolution_setup(conv, table, periodic=cyclic)
+      allocate(force(np, np), disp(np, np))
+      ! The elastic operator of the whole kernel in double precision, estimated plans, no
+      ! preconditioner: c (I * F), g0 and the springs' s of the deck (g0 numbered pixel by
+      ! pixel along rows: p = (i - 1) np + j).
+      plain%single_until = 0
+      plain%precondition = .false.
+      call grid_operator_setup(op, initial_gap_map(problem%lower, problem%upper), problem, problem%pixel, plain, &
+         cyclic)
       do s = 1, size(states)
          if (.not. states(s)%reached .or. handed(s)) cycle
          force = 0
          do k = 1, size(states(s)%force)
             force(states(s)%i(k), states(s)%j(k)) = states(s)%force(k)
          end do
-         call convolution_apply(conv, force, disp)
-         maps(s)%gap = g0 - states(s)%approach + c*disp
+         call op%displace(force, disp)
+         maps(s)%gap = op%g0 - states(s)%approach + disp
          do k = 1, size(states(s)%force)
             ! A capped pixel (--plastic) keeps its negative gap, the springs' compression
             ! s F included: minus its plastic displacement.
             if (allocated(states(s)%plastic)) then
                if (states(s)%plastic(states(s)%i(k), states(s)%j(k)) > 0) then
                   maps(s)%gap(states(s)%i(k), states(s)%j(k)) = maps(s)%gap(states(s)%i(k), states(s)%j(k)) + &
-                     spring*states(s)%force(k)
+                     op%s*states(s)%force(k)
                   cycle
                end if
             end if
             maps(s)%gap(states(s)%i(k), states(s)%j(k)) = 0
          end do
       end do
-      call convolution_free(conv)
+      call grid_operator_free(op)
    contains
       elemental logical function allocated_gap(state)
          type(load_state), intent(in) :: state
