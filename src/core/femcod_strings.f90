@@ -10,7 +10,7 @@ module femcod_strings
    public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, add_lines, add_text, built_text
    public :: without_trailing_zeros, xml_escape, json_string, json_number, sig_str, next_line
    public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, format_reals, is_digit, &
-      append_string, integer_text
+      append_string, integer_text, lower_case
 
    !> A string of any length, for lists of arguments.
    type :: string_type
@@ -168,6 +168,17 @@ contains
       longer(size(list) + 1)%s = text
       call move_alloc(longer, list)
    end subroutine append_string
+
+   !> `s` with the ASCII capitals made small (keys of file headers are compared so).
+   pure function lower_case(s) result(t)
+      character(len=*), intent(in) :: s
+      character(len=len(s)) :: t
+      integer :: k
+      t = s
+      do k = 1, len(s)
+         if (s(k:k) >= "A" .and. s(k:k) <= "Z") t(k:k) = achar(iachar(s(k:k)) + 32)
+      end do
+   end function lower_case
 
    !> Text for XML content and attribute values: & < > " ' as entities.
    pure function xml_escape(s) result(e)
