@@ -8,7 +8,7 @@ module test_options
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, flag_option, real_option, &
       integer_option, text_option, choice_option, real_list_option, integer_list_option, get_option, option_given, &
       refuse_options
-   use femcod_run, only: run_table, run_settings, parse_run_arguments
+   use femcod_run_options, only: run_table, run_settings, parse_run_arguments
    use femcod_cli, only: run_femcod, mkdeck_table, parse_mkdeck_arguments
    use femcod_generate, only: scene_spec
    use test_support, only: scratch_path, read_text

@@ -25,7 +25,7 @@ program femcod_mpi
    use femcod_options, only: option_spec, FLAG
    use femcod_generate, only: scene_spec
    use femcod_mpi_generate, only: generate_columns
-   use femcod_run, only: run_settings, parse_run_arguments
+   use femcod_run_options, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
    use femcod_deck_h5, only: is_hdf5_file, read_deck_h5_header
    use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, slab_rows, is_dataset_scene, &

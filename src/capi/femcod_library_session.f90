@@ -1,6 +1,6 @@
 !> What a library caller holds between calls (capi/femcod_capi): the problem, the
 !> options given by name, and the result of the last solve with its maps. The solve goes
-!> through `femcod run`'s own parser and rules (cli/femcod_run's parse_run_arguments) and
+!> through `femcod run`'s own parser and rules (cli/femcod_run_options' parse_run_arguments) and
 !> the one solver interface, so a combination the command refuses is refused here with
 !> the same words, and an answer is the command's to the last bit.
 module femcod_library_session
@@ -19,7 +19,7 @@ module femcod_library_session
    use femcod_solver, only: solve_contact, run_warnings
    use femcod_maps, only: load_maps, state_maps, tangential_step_maps
    use femcod_options, only: parsed_options, parse_options
-   use femcod_run, only: run_table, run_settings, parse_run_arguments
+   use femcod_run_options, only: run_table, run_settings, parse_run_arguments
    implicit none
    private
    public :: library_session, solve_session, state_value, state_value_names, map_of, map_names, history_column, &

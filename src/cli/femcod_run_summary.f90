@@ -1,0 +1,145 @@
+!> The summary `femcod run` prints on standard output after a deck: the problem, the
+!> states (load, approach, area, pressures, patches, friction, the tangential step), the
+!> solver's own lines and checks.
+module femcod_run_summary
+   use, intrinsic :: iso_fortran_env, only: output_unit
+   use femcod_kinds, only: dp
+   use femcod_strings, only: sig_str, int_str, format_real
+   use femcod_problem, only: contact_problem
+   use femcod_contact_result, only: contact_result, load_state, stop_reason_text, cg_state_diagnostics, cg_work
+   use femcod_solver_options, only: contact_options, SOLVER_CG, LAW_HARD_WALL, solver_name
+   use femcod_shear_model, only: friction_coefficient
+   use femcod_solver, only: report_lines, report_line
+   use femcod_maps, only: state_maps
+   use femcod_patches, only: contact_patches, perimeter_area_fit
+   implicit none
+   private
+   public :: print_summary
+
+contains
+
+   !> The summary on standard output: the scene, the steps, the states at the requested
+   !> loads, the wall time, then what the solver left out and checked.
+   subroutine print_summary(deck_path, prefix, problem, options, res, maps)
+      character(len=*), intent(in) :: deck_path, prefix
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(contact_result), intent(in) :: res
+      type(state_maps), intent(in) :: maps(:)
+      type(report_line), allocatable :: lines(:)
+      type(cg_state_diagnostics) :: work
+      integer :: k, last
+      last = res%nsteps
+      if (deck_path /= "") then
+         write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//solver_name(options%solver)//")"
+      else
+         ! Height files: the scene's label names them (femcod run --lower FILE ...).
+         write(output_unit, '(a)') problem%label//" (solver "//solver_name(options%solver)//")"
+      end if
+      write(output_unit, '(a)') "  scene     : "//problem%label
+      write(output_unit, '(a)') "              NP = "//int_str(problem%np)//", d = "//format_real(problem%pixel)// &
+         " nm, E = "//sig_str(problem%young(1), 4)//" / "//sig_str(problem%young(2), 4)//" / "// &
+         sig_str(problem%young(3), 4)//" GPa (lower / upper / contact)"
+      if (options%solver == SOLVER_CG) then
+         write(output_unit, '(a)') "  loads     : "//int_str(count(res%states%reached))//" of "// &
+            int_str(size(res%states))//" solved"
+      else
+         write(output_unit, '(a)') "  steps     : "//int_str(last)//", stopped: "//stop_reason_text(res%stop_reason)
+         if (last > 0) then
+            write(output_unit, '(a)') "  last step : "//int_str(res%step_contacts(last))//" contacts up to load "// &
+               sig_str(res%step_load(last), 6)//" nN (where the next contact closes), approach "// &
+               sig_str(res%step_approach(last), 6)//" nm"
+         end if
+      end if
+      do k = 1, size(res%states)
+         if (.not. res%states(k)%reached) cycle
+         work = cg_work(res, k)
+         write(output_unit, '(a)') "  at load   : "//sig_str(res%states(k)%load, 6)//" nN: approach "// &
+            sig_str(res%states(k)%approach, 6)//" nm"//trim(bound_text(work%approach_bound))//", "// &
+            int_str(res%states(k)%contacts)//" contacts ("// &
+            sig_str(res%states(k)%contacts*problem%pixel**2, 4)//" nm^2), max pressure "// &
+            sig_str(res%states(k)%max_pressure, 4)//" GPa"
+         call print_patches(maps(k)%patches)
+         if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
+            " of them plastic (at the hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "// &
+            sig_str(res%states(k)%plastic_volume, 4)//" nm^3"
+         if (options%tangential) call print_tangential(res%states(k), problem%pixel)
+         if (options%shear) write(output_unit, '(a)') "              friction "// &
+            sig_str(res%states(k)%friction, 6)//" nN, coefficient "// &
+            sig_str(friction_coefficient(res%states(k)%friction, res%states(k)%load, res%states(k)%contacts), 6)//" (shear model)"
+         if (options%adhesion /= LAW_HARD_WALL) then
+            write(output_unit, '(a)') "              "//int_str(res%states(k)%attractive)//" pixels off contact within the "// &
+               "range ("//sig_str(res%states(k)%attractive*problem%pixel**2, 4)//" nm^2), load off contact "// &
+               sig_str(res%states(k)%attractive_load, 4)//" nN, mean gap "//sig_str(res%states(k)%mean_gap, 4)//" nm"
+            if (res%states(k)%jump /= 0 .and. k > 1) write(output_unit, '(a)') "              "// &
+               trim(merge("contact appears ", "contact vanishes", res%states(k)%jump > 0))//" since the approach "// &
+               sig_str(res%states(k - 1)%approach, 6)//" nm ("//int_str(res%states(k - 1)%contacts)//" -> "// &
+               int_str(res%states(k)%contacts)//" contact pixels, load "//sig_str(res%states(k - 1)%load, 4)// &
+               " -> "//sig_str(res%states(k)%load, 4)//" nN)"
+         end if
+      end do
+      if (options%adhesion /= LAW_HARD_WALL) write(output_unit, '(a)') "  adhesion  : least load "// &
+         sig_str(minval(res%states%load, mask=res%states%reached), 6)//" nN over the approaches (the pull-off force "// &
+         "where they pass it)"
+      if (options%solver == SOLVER_CG) then
+         write(output_unit, '(a)') "  wall time : "//sig_str(res%wall_seconds, 3)//" s"
+      else
+         write(output_unit, '(a)') "  wall time : "//sig_str(res%wall_seconds, 3)//" s in total, "// &
+            sig_str(res%wall_seconds/max(last, 1), 3)//" s per step"
+      end if
+      write(output_unit, '(a)') "  written   : "//prefix//".h5, .xdmf, .summary.json, .history.csv, .contacts.csv, "// &
+         ".load_approach.svg, .area_load.svg"//trim(merge(", .loads.csv, .pressure_<k>.svg", &
+         repeat(" ", 31), size(res%states) > 0))
+      ! The solver's own account last.
+      lines = report_lines(problem, options, res)
+      do k = 1, size(lines)
+         write(output_unit, '(a)') "  "//lines(k)%label//repeat(" ", max(0, 10 - len(lines(k)%label)))//": "// &
+            lines(k)%text
+      end do
+   end subroutine print_summary
+
+   !> The patches line of the summary: the 4- and 8-connected counts, the largest patch
+   !> and the perimeter-area exponent.
+   subroutine print_patches(patches)
+      type(contact_patches), intent(in) :: patches
+      real(dp) :: exponent, prefactor
+      character(len=:), allocatable :: fit
+      call perimeter_area_fit(patches%area4, patches%perimeter4, exponent, prefactor)
+      fit = ""
+      if (exponent == exponent) fit = ", perimeter ~ area^"//sig_str(exponent, 3)
+      write(output_unit, '(a)') "              patches "//int_str(patches%count4)//" (4-connected), "// &
+         int_str(patches%count8)//" (8-connected), the largest "//int_str(maxval([0, patches%area8]))// &
+         " pixels"//fit
+   end subroutine print_patches
+
+   !> A state's tangential step in the summary: the force and shift along x, the stick
+   !> area, or gross sliding.
+   subroutine print_tangential(s, pixel)
+      type(load_state), intent(in) :: s
+      real(dp), intent(in) :: pixel
+      integer :: stick
+      if (.not. allocated(s%stick)) then
+         write(output_unit, '(a)') "              tangential: none (no contact carries it)"
+         return
+      end if
+      stick = count(s%stick)
+      if (s%sliding) then
+         write(output_unit, '(a)') "              tangential "//sig_str(s%tangential_force(1), 6)//" nN: gross "// &
+            "sliding, every contact at mu p (shift "//sig_str(s%tangential_shift(1), 6)//" nm at the onset)"
+      else
+         write(output_unit, '(a)') "              tangential "//sig_str(s%tangential_force(1), 6)//" nN, shift "// &
+            sig_str(s%tangential_shift(1), 6)//" nm; "//int_str(stick)//" of "//int_str(size(s%stick))// &
+            " contacts stick ("//sig_str(stick*pixel**2, 4)//" nm^2, "// &
+            sig_str(100*real(stick, dp)/size(s%stick), 4)//" %); "//int_str(s%tangential_iterations)// &
+            " iterations, residual "//sig_str(s%tangential_residual, 2)
+      end if
+   end subroutine print_tangential
+
+   !> " (+- B nm)" after an approach the solver bounds (B >= 0), "" otherwise.
+   function bound_text(bound) result(text)
+      real(dp), intent(in) :: bound
+      character(len=:), allocatable :: text
+      text = ""
+      if (bound >= 0) text = " (+- "//sig_str(bound, 2)//" nm)"
+   end function bound_text
+end module femcod_run_summary
