@@ -17,7 +17,9 @@ module femcod_cli
    use femcod_output_guard, only: guard_outputs, OUTPUT_DECK, OUTPUT_RESULT
    use femcod_run, only: run_command
    use femcod_process, only: SIGINT, SIGTERM, SIGUSR1
-   use femcod_studies, only: resolution_command, summits_command, multiscale_command
+   use femcod_resolution_command, only: resolution_command
+   use femcod_summits_command, only: summits_command
+   use femcod_multiscale_command, only: multiscale_command
    use femcod_refine_command, only: refine_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
