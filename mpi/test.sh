@@ -5,9 +5,11 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 source ./environment.sh
-# fpm 0.12 may relink a test against a stale library archive: build both afresh.
+# fpm 0.12 may relink a test against a stale library archive, and keeps the test
+# programs' objects when a module of the library they use moved: build them afresh.
 find build -name "libfemcod*.a" -delete 2>/dev/null || true
 find build -path "*/test/*" -type f -perm -u+x -delete 2>/dev/null || true
+find build -path "*/femcod-mpi/test_*.o" -delete 2>/dev/null || true
 for ranks in 1 2 4; do
   echo "== distributed suite on $ranks ranks"
   OMP_NUM_THREADS=1 fpm test --profile release --flag "$FEMCOD_MPI_FLAGS" \
