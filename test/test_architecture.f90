@@ -6,7 +6,7 @@
 !> never stops the program. No routine is longer than a reader can hold (150 lines), but
 !> those listed as not yet split, a list that may only shrink.
 module test_architecture
-   use femcod_strings, only: string_type
+   use femcod_strings, only: string_type, lower_case
    use test_support, only: scratch_path, read_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -122,7 +122,7 @@ contains
       start = 1
       do k = 1, len(text)
          if (text(k:k) /= new_line("a")) cycle
-         line = lower(adjustl(text(start:k - 1)))
+         line = lower_case(adjustl(text(start:k - 1)))
          start = k + 1
          if (index(line, keyword//" ") /= 1) cycle
          word = adjustl(line(len(keyword) + 2:))
@@ -132,16 +132,6 @@ contains
          names = [names, string_type(word)]
       end do
    end subroutine statements
-
-   pure function lower(s) result(t)
-      character(len=*), intent(in) :: s
-      character(len=len(s)) :: t
-      integer :: k
-      t = s
-      do k = 1, len(s)
-         if (s(k:k) >= "A" .and. s(k:k) <= "Z") t(k:k) = achar(iachar(s(k:k)) + 32)
-      end do
-   end function lower
 
    subroutine test_layers(error)
       type(error_type), allocatable, intent(out) :: error
@@ -194,7 +184,7 @@ contains
          in_type = .false.
          do k = 1, len(text)
             if (text(k:k) /= new_line("a")) cycle
-            line = lower(adjustl(text(start:k - 1)))
+            line = lower_case(adjustl(text(start:k - 1)))
             start = k + 1
             if (index(line, "contains") == 1) in_procedure = .true.
             if (index(line, "!") == 1) cycle
@@ -242,7 +232,7 @@ contains
          start = 1
          do k = 1, len(text)
             if (text(k:k) /= new_line("a")) cycle
-            line = lower(adjustl(text(start:k - 1)))
+            line = lower_case(adjustl(text(start:k - 1)))
             start = k + 1
             if (index(line, "!") == 1) cycle
             do q = 1, size(FORBIDDEN)
@@ -326,7 +316,7 @@ contains
       line_no = 0
       do k = 1, len(text)
          if (text(k:k) /= new_line("a")) cycle
-         line = lower(adjustl(text(start:k - 1)))
+         line = lower_case(adjustl(text(start:k - 1)))
          start = k + 1
          line_no = line_no + 1
          if (index(line, "!") == 1) cycle
