@@ -14,36 +14,32 @@ link_dirs=()
 include_dirs=()
 system_dirs=" /usr/lib64 /usr/lib/x86_64-linux-gnu /usr/lib /lib64 /lib/x86_64-linux-gnu /lib "
 
-# The directories to search for a library (one a line): pkg-config's for the given modules
-# (NAME:pc1,pc2), the roots of the given variables, then the library paths and the system's.
-candidate_library_dirs() {
-  local pcs=$1; shift
-  local pc v r
+# The directories to search (one a line) for a library (KIND lib) or a header (KIND
+# include): pkg-config's for the given modules (pc1,pc2), the roots of the given variables,
+# then the paths the compilers read and the system's.
+candidate_dirs() {
+  local kind=$1 pcs=$2; shift 2
+  local pc v r d flag subdirs paths
+  if [ "$kind" = lib ]; then
+    flag=L; subdirs="lib64 lib lib/x86_64-linux-gnu"; paths="${LIBRARY_PATH:-}:${LD_LIBRARY_PATH:-}"
+  else
+    flag=I; subdirs="include include/hdf5/serial include/hdf5/openmpi"; paths="${CPATH:-}:${FPATH:-}:${C_INCLUDE_PATH:-}"
+  fi
   for pc in ${pcs//,/ }; do
-    pkg-config --exists "$pc" 2>/dev/null && pkg-config --libs-only-L "$pc" | tr ' ' '\n' | sed -n 's/^-L//p'
-    pkg-config --exists "$pc" 2>/dev/null && pkg-config --variable=libdir "$pc"
+    pkg-config --exists "$pc" 2>/dev/null || continue
+    if [ "$kind" = lib ]; then pkg-config --libs-only-L "$pc"; else pkg-config --cflags-only-I "$pc"; fi |
+      tr ' ' '\n' | sed -n "s/^-$flag//p"
+    pkg-config --variable="${kind}dir" "$pc"
   done
   for v in "$@"; do
     r=${!v:-}
-    [ -n "$r" ] && printf '%s\n' "$r/lib64" "$r/lib" "$r/lib/x86_64-linux-gnu" "$r"
+    if [ -n "$r" ]; then for d in $subdirs; do printf '%s\n' "$r/$d"; done; printf '%s\n' "$r"; fi
   done
-  tr ':' '\n' <<< "${LIBRARY_PATH:-}:${LD_LIBRARY_PATH:-}"
-  tr ' ' '\n' <<< "$system_dirs"
+  tr ':' '\n' <<< "$paths"
+  if [ "$kind" = lib ]; then tr ' ' '\n' <<< "$system_dirs"; else printf '%s\n' /usr/include /usr/local/include /usr/include/hdf5/serial; fi
 }
-candidate_include_dirs() {
-  local pcs=$1; shift
-  local pc v r
-  for pc in ${pcs//,/ }; do
-    pkg-config --exists "$pc" 2>/dev/null && pkg-config --cflags-only-I "$pc" | tr ' ' '\n' | sed -n 's/^-I//p'
-    pkg-config --exists "$pc" 2>/dev/null && pkg-config --variable=includedir "$pc"
-  done
-  for v in "$@"; do
-    r=${!v:-}
-    [ -n "$r" ] && printf '%s\n' "$r/include" "$r/include/hdf5/serial" "$r/include/hdf5/openmpi" "$r"
-  done
-  tr ':' '\n' <<< "${CPATH:-}:${FPATH:-}:${C_INCLUDE_PATH:-}"
-  printf '%s\n' /usr/include /usr/local/include /usr/include/hdf5/serial
-}
+candidate_library_dirs() { candidate_dirs lib "$@"; }
+candidate_include_dirs() { candidate_dirs include "$@"; }
 # first_with FILE < dirs: the first directory holding FILE (reads all its input: under
 # pipefail, a writer cut short would fail the pipeline)
 first_with() {
