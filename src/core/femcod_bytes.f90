@@ -1,5 +1,5 @@
 !> Scanning text eight bytes at a time, for the deck reader (femcod_deck) and the decimals
-!> of femcod_strings: a 64-bit word holds text(i:i+7), byte k of the text in bits 8k..8k+7
+!> of femcod_decimal: a 64-bit word holds text(i:i+7), byte k of the text in bits 8k..8k+7
 !> (little-endian order, checked by `words_little_endian`; the readers go byte by byte
 !> otherwise), and each test below answers for all eight bytes at once with the high bit of
 !> each byte (bit 8k+7) set where the byte passes. The tests are exact for every byte value:

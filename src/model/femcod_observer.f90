@@ -1,7 +1,7 @@
 !> How a solver reports while it runs, without doing I/O itself: it calls the
 !> type-bound procedures of an observer object, which carries its own context (where
 !> to write a checkpoint, when it last printed a progress line). The base type does
-!> nothing; a program extends it (cli/femcod_run's run_observer, the studies' progress).
+!> nothing; a program extends it (cli/femcod_run_observer's run_observer, the studies' progress).
 module femcod_observer
    use femcod_kinds, only: dp
    use femcod_problem, only: contact_problem
