@@ -56,23 +56,19 @@ add_include_dir() {
   case " ${include_dirs[*]:-} /usr/include " in *" $1 "*) return ;; esac
   include_dirs+=("$1")
 }
-# need_library NAME WHAT PCS VARS...: find libNAME.so; WHAT names it for the message.
-need_library() {
-  local name=$1 what=$2 pcs=$3; shift 3
+# need KIND FILE WHAT PCS VARS...: find FILE, a library (KIND lib) or a header (KIND
+# include); WHAT names it for the message.
+need() {
+  local kind=$1 file=$2 what=$3 pcs=$4; shift 4
   local d
-  if d=$(candidate_library_dirs "$pcs" "$@" | first_with "lib$name.so"); then
-    add_link_dir "$d"; echo "setup:   found lib$name.so in $d"; return 0
-  fi
-  missing+=("lib$name.so ($what)"); return 1
-}
-need_header() {
-  local file=$1 what=$2 pcs=$3; shift 3
-  local d
-  if d=$(candidate_include_dirs "$pcs" "$@" | first_with "$file"); then
-    add_include_dir "$d"; echo "setup:   found $file in $d"; return 0
+  if d=$(candidate_dirs "$kind" "$pcs" "$@" | first_with "$file"); then
+    if [ "$kind" = lib ]; then add_link_dir "$d"; else add_include_dir "$d"; fi
+    echo "setup:   found $file in $d"; return 0
   fi
   missing+=("$file ($what)"); return 1
 }
+need_library() { local name=$1; shift; need lib "lib$name.so" "$@"; }
+need_header() { need include "$@"; }
 
 fpm_fc=${FPM_FC:-gfortran}
 if [ "$mpi" -eq 1 ]; then
