@@ -36,7 +36,8 @@ module femcod_solver_options
       "approaches", "max_contacts", "plastic", "hardness", "adhesion", "work", "range", "tie_tolerance", &
       "final_check", "event_search", "tol", "max_iterations", "kernel_radius", "shear", "shear_strength", &
       "shear_slope", "tangential", "by_slip", "friction", "tangential_load", "slip", "checkpoint_interval"]
-   logical, parameter :: IN_HISTORY(*) = [spread(.true., 1, 24), .false.]
+   !> Every field shapes the answer but the checkpoints' interval.
+   logical, parameter :: IN_HISTORY(*) = OPTION_KEYS /= "checkpoint_interval"
 
    !> The solvers: the event-exact incremental solver, the Appendix B program, and the
    !> fixed-load constrained conjugate gradients. An enumeration, with the names the
