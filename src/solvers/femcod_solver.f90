@@ -25,7 +25,8 @@ module femcod_solver
    use femcod_shear_model, only: shear_model
    use femcod_cerruti, only: second_dundurs_constant
    use femcod_clock, only: wall_clock
-   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential, tangential_storage_bytes
+   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential_on, tangential_storage_bytes
+   use femcod_shear_operator, only: grid_shear_operator, grid_shear_setup, grid_shear_free
    implicit none
    private
    public :: solve_contact, model_notes, report_lines, report_line, run_warnings
@@ -199,7 +200,7 @@ contains
    end function run_warnings
 
    !> The tangential step (solvers/femcod_tangential) at each reached state with contacts,
-   !> after its memory check: the answer into the state.
+   !> after its memory check, on one operator for all of them: the answer into the state.
    subroutine tangential_states(problem, options, res, status, observer)
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
@@ -208,6 +209,7 @@ contains
       class(solver_observer), intent(inout) :: observer
       type(tangential_request) :: request
       type(tangential_answer) :: answer
+      type(grid_shear_operator) :: op
       real(dp) :: t0, t1
       integer :: k
       call wall_clock(t0)
@@ -219,13 +221,16 @@ contains
       request%load = options%tangential_load
       request%slip = options%slip
       request%periodic = options%boundary == BOUNDARY_PERIODIC
+      if (any([(res%states(k)%reached .and. res%states(k)%contacts > 0, k = 1, size(res%states))])) &
+         call grid_shear_setup(op, problem, request%periodic)
       do k = 1, size(res%states)
          associate(s => res%states(k))
             ! A state without contact carries no tangential force: no step (run_warnings).
             if (.not. s%reached .or. .not. allocated(s%force) .or. s%contacts == 0) cycle
-            call solve_tangential(problem, s%i, s%j, s%force, request, answer, status, observer)
+            call solve_tangential_on(op, s%i, s%j, s%force, request, answer, status, observer)
             if (status%code /= 0) then
                status%message = "state "//int_str(k)//" (load "//sig_str(s%load, 6)//" nN): "//status%message
+               call grid_shear_free(op)
                return
             end if
             call move_alloc(answer%tx, s%shear_x)
@@ -238,6 +243,7 @@ contains
             s%tangential_residual = answer%residual
          end associate
       end do
+      call grid_shear_free(op)
       ! The solve's wall time includes the tangential steps.
       call wall_clock(t1)
       res%wall_seconds = res%wall_seconds + (t1 - t0)

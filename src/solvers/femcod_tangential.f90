@@ -7,7 +7,8 @@
 !> (|t_i| < b_i, its surface moves with the rigid shift delta: u_i = delta) or slips
 !> (|t_i| = b_i, t_i along delta - u_i, the way the surface lags behind the shift). u = A t
 !> is the bodies' relative tangential displacement, A their Cerruti compliance
-!> (model/femcod_cerruti, applied by FFT: femcod_convolution's shear_transform). These are
+!> (model/femcod_cerruti, applied by FFT: model/femcod_shear_operator, one process's
+!> grid or, in femcod-mpi, the ranks' slabs). These are
 !> the conditions of the minimum of the complementary energy
 !>     shift given (slip control):  1/2 t.A t - delta . sum t,   |t_i| <= b_i,
 !>     load given (force control):  1/2 t.A t,  sum t = Q,       |t_i| <= b_i,
@@ -33,15 +34,13 @@ module femcod_tangential
    use femcod_kinds, only: dp, i8
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED
    use femcod_observer, only: solver_observer
-   use femcod_strings, only: count_text, int_str, sig_str
+   use femcod_strings, only: count_text, sig_str
    use femcod_problem, only: contact_problem
-   use femcod_cerruti, only: tangential_tables, periodic_tangential_spectra
-   use femcod_convolution, only: shear_transform, shear_transform_setup, shear_transform_setup_periodic, &
-      shear_transform_apply, shear_transform_free
+   use femcod_shear_operator, only: shear_operator, grid_shear_operator, grid_shear_setup, grid_shear_free
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    implicit none
    private
-   public :: tangential_request, tangential_answer, solve_tangential, tangential_storage_bytes
+   public :: tangential_request, tangential_answer, solve_tangential, solve_tangential_on, tangential_storage_bytes
 
    !> What a tangential step asks: the friction coefficient, the load (nN) or, with
    !> `by_slip`, the rigid shift (nm), both along x; the relative residual to reach and
@@ -52,11 +51,13 @@ module femcod_tangential
       real(dp) :: load = 0, slip = 0
       real(dp) :: tol = 1.0e-8_dp
       integer :: max_iterations = 20000
-      !> The grid as one cell of a periodic surface (the kernel summed over the images).
+      !> The grid as one cell of a periodic surface (the kernel summed over the images;
+      !> solve_tangential's operator).
       logical :: periodic = .false.
    end type tangential_request
 
-   !> The answer on the contact pixels, in the order of the state's list.
+   !> The answer on this process's contact pixels, in the order of its list; the shift,
+   !> the force, the iterations and the residual are the whole grid's.
    type :: tangential_answer
       !> Tangential forces (nN) and whether each pixel sticks.
       real(dp), allocatable :: tx(:), ty(:)
@@ -70,23 +71,23 @@ module femcod_tangential
       real(dp) :: residual = 0
    end type tangential_answer
 
-   !> The iteration's state: the contact list, the bounds, the grids the operator takes,
-   !> and the contacts' displacements of the last application.
+   !> The iteration's state: this process's contact list (rows, and columns of its part),
+   !> the bounds, the contacts of the whole grid, the capacity mu P, the grids the
+   !> operator takes, and the contacts' displacements of the last application.
    type :: tangential_state
-      integer :: n = 0
+      integer :: n = 0, contacts = 0
       integer, allocatable :: ci(:), cj(:)
       real(dp), allocatable :: bound(:)
+      real(dp) :: capacity = 0
       !> u(:, k): pixel k's displacement (nm) from the last `displace`.
       real(dp), allocatable :: u(:, :)
       real(dp), allocatable :: gx(:, :), gy(:, :), ux(:, :), uy(:, :)
-      type(shear_transform) :: op
    end type tangential_state
 
 contains
 
    !> The tangential state of contact pixels (ci, cj) with normal forces f (nN) of
-   !> `problem` under `request`. `observer`, when given, is asked every 10 iterations
-   !> whether to stop (a stop signal): STATUS_INTERRUPTED then.
+   !> `problem` under `request`, on one process (its own operator, made and freed here).
    subroutine solve_tangential(problem, ci, cj, f, request, answer, status, observer)
       type(contact_problem), intent(in) :: problem
       integer, intent(in) :: ci(:), cj(:)
@@ -95,13 +96,34 @@ contains
       type(tangential_answer), intent(out) :: answer
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout), optional :: observer
-      type(tangential_state) :: st
+      type(grid_shear_operator) :: op
       type(solver_observer) :: nobody
-      real(dp), allocatable :: xx(:, :), yy(:, :), xy(:, :), t(:, :)
-      real(dp) :: capacity
-      integer :: np
       if (status%code /= 0) return
-      np = problem%np
+      call grid_shear_setup(op, problem, request%periodic)
+      if (present(observer)) then
+         call solve_tangential_on(op, ci, cj, f, request, answer, status, observer)
+      else
+         call solve_tangential_on(op, ci, cj, f, request, answer, status, nobody)
+      end if
+      call grid_shear_free(op)
+   end subroutine solve_tangential
+
+   !> The tangential state under `request` by the operator `op`: this part's contact
+   !> pixels at rows ci and columns cj (1 .. op%nj) with normal forces f (nN). `observer`
+   !> is asked every 10 iterations whether to stop (a stop signal, on any part):
+   !> STATUS_INTERRUPTED then. Collective over the operator's parts.
+   subroutine solve_tangential_on(op, ci, cj, f, request, answer, status, observer)
+      class(shear_operator), intent(inout) :: op
+      integer, intent(in) :: ci(:), cj(:)
+      real(dp), intent(in) :: f(:)
+      type(tangential_request), intent(in) :: request
+      type(tangential_answer), intent(out) :: answer
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      type(tangential_state) :: st
+      real(dp), allocatable :: t(:, :)
+      real(dp) :: totals(2)
+      if (status%code /= 0) return
       st%n = size(ci)
       st%ci = ci
       st%cj = cj
@@ -110,65 +132,60 @@ contains
       answer%tx = 0
       answer%ty = 0
       answer%stick = .false.
-      capacity = sum(st%bound)
-      if (st%n == 0 .or. .not. capacity > 0) return
-      if (request%periodic) then
-         allocate(xx(np/2 + 1, np), yy(np/2 + 1, np), xy(np/2 + 1, np))
-         call periodic_tangential_spectra(np, problem%pixel, problem%young(1:2), problem%poisson(1:2), xx, yy, xy)
-         call shear_transform_setup_periodic(st%op, xx, yy, xy)
-      else
-         allocate(xx(0:np - 1, 0:np - 1), yy(0:np - 1, 0:np - 1), xy(0:np - 1, 0:np - 1))
-         call tangential_tables(np, problem%pixel, problem%young(1:2), problem%poisson(1:2), xx, yy, xy)
-         call shear_transform_setup(st%op, xx, yy, xy)
-      end if
-      deallocate(xx, yy, xy)
-      allocate(st%gx(np, np), st%gy(np, np), st%ux(np, np), st%uy(np, np))
+      totals = [sum(st%bound), real(st%n, dp)]
+      call op%sum_over_grid(totals)
+      st%capacity = totals(1)
+      st%contacts = nint(totals(2))
+      if (.not. st%capacity > 0) return
+      allocate(st%gx(op%np, op%nj), st%gy(op%np, op%nj), st%ux(op%np, op%nj), st%uy(op%np, op%nj))
       st%gx = 0
       st%gy = 0
-      if (.not. request%by_slip .and. request%load >= capacity*(1 - 1.0e-12_dp)) then
-         call gross_sliding(st, request, capacity, t, answer)
+      if (.not. request%by_slip .and. request%load >= st%capacity*(1 - 1.0e-12_dp)) then
+         call gross_sliding(st, op, request, t, answer)
       else
          t = 0
-         if (.not. request%by_slip) t(1, :) = st%bound*request%load/capacity
+         if (.not. request%by_slip) t(1, :) = st%bound*request%load/st%capacity
          answer%shift = [request%slip, 0.0_dp]
-         if (present(observer)) then
-            call projected_gradients(st, request, t, answer, status, observer)
-         else
-            call projected_gradients(st, request, t, answer, status, nobody)
-         end if
+         call projected_gradients(st, op, request, t, answer, status, observer)
       end if
       answer%tx = t(1, :)
       answer%ty = t(2, :)
       answer%force = [sum(answer%tx), sum(answer%ty)]
-      call shear_transform_free(st%op)
-   end subroutine solve_tangential
+      call op%sum_over_grid(answer%force)
+   end subroutine solve_tangential_on
 
    !> Q >= mu P: every pixel at its bound along x. The shift at Q = mu P is the onset's:
    !> the largest u_x, where the last pixel to stick lets go; beyond mu P it is unbounded.
-   subroutine gross_sliding(st, request, capacity, t, answer)
+   subroutine gross_sliding(st, op, request, t, answer)
       type(tangential_state), intent(inout) :: st
+      class(shear_operator), intent(inout) :: op
       type(tangential_request), intent(in) :: request
-      real(dp), intent(in) :: capacity
       real(dp), intent(out) :: t(:, :)
       type(tangential_answer), intent(inout) :: answer
+      real(dp) :: largest(1), mean(1)
       answer%sliding = .true.
       t(1, :) = st%bound
       t(2, :) = 0
-      call displace(st, t)
-      answer%shift = [maxval(st%u(1, :)), sum(st%u(2, :))/st%n]
-      if (request%load > capacity*(1 + 1.0e-12_dp)) answer%shift = ieee_value(1.0_dp, ieee_quiet_nan)
+      call displace(st, op, t)
+      largest = maxval(st%u(1, :))
+      mean = sum(st%u(2, :))
+      call op%max_over_grid(largest)
+      call op%sum_over_grid(mean)
+      answer%shift = [largest(1), mean(1)/st%contacts]
+      if (request%load > st%capacity*(1 + 1.0e-12_dp)) answer%shift = ieee_value(1.0_dp, ieee_quiet_nan)
    end subroutine gross_sliding
 
    !> st%u = A t at the contacts (nm), through the grids.
-   subroutine displace(st, t)
+   subroutine displace(st, op, t)
       type(tangential_state), intent(inout) :: st
+      class(shear_operator), intent(inout) :: op
       real(dp), intent(in) :: t(:, :)
       integer :: k
       do k = 1, st%n
          st%gx(st%ci(k), st%cj(k)) = t(1, k)
          st%gy(st%ci(k), st%cj(k)) = t(2, k)
       end do
-      call shear_transform_apply(st%op, st%gx, st%gy, st%ux, st%uy)
+      call op%displace(st%gx, st%gy, st%ux, st%uy)
       do k = 1, st%n
          st%u(1, k) = st%ux(st%ci(k), st%cj(k))
          st%u(2, k) = st%uy(st%ci(k), st%cj(k))
@@ -177,19 +194,42 @@ contains
       end do
    end subroutine displace
 
+   !> The largest |u| component over the whole grid's contacts (nm), the shift's size
+   !> beside it, and never below the smallest positive number: the residuals' scale.
+   real(dp) function displacement_scale(st, op, shift) result(scale)
+      type(tangential_state), intent(in) :: st
+      class(shear_operator), intent(inout) :: op
+      real(dp), intent(in) :: shift(2)
+      real(dp) :: largest(1)
+      largest = maxval(abs(st%u))
+      call op%max_over_grid(largest)
+      scale = max(norm2(shift), largest(1), tiny(1.0_dp))
+   end function displacement_scale
+
+   !> True on every part when a stop was asked for on one (the parts stop together).
+   logical function stop_asked(op, observer)
+      class(shear_operator), intent(inout) :: op
+      class(solver_observer), intent(inout) :: observer
+      real(dp) :: asked(1)
+      asked = merge(1.0_dp, 0.0_dp, observer%stop_requested())
+      call op%sum_over_grid(asked)
+      stop_asked = asked(1) > 0
+   end function stop_asked
+
    !> FISTA with adaptive restart (module header) from the forces t (feasible: within the
    !> discs, and summing to Q under force control); t the answer's forces (2 x n).
-   subroutine projected_gradients(st, request, t, answer, status, observer)
+   subroutine projected_gradients(st, op, request, t, answer, status, observer)
       type(tangential_state), intent(inout) :: st
+      class(shear_operator), intent(inout) :: op
       type(tangential_request), intent(in) :: request
       real(dp), intent(inout) :: t(:, :)
       type(tangential_answer), intent(inout) :: answer
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
       real(dp), allocatable :: y(:, :), z(:, :), t_new(:, :)
-      real(dp) :: step, theta, theta_new, lambda(2), shift(2), scale, gap, best
+      real(dp) :: step, theta, theta_new, lambda(2), shift(2), gap, best, largest(2), momentum(1)
       integer :: it
-      step = 1/contact_largest(st)
+      step = 1/contact_largest(st, op)
       best = huge(1.0_dp)
       allocate(y(2, st%n), z(2, st%n), t_new(2, st%n))
       shift = answer%shift
@@ -198,29 +238,30 @@ contains
       theta = 1
       do it = 1, request%max_iterations
          if (mod(it, 10) == 0) then
-            if (observer%stop_requested()) then
+            if (stop_asked(op, observer)) then
                call set_error(status, STATUS_INTERRUPTED, "stopped after "//count_text(it, "iteration")//" of the "// &
                   "tangential step")
                return
             end if
          end if
-         call displace(st, y)
+         call displace(st, op, y)
          z = y - step*st%u
          if (request%by_slip) then
             z(1, :) = z(1, :) + step*shift(1)
             z(2, :) = z(2, :) + step*shift(2)
             call project_discs(z, st%bound, t_new)
          else
-            call project_with_load(z, st%bound, [request%load, 0.0_dp], lambda, t_new)
+            call project_with_load(op, z, st%bound, st%capacity, [request%load, 0.0_dp], lambda, t_new)
             shift = lambda/step
          end if
          ! The gradient mapping (nm): how far the step moves the forces, in displacements.
-         scale = max(norm2(shift), maxval(abs(st%u)), tiny(1.0_dp))
-         gap = maxval(norm2(y - t_new, dim=1))/step/scale
+         largest = [maxval(abs(st%u)), maxval(norm2(y - t_new, dim=1))]
+         call op%max_over_grid(largest)
+         gap = largest(2)/step/max(norm2(shift), largest(1), tiny(1.0_dp))
          ! A step too long for A (the power iteration's estimate short of its largest
          ! eigenvalue) shows as a gap growing without bound: half the step, no momentum.
-         if (gap > 1.0e3_dp*best .and. step > (1/st%op%largest)*(1 + 1.0e-12_dp)) then
-            step = max(step/2, 1/st%op%largest)
+         if (gap > 1.0e3_dp*best .and. step > (1/op%largest)*(1 + 1.0e-12_dp)) then
+            step = max(step/2, 1/op%largest)
             lambda = shift*step
             theta = 1
             y = t
@@ -229,7 +270,9 @@ contains
          end if
          best = min(best, gap)
          ! Adaptive restart: momentum against the last step's direction.
-         if (sum((y - t_new)*(t_new - t)) > 0) then
+         momentum = sum((y - t_new)*(t_new - t))
+         call op%sum_over_grid(momentum)
+         if (momentum(1) > 0) then
             theta = 1
             y = t_new
          else
@@ -241,9 +284,9 @@ contains
          if (gap < request%tol) exit
       end do
       answer%iterations = min(it, request%max_iterations)
-      call displace(st, t)
+      call displace(st, op, t)
       answer%shift = shift
-      call classify(st, t, shift, answer)
+      call classify(st, op, t, shift, answer)
       if (answer%residual > 10*request%tol) call set_error(status, STATUS_NUMERICAL, "tangential: residual "// &
          sig_str(answer%residual, 2)//" after "//count_text(answer%iterations, "iteration")//", above 10 x --tol "// &
          sig_str(request%tol, 2))
@@ -254,34 +297,39 @@ contains
    !> to within the ratio of its two largest; 1.25 times that, and never more than the
    !> padded operator's bound, which holds on any set but is the whole grid's (the
    !> lowest frequency's, ~ NP) where a rough surface's contacts are a few per cent of it.
-   real(dp) function contact_largest(st) result(largest)
+   real(dp) function contact_largest(st, op) result(largest)
       type(tangential_state), intent(inout) :: st
+      class(shear_operator), intent(inout) :: op
       real(dp), allocatable :: x(:, :)
+      real(dp) :: total(1)
       integer :: it
       allocate(x(2, st%n))
       x(1, :) = st%bound
       x(2, :) = st%bound/2
       largest = 0
       do it = 1, 20
-         x = x/norm2(x)
-         call displace(st, x)
-         largest = sum(x*st%u)
+         x = x/op%norm_over_grid(x)
+         call displace(st, op, x)
+         total = sum(x*st%u)
+         call op%sum_over_grid(total)
+         largest = total(1)
          x = st%u
       end do
-      largest = min(1.25_dp*largest, st%op%largest)
+      largest = min(1.25_dp*largest, op%largest)
    end function contact_largest
 
    !> Stick and slip from the forces t and the displacements st%u at the shift, and the
    !> largest violation of their conditions over the shift's size: a sticking pixel moves
    !> with the shift; a slipping one lags behind it along its force.
-   subroutine classify(st, t, shift, answer)
+   subroutine classify(st, op, t, shift, answer)
       type(tangential_state), intent(in) :: st
+      class(shear_operator), intent(inout) :: op
       real(dp), intent(in) :: t(:, :), shift(2)
       type(tangential_answer), intent(inout) :: answer
-      real(dp) :: v(2), along, r, scale
+      real(dp) :: v(2), along, r, scale, residual(1)
       integer :: k
-      scale = max(norm2(shift), maxval(abs(st%u)), tiny(1.0_dp))
-      answer%residual = 0
+      scale = displacement_scale(st, op, shift)
+      residual = 0
       do k = 1, st%n
          v = shift - st%u(:, k)
          answer%stick(k) = norm2(t(:, k)) < st%bound(k)*(1 - 1.0e-9_dp)
@@ -291,8 +339,10 @@ contains
             along = dot_product(v, t(:, k))/norm2(t(:, k))
             r = norm2(v - along*t(:, k)/norm2(t(:, k))) + max(0.0_dp, -along)
          end if
-         answer%residual = max(answer%residual, r/scale)
+         residual = max(residual, r/scale)
       end do
+      call op%max_over_grid(residual)
+      answer%residual = residual(1)
    end subroutine classify
 
    !> t_k = the projection of z_k onto the disc of radius b_k.
@@ -311,17 +361,19 @@ contains
       end do
    end subroutine project_discs
 
-   !> The projection of z onto {|t_k| <= b_k, sum t = q}: t_k = P_k(z_k + lambda), lambda
-   !> (warm-started) the root of sum P_k(z_k + lambda) = q by Newton's method with
-   !> halving steps; the Jacobian sum of I (inside) and (b/|w|)(I - w w^T/|w|^2) (outside).
-   pure subroutine project_with_load(z, b, q, lambda, t)
-      real(dp), intent(in) :: z(:, :), b(:), q(2)
+   !> The projection of z onto {|t_k| <= b_k, sum t = q} (over the whole grid's contacts;
+   !> `capacity` the sum of the bounds): t_k = P_k(z_k + lambda), lambda (warm-started)
+   !> the root of sum P_k(z_k + lambda) = q by Newton's method with halving steps; the
+   !> Jacobian sum of I (inside) and (b/|w|)(I - w w^T/|w|^2) (outside).
+   subroutine project_with_load(op, z, b, capacity, q, lambda, t)
+      class(shear_operator), intent(inout) :: op
+      real(dp), intent(in) :: z(:, :), b(:), capacity, q(2)
       real(dp), intent(inout) :: lambda(2)
       real(dp), intent(out) :: t(:, :)
       real(dp) :: jac(2, 2), f(2), trial(2), step(2), det, residual, target
       integer :: it, halving
-      target = 1.0e-14_dp*sum(b)
-      call evaluate(lambda, f, jac)
+      target = 1.0e-14_dp*capacity
+      call load_equation(op, z, b, q, lambda, f, jac)
       residual = norm2(f)
       do it = 1, 200
          if (residual <= target) exit
@@ -331,38 +383,46 @@ contains
          step = -[jac(2, 2)*f(1) - jac(1, 2)*f(2), jac(1, 1)*f(2) - jac(2, 1)*f(1)]/det
          do halving = 0, 40
             trial = lambda + step/2.0_dp**halving
-            call evaluate(trial, f, jac)
+            call load_equation(op, z, b, q, trial, f, jac)
             if (norm2(f) < residual) exit
          end do
          lambda = trial
          residual = norm2(f)
       end do
       call project_discs(z + spread(lambda, 2, size(b)), b, t)
-   contains
-      pure subroutine evaluate(l, f, jac)
-         real(dp), intent(in) :: l(2)
-         real(dp), intent(out) :: f(2), jac(2, 2)
-         real(dp) :: w(2), r
-         integer :: k
-         f = -q
-         jac = 0
-         do k = 1, size(b)
-            w = z(:, k) + l
-            r = norm2(w)
-            if (r <= b(k)) then
-               f = f + w
-               jac(1, 1) = jac(1, 1) + 1
-               jac(2, 2) = jac(2, 2) + 1
-            else
-               f = f + w*(b(k)/r)
-               jac(1, 1) = jac(1, 1) + b(k)/r*(1 - w(1)**2/r**2)
-               jac(2, 2) = jac(2, 2) + b(k)/r*(1 - w(2)**2/r**2)
-               jac(1, 2) = jac(1, 2) - b(k)/r*w(1)*w(2)/r**2
-               jac(2, 1) = jac(1, 2)
-            end if
-         end do
-      end subroutine evaluate
    end subroutine project_with_load
+
+   !> f = sum P_k(z_k + l) - q over the whole grid's contacts and its Jacobian in l
+   !> (project_with_load). The part holding column 0 starts from -q, the others from 0.
+   subroutine load_equation(op, z, b, q, l, f, jac)
+      class(shear_operator), intent(inout) :: op
+      real(dp), intent(in) :: z(:, :), b(:), q(2), l(2)
+      real(dp), intent(out) :: f(2), jac(2, 2)
+      real(dp) :: w(2), r, sums(6)
+      integer :: k
+      f = 0
+      if (op%j0 == 0) f = -q
+      jac = 0
+      do k = 1, size(b)
+         w = z(:, k) + l
+         r = norm2(w)
+         if (r <= b(k)) then
+            f = f + w
+            jac(1, 1) = jac(1, 1) + 1
+            jac(2, 2) = jac(2, 2) + 1
+         else
+            f = f + w*(b(k)/r)
+            jac(1, 1) = jac(1, 1) + b(k)/r*(1 - w(1)**2/r**2)
+            jac(2, 2) = jac(2, 2) + b(k)/r*(1 - w(2)**2/r**2)
+            jac(1, 2) = jac(1, 2) - b(k)/r*w(1)*w(2)/r**2
+            jac(2, 1) = jac(1, 2)
+         end if
+      end do
+      sums = [f, reshape(jac, [4])]
+      call op%sum_over_grid(sums)
+      f = sums(1:2)
+      jac = reshape(sums(3:6), [2, 2])
+   end subroutine load_equation
 
    !> The bytes the tangential step holds at NP (the padded grid's fields and spectra,
    !> the four grids, three spectra): for the memory check.
