@@ -33,15 +33,9 @@
 !>
 !> No I/O and no stop: errors come back in a status, identical on every rank.
 module femcod_mpi_cg
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_float, c_float_complex, &
-      c_intptr_t, c_int, c_f_pointer, c_associated, c_size_t
    use mpi_f08
-   use femcod_fftw_mpi, only: fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, fftw_mpi_execute_r2r, &
-      fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
-      fftw_execute_dft, fftw_alloc_complex, fftw_free, fftw_destroy_plan, FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, &
-      FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK, fftwf_mpi_plan_many_transpose, fftwf_mpi_execute_r2r, &
-      fftwf_plan_many_dft_r2c, fftwf_plan_many_dft_c2r, fftwf_plan_many_dft, fftwf_execute_dft_r2c, &
-      fftwf_execute_dft_c2r, fftwf_execute_dft, fftwf_destroy_plan
+   use femcod_mpi_slab_transform, only: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, &
+      slab_backward, slab_forward_single, slab_backward_single, EXTEND_EVEN
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
@@ -79,34 +73,14 @@ module femcod_mpi_cg
       !> rank 0 the deck's materials and pixel for it (no heights).
       integer :: block = 1
       type(contact_problem) :: materials
-      !> Columns per rank (the last ranks may have fewer): FFTW-MPI's block size.
-      integer :: block_columns = 0
-      !> The padded side m = 2 np, its half spectrum mh = np + 1; this rank's frequencies
-      !> kx (0-based first, number) after the transpose.
-      integer :: m = 0, mh = 0, freq_start = 0, freqs = 0
-      !> Down the columns: in-place r2c / c2r, the real view (2 mh, nj), the complex
-      !> (mh, nj); along the rows: the complex view (m, freqs), its first np*freqs values
-      !> the transpose's (np, freqs).
-      type(c_ptr) :: column_memory = c_null_ptr, row_memory = c_null_ptr
-      real(c_double), pointer :: column_real(:, :) => null(), column_flat(:) => null(), row_flat(:) => null()
-      complex(c_double_complex), pointer :: columns(:, :) => null(), rows(:, :) => null(), row_values(:) => null()
-      type(c_ptr) :: columns_forward = c_null_ptr, columns_backward = c_null_ptr, rows_forward = c_null_ptr, &
-         rows_backward = c_null_ptr, to_rows = c_null_ptr, to_columns = c_null_ptr
+      !> The transforms of this rank's columns (zero-padded to 2 np, or cyclic), and their
+      !> wall seconds; the solver's other communication (sums, halos) is counted with the
+      !> transposes'.
+      type(slab_transform) :: slab
       !> The kernel's spectrum over m^2 (real: the table is even), (m, freqs).
       real(dp), allocatable :: kernel(:, :)
-      !> float32 transforms (cg_settings%single_until > 0): views of the same memory, their
-      !> own plans, the kernel rounded to float32.
-      logical :: has_single = .false.
-      real(c_float), pointer :: column32_real(:, :) => null(), column32_flat(:) => null(), row32_flat(:) => null()
-      complex(c_float_complex), pointer :: columns32(:, :) => null(), rows32(:, :) => null(), &
-         row32_values(:) => null()
-      type(c_ptr) :: columns_forward32 = c_null_ptr, columns_backward32 = c_null_ptr, rows_forward32 = c_null_ptr, &
-         rows_backward32 = c_null_ptr, to_rows32 = c_null_ptr, to_columns32 = c_null_ptr
+      !> The kernel rounded to float32 (cg_settings%single_until > 0: float32 transforms).
       real(sp), allocatable :: kernel32(:, :)
-      !> Wall seconds so far in the transforms (the 1-D transforms and FFTW-MPI's
-      !> transposes) and in the solver's other communication (sums, halos; waiting for
-      !> slower ranks included).
-      real(dp) :: transform_seconds = 0, communication_seconds = 0
       !> The gap-variable iteration's transform grid (gap_grid_setup; femcod_mpi_gap_transform).
       type(distributed_gap_transform) :: gaps
    contains
@@ -210,7 +184,6 @@ contains
       !> One cell of a periodic surface (cyclic convolution on the NP x NP grid, the
       !> periodic Love kernel); default: the free surface.
       logical, intent(in), optional :: periodic
-      integer(c_intptr_t) :: alloc, dims(2), local_columns, column_start, local_freqs, freq_start
       real(dp) :: lo, hi
       call grid_free(grid)
       grid%comm = comm
@@ -248,125 +221,13 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, lo, 1, MPI_DOUBLE_PRECISION, MPI_MIN, comm)
       call MPI_Allreduce(MPI_IN_PLACE, hi, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       grid%scale = max(hi - lo, tiny(1.0_dp))
-      grid%block_columns = grid%count(0)
-      ! The transform length down the columns and along the rows: 2 NP zero-padded (free
-      ! surface), NP (periodic cell); mh the half spectrum's length.
-      grid%m = merge(np, 2*np, grid%periodic)
-      grid%mh = grid%m/2 + 1
-      ! The transpose of the half spectrum: [np][mh] complex by columns (blocks of
-      ! block_columns) to [mh][np] by frequencies (FFTW's default block).
-      dims = [integer(c_intptr_t) :: np, grid%mh]
-      alloc = fftw_mpi_local_size_many_transposed(2_c_int, dims, 2_c_intptr_t, int(grid%block_columns, c_intptr_t), &
-         FFTW_MPI_DEFAULT_BLOCK, comm%MPI_VAL, local_columns, column_start, local_freqs, freq_start)
-      if (int(local_columns) /= grid%nj .or. int(column_start) /= grid%j0) then
-         call set_error(status, STATUS_NUMERICAL, "FFTW-MPI splits the columns otherwise than the solver: rank "// &
-            int_str(grid%rank)//" has "//int_str(int(local_columns))//" from "//int_str(int(column_start)))
-         return
-      end if
-      grid%freqs = int(local_freqs)
-      grid%freq_start = int(freq_start)
-      grid%column_memory = fftw_alloc_complex(int(max(alloc/2, int(grid%mh, c_intptr_t)*grid%nj, 1_c_intptr_t), c_size_t))
-      grid%row_memory = fftw_alloc_complex(int(max(alloc/2, int(grid%m, c_intptr_t)*grid%freqs, 1_c_intptr_t), c_size_t))
-      call make_plans(grid, how, status)
+      call slab_setup(grid%slab, comm, np, grid%j0, grid%nj, grid%count(0), grid%periodic, how%measure_plans, &
+         how%single_until > 0, status)
       if (status%code /= 0) return
       call kernel_spectrum(grid, how)
-      grid%has_single = how%single_until > 0
-      if (grid%has_single) then
-         call make_single_plans(grid, how, status)
-         if (status%code /= 0) return
-         grid%kernel32 = real(grid%kernel, sp)
-      end if
+      if (grid%slab%has_single) grid%kernel32 = real(grid%kernel, sp)
       call preconditioner(grid, how)
    end subroutine grid_setup
-
-   !> FFTW flags: a measured plan when how%measure_plans.
-   pure integer(c_int) function plan_flags(how)
-      type(cg_settings), intent(in) :: how
-      plan_flags = FFTW_ESTIMATE
-      if (how%measure_plans) plan_flags = FFTW_MEASURE
-   end function plan_flags
-
-   !> The double-precision views of the transform memory and their plans: the columns'
-   !> r2c and c2r of length m, the rows' complex transforms of length m, FFTW-MPI's two
-   !> transposes.
-   subroutine make_plans(grid, how, status)
-      type(distributed_grid), intent(inout) :: grid
-      type(cg_settings), intent(in) :: how
-      type(status_type), intent(inout) :: status
-      integer(c_int) :: flags, m, mh, nj, freqs
-      flags = plan_flags(how)
-      m = int(grid%m, c_int)
-      mh = int(grid%mh, c_int)
-      nj = int(grid%nj, c_int)
-      freqs = int(grid%freqs, c_int)
-      call c_f_pointer(grid%column_memory, grid%column_real, [2*grid%mh, grid%nj])
-      call c_f_pointer(grid%column_memory, grid%column_flat, [2*grid%mh*grid%nj])
-      call c_f_pointer(grid%column_memory, grid%columns, [grid%mh, grid%nj])
-      call c_f_pointer(grid%row_memory, grid%rows, [grid%m, max(grid%freqs, 1)])
-      call c_f_pointer(grid%row_memory, grid%row_values, [grid%m*max(grid%freqs, 1)])
-      call c_f_pointer(grid%row_memory, grid%row_flat, [2*grid%m*max(grid%freqs, 1)])
-      grid%columns_forward = fftw_plan_many_dft_r2c(1_c_int, [m], nj, grid%column_real, [2*mh], 1_c_int, 2*mh, &
-         grid%columns, [mh], 1_c_int, mh, flags)
-      grid%columns_backward = fftw_plan_many_dft_c2r(1_c_int, [m], nj, grid%columns, [mh], 1_c_int, mh, &
-         grid%column_real, [2*mh], 1_c_int, 2*mh, flags)
-      if (grid%freqs > 0) then
-         grid%rows_forward = fftw_plan_many_dft(1_c_int, [m], freqs, grid%rows, [m], 1_c_int, m, grid%rows, [m], &
-            1_c_int, m, FFTW_FORWARD, flags)
-         grid%rows_backward = fftw_plan_many_dft(1_c_int, [m], freqs, grid%rows, [m], 1_c_int, m, grid%rows, [m], &
-            1_c_int, m, FFTW_BACKWARD, flags)
-      end if
-      grid%to_rows = fftw_mpi_plan_many_transpose(int(grid%np, c_intptr_t), int(grid%mh, c_intptr_t), 2_c_intptr_t, &
-         int(grid%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, grid%column_flat, grid%row_flat, &
-         grid%comm%MPI_VAL, flags)
-      grid%to_columns = fftw_mpi_plan_many_transpose(int(grid%mh, c_intptr_t), int(grid%np, c_intptr_t), &
-         2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(grid%block_columns, c_intptr_t), grid%row_flat, grid%column_flat, &
-         grid%comm%MPI_VAL, flags)
-      if (.not. (c_associated(grid%columns_forward) .and. c_associated(grid%columns_backward) .and. &
-         c_associated(grid%to_rows) .and. c_associated(grid%to_columns) .and. (grid%freqs == 0 .or. &
-         (c_associated(grid%rows_forward) .and. c_associated(grid%rows_backward))))) &
-         call set_error(status, STATUS_NUMERICAL, "FFTW made no plan for the "//int_str(grid%m)//" x "// &
-         int_str(grid%m)//" grid")
-   end subroutine make_plans
-
-   !> The float32 views of the same memory and their plans (fftwf, fftwf_mpi).
-   subroutine make_single_plans(grid, how, status)
-      type(distributed_grid), intent(inout) :: grid
-      type(cg_settings), intent(in) :: how
-      type(status_type), intent(inout) :: status
-      integer(c_int) :: flags, m, mh, nj, freqs
-      flags = plan_flags(how)
-      m = int(grid%m, c_int)
-      mh = int(grid%mh, c_int)
-      nj = int(grid%nj, c_int)
-      freqs = int(grid%freqs, c_int)
-      call c_f_pointer(grid%column_memory, grid%column32_real, [2*grid%mh, grid%nj])
-      call c_f_pointer(grid%column_memory, grid%column32_flat, [2*grid%mh*grid%nj])
-      call c_f_pointer(grid%column_memory, grid%columns32, [grid%mh, grid%nj])
-      call c_f_pointer(grid%row_memory, grid%rows32, [grid%m, max(grid%freqs, 1)])
-      call c_f_pointer(grid%row_memory, grid%row32_values, [grid%m*max(grid%freqs, 1)])
-      call c_f_pointer(grid%row_memory, grid%row32_flat, [2*grid%m*max(grid%freqs, 1)])
-      grid%columns_forward32 = fftwf_plan_many_dft_r2c(1_c_int, [m], nj, grid%column32_real, [2*mh], 1_c_int, &
-         2*mh, grid%columns32, [mh], 1_c_int, mh, flags)
-      grid%columns_backward32 = fftwf_plan_many_dft_c2r(1_c_int, [m], nj, grid%columns32, [mh], 1_c_int, mh, &
-         grid%column32_real, [2*mh], 1_c_int, 2*mh, flags)
-      if (grid%freqs > 0) then
-         grid%rows_forward32 = fftwf_plan_many_dft(1_c_int, [m], freqs, grid%rows32, [m], 1_c_int, m, grid%rows32, &
-            [m], 1_c_int, m, FFTW_FORWARD, flags)
-         grid%rows_backward32 = fftwf_plan_many_dft(1_c_int, [m], freqs, grid%rows32, [m], 1_c_int, m, grid%rows32, &
-            [m], 1_c_int, m, FFTW_BACKWARD, flags)
-      end if
-      grid%to_rows32 = fftwf_mpi_plan_many_transpose(int(grid%np, c_intptr_t), int(grid%mh, c_intptr_t), &
-         2_c_intptr_t, int(grid%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, grid%column32_flat, &
-         grid%row32_flat, grid%comm%MPI_VAL, flags)
-      grid%to_columns32 = fftwf_mpi_plan_many_transpose(int(grid%mh, c_intptr_t), int(grid%np, c_intptr_t), &
-         2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(grid%block_columns, c_intptr_t), grid%row32_flat, &
-         grid%column32_flat, grid%comm%MPI_VAL, flags)
-      if (.not. (c_associated(grid%columns_forward32) .and. c_associated(grid%columns_backward32) .and. &
-         c_associated(grid%to_rows32) .and. c_associated(grid%to_columns32) .and. (grid%freqs == 0 .or. &
-         (c_associated(grid%rows_forward32) .and. c_associated(grid%rows_backward32))))) &
-         call set_error(status, STATUS_NUMERICAL, "FFTW made no float32 plan for the "//int_str(grid%m)//" x "// &
-         int_str(grid%m)//" grid")
-   end subroutine make_single_plans
 
    !> The kernel's spectrum on this rank's frequencies kx, over all ky (m values), divided
    !> by m^2 (FFTW's transforms are not normalised). Free surface: the Love table's even
@@ -381,11 +242,11 @@ contains
       integer :: jj, q, i, p, np, l, ky
       np = grid%np
       grid%self = love_influence(0, 0)
-      allocate(grid%kernel(grid%m, grid%freqs))
+      allocate(grid%kernel(grid%slab%m, grid%slab%freqs))
       if (grid%periodic) then
          ! (An expression's bounds start at 1: quarter(l, k2 + 1) is S(freq_start + l - 1, k2).)
-         quarter = periodic_love_spectrum_rows(np, grid%freq_start, grid%freqs)
-         do l = 1, grid%freqs
+         quarter = periodic_love_spectrum_rows(np, grid%slab%freq_start, grid%slab%freqs)
+         do l = 1, grid%slab%freqs
             do ky = 0, np - 1
                grid%kernel(ky + 1, l) = quarter(l, min(ky, np - ky) + 1)/real(np, dp)**2
             end do
@@ -400,19 +261,14 @@ contains
          line = love_influence([(p, p = 0, np - 1)], q)
          if (how%kernel_radius > 0) where ([(real(p, dp)**2, p = 0, np - 1)] + real(q, dp)**2 > how%kernel_radius**2) &
             line = 0
-         grid%column_real(1:np, jj) = line
-         grid%column_real(np + 1, jj) = 0
-         do i = np + 2, grid%m
-            grid%column_real(i, jj) = line(grid%m - i + 1)
+         grid%slab%column_real(1:np, jj) = line
+         grid%slab%column_real(np + 1, jj) = 0
+         do i = np + 2, grid%slab%m
+            grid%slab%column_real(i, jj) = line(grid%slab%m - i + 1)
          end do
       end do
-      call fftw_execute_dft_r2c(grid%columns_forward, grid%column_real, grid%columns)
-      call fftw_mpi_execute_r2r(grid%to_rows, grid%column_flat, grid%row_flat)
-      call expand_rows(grid, even=.true.)
-      if (grid%freqs > 0) then
-         call fftw_execute_dft(grid%rows_forward, grid%rows, grid%rows)
-         grid%kernel = real(grid%rows(:, 1:grid%freqs), dp)/real(grid%m, dp)**2
-      end if
+      call slab_forward(grid%slab, EXTEND_EVEN)
+      if (grid%slab%freqs > 0) grid%kernel = real(grid%slab%rows(:, 1:grid%slab%freqs), dp)/real(grid%slab%m, dp)**2
    end subroutine kernel_spectrum
 
    !> I(0, 0) of the periodic table from the spectrum: the sum over all m^2 frequencies of
@@ -421,9 +277,9 @@ contains
       type(distributed_grid), intent(inout) :: grid
       integer :: l, kx
       total = 0
-      do l = 1, grid%freqs
-         kx = grid%freq_start + l - 1
-         total = total + merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%m)*sum(grid%kernel(:, l))
+      do l = 1, grid%slab%freqs
+         kx = grid%slab%freq_start + l - 1
+         total = total + merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%slab%m)*sum(grid%kernel(:, l))
       end do
       call MPI_Allreduce(MPI_IN_PLACE, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
    end function sum_of_spectrum
@@ -438,7 +294,7 @@ contains
       grid%taps = 0
       if (.not. (how%precondition .and. grid%np >= 3)) return
       kmin = huge(1.0_dp)
-      if (grid%freqs > 0) kmin = minval(grid%kernel, mask=.not. zero_frequency())
+      if (grid%slab%freqs > 0) kmin = minval(grid%kernel, mask=.not. zero_frequency())
       call MPI_Allreduce(MPI_IN_PLACE, kmin, 1, MPI_DOUBLE_PRECISION, MPI_MIN, grid%comm)
       if (kmin > 0) then
          call inverse_taps(grid)
@@ -448,9 +304,9 @@ contains
       !> The periodic kernel's zero frequency, where it has no inverse (none for the free
       !> surface).
       function zero_frequency() result(mask)
-         logical :: mask(grid%m, grid%freqs)
+         logical :: mask(grid%slab%m, grid%slab%freqs)
          mask = .false.
-         if (grid%periodic .and. grid%freq_start == 0) mask(1, 1) = .true.
+         if (grid%periodic .and. grid%slab%freq_start == 0) mask(1, 1) = .true.
       end function zero_frequency
    end subroutine preconditioner
 
@@ -465,21 +321,21 @@ contains
       real(dp) :: cy(0:2), cx(0:2), w, partial(0:2, 0:2)
       integer :: l, ky, kx, a, b
       partial = 0
-      do l = 1, grid%freqs
-         kx = grid%freq_start + l - 1
-         w = merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%m)
-         cx = [(w*cos(two_pi*real(a*kx, dp)/real(grid%m, dp)), a = 0, 2)]
-         do ky = 0, grid%m - 1
+      do l = 1, grid%slab%freqs
+         kx = grid%slab%freq_start + l - 1
+         w = merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%slab%m)
+         cx = [(w*cos(two_pi*real(a*kx, dp)/real(grid%slab%m, dp)), a = 0, 2)]
+         do ky = 0, grid%slab%m - 1
             ! The periodic kernel's zero frequency has no inverse: the pseudo-inverse's 0.
             if (grid%periodic .and. kx == 0 .and. ky == 0) cycle
-            cy = [(cos(two_pi*real(b*ky, dp)/real(grid%m, dp)), b = 0, 2)]
+            cy = [(cos(two_pi*real(b*ky, dp)/real(grid%slab%m, dp)), b = 0, 2)]
             do b = 0, 2
                partial(:, b) = partial(:, b) + cx*cy(b)/grid%kernel(ky + 1, l)
             end do
          end do
       end do
       call MPI_Allreduce(MPI_IN_PLACE, partial, 9, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
-      grid%taps = partial/real(grid%m, dp)**4
+      grid%taps = partial/real(grid%slab%m, dp)**4
    end subroutine inverse_taps
 
    !> The grid of `problem` (read on rank 0 only; the others' is not looked at) spread over
@@ -554,76 +410,37 @@ contains
    !> Frees the plans, the transform memory and the column type; the grid is empty after.
    subroutine grid_free(grid)
       type(distributed_grid), intent(inout) :: grid
-      integer :: k
-      type(c_ptr) :: plans(6)
-      plans = [grid%columns_forward, grid%columns_backward, grid%rows_forward, grid%rows_backward, grid%to_rows, &
-         grid%to_columns]
-      do k = 1, size(plans)
-         if (c_associated(plans(k))) call fftw_destroy_plan(plans(k))
-      end do
-      plans = [grid%columns_forward32, grid%columns_backward32, grid%rows_forward32, grid%rows_backward32, &
-         grid%to_rows32, grid%to_columns32]
-      do k = 1, size(plans)
-         if (c_associated(plans(k))) call fftwf_destroy_plan(plans(k))
-      end do
-      if (c_associated(grid%column_memory)) call fftw_free(grid%column_memory)
-      if (c_associated(grid%row_memory)) call fftw_free(grid%row_memory)
+      call slab_free(grid%slab)
       call gap_transform_free(grid%gaps)
       grid = distributed_grid(comm=MPI_COMM_NULL)
    end subroutine grid_free
 
    !> out = factor (I * f) on this rank's columns (np, nj): down the columns, transpose,
-   !> along the rows, the kernel, and back. Collective.
+   !> along the rows, the kernel, and back (femcod_mpi_slab_transform). Collective.
    subroutine distributed_convolve(grid, f, out, factor, single)
       type(distributed_grid), intent(inout) :: grid
       real(dp), intent(in) :: f(:, :)
       real(dp), intent(out) :: out(:, :)
       real(dp), intent(in) :: factor
-      !> In float32 (the grid made with has_single): the same steps, half the bytes.
+      !> In float32 (the grid made with float32 transforms): the same steps, half the bytes.
       logical, intent(in), optional :: single
-      integer :: j, k, np
-      real(dp) :: t0, t1, t2, t3
+      integer :: k
+      real(dp) :: t0, t1
       if (present(single)) then
-         if (single .and. grid%has_single) then
+         if (single .and. grid%slab%has_single) then
             call convolve_single(grid, f, factor, out)
             return
          end if
       end if
-      np = grid%np
+      call slab_forward_field(grid%slab, f)
       call wall_clock(t0)
       !$omp parallel do
-      do j = 1, grid%nj
-         grid%column_real(1:np, j) = f(:, j)
-         grid%column_real(np + 1:, j) = 0
+      do k = 1, grid%slab%freqs
+         grid%slab%rows(:, k) = grid%slab%rows(:, k)*(factor*grid%kernel(:, k))
       end do
-      call fftw_execute_dft_r2c(grid%columns_forward, grid%column_real, grid%columns)
       call wall_clock(t1)
-      call fftw_mpi_execute_r2r(grid%to_rows, grid%column_flat, grid%row_flat)
-      call wall_clock(t2)
-      call expand_rows(grid, even=.false.)
-      if (grid%freqs > 0) then
-         call fftw_execute_dft(grid%rows_forward, grid%rows, grid%rows)
-         !$omp parallel do
-         do k = 1, grid%freqs
-            grid%rows(:, k) = grid%rows(:, k)*(factor*grid%kernel(:, k))
-         end do
-         call fftw_execute_dft(grid%rows_backward, grid%rows, grid%rows)
-      end if
-      call compress_rows(grid)
-      call wall_clock(t3)
-      grid%transform_seconds = grid%transform_seconds + (t1 - t0) + (t3 - t2)
-      grid%communication_seconds = grid%communication_seconds + (t2 - t1)
-      call wall_clock(t0)
-      call fftw_mpi_execute_r2r(grid%to_columns, grid%row_flat, grid%column_flat)
-      call wall_clock(t1)
-      call fftw_execute_dft_c2r(grid%columns_backward, grid%columns, grid%column_real)
-      !$omp parallel do
-      do j = 1, grid%nj
-         out(:, j) = grid%column_real(1:np, j)
-      end do
-      call wall_clock(t2)
-      grid%transform_seconds = grid%transform_seconds + (t2 - t1)
-      grid%communication_seconds = grid%communication_seconds + (t1 - t0)
+      grid%slab%transform_seconds = grid%slab%transform_seconds + (t1 - t0)
+      call slab_backward(grid%slab, out)
    end subroutine distributed_convolve
 
    !> distributed_convolve in float32.
@@ -633,105 +450,18 @@ contains
       real(dp), intent(in) :: factor
       real(dp), intent(out), optional :: out(:, :)
       real(sp), intent(out), optional :: out32(:, :)
-      integer :: j, k, i, np, m
-      real(dp) :: t0, t1, t2, t3
-      np = grid%np
-      m = grid%m
+      integer :: k
+      real(dp) :: t0, t1
+      call slab_forward_single(grid%slab, f)
       call wall_clock(t0)
       !$omp parallel do
-      do j = 1, grid%nj
-         grid%column32_real(1:np, j) = real(f(:, j), sp)
-         grid%column32_real(np + 1:, j) = 0
+      do k = 1, grid%slab%freqs
+         grid%slab%rows32(:, k) = grid%slab%rows32(:, k)*(real(factor, sp)*grid%kernel32(:, k))
       end do
-      call fftwf_execute_dft_r2c(grid%columns_forward32, grid%column32_real, grid%columns32)
       call wall_clock(t1)
-      call fftwf_mpi_execute_r2r(grid%to_rows32, grid%column32_flat, grid%row32_flat)
-      call wall_clock(t2)
-      ! As expand_rows (zero padding), in float32.
-      do k = grid%freqs, 1, -1
-         do i = np, 1, -1
-            grid%row32_values((k - 1)*m + i) = grid%row32_values((k - 1)*np + i)
-         end do
-         grid%row32_values((k - 1)*m + np + 1:k*m) = 0
-      end do
-      if (grid%freqs > 0) then
-         call fftwf_execute_dft(grid%rows_forward32, grid%rows32, grid%rows32)
-         !$omp parallel do
-         do k = 1, grid%freqs
-            grid%rows32(:, k) = grid%rows32(:, k)*(real(factor, sp)*grid%kernel32(:, k))
-         end do
-         call fftwf_execute_dft(grid%rows_backward32, grid%rows32, grid%rows32)
-      end if
-      ! As compress_rows, in float32.
-      do k = 1, grid%freqs
-         do i = 1, np
-            grid%row32_values((k - 1)*np + i) = grid%row32_values((k - 1)*m + i)
-         end do
-      end do
-      call wall_clock(t3)
-      grid%transform_seconds = grid%transform_seconds + (t1 - t0) + (t3 - t2)
-      grid%communication_seconds = grid%communication_seconds + (t2 - t1)
-      call wall_clock(t0)
-      call fftwf_mpi_execute_r2r(grid%to_columns32, grid%row32_flat, grid%column32_flat)
-      call wall_clock(t1)
-      call fftwf_execute_dft_c2r(grid%columns_backward32, grid%columns32, grid%column32_real)
-      if (present(out32)) then
-         !$omp parallel do
-         do j = 1, grid%nj
-            out32(:, j) = grid%column32_real(1:np, j)
-         end do
-      else
-         !$omp parallel do
-         do j = 1, grid%nj
-            out(:, j) = real(grid%column32_real(1:np, j), dp)
-         end do
-      end if
-      call wall_clock(t2)
-      grid%transform_seconds = grid%transform_seconds + (t2 - t1)
-      grid%communication_seconds = grid%communication_seconds + (t1 - t0)
+      grid%slab%transform_seconds = grid%slab%transform_seconds + (t1 - t0)
+      call slab_backward_single(grid%slab, out, out32)
    end subroutine convolve_single
-
-   !> The transposed rows (np values per frequency, packed) spread in place to rows of m:
-   !> zero-padded (even = false) or evenly extended, x(m - q) = x(q), with x(np) = 0
-   !> (even = true). From the last row down, each from its end: nothing is overwritten
-   !> before it is read.
-   subroutine expand_rows(grid, even)
-      type(distributed_grid), intent(inout) :: grid
-      logical, intent(in) :: even
-      integer :: k, i, np, m
-      np = grid%np
-      m = grid%m
-      ! Rows of np are rows of m already on the periodic cell (m = np).
-      if (m == np) return
-      do k = grid%freqs, 1, -1
-         do i = np, 1, -1
-            grid%row_values((k - 1)*m + i) = grid%row_values((k - 1)*np + i)
-         end do
-         grid%row_values((k - 1)*m + np + 1) = 0
-         if (even) then
-            do i = np + 2, m
-               grid%row_values((k - 1)*m + i) = grid%row_values((k - 1)*m + m - i + 2)
-            end do
-         else
-            grid%row_values((k - 1)*m + np + 2:k*m) = 0
-         end if
-      end do
-   end subroutine expand_rows
-
-   !> The first np values of each row of m packed again for the transpose back (from the
-   !> first row up: nothing is overwritten before it is read).
-   subroutine compress_rows(grid)
-      type(distributed_grid), intent(inout) :: grid
-      integer :: k, i, np, m
-      np = grid%np
-      m = grid%m
-      if (m == np) return
-      do k = 1, grid%freqs
-         do i = 1, np
-            grid%row_values((k - 1)*np + i) = grid%row_values((k - 1)*m + i)
-         end do
-      end do
-   end subroutine compress_rows
 
    !> Every target of `targets` (loads in nN, or with `by_approach` approaches in nm;
    !> solved in ascending order, each warm-started from the last; states in the order
@@ -799,8 +529,8 @@ contains
       do kk = 1, m
          k = order(kk)
          call wall_clock(t0)
-         transform0 = grid%transform_seconds
-         communication0 = grid%communication_seconds
+         transform0 = grid%slab%transform_seconds
+         communication0 = grid%slab%communication_seconds
          call solve_target(grid, problem, session, targets(k), approaches, how, answer, status, observer)
          if (status%code /= 0) return
          call record_state(grid, session, answer, cap, friction_model, states(k))
@@ -814,8 +544,8 @@ contains
                if (states(order(kk - 1))%contacts > 0 .and. st%contacts == 0) st%jump = -1
             end if
             st%seconds = t1 - t0
-            st%transform_seconds = grid%transform_seconds - transform0
-            st%communication_seconds = grid%communication_seconds - communication0
+            st%transform_seconds = grid%slab%transform_seconds - transform0
+            st%communication_seconds = grid%slab%communication_seconds - communication0
             call observer%progress(kk, st%contacts, st%load, t1 - t0)
             if (st%cg%residual > how%tol) then
                call set_error(status, STATUS_NUMERICAL, unconverged_message(approaches, by_gaps, targets(k), &
@@ -983,8 +713,8 @@ contains
       type(distributed_grid), intent(inout) :: grid
       type(status_type), intent(inout) :: status
       if (grid%tm > 0) return
-      call gap_transform_setup(grid%gaps, grid%comm, grid%np, grid%first, grid%count, grid%block_columns, &
-         grid%periodic, grid%kernel, grid%freq_start, grid%c, grid%s, status)
+      call gap_transform_setup(grid%gaps, grid%comm, grid%np, grid%first, grid%count, grid%slab%block_columns, &
+         grid%periodic, grid%kernel, grid%slab%freq_start, grid%c, grid%s, status)
       if (status%code /= 0) return
       grid%tm = grid%gaps%m
       grid%tmj = grid%gaps%columns
@@ -1002,7 +732,7 @@ contains
       call wall_clock(t0)
       call gap_transform_apply(op%gaps, which, in, out)
       call wall_clock(t1)
-      op%transform_seconds = op%transform_seconds + (t1 - t0)
+      op%slab%transform_seconds = op%slab%transform_seconds + (t1 - t0)
    end subroutine distributed_apply_spectrum
 
    !> out = c (I * f) on this rank's columns, in double (the elastic operator's displace).
@@ -1020,7 +750,7 @@ contains
       real(dp), intent(out), optional :: out(:, :)
       real(sp), intent(out), optional :: out32(:, :)
       real(dp), allocatable :: double(:, :)
-      if (op%has_single) then
+      if (op%slab%has_single) then
          call convolve_single(op, f, op%c, out, out32)
       else if (present(out32)) then
          allocate(double(op%np, op%nj))
@@ -1058,7 +788,7 @@ contains
       call wall_clock(start)
       call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, operation, op%comm)
       call wall_clock(done)
-      op%communication_seconds = op%communication_seconds + (done - start)
+      op%slab%communication_seconds = op%slab%communication_seconds + (done - start)
    end subroutine reduce_over_ranks
 
    !> True on every rank when `flag` is on one.
@@ -1070,7 +800,7 @@ contains
       any_flag = flag
       call MPI_Allreduce(MPI_IN_PLACE, any_flag, 1, MPI_LOGICAL, MPI_LOR, op%comm)
       call wall_clock(done)
-      op%communication_seconds = op%communication_seconds + (done - start)
+      op%slab%communication_seconds = op%slab%communication_seconds + (done - start)
    end function any_over_ranks
 
    !> The two columns each side of this rank's slab from its neighbours (zero beyond the
@@ -1091,6 +821,6 @@ contains
       call MPI_Sendrecv(gm(:, 1:2), n, MPI_REAL, left, 2, gm(:, nj + 1:nj + 2), n, MPI_REAL, right, 2, op%comm, &
          MPI_STATUS_IGNORE)
       call wall_clock(done)
-      op%communication_seconds = op%communication_seconds + (done - start)
+      op%slab%communication_seconds = op%slab%communication_seconds + (done - start)
    end subroutine exchange_halo
 end module femcod_mpi_cg

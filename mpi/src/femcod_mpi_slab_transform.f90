@@ -1,0 +1,377 @@
+!> One rank's part of the 2-D real transform of an NP x NP grid split in column slabs
+!> across the ranks (femcod_mpi_cg's Love convolution and femcod_mpi_shear's Cerruti
+!> operator both apply theirs through it): real-to-complex transforms of length M down
+!> this rank's columns (M = 2 NP zero-padded on the free surface, NP on the periodic cell;
+!> only NP of the M are not zero), FFTW-MPI's distributed transpose of the (M/2 + 1) x NP
+!> half spectrum, and complex transforms of length M along the rows of this rank's
+!> frequencies; and back the same way. Only the non-zero half is transformed and moved.
+!> The spectrum (M, freqs) lies in `rows` between slab_forward and slab_backward, where
+!> the operator multiplies it. float32 views of the same memory with their own plans.
+!>
+!> The transposed rows are extended to M in place: zero-padded (a field), or evenly or
+!> oddly (a kernel table placed at the offsets -(NP-1) .. NP-1, each rank from its own
+!> columns).
+!>
+!> No I/O and no stop: errors come back in a status.
+module femcod_mpi_slab_transform
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_float, c_float_complex, &
+      c_intptr_t, c_int, c_f_pointer, c_associated, c_size_t
+   use mpi_f08, only: MPI_Comm, MPI_COMM_NULL
+   use femcod_fftw_mpi, only: fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, fftw_mpi_execute_r2r, &
+      fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
+      fftw_execute_dft, fftw_alloc_complex, fftw_free, fftw_destroy_plan, FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, &
+      FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK, fftwf_mpi_plan_many_transpose, fftwf_mpi_execute_r2r, &
+      fftwf_plan_many_dft_r2c, fftwf_plan_many_dft_c2r, fftwf_plan_many_dft, fftwf_execute_dft_r2c, &
+      fftwf_execute_dft_c2r, fftwf_execute_dft, fftwf_destroy_plan
+   use femcod_kinds, only: dp, sp
+   use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
+   use femcod_strings, only: int_str
+   use femcod_clock, only: wall_clock
+   implicit none
+   private
+   public :: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, slab_backward, &
+      slab_forward_single, slab_backward_single
+   public :: PAD_ZEROS, EXTEND_EVEN, EXTEND_ODD
+
+   !> How the transposed rows of NP become rows of M (module header).
+   integer, parameter :: PAD_ZEROS = 0, EXTEND_EVEN = 1, EXTEND_ODD = -1
+
+   type :: slab_transform
+      type(MPI_Comm) :: comm = MPI_COMM_NULL
+      !> Grid side; this rank's first column (0-based) and number of columns; columns per
+      !> rank (FFTW-MPI's block; the last ranks may have fewer).
+      integer :: np = 0, j0 = 0, nj = 0, block_columns = 0
+      !> The transform length m, its half spectrum mh = m/2 + 1; this rank's frequencies
+      !> (0-based first, number) after the transpose.
+      integer :: m = 0, mh = 0, freq_start = 0, freqs = 0
+      !> Down the columns: in-place r2c / c2r, the real view (2 mh, nj), the complex
+      !> (mh, nj); along the rows: the complex view (m, freqs), its first np*freqs values
+      !> the transpose's (np, freqs).
+      type(c_ptr) :: column_memory = c_null_ptr, row_memory = c_null_ptr
+      real(c_double), pointer :: column_real(:, :) => null(), column_flat(:) => null(), row_flat(:) => null()
+      complex(c_double_complex), pointer :: columns(:, :) => null(), rows(:, :) => null(), row_values(:) => null()
+      type(c_ptr) :: columns_forward = c_null_ptr, columns_backward = c_null_ptr, rows_forward = c_null_ptr, &
+         rows_backward = c_null_ptr, to_rows = c_null_ptr, to_columns = c_null_ptr
+      !> float32 views of the same memory and their plans (made with `single`).
+      logical :: has_single = .false.
+      real(c_float), pointer :: column32_real(:, :) => null(), column32_flat(:) => null(), row32_flat(:) => null()
+      complex(c_float_complex), pointer :: columns32(:, :) => null(), rows32(:, :) => null(), &
+         row32_values(:) => null()
+      type(c_ptr) :: columns_forward32 = c_null_ptr, columns_backward32 = c_null_ptr, rows_forward32 = c_null_ptr, &
+         rows_backward32 = c_null_ptr, to_rows32 = c_null_ptr, to_columns32 = c_null_ptr
+      !> Wall seconds so far in the transforms (the 1-D transforms, the multiplications
+      !> between them) and in FFTW-MPI's transposes.
+      real(dp) :: transform_seconds = 0, communication_seconds = 0
+   end type slab_transform
+
+contains
+
+   !> The transform of this rank's columns j0 + 1 .. j0 + nj of the NP x NP grid (every
+   !> rank's block_columns, but the last ranks'), zero-padded to 2 NP or, with `periodic`,
+   !> cyclic; measured plans with `measure`, the float32 ones too with `single`.
+   !> Collective over `comm`.
+   subroutine slab_setup(t, comm, np, j0, nj, block_columns, periodic, measure, single, status)
+      type(slab_transform), intent(inout) :: t
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: np, j0, nj, block_columns
+      logical, intent(in) :: periodic, measure, single
+      type(status_type), intent(inout) :: status
+      integer(c_intptr_t) :: alloc, dims(2), local_columns, column_start, local_freqs, freq_start
+      integer(c_int) :: flags
+      call slab_free(t)
+      t%comm = comm
+      t%np = np
+      t%j0 = j0
+      t%nj = nj
+      t%block_columns = block_columns
+      t%m = merge(np, 2*np, periodic)
+      t%mh = t%m/2 + 1
+      ! The transpose of the half spectrum: [np][mh] complex by columns (blocks of
+      ! block_columns) to [mh][np] by frequencies (FFTW's default block).
+      dims = [integer(c_intptr_t) :: np, t%mh]
+      alloc = fftw_mpi_local_size_many_transposed(2_c_int, dims, 2_c_intptr_t, int(block_columns, c_intptr_t), &
+         FFTW_MPI_DEFAULT_BLOCK, comm%MPI_VAL, local_columns, column_start, local_freqs, freq_start)
+      if (int(local_columns) /= nj .or. int(column_start) /= j0) then
+         call set_error(status, STATUS_NUMERICAL, "FFTW-MPI splits the columns otherwise than the solver: "// &
+            int_str(int(local_columns))//" from "//int_str(int(column_start))//" where this rank has "// &
+            int_str(nj)//" from "//int_str(j0))
+         return
+      end if
+      t%freqs = int(local_freqs)
+      t%freq_start = int(freq_start)
+      t%column_memory = fftw_alloc_complex(int(max(alloc/2, int(t%mh, c_intptr_t)*nj, 1_c_intptr_t), c_size_t))
+      t%row_memory = fftw_alloc_complex(int(max(alloc/2, int(t%m, c_intptr_t)*t%freqs, 1_c_intptr_t), c_size_t))
+      flags = FFTW_ESTIMATE
+      if (measure) flags = FFTW_MEASURE
+      call make_plans(t, flags, status)
+      if (status%code /= 0) return
+      t%has_single = single
+      if (single) call make_single_plans(t, flags, status)
+   end subroutine slab_setup
+
+   !> The double-precision views of the transform memory and their plans: the columns'
+   !> r2c and c2r of length m, the rows' complex transforms of length m, FFTW-MPI's two
+   !> transposes.
+   subroutine make_plans(t, flags, status)
+      type(slab_transform), intent(inout) :: t
+      integer(c_int), intent(in) :: flags
+      type(status_type), intent(inout) :: status
+      integer(c_int) :: m, mh, nj, freqs
+      m = int(t%m, c_int)
+      mh = int(t%mh, c_int)
+      nj = int(t%nj, c_int)
+      freqs = int(t%freqs, c_int)
+      call c_f_pointer(t%column_memory, t%column_real, [2*t%mh, t%nj])
+      call c_f_pointer(t%column_memory, t%column_flat, [2*t%mh*t%nj])
+      call c_f_pointer(t%column_memory, t%columns, [t%mh, t%nj])
+      call c_f_pointer(t%row_memory, t%rows, [t%m, max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%row_values, [t%m*max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%row_flat, [2*t%m*max(t%freqs, 1)])
+      t%columns_forward = fftw_plan_many_dft_r2c(1_c_int, [m], nj, t%column_real, [2*mh], 1_c_int, 2*mh, &
+         t%columns, [mh], 1_c_int, mh, flags)
+      t%columns_backward = fftw_plan_many_dft_c2r(1_c_int, [m], nj, t%columns, [mh], 1_c_int, mh, &
+         t%column_real, [2*mh], 1_c_int, 2*mh, flags)
+      if (t%freqs > 0) then
+         t%rows_forward = fftw_plan_many_dft(1_c_int, [m], freqs, t%rows, [m], 1_c_int, m, t%rows, [m], &
+            1_c_int, m, FFTW_FORWARD, flags)
+         t%rows_backward = fftw_plan_many_dft(1_c_int, [m], freqs, t%rows, [m], 1_c_int, m, t%rows, [m], &
+            1_c_int, m, FFTW_BACKWARD, flags)
+      end if
+      t%to_rows = fftw_mpi_plan_many_transpose(int(t%np, c_intptr_t), int(t%mh, c_intptr_t), 2_c_intptr_t, &
+         int(t%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, t%column_flat, t%row_flat, t%comm%MPI_VAL, flags)
+      t%to_columns = fftw_mpi_plan_many_transpose(int(t%mh, c_intptr_t), int(t%np, c_intptr_t), 2_c_intptr_t, &
+         FFTW_MPI_DEFAULT_BLOCK, int(t%block_columns, c_intptr_t), t%row_flat, t%column_flat, t%comm%MPI_VAL, flags)
+      if (.not. (c_associated(t%columns_forward) .and. c_associated(t%columns_backward) .and. &
+         c_associated(t%to_rows) .and. c_associated(t%to_columns) .and. (t%freqs == 0 .or. &
+         (c_associated(t%rows_forward) .and. c_associated(t%rows_backward))))) &
+         call set_error(status, STATUS_NUMERICAL, "FFTW made no plan for the "//int_str(t%m)//" x "// &
+         int_str(t%m)//" grid")
+   end subroutine make_plans
+
+   !> The float32 views of the same memory and their plans (fftwf, fftwf_mpi).
+   subroutine make_single_plans(t, flags, status)
+      type(slab_transform), intent(inout) :: t
+      integer(c_int), intent(in) :: flags
+      type(status_type), intent(inout) :: status
+      integer(c_int) :: m, mh, nj, freqs
+      m = int(t%m, c_int)
+      mh = int(t%mh, c_int)
+      nj = int(t%nj, c_int)
+      freqs = int(t%freqs, c_int)
+      call c_f_pointer(t%column_memory, t%column32_real, [2*t%mh, t%nj])
+      call c_f_pointer(t%column_memory, t%column32_flat, [2*t%mh*t%nj])
+      call c_f_pointer(t%column_memory, t%columns32, [t%mh, t%nj])
+      call c_f_pointer(t%row_memory, t%rows32, [t%m, max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%row32_values, [t%m*max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%row32_flat, [2*t%m*max(t%freqs, 1)])
+      t%columns_forward32 = fftwf_plan_many_dft_r2c(1_c_int, [m], nj, t%column32_real, [2*mh], 1_c_int, &
+         2*mh, t%columns32, [mh], 1_c_int, mh, flags)
+      t%columns_backward32 = fftwf_plan_many_dft_c2r(1_c_int, [m], nj, t%columns32, [mh], 1_c_int, mh, &
+         t%column32_real, [2*mh], 1_c_int, 2*mh, flags)
+      if (t%freqs > 0) then
+         t%rows_forward32 = fftwf_plan_many_dft(1_c_int, [m], freqs, t%rows32, [m], 1_c_int, m, t%rows32, &
+            [m], 1_c_int, m, FFTW_FORWARD, flags)
+         t%rows_backward32 = fftwf_plan_many_dft(1_c_int, [m], freqs, t%rows32, [m], 1_c_int, m, t%rows32, &
+            [m], 1_c_int, m, FFTW_BACKWARD, flags)
+      end if
+      t%to_rows32 = fftwf_mpi_plan_many_transpose(int(t%np, c_intptr_t), int(t%mh, c_intptr_t), &
+         2_c_intptr_t, int(t%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, t%column32_flat, &
+         t%row32_flat, t%comm%MPI_VAL, flags)
+      t%to_columns32 = fftwf_mpi_plan_many_transpose(int(t%mh, c_intptr_t), int(t%np, c_intptr_t), &
+         2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(t%block_columns, c_intptr_t), t%row32_flat, &
+         t%column32_flat, t%comm%MPI_VAL, flags)
+      if (.not. (c_associated(t%columns_forward32) .and. c_associated(t%columns_backward32) .and. &
+         c_associated(t%to_rows32) .and. c_associated(t%to_columns32) .and. (t%freqs == 0 .or. &
+         (c_associated(t%rows_forward32) .and. c_associated(t%rows_backward32))))) &
+         call set_error(status, STATUS_NUMERICAL, "FFTW made no float32 plan for the "//int_str(t%m)//" x "// &
+         int_str(t%m)//" grid")
+   end subroutine make_single_plans
+
+   subroutine slab_free(t)
+      type(slab_transform), intent(inout) :: t
+      integer :: k
+      type(c_ptr) :: plans(6)
+      plans = [t%columns_forward, t%columns_backward, t%rows_forward, t%rows_backward, t%to_rows, t%to_columns]
+      do k = 1, size(plans)
+         if (c_associated(plans(k))) call fftw_destroy_plan(plans(k))
+      end do
+      plans = [t%columns_forward32, t%columns_backward32, t%rows_forward32, t%rows_backward32, t%to_rows32, &
+         t%to_columns32]
+      do k = 1, size(plans)
+         if (c_associated(plans(k))) call fftwf_destroy_plan(plans(k))
+      end do
+      if (c_associated(t%column_memory)) call fftw_free(t%column_memory)
+      if (c_associated(t%row_memory)) call fftw_free(t%row_memory)
+      t = slab_transform()
+   end subroutine slab_free
+
+   !> The field f (np, nj; this rank's columns) zero-padded into the columns and
+   !> transformed: its spectrum in t%rows. Collective.
+   subroutine slab_forward_field(t, f)
+      type(slab_transform), intent(inout) :: t
+      real(dp), intent(in) :: f(:, :)
+      integer :: j
+      real(dp) :: t0, t1
+      call wall_clock(t0)
+      !$omp parallel do
+      do j = 1, t%nj
+         t%column_real(1:t%np, j) = f(:, j)
+         t%column_real(t%np + 1:, j) = 0
+      end do
+      call wall_clock(t1)
+      t%transform_seconds = t%transform_seconds + (t1 - t0)
+      call slab_forward(t, PAD_ZEROS)
+   end subroutine slab_forward_field
+
+   !> The columns as they stand in t%column_real (m values each) transformed, the rows
+   !> extended by `rows` (PAD_ZEROS, EXTEND_EVEN or EXTEND_ODD): the spectrum in t%rows.
+   !> Collective.
+   subroutine slab_forward(t, rows)
+      type(slab_transform), intent(inout) :: t
+      integer, intent(in) :: rows
+      real(dp) :: t0, t1, t2, t3
+      call wall_clock(t0)
+      call fftw_execute_dft_r2c(t%columns_forward, t%column_real, t%columns)
+      call wall_clock(t1)
+      call fftw_mpi_execute_r2r(t%to_rows, t%column_flat, t%row_flat)
+      call wall_clock(t2)
+      call expand_rows(t, rows)
+      if (t%freqs > 0) call fftw_execute_dft(t%rows_forward, t%rows, t%rows)
+      call wall_clock(t3)
+      t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
+      t%communication_seconds = t%communication_seconds + (t2 - t1)
+   end subroutine slab_forward
+
+   !> The spectrum in t%rows transformed back: out (np, nj), this rank's columns, not
+   !> normalised (FFTW's transforms). Collective.
+   subroutine slab_backward(t, out)
+      type(slab_transform), intent(inout) :: t
+      real(dp), intent(out) :: out(:, :)
+      integer :: j
+      real(dp) :: t0, t1, t2, t3
+      call wall_clock(t0)
+      if (t%freqs > 0) call fftw_execute_dft(t%rows_backward, t%rows, t%rows)
+      call compress_rows(t)
+      call wall_clock(t1)
+      call fftw_mpi_execute_r2r(t%to_columns, t%row_flat, t%column_flat)
+      call wall_clock(t2)
+      call fftw_execute_dft_c2r(t%columns_backward, t%columns, t%column_real)
+      !$omp parallel do
+      do j = 1, t%nj
+         out(:, j) = t%column_real(1:t%np, j)
+      end do
+      call wall_clock(t3)
+      t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
+      t%communication_seconds = t%communication_seconds + (t2 - t1)
+   end subroutine slab_backward
+
+   !> slab_forward_field in float32: the spectrum in t%rows32. Collective.
+   subroutine slab_forward_single(t, f)
+      type(slab_transform), intent(inout) :: t
+      real(dp), intent(in) :: f(:, :)
+      integer :: j, k, i, np, m
+      real(dp) :: t0, t1, t2, t3
+      np = t%np
+      m = t%m
+      call wall_clock(t0)
+      !$omp parallel do
+      do j = 1, t%nj
+         t%column32_real(1:np, j) = real(f(:, j), sp)
+         t%column32_real(np + 1:, j) = 0
+      end do
+      call fftwf_execute_dft_r2c(t%columns_forward32, t%column32_real, t%columns32)
+      call wall_clock(t1)
+      call fftwf_mpi_execute_r2r(t%to_rows32, t%column32_flat, t%row32_flat)
+      call wall_clock(t2)
+      ! As expand_rows (zero padding), in float32.
+      do k = t%freqs, 1, -1
+         do i = np, 1, -1
+            t%row32_values((k - 1)*m + i) = t%row32_values((k - 1)*np + i)
+         end do
+         t%row32_values((k - 1)*m + np + 1:k*m) = 0
+      end do
+      if (t%freqs > 0) call fftwf_execute_dft(t%rows_forward32, t%rows32, t%rows32)
+      call wall_clock(t3)
+      t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
+      t%communication_seconds = t%communication_seconds + (t2 - t1)
+   end subroutine slab_forward_single
+
+   !> slab_backward in float32: into out (double) or out32. Collective.
+   subroutine slab_backward_single(t, out, out32)
+      type(slab_transform), intent(inout) :: t
+      real(dp), intent(out), optional :: out(:, :)
+      real(sp), intent(out), optional :: out32(:, :)
+      integer :: j, k, i, np, m
+      real(dp) :: t0, t1, t2, t3
+      np = t%np
+      m = t%m
+      call wall_clock(t0)
+      if (t%freqs > 0) call fftwf_execute_dft(t%rows_backward32, t%rows32, t%rows32)
+      ! As compress_rows, in float32.
+      do k = 1, t%freqs
+         do i = 1, np
+            t%row32_values((k - 1)*np + i) = t%row32_values((k - 1)*m + i)
+         end do
+      end do
+      call wall_clock(t1)
+      call fftwf_mpi_execute_r2r(t%to_columns32, t%row32_flat, t%column32_flat)
+      call wall_clock(t2)
+      call fftwf_execute_dft_c2r(t%columns_backward32, t%columns32, t%column32_real)
+      if (present(out32)) then
+         !$omp parallel do
+         do j = 1, t%nj
+            out32(:, j) = t%column32_real(1:np, j)
+         end do
+      else
+         !$omp parallel do
+         do j = 1, t%nj
+            out(:, j) = real(t%column32_real(1:np, j), dp)
+         end do
+      end if
+      call wall_clock(t3)
+      t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
+      t%communication_seconds = t%communication_seconds + (t2 - t1)
+   end subroutine slab_backward_single
+
+   !> The transposed rows (np values per frequency, packed) spread in place to rows of m:
+   !> zero-padded, or evenly (x(m - q) = x(q)) or oddly (x(m - q) = -x(q)) extended, with
+   !> x(np) = 0. From the last row down, each from its end: nothing is overwritten
+   !> before it is read.
+   subroutine expand_rows(t, how)
+      type(slab_transform), intent(inout) :: t
+      integer, intent(in) :: how
+      integer :: k, i, np, m
+      np = t%np
+      m = t%m
+      ! Rows of np are rows of m already on the periodic cell (m = np).
+      if (m == np) return
+      do k = t%freqs, 1, -1
+         do i = np, 1, -1
+            t%row_values((k - 1)*m + i) = t%row_values((k - 1)*np + i)
+         end do
+         t%row_values((k - 1)*m + np + 1) = 0
+         if (how == PAD_ZEROS) then
+            t%row_values((k - 1)*m + np + 2:k*m) = 0
+         else
+            do i = np + 2, m
+               t%row_values((k - 1)*m + i) = how*t%row_values((k - 1)*m + m - i + 2)
+            end do
+         end if
+      end do
+   end subroutine expand_rows
+
+   !> The first np values of each row of m packed again for the transpose back (from the
+   !> first row up: nothing is overwritten before it is read).
+   subroutine compress_rows(t)
+      type(slab_transform), intent(inout) :: t
+      integer :: k, i, np, m
+      np = t%np
+      m = t%m
+      if (m == np) return
+      do k = 1, t%freqs
+         do i = 1, np
+            t%row_values((k - 1)*np + i) = t%row_values((k - 1)*m + i)
+         end do
+      end do
+   end subroutine compress_rows
+end module femcod_mpi_slab_transform
