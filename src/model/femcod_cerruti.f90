@@ -31,7 +31,8 @@ module femcod_cerruti
    use femcod_love_periodic, only: periodic_cerruti_spectra
    implicit none
    private
-   public :: cerruti_integrals, tangential_tables, second_dundurs_constant, periodic_tangential_spectra
+   public :: cerruti_integrals, tangential_tables, tangential_table_column, second_dundurs_constant, &
+      periodic_tangential_spectra, periodic_tangential_spectra_rows
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -93,25 +94,35 @@ contains
       integer, intent(in) :: np
       real(dp), intent(in) :: pixel, young(2), poisson(2)
       real(dp), intent(out) :: xx(0:np - 1, 0:np - 1), yy(0:np - 1, 0:np - 1), xy(0:np - 1, 0:np - 1)
+      integer :: q
+      do q = 0, np - 1
+         call tangential_table_column(np, q, pixel, young, poisson, xx(:, q), yy(:, q), xy(:, q))
+      end do
+   end subroutine tangential_tables
+
+   !> Column q of tangential_tables: the offsets (p, q), p = 0 .. np-1 (so that a process
+   !> holding some columns makes only its own).
+   pure subroutine tangential_table_column(np, q, pixel, young, poisson, xx, yy, xy)
+      integer, intent(in) :: np, q
+      real(dp), intent(in) :: pixel, young(2), poisson(2)
+      real(dp), intent(out) :: xx(0:np - 1), yy(0:np - 1), xy(0:np - 1)
       real(dp) :: w(3), c(2)
-      integer :: p, q, b
+      integer :: p, b
       do b = 1, 2
          c(b) = (1 + poisson(b))/(pi*young(b)*pixel)
       end do
-      do q = 0, np - 1
-         do p = 0, np - 1
-            w = cerruti_integrals(p, q)
-            xx(p, q) = 0
-            yy(p, q) = 0
-            xy(p, q) = 0
-            do b = 1, 2
-               xx(p, q) = xx(p, q) + c(b)*(w(1) + (1 - poisson(b))*w(2))
-               yy(p, q) = yy(p, q) + c(b)*(w(2) + (1 - poisson(b))*w(1))
-               xy(p, q) = xy(p, q) + c(b)*poisson(b)*w(3)
-            end do
+      do p = 0, np - 1
+         w = cerruti_integrals(p, q)
+         xx(p) = 0
+         yy(p) = 0
+         xy(p) = 0
+         do b = 1, 2
+            xx(p) = xx(p) + c(b)*(w(1) + (1 - poisson(b))*w(2))
+            yy(p) = yy(p) + c(b)*(w(2) + (1 - poisson(b))*w(1))
+            xy(p) = xy(p) + c(b)*poisson(b)*w(3)
          end do
       end do
-   end subroutine tangential_tables
+   end subroutine tangential_table_column
 
    !> The periodic cell's tangential compliance spectra (nm/nN; the DFT of the tables of
    !> the kernel summed over all images, zero-mean), in the layout of a 2-D r2c transform
@@ -123,9 +134,20 @@ contains
       integer, intent(in) :: np
       real(dp), intent(in) :: pixel, young(2), poisson(2)
       real(dp), intent(out) :: xx(np/2 + 1, np), yy(np/2 + 1, np), xy(np/2 + 1, np)
+      call periodic_tangential_spectra_rows(np, 0, np/2 + 1, pixel, young, poisson, xx, yy, xy)
+   end subroutine periodic_tangential_spectra
+
+   !> The rows kp = first .. first + count - 1 of periodic_tangential_spectra:
+   !> xx(kp - first + 1, kq + 1) (so that a process holding some of the rows' frequencies,
+   !> femcod-mpi's ranks, keeps only its own; each makes the quarter alias sums).
+   subroutine periodic_tangential_spectra_rows(np, first, count, pixel, young, poisson, xx, yy, xy)
+      integer, intent(in) :: np, first, count
+      real(dp), intent(in) :: pixel, young(2), poisson(2)
+      real(dp), intent(out) :: xx(count, np), yy(count, np), xy(count, np)
       real(dp), allocatable :: wxx(:, :), wc(:, :)
       real(dp) :: c(2), w1, w2, w3
-      integer :: kp, kq, q, b
+      integer :: kp, kq, q, b, r
+      if (count <= 0) return
       allocate(wxx(0:np/2, 0:np/2), wc(0:np/2, 0:np/2))
       call periodic_cerruti_spectra(np, wxx, wc)
       do b = 1, 2
@@ -133,23 +155,24 @@ contains
       end do
       do kq = 0, np - 1
          q = min(kq, np - kq)
-         do kp = 0, np/2
+         do r = 1, count
+            kp = first + r - 1
             ! wxx(kx, ky): the X^2 integral at column frequency kx, row frequency ky.
             w1 = wxx(q, kp)
             w2 = wxx(kp, q)
             w3 = wc(q, kp)
             if (kq > np/2) w3 = -w3
-            xx(kp + 1, kq + 1) = 0
-            yy(kp + 1, kq + 1) = 0
-            xy(kp + 1, kq + 1) = 0
+            xx(r, kq + 1) = 0
+            yy(r, kq + 1) = 0
+            xy(r, kq + 1) = 0
             do b = 1, 2
-               xx(kp + 1, kq + 1) = xx(kp + 1, kq + 1) + c(b)*(w1 + (1 - poisson(b))*w2)
-               yy(kp + 1, kq + 1) = yy(kp + 1, kq + 1) + c(b)*(w2 + (1 - poisson(b))*w1)
-               xy(kp + 1, kq + 1) = xy(kp + 1, kq + 1) + c(b)*poisson(b)*w3
+               xx(r, kq + 1) = xx(r, kq + 1) + c(b)*(w1 + (1 - poisson(b))*w2)
+               yy(r, kq + 1) = yy(r, kq + 1) + c(b)*(w2 + (1 - poisson(b))*w1)
+               xy(r, kq + 1) = xy(r, kq + 1) + c(b)*poisson(b)*w3
             end do
          end do
       end do
-   end subroutine periodic_tangential_spectra
+   end subroutine periodic_tangential_spectra_rows
 
    !> Dundurs' second constant of two bodies (E GPa, nu): beta = [G1 (1 - 2 nu2) - G2
    !> (1 - 2 nu1)] / [2 G1 (1 - nu2) + 2 G2 (1 - nu1)]: the coupling of normal and
