@@ -75,8 +75,6 @@ expect 2 "--generate of a kind the ranks do not make refused" mpirun_2 "$femcod_
 expect 2 "--generate next to a deck refused" mpirun_2 "$femcod_mpi" "$deck" --generate self-affine --np 32 \
   --pixel 1 --loads 10 -o "$work/bad"
 expect 2 "the event solver refused" mpirun_2 "$femcod_mpi" "$deck" --solver incremental --loads 10 -o "$work/bad"
-expect 2 "--tangential (one node only) refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 --tangential 1 \
-  --friction 0.3 -o "$work/bad"
 printf 'a deck\n3 1 x\n' >"$work/broken.deck"
 expect 3 "a broken deck" mpirun_2 "$femcod_mpi" "$work/broken.deck" --loads 10 -o "$work/bad"
 printf '1 2 3\n4 5 6\n7 8 9\n' >"$work/tiny.txt"
@@ -139,7 +137,9 @@ if [ "$got" -eq 3 ] && grep -q "late.deck:[0-9]*: expected an upper-surface heig
 else echo "  FAILED   a late bad height (exit $got)"; sed 's/^/           /' "$work/late.out" | head -3; failed=1; fi
 # The combination matrix on 2 ranks (issue 34): boundary x plastic cap x interface law x
 # question (loads, increasing, decreasing approaches) x (plain, --restart, the shear model
-# --shear-strength 0 --shear-slope 0.1: friction as serial too) on the 2 nm sphere. Each
+# --shear-strength 0 --shear-slope 0.1: friction as serial too, a tangential step
+# --tangential 40 --friction 0.3: its force, shift and sticking pixels as serial's too) on
+# the 2 nm sphere. Each
 # combination answers (exit 0, as serial `femcod run --solver cg` does: loads, approaches
 # and plastic volumes to 1e-6, the same contact and plastic counts) or is refused (exit 2)
 # with no output and no lock; none ends in a runtime error. With --kernel-radius once more,
@@ -157,11 +157,17 @@ keys = ["load_nN", "approach_nm", "plastic_volume_nm3"]
 assert ("friction_nN" in a[0]) == ("friction_nN" in b[0]), "friction columns in one file only"
 if "friction_nN" in a[0]:
     keys.append("friction_nN")
+counts = ["contacts", "n_plastic"]
+# The tangential step's columns (a shift of NaN beyond mu P: NaN on both).
+assert ("tangential_force_nN" in a[0]) == ("tangential_force_nN" in b[0]), "tangential columns in one file only"
+if "tangential_force_nN" in a[0]:
+    keys += ["tangential_force_nN", "tangential_shift_nm"]
+    counts.append("stick_contacts")
 for x, y in zip(a, b):
     for key in keys:
         u, v = float(x[key]), float(y[key])
-        assert abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
-    for key in ("contacts", "n_plastic"):
+        assert (u != u and v != v) or abs(u - v) <= 1e-6 * max(1.0, abs(u)), (key, u, v)
+    for key in counts:
         assert x[key] == y[key], (key, x[key], y[key])
 PY
 }
@@ -193,7 +199,7 @@ matrix_deck=../input/sphere_d2.deck
 combos=0; answered=0; refused=0; matrix_failed=0
 for boundary in free periodic; do for plastic in "" "--plastic --hardness 11"; do
 for law in none dugdale exponential; do for question in "--loads 300,800" "--approach 0.5,1" "--approach 1,0.5"; do
-for variant in "" "--restart" "--shear-strength 0 --shear-slope 0.1"; do
+for variant in "" "--restart" "--shear-strength 0 --shear-slope 0.1" "--tangential 40 --friction 0.3"; do
   combos=$((combos + 1))
   args="--boundary $boundary $plastic $question --tol 1e-10 --max-iterations 20000 $variant --quiet"
   [ "$law" = none ] || args="$args --adhesion $law --work 0.05 --range 1"

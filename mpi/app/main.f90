@@ -52,6 +52,9 @@ program femcod_mpi
    use femcod_solver_options, only: by_gap_variables, run_shear_model, &
       SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL
    use femcod_shear_model, only: friction_coefficient
+   use femcod_tangential, only: tangential_request, tangential_storage_bytes
+   use femcod_mpi_shear, only: tangential_on_ranks
+   use femcod_result_schema, only: TANGENTIAL_COLUMNS
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -201,6 +204,8 @@ program femcod_mpi
       settings%solve%hardness, settings%solve%plastic, by_approach(), make_interface_law(settings%solve%adhesion, &
       settings%solve%work, settings%solve%range, grid%pixel, settings%solve%plastic, settings%solve%hardness), &
       run_shear_model(settings%solve))
+   if (status%code == 0 .and. settings%solve%tangential) call tangential_on_ranks(grid, problem, tangential_of(), &
+      states, status, observer)
    call wall_clock(t_solve)
    if (status%code /= 0) then
       if (status%code == STATUS_INTERRUPTED) call finish(128 + stop_signal(), signal_name(stop_signal())//": "// &
@@ -224,6 +229,7 @@ program femcod_mpi
    info%ranks = ranks
    info%threads = omp_get_max_threads()
    info%friction = settings%solve%shear
+   info%tangential = settings%solve%tangential
    if (.not. allocated(info%label)) info%label = ""
    info%wall_seconds = t_solve - t_start
    call write_distributed_results(prefix//".h5.part", grid, states, info, status)
@@ -267,8 +273,9 @@ contains
 
    !> The options femcod run has and femcod-mpi does not (yet): refused, not ignored.
    !> The ranks run femcod_cg's fixed-load and fixed-approach solve (with --plastic and
-   !> --kernel-radius) and its gap-variable path (--adhesion, or --plastic with
-   !> --approach) on the free surface or the periodic cell.
+   !> --kernel-radius), its gap-variable path (--adhesion, or --plastic with --approach)
+   !> and the tangential step (--tangential, --slip) on the free surface or the periodic
+   !> cell.
    subroutine refuse_unsupported(settings, status)
       type(run_settings), intent(in) :: settings
       type(status_type), intent(inout) :: status
@@ -282,9 +289,6 @@ contains
          else if (size(targets()) == 0) then
             call set_error(status, STATUS_USAGE, "give the loads or the approaches: --loads F1,F2,... or "// &
                "--approach D1,D2,...")
-         else if (o%tangential) then
-            call set_error(status, STATUS_USAGE, "--tangential/--slip: the tangential step runs on one node: "// &
-               "femcod run")
          else if (o%boundary == BOUNDARY_PERIODIC .and. o%cg%kernel_radius > 0) then
             call set_error(status, STATUS_USAGE, "--kernel-radius with --boundary periodic: the ranks take the "// &
                "periodic kernel's spectrum in closed form, untruncated; it runs on one node: femcod run --solver cg")
@@ -408,6 +412,8 @@ contains
       ! The gap variables: their transform grid besides the fixed-load solver's grid.
       if (by_gap_variables(settings%solve)) estimated_rank_bytes = estimated_rank_bytes + &
          gap_solver_storage_bytes(n, nstates, settings%solve%boundary == BOUNDARY_PERIODIC, settings%solve%plastic)
+      ! The tangential step: its operator and grids besides the solver's.
+      if (settings%solve%tangential) estimated_rank_bytes = estimated_rank_bytes + tangential_storage_bytes(n)
       estimated_rank_bytes = resident_bytes() + (estimated_rank_bytes + ranks - 1)/ranks
       call MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
       call MPI_Allreduce(estimated_rank_bytes, on_node, 1, MPI_INTEGER8, MPI_SUM, node)
@@ -487,13 +493,15 @@ contains
       integer :: s
       text = "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
          "plastic_volume_nm3"//trim(merge(",friction_nN,friction_coefficient", "                                 ", &
-         settings%solve%shear))//",patches_4,patches_8"//new_line('a')
+         settings%solve%shear))//trim(merge(TANGENTIAL_COLUMNS, repeat(" ", len(TANGENTIAL_COLUMNS)), &
+         settings%solve%tangential))//",patches_4,patches_8"//new_line('a')
       do s = 1, size(states)
          associate(st => states(s))
             text = text//format_real(st%load)//","//format_real(st%approach)//","//int_str(st%contacts)//","// &
                format_real(st%contacts*grid%pixel**2)//","//format_real(real(st%contacts, dp)/real(np, dp)**2)//","// &
                format_real(st%max_pressure)//","//int_str(st%above_hardness)//","//int_str(st%n_plastic)//","// &
-               format_real(st%plastic_volume)//friction_fields(st)//","//int_str(st%patches_4)//","// &
+               format_real(st%plastic_volume)//friction_fields(st)//tangential_fields(st)//","// &
+               int_str(st%patches_4)//","// &
                int_str(st%patches_8)//new_line('a')
          end associate
       end do
@@ -507,6 +515,31 @@ contains
       if (settings%solve%shear) text = ","//format_real(st%friction)//","// &
          format_real(friction_coefficient(st%friction, st%load, st%contacts))
    end function friction_fields
+
+   !> ",Q,delta,stick,stick_fraction" of a state's tangential step (the serial writer's
+   !> columns); "" without --tangential or --slip.
+   function tangential_fields(st) result(text)
+      type(distributed_state), intent(in) :: st
+      character(len=:), allocatable :: text
+      text = ""
+      if (.not. settings%solve%tangential) return
+      if (st%contacts == 0) then
+         text = ",0,0,0,nan"
+         return
+      end if
+      text = ","//format_real(st%tangential_force(1))//","//format_real(st%tangential_shift(1))//","// &
+         int_str(st%stick_contacts)//","//format_real(real(st%stick_contacts, dp)/max(st%contacts, 1))
+   end function tangential_fields
+
+   !> What the tangential step asks (--friction, --tangential or --slip).
+   function tangential_of() result(request)
+      type(tangential_request) :: request
+      request%mu = settings%solve%friction
+      request%by_slip = settings%solve%by_slip
+      request%load = settings%solve%tangential_load
+      request%slip = settings%solve%slip
+      request%periodic = settings%solve%boundary == BOUNDARY_PERIODIC
+   end function tangential_of
 
    !> The summary as JSON: numbers with their units in the names.
    function summary_json() result(text)
@@ -545,6 +578,12 @@ contains
                ', "attractive_load_nN": '//json_number(st%attractive_load)//', "jump": '//int_str(st%jump)
             if (settings%solve%shear) text = text//', "friction_nN": '//json_number(st%friction)// &
                ', "friction_coefficient": '//json_number(friction_coefficient(st%friction, st%load, st%contacts))
+            if (settings%solve%tangential) text = text//', "tangential_force_nN": '// &
+               json_number(st%tangential_force(1))//', "tangential_shift_nm": '//json_number(st%tangential_shift(1))// &
+               ', "stick_contacts": '//int_str(st%stick_contacts)//', "stick_area_nm2": '// &
+               json_number(st%stick_contacts*grid%pixel**2)//', "gross_sliding": '// &
+               trim(merge("true ", "false", st%sliding))//', "tangential_iterations": '// &
+               int_str(st%tangential_iterations)//', "tangential_residual": '//json_number(st%tangential_residual)
             text = text//'}'
          end associate
          if (s < size(states)) text = text//', '
@@ -575,6 +614,11 @@ contains
                " on coarser grids), "//int_str(st%cg%convolutions)//" fresh convolutions, residual "// &
                sig_str(st%cg%residual, 2)//", "//sig_str(st%seconds, 3)//" s (rank 0: transforms "// &
                sig_str(st%transform_seconds, 3)//" s, communication "//sig_str(st%communication_seconds, 3)//" s)"
+            if (settings%solve%tangential .and. st%contacts > 0) write(output_unit, '(a)') "    tangential "// &
+               sig_str(st%tangential_force(1), 6)//" nN, shift "//sig_str(st%tangential_shift(1), 6)//" nm"// &
+               trim(merge(" (gross sliding)", "                ", st%sliding))//"; "//int_str(st%stick_contacts)// &
+               " of "//int_str(st%contacts)//" contacts stick; "//int_str(st%tangential_iterations)// &
+               " iterations, residual "//sig_str(st%tangential_residual, 2)
          end associate
       end do
       write(output_unit, '(a)') "  peak memory per rank: "//sig_str(maxval(info%peak_mb), 4)//" MB (largest), "// &
@@ -600,12 +644,14 @@ contains
       write(output_unit, '(a)') "  --boundary free|periodic, --plastic --hardness H, --kernel-radius R (free surface,"
       write(output_unit, '(a)') "  --loads), --adhesion dugdale|exponential --work W --range R (with --approach),"
       write(output_unit, '(a)') "  --shear-strength TAU0 --shear-slope ALPHA (friction from the pressures), --tol T"
-      write(output_unit, '(a)') "  (default 1e-8),"
+      write(output_unit, '(a)') "  (default 1e-8), --tangential Q or --slip S with --friction MU (a tangential"
+      write(output_unit, '(a)') "  step with Coulomb friction at each state),"
       write(output_unit, '(a)') "  --max-iterations N, -o PREFIX, --outdir DIR, --force, --quiet; the height-file"
       write(output_unit, '(a)') "  options (--lower, --upper, --pixel, --young, --poisson, --height-unit, ...)"
       write(output_unit, '(a)') "Refused (they run on one node with femcod run): --kernel-radius on the periodic"
-      write(output_unit, '(a)') "cell, --tangential and --slip, several decks, the event solvers."
-      write(output_unit, '(a)') "Writes PREFIX.h5 (/deck, /loads/<kkk> with pressure and gap maps, /run with the"
+      write(output_unit, '(a)') "cell, several decks, the event solvers."
+      write(output_unit, '(a)') "Writes PREFIX.h5 (/deck, /loads/<kkk> with pressure and gap maps and, with a"
+      write(output_unit, '(a)') "tangential step, shear_x, shear_y, stick and slip, /run with the"
       write(output_unit, '(a)') "peak memory of every rank) and PREFIX.summary.json. Exit codes: 0 ok, 2 usage,"
       write(output_unit, '(a)') "3 bad input, 4 numerical failure, 5 I/O, 128 + signal after SIGTERM/SIGINT/SIGUSR1."
       write(output_unit, '(a)') "Ranks and threads: doc/cluster.md."

@@ -125,6 +125,16 @@ module femcod_mpi_cg
       real(dp) :: friction = 0
       !> The contact patches over all ranks, 4- and 8-connected (femcod_mpi_patches).
       integer :: patches_4 = 0, patches_8 = 0
+      !> With --tangential or --slip (femcod_mpi_shear): this rank's contact pixels (rows,
+      !> columns 1 .. nj, in column order), their tangential forces (nN) and whether each
+      !> sticks; over all ranks the sticking pixels, the shift (nm), the force (nN), gross
+      !> sliding, the iterations and the residual (solvers/femcod_tangential's answer).
+      integer, allocatable :: tangential_i(:), tangential_j(:)
+      real(dp), allocatable :: shear_x(:), shear_y(:)
+      logical, allocatable :: stick(:)
+      integer :: stick_contacts = 0, tangential_iterations = 0
+      real(dp) :: tangential_shift(2) = 0, tangential_force(2) = 0, tangential_residual = 0
+      logical :: sliding = .false.
    end type distributed_state
 
 contains

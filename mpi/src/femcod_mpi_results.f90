@@ -27,6 +27,9 @@ module femcod_mpi_results
       real(dp) :: wall_seconds = 0
       !> With the shear model: each load group gets friction_nN and friction_coefficient.
       logical :: friction = .false.
+      !> With a tangential step: each load group gets its attributes and maps (the serial
+      !> writer's: femcod_results_hdf5's write_tangential).
+      logical :: tangential = .false.
       !> Peak resident memory of each rank (MB).
       real(dp), allocatable :: peak_mb(:)
    end type distributed_run_info
@@ -76,6 +79,17 @@ contains
                   call h5_attribute(file, g, "friction_coefficient", &
                      friction_coefficient(s%friction, s%load, s%contacts), status)
                end if
+               if (info%tangential) then
+                  call h5_attribute(file, g, "tangential_force_nN", s%tangential_force(1), status)
+                  call h5_attribute(file, g, "tangential_force_y_nN", s%tangential_force(2), status)
+                  call h5_attribute(file, g, "tangential_shift_nm", s%tangential_shift(1), status)
+                  call h5_attribute(file, g, "tangential_shift_y_nm", s%tangential_shift(2), status)
+                  call h5_attribute(file, g, "stick_contacts", s%stick_contacts, status)
+                  call h5_attribute(file, g, "stick_area_nm2", s%stick_contacts*grid%pixel**2, status)
+                  call h5_attribute(file, g, "gross_sliding", merge(1, 0, s%sliding), status)
+                  call h5_attribute(file, g, "tangential_iterations", s%tangential_iterations, status)
+                  call h5_attribute(file, g, "tangential_residual", s%tangential_residual, status)
+               end if
             end associate
          end do
          call h5_group(file, "/run", status)
@@ -99,7 +113,7 @@ contains
       end if
       call agree(status, grid%comm)
       if (status%code /= 0) return
-      call write_maps(path, grid, states, status)
+      call write_maps(path, grid, states, info%tangential, status)
       code = status%code
       call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, grid%comm)
       if (code /= 0 .and. status%code == 0) call set_error(status, code, path//": another rank failed to write its maps")
@@ -124,11 +138,14 @@ contains
       call h5_close(file, status)
    end subroutine write_peaks
 
-   !> Each load's /pressure (GPa) and /gap (nm): every rank its columns, collectively.
-   subroutine write_maps(path, grid, states, status)
+   !> Each load's /pressure (GPa) and /gap (nm), and with `tangential` the tractions
+   !> shear_x, shear_y (GPa) and the stick and slip maps (1 where the contact sticks, or
+   !> slips): every rank its columns, collectively.
+   subroutine write_maps(path, grid, states, tangential, status)
       character(len=*), intent(in) :: path
       type(distributed_grid), intent(in) :: grid
       type(distributed_state), intent(in) :: states(:)
+      logical, intent(in) :: tangential
       type(status_type), intent(inout) :: status
       integer(hid_t) :: fapl, dxpl, fid
       type(h5_file) :: file
@@ -152,11 +169,32 @@ contains
          call write_map(g//"/pressure", states(k)%force/grid%pixel**2, "GPa")
          call write_map(g//"/gap", states(k)%gap, "nm")
          if (allocated(states(k)%plastic)) call write_map(g//"/plastic_displacement", states(k)%plastic, "nm")
+         if (tangential) call write_tangential_maps(g, states(k))
       end do
       call h5pclose_f(dxpl, error)
       call h5fclose_f(fid, error)
       if (error /= 0 .and. status%code == 0) call set_error(status, STATUS_IO, path//": error closing the file")
    contains
+      !> The tangential step's four maps of one state (zero where it has no contact).
+      subroutine write_tangential_maps(g, st)
+         character(len=*), intent(in) :: g
+         type(distributed_state), intent(in) :: st
+         real(dp), allocatable :: map(:, :, :)
+         integer :: n
+         allocate(map(grid%np, grid%nj, 4))
+         map = 0
+         if (allocated(st%stick)) then
+            do n = 1, size(st%stick)
+               map(st%tangential_i(n), st%tangential_j(n), :) = [st%shear_x(n)/grid%pixel**2, &
+                  st%shear_y(n)/grid%pixel**2, merge(1.0_dp, 0.0_dp, st%stick(n)), merge(0.0_dp, 1.0_dp, st%stick(n))]
+            end do
+         end if
+         call write_map(g//"/shear_x", map(:, :, 1), "GPa")
+         call write_map(g//"/shear_y", map(:, :, 2), "GPa")
+         call write_map(g//"/stick", map(:, :, 3), "1")
+         call write_map(g//"/slip", map(:, :, 4), "1")
+      end subroutine write_tangential_maps
+
       subroutine write_map(name, local, units)
          character(len=*), intent(in) :: name, units
          real(dp), intent(in) :: local(:, :)

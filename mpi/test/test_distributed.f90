@@ -21,6 +21,8 @@ module test_distributed
    use femcod_scene, only: initial_gap_map
    use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, &
       coarse_factor, distribute_problem, distributed_convolve
+   use femcod_tangential, only: tangential_request
+   use femcod_mpi_shear, only: tangential_on_ranks
    implicit none
    private
    public :: collect_distributed
@@ -51,7 +53,11 @@ contains
          new_unittest("--boundary periodic --approach: the serial loads on 1, 2 and 4 ranks", &
          test_periodic_approach_against_serial), &
          new_unittest("--shear-strength --shear-slope --plastic: the serial friction on 1, 2 and 4 ranks", &
-         test_friction_against_serial) &
+         test_friction_against_serial), &
+         new_unittest("--tangential (partial slip): the serial tractions and stick map on 1, 2 and 4 ranks", &
+         test_tangential_against_serial), &
+         new_unittest("--boundary periodic --slip: the serial tractions and stick map on 1, 2 and 4 ranks", &
+         test_periodic_slip_against_serial) &
          ]
    end subroutine collect_distributed
 
@@ -351,6 +357,35 @@ contains
       call against_serial(error, options)
    end subroutine test_friction_against_serial
 
+   !> The tangential step after the normal one (solvers/femcod_tangential through
+   !> femcod_mpi_shear's operator): a force of 900 nN (mu = 0.5: 0.6 mu P at the first load,
+   !> 0.09 mu P at the second; partial slip, some pixels sticking, some slipping), the
+   !> shift, the force and every traction within 1e-8 of the serial step's (the largest
+   !> traction's), the same stick map pixel for pixel.
+   subroutine test_tangential_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%loads = [3.0e3_dp, 2.0e4_dp]
+      options%tangential = .true.
+      options%friction = 0.5_dp
+      options%tangential_load = 900
+      call against_serial(error, options)
+   end subroutine test_tangential_against_serial
+
+   !> The same on the periodic cell under a rigid shift (slip control, 0.05 nm: partial
+   !> slip at both loads), the Cerruti spectra in closed form on each rank's frequencies.
+   subroutine test_periodic_slip_against_serial(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%loads = [3.0e3_dp, 2.0e4_dp]
+      options%boundary = BOUNDARY_PERIODIC
+      options%tangential = .true.
+      options%by_slip = .true.
+      options%friction = 0.5_dp
+      options%slip = 0.05_dp
+      call against_serial(error, options)
+   end subroutine test_periodic_slip_against_serial
+
    !> The periodic cell under displacement control (the fall of the mean gap; 2 and 6 %
    !> of the height range, below the mean gap).
    subroutine test_periodic_approach_against_serial(error)
@@ -420,7 +455,7 @@ contains
       real(dp), allocatable :: forces(:, :)
       integer, allocatable :: firsts(:), counts(:)
       integer :: ranks, rank, group_size, group_rank, block, k, worst_code
-      real(dp) :: range, bad(5), load_scale
+      real(dp) :: range, bad(7), load_scale
       real(dp), allocatable :: targets(:)
       logical :: by_approach, by_gaps
       call MPI_Comm_size(MPI_COMM_WORLD, ranks)
@@ -458,7 +493,8 @@ contains
             if (status%code == 0) call solve_loads(grid, deck, targets, options%cg, states, status, observer, &
                options%hardness, options%plastic, by_approach, make_interface_law(options%adhesion, options%work, &
                options%range, deck%pixel, options%plastic, options%hardness), run_shear_model(options))
-            call grid_free(grid)
+            if (status%code == 0 .and. options%tangential) call tangential_on_ranks(grid, deck, &
+               tangential_of(options), states, status, observer)
             worst_code = status%code
             if (group_rank == 0) call solve_contact(deck, options, res, serial_status)
             if (group_rank == 0) worst_code = max(worst_code, serial_status%code)
@@ -493,11 +529,13 @@ contains
                         max(res%states(k)%plastic_volume, 1.0e-300_dp)*1.0e9_dp
                   end if
                   deallocate(forces)
+                  if (options%tangential) call tangential_differences(grid, group, states(k), res%states(k), bad(6:7))
                end do
             end if
+            call grid_free(grid)
             call MPI_Comm_free(group)
          end if
-         call MPI_Allreduce(MPI_IN_PLACE, bad, 5, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+         call MPI_Allreduce(MPI_IN_PLACE, bad, 7, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
          call MPI_Allreduce(MPI_IN_PLACE, worst_code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
          call check(error, worst_code, 0, "solve on "//to_string(group_size)//" ranks")
          if (allocated(error)) return
@@ -512,6 +550,10 @@ contains
          if (allocated(error)) return
          call check(error, bad(5) < 1, "plastic set or volume on "//to_string(group_size)//" ranks differs (n "// &
             "plastic differences + 1e9 x relative volume difference = "//to_string(bad(5))//")")
+         if (allocated(error)) return
+         call check(error, bad(6) <= 1.0e-8_dp .and. bad(7) == 0, "tangential step on "//to_string(group_size)// &
+            " ranks: shift, force or tractions off by "//to_string(bad(6))//" of the serial ones, "// &
+            to_string(nint(bad(7)))//" pixels stick otherwise (or no partial slip to compare)")
          if (allocated(error)) return
          group_size = 2*group_size
       end do
@@ -530,4 +572,48 @@ contains
          n = count(serial .neqv. forces > 0)
       end function count_differences
    end subroutine against_serial
+
+   !> The tangential step of `options` (femcod run's request).
+   function tangential_of(options) result(request)
+      type(contact_options), intent(in) :: options
+      type(tangential_request) :: request
+      request%mu = options%friction
+      request%by_slip = options%by_slip
+      request%load = options%tangential_load
+      request%slip = options%slip
+      request%periodic = options%boundary == BOUNDARY_PERIODIC
+   end function tangential_of
+
+   !> On the group's rank 0, into bad(1) the largest difference of the ranks' tangential
+   !> step from the serial one's (shift and force relative to their size, tractions to
+   !> the largest), into bad(2) the pixels whose stick differs (1 more where the serial
+   !> state has no partial slip: nothing to compare). Collective over `group`.
+   subroutine tangential_differences(grid, group, st, serial, bad)
+      use femcod_contact_result, only: load_state
+      type(distributed_grid), intent(in) :: grid
+      type(MPI_Comm), intent(in) :: group
+      type(distributed_state), intent(in) :: st
+      type(load_state), intent(in) :: serial
+      real(dp), intent(inout) :: bad(2)
+      real(dp), allocatable :: local(:, :, :), whole(:, :, :)
+      integer :: n, np
+      np = grid%np
+      allocate(local(np, grid%nj, 2), whole(np, np, 2))
+      local = 0
+      do n = 1, size(st%stick)
+         local(st%tangential_i(n), st%tangential_j(n), :) = [st%shear_x(n), merge(1.0_dp, 0.0_dp, st%stick(n))]
+      end do
+      do n = 1, 2
+         call MPI_Gatherv(local(:, :, n), np*grid%nj, MPI_DOUBLE_PRECISION, whole(:, :, n), np*grid%count, &
+            np*grid%first, MPI_DOUBLE_PRECISION, 0, group)
+      end do
+      if (grid%rank /= 0) return
+      bad(1) = max(bad(1), abs(st%tangential_shift(1) - serial%tangential_shift(1))/abs(serial%tangential_shift(1)), &
+         abs(st%tangential_force(1) - serial%tangential_force(1))/abs(serial%tangential_force(1)), &
+         maxval(abs([(whole(serial%i(n), serial%j(n), 1) - serial%shear_x(n), n = 1, size(serial%i))]))/ &
+         maxval(abs(serial%shear_x)))
+      bad(2) = bad(2) + count([(whole(serial%i(n), serial%j(n), 2) > 0 .neqv. serial%stick(n), n = 1, size(serial%i))]) &
+         + abs(sum(whole(:, :, 2)) - count(serial%stick))
+      if (count(serial%stick) == 0 .or. all(serial%stick)) bad(2) = bad(2) + 1
+   end subroutine tangential_differences
 end module test_distributed
