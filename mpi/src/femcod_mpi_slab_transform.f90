@@ -30,7 +30,7 @@ module femcod_mpi_slab_transform
    implicit none
    private
    public :: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, slab_backward, &
-      slab_forward_single, slab_backward_single
+      slab_forward_single, slab_backward_single, slab_permute
    public :: PAD_ZEROS, EXTEND_EVEN, EXTEND_ODD
 
    !> How the transposed rows of NP become rows of M (module header).
@@ -62,6 +62,10 @@ module femcod_mpi_slab_transform
       !> Wall seconds so far in the transforms (the 1-D transforms, the multiplications
       !> between them) and in FFTW-MPI's transposes.
       real(dp) :: transform_seconds = 0, communication_seconds = 0
+      !> Columns the ranks hold in another order than the grid's (femcod_mpi_gap_transform's
+      !> pixel and padding columns): natural(P), the position along a row (1-based) of the
+      !> P-th value of a transposed row; not allocated: the grid's own order.
+      integer, allocatable :: natural(:)
    end type slab_transform
 
 contains
@@ -236,6 +240,7 @@ contains
       call fftw_mpi_execute_r2r(t%to_rows, t%column_flat, t%row_flat)
       call wall_clock(t2)
       call expand_rows(t, rows)
+      if (allocated(t%natural)) call reorder_rows(t, .true.)
       if (t%freqs > 0) call fftw_execute_dft(t%rows_forward, t%rows, t%rows)
       call wall_clock(t3)
       t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
@@ -251,6 +256,7 @@ contains
       real(dp) :: t0, t1, t2, t3
       call wall_clock(t0)
       if (t%freqs > 0) call fftw_execute_dft(t%rows_backward, t%rows, t%rows)
+      if (allocated(t%natural)) call reorder_rows(t, .false.)
       call compress_rows(t)
       call wall_clock(t1)
       call fftw_mpi_execute_r2r(t%to_columns, t%row_flat, t%column_flat)
@@ -359,6 +365,39 @@ contains
          end if
       end do
    end subroutine expand_rows
+
+   !> The order of the ranks' columns (slab_transform's natural): `natural` (1 .. m, each
+   !> once) for a transform whose rows are m long and not extended (slab_setup's np = m).
+   subroutine slab_permute(t, natural)
+      type(slab_transform), intent(inout) :: t
+      integer, intent(in) :: natural(:)
+      t%natural = natural
+   end subroutine slab_permute
+
+   !> Each transposed row put in the grid's order (`to_natural`) or back in the ranks'.
+   subroutine reorder_rows(t, to_natural)
+      type(slab_transform), intent(inout) :: t
+      logical, intent(in) :: to_natural
+      complex(dp), allocatable :: line(:)
+      integer :: k, p
+      !$omp parallel private(line, p)
+      allocate(line(t%m))
+      !$omp do
+      do k = 1, t%freqs
+         if (to_natural) then
+            do p = 1, t%m
+               line(t%natural(p)) = t%rows(p, k)
+            end do
+         else
+            do p = 1, t%m
+               line(p) = t%rows(t%natural(p), k)
+            end do
+         end if
+         t%rows(:, k) = line
+      end do
+      !$omp end do
+      !$omp end parallel
+   end subroutine reorder_rows
 
    !> The first np values of each row of m packed again for the transpose back (from the
    !> first row up: nothing is overwritten before it is read).
