@@ -34,7 +34,13 @@ module femcod_elastic_operator
    implicit none
    private
    public :: elastic_operator, grid_operator, grid_operator_setup, grid_operator_free, truncate_table, spread_load
-   public :: SPECTRUM_COMPLIANCE, SPECTRUM_STIFFNESS
+   public :: SPECTRUM_COMPLIANCE, SPECTRUM_STIFFNESS, TABLE_NONE, TABLE_SINGLE, TABLE_DOUBLE
+
+   !> Which Love table a grid operator keeps besides its convolution (grid_operator_setup's
+   !> `tables`): none (the maps' operator), the float32 one for the cg family's direct
+   !> corrections and kernel split, or the double one for the event solvers' exact
+   !> evaluations.
+   integer, parameter :: TABLE_NONE = 0, TABLE_SINGLE = 1, TABLE_DOUBLE = 2
 
    !> What every elastic operator has and does (module header).
    type, abstract :: elastic_operator
@@ -103,9 +109,11 @@ module femcod_elastic_operator
    !> (femcod_convolution), with the float32 Love table for direct corrections and the
    !> kernel split.
    type, extends(elastic_operator) :: grid_operator
-      !> The Love table I(0:np-1, 0:np-1) rounded to float32 (its double is needed only to
-      !> set up the convolution; at NP = 4096 the float32 table is 67 MB).
+      !> The Love table I(0:np-1, 0:np-1) rounded to float32 (TABLE_SINGLE, the cg family's;
+      !> its double is needed only to set up the convolution; at NP = 4096 the float32
+      !> table is 67 MB), or in double (TABLE_DOUBLE, the event solvers': dimensionless).
       real(sp), allocatable :: table(:, :)
+      real(dp), allocatable :: exact(:, :)
       type(love_convolution) :: conv
       type(split_correction) :: split
       !> The kernel is truncated (--kernel-radius): no kernel split.
@@ -213,8 +221,9 @@ contains
    !> materials, one cell of a periodic surface when `periodic`; the kernel truncated to
    !> how%kernel_radius pixels of the deck's pixel (scaled to this grid's pixel). With
    !> `gap_variables` the operator has the gap-variable iteration's transform grid
-   !> (apply_spectrum) instead of the convolution (displace).
-   subroutine grid_operator_setup(op, g0, problem, pixel, how, periodic, gap_variables)
+   !> (apply_spectrum) instead of the convolution (displace). `tables` (TABLE_SINGLE by
+   !> default): the Love table it keeps besides.
+   subroutine grid_operator_setup(op, g0, problem, pixel, how, periodic, gap_variables, tables)
       type(grid_operator), intent(inout) :: op
       real(dp), intent(in) :: g0(:, :)
       type(contact_problem), intent(in) :: problem
@@ -222,8 +231,10 @@ contains
       type(cg_settings), intent(in) :: how
       logical, intent(in) :: periodic
       logical, intent(in), optional :: gap_variables
+      integer, intent(in), optional :: tables
       real(dp), allocatable :: table(:, :)
       logical :: ok
+      integer :: keep
       op%np = size(g0, 1)
       op%j0 = 0
       op%nj = size(g0, 2)
@@ -252,9 +263,15 @@ contains
          end if
       end if
       call convolution_setup(op%conv, table, how%single_until > 0, how%measure_plans, periodic)
-      allocate(op%table(0:op%np - 1, 0:op%np - 1))
-      op%table(:, :) = real(table, sp)
       if (how%precondition) call inverse_kernel_taps(op%conv, op%taps, op%preconditioned)
+      keep = TABLE_SINGLE
+      if (present(tables)) keep = tables
+      if (keep == TABLE_SINGLE) then
+         allocate(op%table(0:op%np - 1, 0:op%np - 1))
+         op%table(:, :) = real(table, sp)
+      else if (keep == TABLE_DOUBLE) then
+         call move_alloc(table, op%exact)
+      end if
    end subroutine grid_operator_setup
 
    !> The plans and transform memory freed.
@@ -263,6 +280,8 @@ contains
       call convolution_free(op%conv)
       call split_free(op%split)
       call gap_transform_free(op%gaps)
+      if (allocated(op%table)) deallocate(op%table)
+      if (allocated(op%exact)) deallocate(op%exact)
    end subroutine grid_operator_free
 
    !> The kernel truncated: entries at offsets beyond `radius` pixels set to 0 (--kernel-
@@ -312,8 +331,11 @@ contains
       class(grid_operator), intent(in) :: op
       type(cg_settings), intent(in) :: how
       integer, intent(out) :: limit, split_limit
-      limit = max(how%direct_corrections, 0)
+      limit = 0
       split_limit = 0
+      ! The corrections read the float32 table: an operator without it convolves afresh.
+      if (.not. allocated(op%table)) return
+      limit = max(how%direct_corrections, 0)
       if (how%split_radius >= how%split_cell .and. how%split_cell >= 1 .and. .not. op%periodic .and. &
          .not. op%truncated) &
          split_limit = int(min(how%split_budget*real(op%np, dp)**2/real(2*how%split_cell + 1, dp)**2, &

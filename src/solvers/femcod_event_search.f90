@@ -16,7 +16,6 @@
 !> so runs and restarts repeat bit for bit.
 module femcod_event_search
    use femcod_kinds, only: dp
-   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_heap, only: heap_pop, heap_push, heap_top_key
    use femcod_sort, only: merge_sort_index
    use femcod_solver_options, only: contact_options
@@ -49,11 +48,9 @@ module femcod_event_search
       real(dp), allocatable :: lam_open(:)
       !> Whether this step searched the full field.
       logical :: used_fft = .false.
-      type(love_convolution) :: conv
       real(dp), allocatable :: field_f(:, :), field_u(:, :), disp_f(:, :), disp_u(:, :)
    contains
       procedure :: next_event
-      procedure :: free
    end type event_search
 
 contains
@@ -273,18 +270,16 @@ contains
       real(dp), allocatable :: lam(:)
       integer :: qq, iq, jq, np
       np = state%np
-      if (search%conv%m == 0) then
-         call convolution_setup(search%conv, state%table, periodic=state%periodic)
+      if (.not. allocated(search%field_f)) &
          allocate(search%field_f(np, np), search%field_u(np, np), search%disp_f(np, np), search%disp_u(np, np))
-      end if
       search%field_f = 0
       search%field_u = 0
       do qq = 1, state%n
          search%field_f(state%ic(qq), state%jc(qq)) = state%ftot(qq)
          search%field_u(state%ic(qq), state%jc(qq)) = state%funit(qq)
       end do
-      call convolution_apply(search%conv, search%field_f, search%disp_f)
-      call convolution_apply(search%conv, search%field_u, search%disp_u)
+      call state%op%displace(search%field_f, search%disp_f)
+      call state%op%displace(search%field_u, search%disp_u)
       allocate(lam(state%npix))
       lam_min = search%lam_release
       do qq = 1, state%npix
@@ -292,8 +287,8 @@ contains
          if (state%slot(qq) /= 0) cycle
          iq = (qq - 1)/np + 1
          jq = qq - (iq - 1)*np
-         gq = state%g0(qq) - state%path%approach + state%c*search%disp_f(iq, jq)
-         rq = state%delta - state%c*search%disp_u(iq, jq)
+         gq = state%g0(qq) - state%path%approach + search%disp_f(iq, jq)
+         rq = state%delta - search%disp_u(iq, jq)
          if (gq <= 0) then
             lam(qq) = 0
          else if (rq > 0) then
@@ -309,10 +304,4 @@ contains
          call record_evaluation(search, state, qq)
       end do
    end subroutine fft_search
-
-   !> Free the FFT plans.
-   subroutine free(search)
-      class(event_search), intent(inout) :: search
-      call convolution_free(search%conv)
-   end subroutine free
 end module femcod_event_search

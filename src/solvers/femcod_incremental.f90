@@ -20,12 +20,12 @@ module femcod_incremental
    use femcod_lapack, only: dtrsv
    use femcod_heap, only: heap_pop, heap_push, heap_top_key
    use femcod_sort, only: merge_sort_index
-   use femcod_convolution, only: love_convolution, convolution_setup, convolution_apply, convolution_free
    use femcod_contact_result, only: contact_result, STOP_MAXCONT, STOP_NO_CONTACT, finish_contacts
    use femcod_solver_options, only: contact_options
    use femcod_observer, only: solver_observer
    use femcod_event_path, only: first_touch_limit, NO_EVENT
    use femcod_incremental_state, only: incremental_state, REFILL_EVERY, factor_peak_bytes
+   use femcod_elastic_operator, only: grid_operator_free
    use femcod_memory, only: memory_text, usable_text
    use femcod_event_search, only: event_search
    use femcod_clock, only: wall_clock
@@ -194,8 +194,8 @@ contains
          if (state%since_refill >= REFILL_EVERY) call state%refill_cache()
       end do
 
-      call search%free()
       call finish_events(state, options, res, tstart)
+      call grid_operator_free(state%op)
 
    contains
 
@@ -302,7 +302,6 @@ contains
    subroutine final_check(state, options)
       type(incremental_state), intent(inout) :: state
       type(contact_options), intent(in) :: options
-      type(love_convolution) :: conv
       real(dp), allocatable :: field(:, :), disp(:, :), w(:), fex(:)
       real(dp) :: gq, worst, allowance, aex
       integer :: qq, iq, jq, np
@@ -312,9 +311,7 @@ contains
       do qq = 1, state%n
          field(state%ic(qq), state%jc(qq)) = state%ftot(qq)
       end do
-      call convolution_setup(conv, state%table, periodic=state%periodic)
-      call convolution_apply(conv, field, disp)
-      call convolution_free(conv)
+      call state%op%displace(field, disp)
       worst = 0
       state%checks%missed_final_check = 0
       ! Round-off allowance: the tie tolerance of the approach plus the FFT's round-off
@@ -324,7 +321,7 @@ contains
          if (state%slot(qq) /= 0) cycle
          iq = (qq - 1)/np + 1
          jq = qq - (iq - 1)*np
-         gq = state%g0(qq) - state%path%approach + state%c*disp(iq, jq)
+         gq = state%g0(qq) - state%path%approach + disp(iq, jq)
          if (gq < -allowance) state%checks%missed_final_check = state%checks%missed_final_check + 1
          worst = min(worst, gq)
       end do
@@ -393,7 +390,7 @@ contains
                if (st%force(k) < state%fmax) cycle
                gap = state%g0_deck((st%i(k) - 1)*np + st%j(k)) - st%approach + state%s*st%force(k)
                do m = 1, size(st%force)
-                  gap = gap + state%c*state%table(abs(st%i(k) - st%i(m)), abs(st%j(k) - st%j(m)))*st%force(m)
+                  gap = gap + state%c*state%op%exact(abs(st%i(k) - st%i(m)), abs(st%j(k) - st%j(m)))*st%force(m)
                end do
                st%plastic(st%i(k), st%j(k)) = max(-gap, 0.0_dp)
             end do

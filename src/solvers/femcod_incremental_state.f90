@@ -22,17 +22,15 @@ module femcod_incremental_state
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_BAD_INPUT
    use femcod_strings, only: int_str
    use femcod_problem, only: contact_problem
-   use femcod_scene, only: initial_gaps
-   use femcod_love, only: offset_table, surface_compliance
-   use femcod_love_periodic, only: periodic_offset_table
-   use femcod_spring, only: spring_stiffness
+   use femcod_scene, only: initial_gaps, initial_gap_map
+   use femcod_elastic_operator, only: grid_operator, grid_operator_setup, grid_operator_free, TABLE_DOUBLE
    use femcod_lapack, only: dtrsv, dtrsm
    use femcod_condensed, only: gap_and_rate
    use femcod_heap, only: min_heap, heap_build, heap_push
    use femcod_sort, only: merge_sort_index
    use femcod_memory, only: memory_text, usable_text
    use femcod_state_visitor, only: state_visitor, visitable
-   use femcod_solver_options, only: contact_options, &
+   use femcod_solver_options, only: contact_options, cg_settings, &
       BOUNDARY_PERIODIC
    use femcod_contact_result, only: contact_result, visit_result, event_path_diagnostics, visit_event_checks
    use femcod_event_path, only: load_path
@@ -49,11 +47,14 @@ module femcod_incremental_state
    type, extends(visitable) :: incremental_state
       !> The problem as the solver sees it (set by `init`, never stored): pixels per side,
       !> pixels, the most contacts, cache slots; composite compliance c (nm/nN), spring
-      !> compliance s (nm/nN), a contact's self-compliance c I(0,0) + s; the Love table
-      !> and the initial gaps (nm, pixel p = (i-1) NP + j).
+      !> compliance s (nm/nN), a contact's self-compliance c I(0,0) + s (the operator's);
+      !> the elastic operator, whose double Love table (op%exact) the exact evaluations read
+      !> and whose convolution the searches and the final check take; the initial gaps
+      !> (nm, pixel p = (i-1) NP + j).
       integer :: np = 0, npix = 0, maxc = 0, kc = 0
       real(dp) :: c = 0, s = 0, self = 0
-      real(dp), allocatable :: table(:, :), g0(:)
+      type(grid_operator) :: op
+      real(dp), allocatable :: g0(:)
       !> The grid is one cell of a periodic surface (--boundary periodic); the smallest
       !> entry of the table if negative, else 0 (for the gap bound of unit_load).
       logical :: periodic = .false.
@@ -140,20 +141,21 @@ contains
       integer, allocatable :: items(:)
       integer :: p
       type(interface_law) :: law
+      type(cg_settings) :: plain
       call self%path%start(problem, options, self%res)
       self%np = problem%np
       self%npix = self%np*self%np
       self%maxc = self%path%max_contacts
-      allocate(self%table(0:self%np - 1, 0:self%np - 1))
       self%periodic = options%boundary == BOUNDARY_PERIODIC
       self%memory_available = options%memory_available
-      if (self%periodic) then
-         self%table(:, :) = periodic_offset_table(self%np)
-      else
-         self%table(:, :) = offset_table(self%np)
-      end if
+      ! The whole kernel, double transforms by estimated plans, no preconditioner: the
+      ! event solvers' convolution; the double table kept.
+      plain%single_until = 0
+      plain%precondition = .false.
+      call grid_operator_setup(self%op, initial_gap_map(problem%lower, problem%upper), problem, problem%pixel, &
+         plain, self%periodic, tables=TABLE_DOUBLE)
       ! The most negative influence (a periodic table's, whose mean is 0; none free).
-      self%table_min = min(minval(self%table), 0.0_dp)
+      self%table_min = min(minval(self%op%exact), 0.0_dp)
       self%g0 = initial_gaps(problem%lower, problem%upper)
       self%fmax = 0
       self%nplastic = 0
@@ -167,10 +169,9 @@ contains
          self%g0_deck = self%g0
          allocate(self%res%step_plastic(0))
       end if
-      self%c = surface_compliance(problem%young(1), problem%poisson(1), problem%pixel) + &
-         surface_compliance(problem%young(2), problem%poisson(2), problem%pixel)
-      self%s = 3/spring_stiffness(problem%young(3), problem%poisson(3), problem%pixel, problem%pixel)
-      self%self = self%c*self%table(0, 0) + self%s
+      self%c = self%op%c
+      self%s = self%op%s
+      self%self = self%c*self%op%exact(0, 0) + self%s
       self%ld = min(self%maxc, 256)
       self%kc = min(CACHE_SIZE, self%npix)
       allocate(self%u(self%ld, self%ld), self%lc(self%ld, self%kc), self%wc(self%ld, self%kc))
@@ -298,11 +299,11 @@ contains
          beta = sum(self%y(1:n)**2)
          self%delta = 1/beta
          self%funit(1:n) = self%x(1:n)*self%delta
-         self%delta_max = self%delta + self%c*self%table(0, 0)*sum(max(-self%funit(1:n), 0.0_dp))
+         self%delta_max = self%delta + self%c*self%op%exact(0, 0)*sum(max(-self%funit(1:n), 0.0_dp))
          if (self%table_min < 0) self%delta_max = self%delta_max - self%c*self%table_min*sum(max(self%funit(1:n), 0.0_dp))
          ! The fastest any gap can open: c I sum f - delta, with I at most I(0, 0) where
          ! f > 0 and at least min I where f < 0.
-         if (self%fmax > 0) self%open_max = max(0.0_dp, self%c*self%table(0, 0)*sum(max(self%funit(1:n), 0.0_dp)) - &
+         if (self%fmax > 0) self%open_max = max(0.0_dp, self%c*self%op%exact(0, 0)*sum(max(self%funit(1:n), 0.0_dp)) - &
             self%c*self%table_min*sum(max(-self%funit(1:n), 0.0_dp)) - self%delta)
       end associate
    end subroutine unit_load
@@ -317,7 +318,7 @@ contains
       associate(n => self%n)
          ip = (pixel - 1)/self%np + 1
          jp = pixel - (ip - 1)*self%np
-         call gap_and_rate(self%g0(pixel), self%path%approach, self%delta, self%c, self%table, ip, jp, &
+         call gap_and_rate(self%g0(pixel), self%path%approach, self%delta, self%c, self%op%exact, ip, jp, &
             self%ic(1:n), self%jc(1:n), self%ftot(1:n), self%funit(1:n), gap, closing)
       end associate
    end subroutine evaluate
@@ -359,7 +360,7 @@ contains
          else
             ! l = U^-T m and w = U^-1 l = M^-1 m by two triangular solves.
             do kk = 1, n
-               col(kk) = self%c*self%table(abs(ip - self%ic(kk)), abs(jp - self%jc(kk)))
+               col(kk) = self%c*self%op%exact(abs(ip - self%ic(kk)), abs(jp - self%jc(kk)))
             end do
             if (n > 0) call dtrsv("U", "T", "N", n, u, self%ld, col, 1)
             wq(1:n) = col(1:n)
@@ -380,7 +381,7 @@ contains
             if (self%cpix(ss) == 0) cycle
             ipp = (self%cpix(ss) - 1)/np + 1
             jpp = self%cpix(ss) - (ipp - 1)*np
-            tt = (self%c*self%table(abs(ipp - ip), abs(jpp - jp)) - dot_product(col(1:n), self%lc(1:n, ss)))/dq
+            tt = (self%c*self%op%exact(abs(ipp - ip), abs(jpp - jp)) - dot_product(col(1:n), self%lc(1:n, ss)))/dq
             self%lc(n + 1, ss) = tt
             self%wc(1:n, ss) = self%wc(1:n, ss) - wq(1:n)*(tt/dq)
             self%wc(n + 1, ss) = tt/dq
@@ -474,7 +475,7 @@ contains
       q = findloc(self%plastic_pix(1:self%nplastic), pixel, 1)
       if (q == 0) return
       call fold_force(self, pixel, -self%fmax)
-      self%phi = self%phi + self%c*self%fmax*self%table(0, 0)
+      self%phi = self%phi + self%c*self%fmax*self%op%exact(0, 0)
       self%plastic_pix = [self%plastic_pix(1:q - 1), self%plastic_pix(q + 1:self%nplastic)]
       self%plastic_step = [self%plastic_step(1:q - 1), self%plastic_step(q + 1:self%nplastic)]
       self%plastic_key = [self%plastic_key(1:q - 1), self%plastic_key(q + 1:self%nplastic)]
@@ -497,7 +498,7 @@ contains
       do i = 1, self%np
          do j = 1, self%np
             self%g0((i - 1)*self%np + j) = self%g0((i - 1)*self%np + j) + &
-               self%c*f*self%table(abs(i - ip), abs(j - jp))
+               self%c*f*self%op%exact(abs(i - ip), abs(j - jp))
          end do
       end do
       !$omp end parallel do
@@ -611,7 +612,7 @@ contains
             ia = (fresh(b) - 1)/np + 1
             ja = fresh(b) - (ia - 1)*np
             do a = 1, n
-               block(a, b) = self%c*self%table(abs(ia - self%ic(a)), abs(ja - self%jc(a)))
+               block(a, b) = self%c*self%op%exact(abs(ia - self%ic(a)), abs(ja - self%jc(a)))
             end do
          end do
          call dtrsm("L", "U", "T", "N", n, nfresh, 1.0_dp, self%u, self%ld, block, n)

@@ -4,7 +4,7 @@ module femcod_maps
    use femcod_problem, only: contact_problem
    use femcod_scene, only: initial_gap_map
    use femcod_solver_options, only: cg_settings
-   use femcod_elastic_operator, only: grid_operator, grid_operator_setup, grid_operator_free
+   use femcod_elastic_operator, only: grid_operator, grid_operator_setup, grid_operator_free, TABLE_NONE
    use femcod_contact_result, only: load_state
    use femcod_patches, only: contact_patches, find_patches
    implicit none
@@ -54,12 +54,11 @@ contains
       if (all(handed .or. .not. states%reached)) return
       allocate(force(np, np), disp(np, np))
       ! The elastic operator of the whole kernel in double precision, estimated plans, no
-      ! preconditioner: c (I * F), g0 and the springs' s of the deck (g0 numbered pixel by
-      ! pixel along rows: p = (i - 1) np + j).
+      ! preconditioner, no table kept: c (I * F), g0 and the springs' s of the deck.
       plain%single_until = 0
       plain%precondition = .false.
       call grid_operator_setup(op, initial_gap_map(problem%lower, problem%upper), problem, problem%pixel, plain, &
-         cyclic)
+         cyclic, tables=TABLE_NONE)
       do s = 1, size(states)
          if (.not. states(s)%reached .or. handed(s)) cycle
          force = 0
