@@ -541,7 +541,7 @@ contains
          call wall_clock(t0)
          transform0 = grid%slab%transform_seconds
          communication0 = grid%slab%communication_seconds
-         call solve_target(grid, problem, session, targets(k), approaches, how, answer, status, observer)
+         call solve_target(grid, session, targets(k), approaches, how, answer, status, observer)
          if (status%code /= 0) return
          call record_state(grid, session, answer, cap, friction_model, states(k))
          if (.not. (approaches .or. capped .or. grid%periodic .or. how%kernel_radius > 0)) states(k)%cg%approach_bound = &

@@ -93,6 +93,15 @@ module femcod_cg
    public :: cg_residuals, cg_session, cg_answer, session_start, solve_target, ascending_order, &
       refuse_beyond_full_contact, unconverged_message
 
+   !> The whole grid in one process (model/femcod_elastic_operator's grid_operator) whose
+   !> solves start from nested coarser grids (nested_start, with how%nested), each made
+   !> from the deck's materials kept here (no heights).
+   type, extends(grid_operator) :: nested_grid_operator
+      type(contact_problem) :: materials
+   contains
+      procedure :: start_forces => nested_grid_start
+   end type nested_grid_operator
+
    !> What the solver carries from one target (load or approach) to the next, on this
    !> process's columns of the operator's grid: the forces (nN; the next target's warm
    !> start), the approach (nm) they give, the interface law (with --plastic its pixel
@@ -196,7 +205,7 @@ contains
       type(cg_residuals), allocatable :: report(:)
       !> The solver's work at each state (res%diagnostics).
       type(cg_diagnostics) :: work
-      type(grid_operator) :: fine
+      type(nested_grid_operator) :: fine
       type(cg_session) :: session
       type(cg_answer) :: answer
       real(dp), allocatable :: targets(:)
@@ -230,7 +239,7 @@ contains
       if (status%code /= 0) return
       if (by_approach .and. .not. options%plastic) call refuse_beyond_full_contact(fine, targets, status)
       if (status%code /= 0) then
-         call grid_operator_free(fine)
+         call grid_operator_free(fine%grid_operator)
          return
       end if
       if (options%plastic) allocate(res%step_plastic(0))
@@ -247,7 +256,7 @@ contains
       do kk = 1, m
          k = order(kk)
          call wall_clock(t0)
-         call solve_target(fine, problem, session, targets(k), by_approach, options%cg, answer, status, observer)
+         call solve_target(fine, session, targets(k), by_approach, options%cg, answer, status, observer)
          if (status%code /= 0) exit
          call wall_clock(t1)
          report(k) = answer%rep
@@ -258,7 +267,7 @@ contains
          if ((by_gaps .and. kk == m) .or. (.not. by_gaps .and. targets(k) == maxval(targets))) &
             call report_state(res, res%states(k), kk)
       end do
-      call grid_operator_free(fine)
+      call grid_operator_free(fine%grid_operator)
       allocate(res%diagnostics, source=work)
       res%stop_reason = STOP_LOADS
       if (status%code == STATUS_INTERRUPTED .and. kk > 1) then
@@ -315,7 +324,7 @@ contains
       type(contact_problem), intent(in) :: problem
       type(contact_options), intent(in) :: options
       logical, intent(in) :: by_gaps
-      type(grid_operator), intent(inout) :: fine
+      type(nested_grid_operator), intent(inout) :: fine
       integer(i8), intent(out) :: estimated
       type(status_type), intent(inout) :: status
       integer :: m
@@ -329,9 +338,18 @@ contains
          call refuse_beyond_memory("cg: NP = "//int_str(problem%np), estimated, options%memory_available, status)
       end if
       if (status%code /= 0) return
-      call grid_operator_setup(fine, initial_gap_map(problem%lower, problem%upper), problem, problem%pixel, &
-         options%cg, options%boundary == BOUNDARY_PERIODIC, gap_variables=by_gaps)
+      call grid_operator_setup(fine%grid_operator, initial_gap_map(problem%lower, problem%upper), problem, &
+         problem%pixel, options%cg, options%boundary == BOUNDARY_PERIODIC, gap_variables=by_gaps)
+      fine%materials = materials_of(problem)
    end subroutine make_fine_grid
+
+   !> The deck's label, grid, pixel and materials, without its heights.
+   pure function materials_of(problem) result(materials)
+      type(contact_problem), intent(in) :: problem
+      type(contact_problem) :: materials
+      materials = contact_problem(label="", np=problem%np, pixel=problem%pixel, maxcont=problem%maxcont, &
+         young=problem%young, poisson=problem%poisson)
+   end function materials_of
 
    !> One target's state from its answer and the session's forces (nN), on the whole grid
    !> of pixel `pixel` (nm); `seconds` its solve's wall time.
@@ -460,9 +478,8 @@ contains
    !> One target: the load `target` (nN), or with `by_approach` the approach `target`
    !> (nm), solved from the session's forces; the answer, and the session moved on to it.
    !> The same on one core and on ranks: everything over the grid goes through `grid`.
-   subroutine solve_target(grid, problem, session, target, by_approach, how, answer, status, observer)
+   subroutine solve_target(grid, session, target, by_approach, how, answer, status, observer)
       class(elastic_operator), intent(inout) :: grid
-      type(contact_problem), intent(in) :: problem
       type(cg_session), intent(inout) :: session
       real(dp), intent(in) :: target
       logical, intent(in) :: by_approach
@@ -473,10 +490,10 @@ contains
       if (session%by_gaps) then
          call solve_by_gaps(grid, session, target, how, answer, status, observer)
       else if (by_approach) then
-         call find_load(grid, problem, session, target, how, answer, status, observer)
+         call find_load(grid, session, target, how, answer, status, observer)
       else
          answer%load = target
-         call solve_load(grid, problem, session, target, how, answer, status, observer)
+         call solve_load(grid, session, target, how, answer, status, observer)
       end if
       answer%approach = session%approach
    end subroutine solve_target
@@ -525,9 +542,8 @@ contains
 
    !> The state at `load` (nN): the forces (warm start: the session's, scaled by the
    !> solver to the load) and the approach, into the session; the maps into `answer`.
-   subroutine solve_load(grid, problem, session, load, how, answer, status, observer)
+   subroutine solve_load(grid, session, load, how, answer, status, observer)
       class(elastic_operator), intent(inout) :: grid
-      type(contact_problem), intent(in) :: problem
       type(cg_session), intent(inout) :: session
       real(dp), intent(in) :: load
       type(cg_settings), intent(in) :: how
@@ -542,12 +558,12 @@ contains
          session%approach = -total(1)
          if (session%plastic) session%capped = .false.
       else if (session%plastic) then
-         call capped_solve(grid, problem, session, load, how, answer, status, observer)
+         call capped_solve(grid, session, load, how, answer, status, observer)
       else
          total(1) = sum(session%p)
          call grid%sum_over_grid(total)
          if (.not. total(1) > 0) then
-            call start_forces(grid, problem, load, how, .true., session%p, answer%rep, status, observer)
+            call start_forces(grid, load, how, .true., session%p, answer%rep, status, observer)
             if (status%code /= 0) return
          end if
          call constrained_cg(grid, load, how%tol, how%max_iterations, how, session%p, session%approach, answer%rep, &
@@ -561,9 +577,8 @@ contains
    !> height range, the fixed-load solver's own accuracy. At or below first touch
    !> (target <= 0) the state has no load and no contact. The load is the answer
    !> (answer%load); answer%rep counts the iterations of every solve.
-   subroutine find_load(grid, problem, session, target, how, answer, status, observer)
+   subroutine find_load(grid, session, target, how, answer, status, observer)
       class(elastic_operator), intent(inout) :: grid
-      type(contact_problem), intent(in) :: problem
       type(cg_session), intent(inout) :: session
       real(dp), intent(in) :: target
       type(cg_settings), intent(in) :: how
@@ -576,7 +591,7 @@ contains
       accuracy = how%tol*max(grid%scale, abs(target))
       if (target <= 0) then
          answer%load = 0
-         call solve_load(grid, problem, session, 0.0_dp, how, answer, status, observer)
+         call solve_load(grid, session, 0.0_dp, how, answer, status, observer)
          session%approach = target
          return
       end if
@@ -595,7 +610,7 @@ contains
          trial = target/(grid%c*grid%self + grid%s)
       end if
       do solve = 1, MAX_SOLVES
-         call solve_load(grid, problem, session, trial, how, answer, status, observer)
+         call solve_load(grid, session, trial, how, answer, status, observer)
          if (status%code /= 0) return
          if (abs(session%approach - target) <= accuracy) exit
          ! Illinois: an end kept twice in a row has its residual halved.
@@ -626,13 +641,12 @@ contains
       answer%load = trial
    end subroutine find_load
 
-   !> The forces (nN) a solve at total load P starts from: on the whole grid in one
-   !> process, from nested coarser grids (when `coarse` and how%nested) or the load spread
-   !> near the first touch; another operator starts as it knows best (femcod-mpi's from a
-   !> coarse solve on rank 0).
-   subroutine start_forces(grid, problem, total_load, how, coarse, p, rep, status, observer)
+   !> The forces (nN) a solve at total load P starts from: with `coarse`, as the operator
+   !> starts (nested coarser grids on one process, a coarse solve on rank 0 in femcod-mpi;
+   !> the load spread near the first touch by default), else the load spread near the
+   !> first touch.
+   subroutine start_forces(grid, total_load, how, coarse, p, rep, status, observer)
       class(elastic_operator), intent(inout) :: grid
-      type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: total_load
       type(cg_settings), intent(in) :: how
       logical, intent(in) :: coarse
@@ -640,21 +654,32 @@ contains
       type(cg_residuals), intent(inout) :: rep
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
-      select type (grid)
-      type is (grid_operator)
-         if (how%nested .and. coarse) then
-            call nested_start(grid, problem, total_load, how, p, rep, status, observer)
-         else
-            call spread_load(grid, total_load, p)
-         end if
-      class default
-         if (coarse) then
-            call grid%start_forces(total_load, how, p, rep%coarse_iterations, status, observer)
-         else
-            call spread_load(grid, total_load, p)
-         end if
-      end select
+      if (coarse) then
+         call grid%start_forces(total_load, how, p, rep%coarse_iterations, status, observer)
+      else
+         call spread_load(grid, total_load, p)
+      end if
    end subroutine start_forces
+
+   !> The nested grid operator's start: nested_start with how%nested, else the load spread
+   !> near the first touch.
+   subroutine nested_grid_start(op, total_load, how, p, coarse_iterations, status, observer)
+      class(nested_grid_operator), intent(inout) :: op
+      real(dp), intent(in) :: total_load
+      type(cg_settings), intent(in) :: how
+      real(dp), intent(out) :: p(:, :)
+      integer, intent(inout) :: coarse_iterations
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      type(cg_residuals) :: rep
+      if (.not. how%nested) then
+         call spread_load(op, total_load, p)
+         return
+      end if
+      rep%coarse_iterations = coarse_iterations
+      call nested_start(op, op%materials, total_load, how, p, rep, status, observer)
+      coarse_iterations = rep%coarse_iterations
+   end subroutine nested_grid_start
 
    !> The elastic-perfectly-plastic interface at one load: 0 <= F <= fmax = H d^2 per
    !> pixel, with
@@ -670,9 +695,8 @@ contains
    !> Into the session: the forces (fmax on the capped pixels), the approach, the plastic
    !> set; into `answer`: the gap map (0 on the elastic contacts, minus the plastic
    !> displacement on the capped ones) and the plastic displacement map.
-   subroutine capped_solve(grid, problem, session, load, how, answer, status, observer)
+   subroutine capped_solve(grid, session, load, how, answer, status, observer)
       class(elastic_operator), intent(inout) :: grid
-      type(contact_problem), intent(in) :: problem
       type(cg_session), intent(inout) :: session
       real(dp), intent(in) :: load
       type(cg_settings), intent(in) :: how
@@ -704,7 +728,7 @@ contains
          end if
          left = load - ncap*fmax
          if (.not. total(2) > 0) then
-            call start_forces(grid, problem, left, how, ncap == 0, p, answer%rep, status, observer)
+            call start_forces(grid, left, how, ncap == 0, p, answer%rep, status, observer)
             if (status%code /= 0) exit
          end if
          call constrained_cg(grid, left, how%tol, how%max_iterations, how, p, session%approach, answer%rep, status, &
@@ -742,7 +766,7 @@ contains
    !> least 2 * coarsest; solve the coarsest from the first guess, then each finer grid
    !> from the coarser solution, to coarse_tol; return the forces on the finest grid.
    recursive subroutine nested_start(grid, problem, total_load, how, p, rep, status, observer)
-      type(grid_operator), intent(inout) :: grid
+      class(grid_operator), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
       real(dp), intent(in) :: total_load
       type(cg_settings), intent(in) :: how
