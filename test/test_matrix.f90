@@ -2,8 +2,9 @@
 !> law x way of asking (loads, increasing approaches, decreasing approaches) x (plain,
 !> restart, friction from the pressures: --shear-strength 0 --shear-slope 0.1 (with
 !> --figures none, which writes no pressure figure and changes nothing else), a
-!> tangential step: --friction 0.3 --tangential 10, the Love kernel cut beyond the grid:
-!> --kernel-radius 30 on the 15 x 15 grid, whose offsets reach 14 sqrt 2 = 19.8), run
+!> tangential step: --friction 0.3 --tangential 10 --tangential-tol 1e-10, the Love
+!> kernel cut beyond the grid: --kernel-radius 30 on the 15 x 15 grid, whose offsets
+!> reach 14 sqrt 2 = 19.8), run
 !> as a user runs it (this test executable as femcod, in its own process) on the thesis'
 !> 2 nm sphere (input/sphere_d2.deck, 15 x 15 pixels). Each combination either answers
 !> (exit 0, one row of PREFIX.loads.csv per state asked) or is refused (exit 2) with no
@@ -76,7 +77,7 @@ contains
                         if (LAWS(l) /= "none") args = args//" --adhesion "//trim(LAWS(l))//" --work 0.05 --range 1"
                         if (r == 2) args = args//" --restart"
                         if (r == 3) args = args//" --shear-strength 0 --shear-slope 0.1 --figures none"
-                        if (r == 4) args = args//" --friction 0.3 --tangential 10"
+                        if (r == 4) args = args//" --friction 0.3 --tangential 10 --tangential-tol 1e-10"
                         if (r == 5) args = args//" --kernel-radius 30"
                         call execute_command_line(self_command()//" "//args//" > "//prefix//".out 2> "//prefix// &
                            ".err", exitstat=code)

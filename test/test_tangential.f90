@@ -60,6 +60,8 @@ contains
          new_unittest("a dense QP with disc constraints (block Gauss-Seidel) on a rough surface", test_dense), &
          new_unittest("the same on a periodic rough cell, its matrix from real-space image sums", test_dense_periodic), &
          new_unittest("femcod run --tangential/--slip: maps obey Coulomb, columns, refusals", test_command), &
+         new_unittest("--tangential-tol: the residual within 10 T, the step solve_tangential makes at T", &
+            test_tolerance), &
          new_unittest("a stop request ends the tangential step: STATUS_INTERRUPTED, no answer", test_stop)]
    end subroutine collect_tangential
 
@@ -499,7 +501,7 @@ contains
       type(h5_file) :: file
       type(status_type) :: st
       real(dp), allocatable :: p(:, :), tx(:, :), ty(:, :), stick(:, :), slip(:, :), column(:)
-      character(len=24) :: refused(5, 6)
+      character(len=24) :: refused(5, 8)
       integer :: code, k, n
       prefix = scratch_path("tangential_run")
       call run_femcod([string_type("run"), string_type("input/sphere_d05.deck"), string_type("--solver"), &
@@ -549,6 +551,8 @@ contains
       refused(:, 4) = [character(len=24) :: "--tangential", "10", "--friction", "-1", ""]
       refused(:, 5) = [character(len=24) :: "--tangential", "10", "--friction", "0.3", "--adhesion"]
       refused(:, 6) = [character(len=24) :: "--slip", "0.1", "--friction", "0", ""]
+      refused(:, 7) = [character(len=24) :: "--tangential-tol", "1e-9", "", "", ""]
+      refused(:, 8) = [character(len=24) :: "--tangential", "10", "--friction", "0.3", "--tangential-tol"]
       do k = 1, size(refused, 2)
          prefix = scratch_path("tangential_refused"//to_string(k))
          call run_femcod([string_type("run"), string_type("input/sphere_d2.deck"), string_type("--solver"), &
@@ -576,11 +580,61 @@ contains
             words(3)%s = "0.1"
             words(4)%s = "--range"
             words(5)%s = "1"
+         case (8)
+            allocate(words(1))
+            words(1)%s = "1"
          case default
             allocate(words(0))
          end select
       end function extra
    end subroutine test_command
+   !> --tangential-tol T (contact_options%tangential_tol, read by tangential_request_of):
+   !> the step iterates until its gradient mapping is below T of the shift and accepts a
+   !> residual (the largest violation of stick and slip over the shift) up to 10 T. On the
+   !> Hertz state at a/d = 8 under Q = mu P/2 through solve_contact at T = 1e-4 and 1e-12:
+   !> each residual within 10 T, more iterations at the smaller T, and at 1e-12 the answer
+   !> of solve_tangential asked for that tolerance directly, bit for bit.
+   subroutine test_tolerance(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(contact_result) :: res, loose, tight
+      type(contact_options) :: options
+      type(tangential_request) :: request
+      type(tangential_answer) :: answer
+      type(status_type) :: status
+      call hertz_state(3.0_dp, deck, res, error)
+      if (allocated(error)) return
+      options%solver = SOLVER_CG
+      options%loads = res%states(1:1)%load
+      options%cg = cg_settings()
+      options%cg%tol = 1.0e-10_dp
+      options%cg%max_iterations = 5000
+      options%tangential = .true.
+      options%friction = 0.3_dp
+      options%tangential_load = 0.5_dp*options%friction*res%states(1)%load
+      options%tangential_tol = 1.0e-4_dp
+      call solve_contact(deck, options, loose, status)
+      options%tangential_tol = 1.0e-12_dp
+      if (status%code == 0) call solve_contact(deck, options, tight, status)
+      call check(error, status%code, 0, status%message)
+      if (allocated(error)) return
+      call check(error, loose%states(1)%tangential_residual <= 1.0e-3_dp .and. &
+         tight%states(1)%tangential_residual <= 1.0e-11_dp .and. &
+         tight%states(1)%tangential_iterations > loose%states(1)%tangential_iterations, "residuals "// &
+         to_string(loose%states(1)%tangential_residual)//" at 1e-4 ("//to_string(loose%states(1)%tangential_iterations)// &
+         " iterations), "//to_string(tight%states(1)%tangential_residual)//" at 1e-12 ("// &
+         to_string(tight%states(1)%tangential_iterations)//")")
+      if (allocated(error)) return
+      request%mu = options%friction
+      request%load = options%tangential_load
+      request%tol = 1.0e-12_dp
+      associate(s => tight%states(1))
+         call solve_tangential(deck, s%i, s%j, s%force, request, answer, status)
+         call check(error, status%code == 0 .and. all(answer%tx == s%shear_x) .and. all(answer%ty == s%shear_y) .and. &
+            answer%iterations == s%tangential_iterations, "the run's step is solve_tangential's at T = 1e-12")
+      end associate
+   end subroutine test_tolerance
+
    logical function third_time(self)
       class(stop_soon), intent(inout) :: self
       self%asked = self%asked + 1

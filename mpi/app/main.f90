@@ -52,7 +52,7 @@ program femcod_mpi
    use femcod_solver_options, only: by_gap_variables, run_shear_model, &
       SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL
    use femcod_shear_model, only: friction_coefficient
-   use femcod_tangential, only: tangential_request, tangential_storage_bytes
+   use femcod_tangential, only: tangential_request_of, tangential_storage_bytes
    use femcod_mpi_shear, only: tangential_on_ranks
    use femcod_result_schema, only: TANGENTIAL_COLUMNS
    implicit none
@@ -204,8 +204,8 @@ program femcod_mpi
       settings%solve%hardness, settings%solve%plastic, by_approach(), make_interface_law(settings%solve%adhesion, &
       settings%solve%work, settings%solve%range, grid%pixel, settings%solve%plastic, settings%solve%hardness), &
       run_shear_model(settings%solve))
-   if (status%code == 0 .and. settings%solve%tangential) call tangential_on_ranks(grid, problem, tangential_of(), &
-      states, status, observer)
+   if (status%code == 0 .and. settings%solve%tangential) call tangential_on_ranks(grid, problem, &
+      tangential_request_of(settings%solve), states, status, observer)
    call wall_clock(t_solve)
    if (status%code /= 0) then
       if (status%code == STATUS_INTERRUPTED) call finish(128 + stop_signal(), signal_name(stop_signal())//": "// &
@@ -530,16 +530,6 @@ contains
       text = ","//format_real(st%tangential_force(1))//","//format_real(st%tangential_shift(1))//","// &
          int_str(st%stick_contacts)//","//format_real(real(st%stick_contacts, dp)/max(st%contacts, 1))
    end function tangential_fields
-
-   !> What the tangential step asks (--friction, --tangential or --slip).
-   function tangential_of() result(request)
-      type(tangential_request) :: request
-      request%mu = settings%solve%friction
-      request%by_slip = settings%solve%by_slip
-      request%load = settings%solve%tangential_load
-      request%slip = settings%solve%slip
-      request%periodic = settings%solve%boundary == BOUNDARY_PERIODIC
-   end function tangential_of
 
    !> The summary as JSON: numbers with their units in the names.
    function summary_json() result(text)

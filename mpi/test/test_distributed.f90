@@ -21,7 +21,7 @@ module test_distributed
    use femcod_scene, only: initial_gap_map
    use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, &
       coarse_factor, distribute_problem, distributed_convolve
-   use femcod_tangential, only: tangential_request
+   use femcod_tangential, only: tangential_request_of
    use femcod_mpi_shear, only: tangential_on_ranks
    implicit none
    private
@@ -494,7 +494,7 @@ contains
                options%hardness, options%plastic, by_approach, make_interface_law(options%adhesion, options%work, &
                options%range, deck%pixel, options%plastic, options%hardness), run_shear_model(options))
             if (status%code == 0 .and. options%tangential) call tangential_on_ranks(grid, deck, &
-               tangential_of(options), states, status, observer)
+               tangential_request_of(options), states, status, observer)
             worst_code = status%code
             if (group_rank == 0) call solve_contact(deck, options, res, serial_status)
             if (group_rank == 0) worst_code = max(worst_code, serial_status%code)
@@ -572,17 +572,6 @@ contains
          n = count(serial .neqv. forces > 0)
       end function count_differences
    end subroutine against_serial
-
-   !> The tangential step of `options` (femcod run's request).
-   function tangential_of(options) result(request)
-      type(contact_options), intent(in) :: options
-      type(tangential_request) :: request
-      request%mu = options%friction
-      request%by_slip = options%by_slip
-      request%load = options%tangential_load
-      request%slip = options%slip
-      request%periodic = options%boundary == BOUNDARY_PERIODIC
-   end function tangential_of
 
    !> On the group's rank 0, into bad(1) the largest difference of the ranks' tangential
    !> step from the serial one's (shift and force relative to their size, tractions to

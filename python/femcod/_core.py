@@ -221,7 +221,8 @@ def _option_list(values, name):
 
 #: Keyword arguments of solve that are femcod run's options (--kebab-case).
 _VALUE_OPTIONS = ("hardness", "boundary", "tol", "max_iterations", "kernel_radius", "max_contacts", "event_search",
-                  "work", "range", "shear_strength", "shear_slope", "tangential", "slip", "friction")
+                  "work", "range", "shear_strength", "shear_slope", "tangential", "slip", "friction",
+                  "tangential_tol")
 
 
 def _options(solver, loads, approach, plastic, adhesion, final_check, extra):
@@ -408,7 +409,8 @@ def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=None, po
                every 0.1 s while iterating; returning True stops the solve (femcod.Stopped).
     Further keywords are femcod run's options: hardness, tol, max_iterations,
     kernel_radius, max_contacts, event_search, work, range, shear_strength, shear_slope,
-    tangential, slip, friction. Ctrl-C stops the solve and raises KeyboardInterrupt.
+    tangential, slip, friction, tangential_tol. Ctrl-C stops the solve and raises
+    KeyboardInterrupt.
     """
     extra = dict(options)
     if boundary != "free":

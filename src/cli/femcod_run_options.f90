@@ -114,6 +114,8 @@ contains
             lower=0.0_dp), &
          real_option("--friction", "MU", "the Coulomb coefficient of --tangential or --slip", lower=0.0_dp, &
             closed="()"), &
+         real_option("--tangential-tol", "T", "the tangential step stops when its gradient mapping is below T of "// &
+            "the shift (default 1e-8; --tol is the normal solve's)", lower=0.0_dp, closed="()"), &
          real_option("--range", "R", "range of the adhesion law in nm, with --adhesion", lower=0.0_dp, closed="()", &
             mode="cg"), &
          text_option("--fftw-wisdom", "FILE", "FFTW measures its plans once and keeps them in FILE and FILE.float32 "// &
@@ -301,6 +303,9 @@ contains
          call set_error(status, STATUS_USAGE, "give --tangential Q (a force) or --slip S (a shift), not both")
       else if (option_given(parsed, "--friction") .and. .not. settings%solve%tangential) then
          call set_error(status, STATUS_USAGE, "--friction MU is the Coulomb coefficient of a tangential step: add "// &
+            "--tangential Q or --slip S")
+      else if (option_given(parsed, "--tangential-tol") .and. .not. settings%solve%tangential) then
+         call set_error(status, STATUS_USAGE, "--tangential-tol T is the tolerance of a tangential step: add "// &
             "--tangential Q or --slip S")
       else if (settings%solve%adhesion /= LAW_HARD_WALL .and. .not. (option_given(parsed, "--work") .and. &
          option_given(parsed, "--range"))) then

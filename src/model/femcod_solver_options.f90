@@ -31,11 +31,12 @@ module femcod_solver_options
    character(len=*), parameter :: OPTION_NAMES(*) = [character(len=21) :: "--solver", "--boundary", "--loads", &
       "--approach", "--max-contacts", "--plastic", "--hardness", "--adhesion", "--work", "--range", "", &
       "--no-final-check", "--event-search", "--tol", "--max-iterations", "--kernel-radius", "", "--shear-strength", &
-      "--shear-slope", "", "", "--friction", "--tangential", "--slip", "--checkpoint-interval"]
+      "--shear-slope", "", "", "--friction", "--tangential", "--slip", "--tangential-tol", "--checkpoint-interval"]
    character(len=*), parameter :: OPTION_KEYS(*) = [character(len=19) :: "solver", "boundary", "loads", &
       "approaches", "max_contacts", "plastic", "hardness", "adhesion", "work", "range", "tie_tolerance", &
       "final_check", "event_search", "tol", "max_iterations", "kernel_radius", "shear", "shear_strength", &
-      "shear_slope", "tangential", "by_slip", "friction", "tangential_load", "slip", "checkpoint_interval"]
+      "shear_slope", "tangential", "by_slip", "friction", "tangential_load", "slip", "tangential_tol", &
+      "checkpoint_interval"]
    !> Every field shapes the answer but the checkpoints' interval.
    logical, parameter :: IN_HISTORY(*) = OPTION_KEYS /= "checkpoint_interval"
 
@@ -147,9 +148,10 @@ module femcod_solver_options
       real(dp) :: shear_strength = 0, shear_slope = 0
       !> Tangential loading with Coulomb friction (solvers/femcod_tangential) at every
       !> reached state: the coefficient `friction`, and the tangential force (nN) or, with
-      !> `by_slip`, the rigid shift (nm), along x. `tangential` false: none.
+      !> `by_slip`, the rigid shift (nm), along x. `tangential` false: none. The step
+      !> iterates until its gradient mapping is below `tangential_tol` of the shift.
       logical :: tangential = .false., by_slip = .false.
-      real(dp) :: friction = 0, tangential_load = 0, slip = 0
+      real(dp) :: friction = 0, tangential_load = 0, slip = 0, tangential_tol = 1.0e-8_dp
       !> Candidates whose closing load is within this fraction of the total load of the
       !> smallest one join in the same step (ties).
       real(dp) :: tie_tolerance = 1.0e-9_dp
@@ -365,6 +367,7 @@ contains
       case ("friction"); call real_value(o%friction)
       case ("tangential_load"); call real_value(o%tangential_load, o%tangential)
       case ("slip"); call real_value(o%slip, o%tangential, o%by_slip)
+      case ("tangential_tol"); call real_value(o%tangential_tol)
       case ("checkpoint_interval"); call real_value(o%checkpoint_interval)
       end select
    contains
@@ -425,6 +428,8 @@ contains
             "coefficient)")
       else if (.not. (options%tangential_load >= 0 .and. options%slip >= 0)) then
          call set_error(status, STATUS_USAGE, "--tangential Q and --slip S are at least 0 (along x)")
+      else if (.not. (options%tangential_tol > 0 .and. options%tangential_tol < 1)) then
+         call set_error(status, STATUS_USAGE, "--tangential-tol T is a relative residual: 0 < T < 1")
       else if (options%adhesion /= LAW_HARD_WALL) then
          call set_error(status, STATUS_USAGE, "--tangential/--slip with --adhesion: the Coulomb bound mu p needs a "// &
             "compressive contact, and adhesive contacts carry tension")

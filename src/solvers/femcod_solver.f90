@@ -25,7 +25,8 @@ module femcod_solver
    use femcod_shear_model, only: shear_model
    use femcod_cerruti, only: second_dundurs_constant
    use femcod_clock, only: wall_clock
-   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential_on, tangential_storage_bytes
+   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential_on, tangential_storage_bytes, &
+      tangential_request_of
    use femcod_shear_operator, only: grid_shear_operator, grid_shear_setup, grid_shear_free
    implicit none
    private
@@ -216,11 +217,7 @@ contains
       call refuse_beyond_memory("the tangential step: NP = "//int_str(problem%np), &
          tangential_storage_bytes(problem%np), options%memory_available, status)
       if (status%code /= 0) return
-      request%mu = options%friction
-      request%by_slip = options%by_slip
-      request%load = options%tangential_load
-      request%slip = options%slip
-      request%periodic = options%boundary == BOUNDARY_PERIODIC
+      request = tangential_request_of(options)
       if (any([(res%states(k)%reached .and. res%states(k)%contacts > 0, k = 1, size(res%states))])) &
          call grid_shear_setup(op, problem, request%periodic)
       do k = 1, size(res%states)

@@ -36,11 +36,13 @@ module femcod_tangential
    use femcod_observer, only: solver_observer
    use femcod_strings, only: count_text, sig_str
    use femcod_problem, only: contact_problem
+   use femcod_solver_options, only: contact_options, BOUNDARY_PERIODIC
    use femcod_shear_operator, only: shear_operator, grid_shear_operator, grid_shear_setup, grid_shear_free
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    implicit none
    private
-   public :: tangential_request, tangential_answer, solve_tangential, solve_tangential_on, tangential_storage_bytes
+   public :: tangential_request, tangential_answer, solve_tangential, solve_tangential_on, tangential_storage_bytes, &
+      tangential_request_of
 
    !> What a tangential step asks: the friction coefficient, the load (nN) or, with
    !> `by_slip`, the rigid shift (nm), both along x; the relative residual to reach and
@@ -85,6 +87,20 @@ module femcod_tangential
    end type tangential_state
 
 contains
+
+   !> The tangential step a run's options ask for (--friction, --tangential or --slip,
+   !> --tangential-tol, --boundary): femcod run's, femcod-mpi's and the libraries' one
+   !> reading of them.
+   pure function tangential_request_of(options) result(request)
+      type(contact_options), intent(in) :: options
+      type(tangential_request) :: request
+      request%mu = options%friction
+      request%by_slip = options%by_slip
+      request%load = options%tangential_load
+      request%slip = options%slip
+      request%tol = options%tangential_tol
+      request%periodic = options%boundary == BOUNDARY_PERIODIC
+   end function tangential_request_of
 
    !> The tangential state of contact pixels (ci, cj) with normal forces f (nN) of
    !> `problem` under `request`, on one process (its own operator, made and freed here).
