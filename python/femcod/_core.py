@@ -219,10 +219,22 @@ def _option_list(values, name):
     return ",".join(_number_text(v) for v in values)
 
 
-#: Keyword arguments of solve that are femcod run's options (--kebab-case).
-_VALUE_OPTIONS = ("hardness", "boundary", "tol", "max_iterations", "kernel_radius", "max_contacts", "event_search",
-                  "work", "range", "shear_strength", "shear_slope", "tangential", "slip", "friction",
-                  "tangential_tol")
+#: solve's own keywords for femcod run's options (the others pass through by name).
+_OWN_KEYWORDS = ("solver", "loads", "approach", "plastic", "adhesion", "no_final_check")
+_value_options_cache = None
+
+
+def _value_options():
+    """Keyword arguments of solve that are femcod run's options (--kebab-case): the names
+    the library takes (femcod_option_names, from the solver's option table), but solve's
+    own keywords."""
+    global _value_options_cache
+    if _value_options_cache is None:
+        buf = ctypes.create_string_buffer(4096)
+        _library.lib().femcod_option_names(buf, len(buf))
+        names = [n[2:].replace("-", "_") for n in buf.value.decode().split()]
+        _value_options_cache = tuple(n for n in names if n not in _OWN_KEYWORDS)
+    return _value_options_cache
 
 
 def _options(solver, loads, approach, plastic, adhesion, final_check, extra):
@@ -240,8 +252,9 @@ def _options(solver, loads, approach, plastic, adhesion, final_check, extra):
     if not final_check:
         opts.append(("--no-final-check", ""))
     for key, value in extra.items():
-        if key not in _VALUE_OPTIONS:
-            raise TypeError(f"solve() got an unexpected keyword argument {key!r} (options: {', '.join(_VALUE_OPTIONS)})")
+        if key not in _value_options():
+            raise TypeError(f"solve() got an unexpected keyword argument {key!r} (options: "
+                            f"{', '.join(_value_options())})")
         if value is None:
             continue
         if isinstance(value, str):
@@ -407,10 +420,10 @@ def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=None, po
     threads    OpenMP threads for this and later solves (default: OMP_NUM_THREADS or all).
     progress   f(step, contacts, load_nN, seconds), called after each step or state and
                every 0.1 s while iterating; returning True stops the solve (femcod.Stopped).
-    Further keywords are femcod run's options: hardness, tol, max_iterations,
-    kernel_radius, max_contacts, event_search, work, range, shear_strength, shear_slope,
-    tangential, slip, friction, tangential_tol. Ctrl-C stops the solve and raises
-    KeyboardInterrupt.
+    Further keywords are femcod run's options that shape the answer, with _ for -
+    (femcod.option_keywords(): hardness, tol, max_iterations, kernel_radius, max_contacts,
+    event_search, work, range, shear_strength, shear_slope, tangential, slip, friction,
+    tangential_tol, ...). Ctrl-C stops the solve and raises KeyboardInterrupt.
     """
     extra = dict(options)
     if boundary != "free":
@@ -464,6 +477,11 @@ def set_threads(threads):
     """OpenMP threads of the solvers for the whole process."""
     session = _Session()
     session.check(session.lib.femcod_set_threads(int(threads)))
+
+
+def option_keywords():
+    """The keywords solve() takes for femcod run's options (the library's option table)."""
+    return _value_options()
 
 
 def version():

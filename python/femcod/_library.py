@@ -68,6 +68,7 @@ def _declare(lib):
         "femcod_create": (c_void_p, []),
         "femcod_destroy": (None, [c_void_p]),
         "femcod_version": (c_int, [c_char_p, c_size_t]),
+        "femcod_option_names": (c_int, [c_char_p, c_size_t]),
         "femcod_message": (c_int, [c_void_p, c_char_p, c_size_t]),
         "femcod_set_threads": (c_int, [c_int]),
         "femcod_set_heights": (c_int, [c_void_p, c_int, c_double, p_double, p_double, c_double, c_double, c_int]),

@@ -44,3 +44,15 @@ def test_doc_table_names_every_run_option():
 def test_doc_table_names_no_unknown_option():
     listed, documented = help_options(), doc_table_options()
     assert not documented - listed, f"doc/solver.md names options femcod run lacks: {sorted(documented - listed)}"
+
+
+def test_library_keywords_are_the_option_table():
+    """femcod.solve's keywords for run's options come from the library's option table
+    (femcod_option_names): every one is an option femcod run --help lists, and the table's
+    newest, --tangential-tol, is among them."""
+    import femcod
+    keywords = femcod.option_keywords()
+    listed = help_options()
+    assert "tangential_tol" in keywords and "tol" in keywords, keywords
+    assert all("--" + k.replace("_", "-") in listed for k in keywords), keywords
+    assert not {"solver", "loads", "approach", "plastic", "adhesion"} & set(keywords), keywords

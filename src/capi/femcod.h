@@ -71,8 +71,10 @@ int femcod_get_problem(femcod_session *s, double *pixel, int *maxcont, double yo
                        double *lower, double *upper);
 int femcod_get_label(femcod_session *s, char *text, size_t length);
 
-/* value is "" for a flag ("--plastic"). */
+/* value is "" for a flag ("--plastic"). femcod_option_names: the names it takes,
+ * separated by spaces (femcod run's options that shape the answer). */
 int femcod_set_option(femcod_session *s, const char *name, const char *value);
+int femcod_option_names(char *text, size_t length);
 int femcod_clear_options(femcod_session *s);
 int femcod_solve(femcod_session *s, femcod_progress progress, void *user);
 

@@ -27,14 +27,14 @@ module femcod_capi
    use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
    !$ use omp_lib, only: omp_set_num_threads
    use femcod_library_session, only: library_session, solve_session, state_value, state_value_names, &
-      history_column, HISTORY_COLUMNS, map_of, map_names
+      history_column, HISTORY_COLUMNS, map_of, map_names, library_options
    implicit none
    private
    public :: femcod_create, femcod_destroy, femcod_version, femcod_message, femcod_set_heights, femcod_set_problem, &
       femcod_read_deck, femcod_write_deck, femcod_problem_size, femcod_get_problem, femcod_get_label, &
       femcod_set_option, femcod_clear_options, femcod_solve, femcod_state_count, femcod_state_value, &
       femcod_value_names, femcod_state_map, femcod_history_length, femcod_history, femcod_set_threads, &
-      femcod_read_heights, femcod_warnings
+      femcod_read_heights, femcod_warnings, femcod_option_names
 
    !> Longest C string read from a caller (a path, an option's value).
    integer, parameter :: MAX_C_STRING = 1048576
@@ -75,6 +75,20 @@ contains
       call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_version = copy_out(VERSION_TEXT, text_out, length)
    end function femcod_version
+
+   !> The options femcod_set_option takes, `femcod run`'s names separated by spaces (from
+   !> the solver's option table: those that shape the answer).
+   integer(c_int) function femcod_option_names(text, length) bind(C, name="femcod_option_names")
+      integer(c_size_t), value :: length
+      type(c_ptr), value :: text
+      character(kind=c_char), pointer :: text_out(:)
+      if (.not. all_given([text])) then
+         femcod_option_names = null_argument(c_null_ptr, "femcod_option_names", "text")
+         return
+      end if
+      call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
+      femcod_option_names = copy_out(library_options(), text_out, length)
+   end function femcod_option_names
 
    !> The message of the session's last failure ("" after a success).
    integer(c_int) function femcod_message(handle, text, length) bind(C, name="femcod_message")
