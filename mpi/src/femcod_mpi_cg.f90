@@ -45,8 +45,8 @@ module femcod_mpi_cg
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: cg_settings
    use femcod_elastic_operator, only: elastic_operator, spread_load
-   use femcod_cg, only: coarse_start_forces, approach_error_bound, cg_session, cg_answer, session_start, solve_target, &
-      ascending_order, refuse_beyond_full_contact, unconverged_message
+   use femcod_cg, only: coarse_start_forces, materials_of, approach_error_bound, cg_session, cg_answer, session_start, &
+      solve_target, ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
    use femcod_shear_model, only: shear_model, friction_force
    use femcod_contact_result, only: cg_state_diagnostics
@@ -528,8 +528,7 @@ contains
       end if
       if (by_gaps) call gap_grid_setup(grid, status)
       if (status%code /= 0) return
-      if (grid%rank == 0) grid%materials = contact_problem(label="", np=problem%np, pixel=problem%pixel, &
-         young=problem%young, poisson=problem%poisson)
+      if (grid%rank == 0) grid%materials = materials_of(problem)
       call session_start(grid, session, interface, by_gaps)
       if (by_gaps) then
          order = [(k, k = 1, m)]

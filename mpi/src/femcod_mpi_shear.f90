@@ -109,14 +109,14 @@ contains
          real(dp), intent(in) :: table(0:, :)
          integer, intent(in) :: how
          real(dp), intent(out) :: spectrum(:, :)
-         integer :: i, np, m
+         integer :: i, j, np, m
          np = op%np
          m = op%slab%m
-         do jj = 1, op%nj
-            op%slab%column_real(1:np, jj) = table(:, jj)
-            op%slab%column_real(np + 1, jj) = 0
+         do j = 1, op%nj
+            op%slab%column_real(1:np, j) = table(:, j)
+            op%slab%column_real(np + 1, j) = 0
             do i = np + 2, m
-               op%slab%column_real(i, jj) = how*table(m - i + 1, jj)
+               op%slab%column_real(i, j) = how*table(m - i + 1, j)
             end do
          end do
          call slab_forward(op%slab, how)

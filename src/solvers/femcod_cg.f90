@@ -89,7 +89,8 @@ module femcod_cg
    use femcod_clock, only: wall_clock
    implicit none
    private
-   public :: solve_cg, coarse_start_forces, approach_error_bound, cg_storage_bytes, distributed_storage_bytes
+   public :: solve_cg, coarse_start_forces, approach_error_bound, cg_storage_bytes, distributed_storage_bytes, &
+      materials_of
    public :: cg_residuals, cg_session, cg_answer, session_start, solve_target, ascending_order, &
       refuse_beyond_full_contact, unconverged_message
 
@@ -343,7 +344,8 @@ contains
       fine%materials = materials_of(problem)
    end subroutine make_fine_grid
 
-   !> The deck's label, grid, pixel and materials, without its heights.
+   !> The deck's grid, pixel, MAXCONT and materials, without its label and heights (what a
+   !> coarse start needs: the nested operator's and femcod-mpi's rank 0).
    pure function materials_of(problem) result(materials)
       type(contact_problem), intent(in) :: problem
       type(contact_problem) :: materials
