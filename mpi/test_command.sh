@@ -43,6 +43,29 @@ for x, y in zip(a, b):
     assert x["contacts"] == y["contacts"], ("contacts", x["contacts"], y["contacts"])
 PY
 then echo "  passed   the serial solver's approaches and contacts"; else echo "  FAILED   the serial solver's approaches and contacts"; failed=1; fi
+# One schema (io/femcod_state_record): every field of a serial state is in femcod-mpi's
+# (beside the serial patch detail), the counts equal; the scene and the run as in the
+# serial summary, so that doc/cluster/collect.py reads both.
+if python3 - "$work/serial.summary.json" "$work/mpi.summary.json" <<'PY'
+import json, sys
+serial, mpi = (json.load(open(p)) for p in sys.argv[1:])
+for key in ("scene", "solver", "boundary", "stopped", "wall_time_s", "memory_bytes"):
+    assert key in mpi, key
+assert mpi["scene"]["NP"] == serial["scene"]["NP"] and mpi["scene"]["label"] == serial["scene"]["label"]
+for a, b in zip(serial["loads"], mpi["loads"]):
+    missing = set(a) - {"largest_patch_pixels", "patch_perimeter_exponent"} - set(b)
+    assert not missing, missing
+    for key in ("contacts", "patches_4", "patches_8", "n_above_hardness", "hdf5_group"):
+        assert a[key] == b[key], (key, a[key], b[key])
+PY
+then echo "  passed   the serial summary's fields in femcod-mpi's"
+else echo "  FAILED   the serial summary's fields in femcod-mpi's"; failed=1; fi
+mkdir "$work/both" && cp "$work/serial.summary.json" "$work/mpi.summary.json" "$work/both/"
+if [ "$(python3 ../doc/cluster/collect.py "$work/both" | wc -l)" -eq 7 ]; then
+  echo "  passed   doc/cluster/collect.py reads femcod run's and femcod-mpi's summaries"
+else
+  echo "  FAILED   doc/cluster/collect.py on femcod run's and femcod-mpi's summaries"; failed=1
+fi
 # loads.csv: the serial writer's header, the same contact counts and contact patches
 # (the last two columns: 4- and 8-connected, joined across the ranks' slabs); one figure
 # per load.

@@ -122,7 +122,7 @@ contains
          serial_approach = json_value(text, '"approach_nm"')
          write(output_unit, '(a)') "| "//int_str(np)//" | femcod run | 1 x "//int_str(cores)//" | "// &
             fixed_str(t_run, 2)//" | "//fixed_str(json_value(text, '"wall_time_s"'), 2)//" | | | "// &
-            int_str(nint(json_value(text, '"iterations"')))//" | | "// &
+            int_str(nint(json_value(text, '"cg_iterations"')))//" | | "// &
             fixed_str(100*json_value(text, '"area_fraction"'), 2)//" | (reference) |"
          flush(output_unit)
          do r = 1, size(ranks)
@@ -138,7 +138,7 @@ contains
             end if
             text = read_text_file(prefix//".summary.json")
             t_solve = json_value(text, '"solve_time_s"')
-            measured(1, n) = json_value(text, '"iterations"') + json_value(text, '"convolutions"')
+            measured(1, n) = json_value(text, '"cg_iterations"') + json_value(text, '"convolutions"')
             if (ranks(r) == 1) measured([2, 3, 4, 5, 6, 9, 10], n) = [real(threads, dp), &
                json_value(text, '"transform_s"'), json_value(text, '"communication_s"'), t_solve, &
                json_list_max(text, '"peak_memory_MB_per_rank"'), json_value(text, '"read_peak_memory_MB"'), &
@@ -152,7 +152,7 @@ contains
                int_str(threads)//" | "//fixed_str(t_run, 2)//" | "//fixed_str(t_solve, 2)//" | "// &
                int_str(nint(100*transform/max(t_solve, 1.0e-9_dp)))//" | "// &
                int_str(nint(100*communication/max(t_solve, 1.0e-9_dp)))//" | "// &
-               int_str(nint(json_value(text, '"iterations"')))//" (+"// &
+               int_str(nint(json_value(text, '"cg_iterations"')))//" (+"// &
                int_str(nint(json_value(text, '"coarse_iterations"')))//" coarse, "// &
                int_str(nint(json_value(text, '"convolutions"')))//" fresh) | "// &
                int_str(nint(json_list_max(text, '"peak_memory_MB_per_rank"')))//" | "// &

@@ -50,11 +50,13 @@ program femcod_mpi
    use femcod_gap_cg, only: gap_solver_storage_bytes
    use femcod_interface_law, only: make_interface_law
    use femcod_solver_options, only: by_gap_variables, run_shear_model, &
-      SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL
+      SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_shear_model, only: friction_coefficient
    use femcod_tangential, only: tangential_request_of, tangential_storage_bytes
    use femcod_mpi_shear, only: tangential_on_ranks
-   use femcod_result_schema, only: TANGENTIAL_COLUMNS
+   use femcod_contact_result, only: stop_reason_text, STOP_LOADS
+   use femcod_state_record, only: loads_csv_header, loads_csv_row, state_json, run_info_of
+   use femcod_results_json, only: run_header_json
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -221,6 +223,9 @@ program femcod_mpi
    allocate(estimated_mb(ranks))
    call MPI_Gather(real(estimated_rank_bytes, dp)/1024**2, 1, MPI_DOUBLE_PRECISION, estimated_mb, 1, &
       MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD)
+   ! The run's record as femcod run's (its columns from the options), on the ranks.
+   info%run_info = run_info_of(settings%solve)
+   info%solver = "cg (femcod-mpi)"
    info%version = FEMCOD_VERSION
    info%command_line = "femcod-mpi "//settings%command_line
    info%host = host_name()
@@ -228,8 +233,6 @@ program femcod_mpi
    info%finished = local_time_iso()
    info%ranks = ranks
    info%threads = omp_get_max_threads()
-   info%friction = settings%solve%shear
-   info%tangential = settings%solve%tangential
    if (.not. allocated(info%label)) info%label = ""
    info%wall_seconds = t_solve - t_start
    call write_distributed_results(prefix//".h5.part", grid, states, info, status)
@@ -487,99 +490,62 @@ contains
       close(unit)
    end function peak_memory_mb
 
-   !> PREFIX.loads.csv, the serial writer's columns.
+   !> PREFIX.loads.csv: the serial writer's rows (io/femcod_state_record).
    function loads_csv() result(text)
       character(len=:), allocatable :: text
       integer :: s
-      text = "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
-         "plastic_volume_nm3"//trim(merge(",friction_nN,friction_coefficient", "                                 ", &
-         settings%solve%shear))//trim(merge(TANGENTIAL_COLUMNS, repeat(" ", len(TANGENTIAL_COLUMNS)), &
-         settings%solve%tangential))//",patches_4,patches_8"//new_line('a')
+      text = loads_csv_header(info%run_info)//new_line('a')
       do s = 1, size(states)
-         associate(st => states(s))
-            text = text//format_real(st%load)//","//format_real(st%approach)//","//int_str(st%contacts)//","// &
-               format_real(st%contacts*grid%pixel**2)//","//format_real(real(st%contacts, dp)/real(np, dp)**2)//","// &
-               format_real(st%max_pressure)//","//int_str(st%above_hardness)//","//int_str(st%n_plastic)//","// &
-               format_real(st%plastic_volume)//friction_fields(st)//tangential_fields(st)//","// &
-               int_str(st%patches_4)//","// &
-               int_str(st%patches_8)//new_line('a')
-         end associate
+         text = text//loads_csv_row(states(s)%state_values, grid%pixel, np, info%run_info)//new_line('a')
       end do
    end function loads_csv
 
-   !> ",F_t,mu" of a state with the shear model; "" without.
-   function friction_fields(st) result(text)
-      type(distributed_state), intent(in) :: st
-      character(len=:), allocatable :: text
-      text = ""
-      if (settings%solve%shear) text = ","//format_real(st%friction)//","// &
-         format_real(friction_coefficient(st%friction, st%load, st%contacts))
-   end function friction_fields
-
-   !> ",Q,delta,stick,stick_fraction" of a state's tangential step (the serial writer's
-   !> columns); "" without --tangential or --slip.
-   function tangential_fields(st) result(text)
-      type(distributed_state), intent(in) :: st
-      character(len=:), allocatable :: text
-      text = ""
-      if (.not. settings%solve%tangential) return
-      if (st%contacts == 0) then
-         text = ",0,0,0,nan"
-         return
-      end if
-      text = ","//format_real(st%tangential_force(1))//","//format_real(st%tangential_shift(1))//","// &
-         int_str(st%stick_contacts)//","//format_real(real(st%stick_contacts, dp)/max(st%contacts, 1))
-   end function tangential_fields
-
-   !> The summary as JSON: numbers with their units in the names.
+   !> PREFIX.summary.json in the serial summary's layout (io/femcod_results_json: the
+   !> run, the scene, each state's values), each state with the ranks' work on it, then
+   !> the ranks' times and memory.
    function summary_json() result(text)
       character(len=:), allocatable :: text
+      character(len=1), parameter :: nl = new_line('a')
       integer :: s
-      text = '{"femcod_version": '//json_string(FEMCOD_VERSION)//', "solver": "cg (femcod-mpi)", '// &
-         '"label": '//json_string(info%label)//', "NP": '//int_str(np)//', "pixel_nm": '//json_number(grid%pixel)// &
-         ', "mpi_ranks": '//int_str(ranks)//', "threads_per_rank": '//int_str(info%threads)// &
-         ', "wall_time_s": '//json_number(t_write - t_start)//', "read_time_s": '//json_number(t_read - t_start)// &
-         ', "solve_time_s": '//json_number(t_solve - t_read)//', "write_time_s": '//json_number(t_write - t_solve)// &
-         ', "input": '//json_string(input_path())//', "peak_memory_MB_per_rank": ['
-      do s = 1, ranks
-         text = text//json_number(info%peak_mb(s))//trim(merge(", ", "  ", s < ranks))
-      end do
-      text = trim(text)//'], "estimated_peak_memory_MB_per_rank": ['
-      do s = 1, ranks
-         text = text//json_number(estimated_mb(s))//trim(merge(", ", "  ", s < ranks))
-      end do
-      text = trim(text)//'], "read_peak_memory_MB": '//json_number(read_peak)//', "loads": ['
+      problem%np = np
+      problem%pixel = grid%pixel
+      text = run_header_json(prefix, problem, info%run_info)//'  "steps": 0,'//nl//'  "stopped": '// &
+         json_string(stop_reason_text(STOP_LOADS))//','//nl//'  "loads": ['//nl
       do s = 1, size(states)
          associate(st => states(s))
-            text = text//'{"load_nN": '//json_number(st%load)//', "approach_nm": '//json_number(st%approach)
-            if (st%cg%approach_bound >= 0) text = text//', "approach_error_bound_nm": '//json_number(st%cg%approach_bound)
-            text = text//', "contacts": '//int_str(st%contacts)//', "area_fraction": '// &
-               json_number(real(st%contacts, dp)/real(np, dp)**2)//', "max_pressure_GPa": '// &
-               json_number(st%max_pressure)//', "n_above_hardness": '//int_str(st%above_hardness)// &
-               ', "n_plastic": '//int_str(st%n_plastic)//', "plastic_volume_nm3": '// &
-               json_number(st%plastic_volume)//', "iterations": '//int_str(st%cg%iterations)// &
-               ', "coarse_iterations": '//int_str(st%cg%coarse_iterations)//', "convolutions": '// &
-               int_str(st%cg%convolutions)//', "residual": '//json_number(st%cg%residual)//', "time_s": '// &
-               json_number(st%seconds)//', "transform_s": '//json_number(st%transform_seconds)// &
-               ', "communication_s": '//json_number(st%communication_seconds)
-            text = text//', "mean_gap_nm": '//json_number(st%mean_gap)//', "patches_4": '//int_str(st%patches_4)// &
-               ', "patches_8": '//int_str(st%patches_8)
-            if (settings%solve%adhesion /= LAW_HARD_WALL) text = text//', "attractive_pixels": '//int_str(st%attractive)// &
-               ', "attractive_load_nN": '//json_number(st%attractive_load)//', "jump": '//int_str(st%jump)
-            if (settings%solve%shear) text = text//', "friction_nN": '//json_number(st%friction)// &
-               ', "friction_coefficient": '//json_number(friction_coefficient(st%friction, st%load, st%contacts))
-            if (settings%solve%tangential) text = text//', "tangential_force_nN": '// &
-               json_number(st%tangential_force(1))//', "tangential_shift_nm": '//json_number(st%tangential_shift(1))// &
-               ', "stick_contacts": '//int_str(st%stick_contacts)//', "stick_area_nm2": '// &
-               json_number(st%stick_contacts*grid%pixel**2)//', "gross_sliding": '// &
-               trim(merge("true ", "false", st%sliding))//', "tangential_iterations": '// &
-               int_str(st%tangential_iterations)//', "tangential_residual": '//json_number(st%tangential_residual)
-            text = text//'}'
+            text = text//'    '//state_json(st%state_values, s, size(states), grid%pixel, np, info%run_info, &
+               st%cg, "", ', "coarse_iterations": '//int_str(st%cg%coarse_iterations)//', "convolutions": '// &
+               int_str(st%cg%convolutions)//', "time_s": '//json_number(st%seconds)// &
+               ', "transform_s": '//json_number(st%transform_seconds)//', "communication_s": '// &
+               json_number(st%communication_seconds))//trim(merge(",", " ", s < size(states)))//nl
          end associate
-         if (s < size(states)) text = text//', '
       end do
-      text = text//']}'//new_line('a')
+      text = text//'  ],'//nl//'  "wall_time_s": '//json_number(t_solve - t_read)//','//nl// &
+         '  "timings_s": {"read_inputs": '//json_number(t_read - t_start)//', "solve": '// &
+         json_number(t_solve - t_read)//', "write": '//json_number(t_write - t_solve)//', "total": '// &
+         json_number(t_write - t_start)//'},'//nl// &
+         '  "read_time_s": '//json_number(t_read - t_start)//', "solve_time_s": '//json_number(t_solve - t_read)// &
+         ', "write_time_s": '//json_number(t_write - t_solve)//','//nl// &
+         '  "input": '//json_string(input_path())//','//nl// &
+         '  "mpi_ranks": '//int_str(ranks)//', "threads_per_rank": '//int_str(info%threads)//','//nl// &
+         '  "memory_bytes": {"estimated_peak": '//int_str(nint(maxval(estimated_mb)*1024**2, i8))//', "peak": '// &
+         int_str(nint(maxval(info%peak_mb)*1024**2, i8))//'},'//nl// &
+         '  "peak_memory_MB_per_rank": '//json_list(info%peak_mb)//','//nl// &
+         '  "estimated_peak_memory_MB_per_rank": '//json_list(estimated_mb)//','//nl// &
+         '  "read_peak_memory_MB": '//json_number(read_peak)//nl//'}'//nl
    end function summary_json
+
+   !> [a, b, ...] of numbers.
+   function json_list(values) result(text)
+      real(dp), intent(in) :: values(:)
+      character(len=:), allocatable :: text
+      integer :: s
+      text = '['
+      do s = 1, size(values)
+         text = text//json_number(values(s))//trim(merge(", ", "  ", s < size(values)))
+      end do
+      text = trim(text)//']'
+   end function json_list
 
    subroutine print_summary()
       character(len=:), allocatable :: bound_note, plastic_note

@@ -49,7 +49,7 @@ module femcod_mpi_cg
       solve_target, ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
    use femcod_shear_model, only: shear_model, friction_force
-   use femcod_contact_result, only: cg_state_diagnostics
+   use femcod_contact_result, only: cg_state_diagnostics, state_values
    use femcod_mpi_gap_transform, only: distributed_gap_transform, gap_transform_setup, gap_transform_apply, &
       gap_transform_free
    use femcod_observer, only: solver_observer
@@ -96,45 +96,24 @@ module femcod_mpi_cg
    end type distributed_grid
 
    !> What the solver reached at one load (the same quantities as femcod_cg's residuals).
-   type :: distributed_state
-      real(dp) :: load = 0, approach = 0
-      real(dp) :: max_pressure = 0, seconds = 0
+   !> One requested state on the ranks: its values (model/femcod_contact_result: the
+   !> totals over all ranks, the tangential tractions and stick flags of this rank's
+   !> contacts), and this rank's columns of the fields.
+   type, extends(state_values) :: distributed_state
+      real(dp) :: seconds = 0
       !> The cg iteration's work at this state, as on one core (femcod_contact_result):
       !> iterations, residuals, the approach's error bound where there is one (fixed
       !> loads, the full kernel, no cap; -1 elsewhere), the plastic rounds.
       type(cg_state_diagnostics) :: cg
-      !> With --plastic: the capped pixels (all ranks), the plastic volume (nm^3); this
-      !> rank's columns of the plastic displacement (nm).
-      integer :: n_plastic = 0
-      real(dp) :: plastic_volume = 0
+      !> With --plastic: this rank's columns of the plastic displacement (nm).
       real(dp), allocatable :: plastic(:, :)
       !> Of `seconds`: in the transforms and in communication (distributed_grid).
       real(dp) :: transform_seconds = 0, communication_seconds = 0
-      integer :: contacts = 0
-      !> Pixels whose pressure is above the hardness given to solve_loads (all ranks).
-      integer :: above_hardness = 0
       !> This rank's columns: contact forces (nN) and gaps (nm, 0 at the contacts).
       real(dp), allocatable :: force(:, :), gap(:, :)
-      !> In the gap variables (adhesion, or the cap under displacement control), over all
-      !> ranks: the pixels off contact within the law's range, their load (nN), the mean
-      !> gap (nm), and a jump into contact (1) or off it (-1) since the last approach.
-      integer :: attractive = 0, jump = 0
-      real(dp) :: attractive_load = 0, mean_gap = 0
-      !> With the shear model (--shear-strength, --shear-slope): the friction force (nN)
-      !> over all ranks, femcod_shear_model's sum over the contact pixels.
-      real(dp) :: friction = 0
-      !> The contact patches over all ranks, 4- and 8-connected (femcod_mpi_patches).
-      integer :: patches_4 = 0, patches_8 = 0
       !> With --tangential or --slip (femcod_mpi_shear): this rank's contact pixels (rows,
-      !> columns 1 .. nj, in column order), their tangential forces (nN) and whether each
-      !> sticks; over all ranks the sticking pixels, the shift (nm), the force (nN), gross
-      !> sliding, the iterations and the residual (solvers/femcod_tangential's answer).
+      !> columns 1 .. nj, in column order), the order of the values' tractions.
       integer, allocatable :: tangential_i(:), tangential_j(:)
-      real(dp), allocatable :: shear_x(:), shear_y(:)
-      logical, allocatable :: stick(:)
-      integer :: stick_contacts = 0, tangential_iterations = 0
-      real(dp) :: tangential_shift(2) = 0, tangential_force(2) = 0, tangential_residual = 0
-      logical :: sliding = .false.
    end type distributed_state
 
 contains
@@ -489,7 +468,7 @@ contains
       type(distributed_state), allocatable, intent(out) :: states(:)
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
-      !> GPa: the pressure above_hardness counts beyond (default: none counted), and the
+      !> GPa: the pressure n_above_hardness counts beyond (default: none counted), and the
       !> cap with `plastic`.
       real(dp), intent(in), optional :: hardness
       logical, intent(in), optional :: plastic, by_approach
@@ -595,6 +574,7 @@ contains
       type(distributed_state), intent(inout) :: st
       real(dp) :: total(6), top(1)
       logical, allocatable :: contact(:, :)
+      st%reached = .true.
       st%load = answer%load
       st%approach = answer%approach
       st%cg%iterations = answer%rep%iterations
@@ -638,7 +618,7 @@ contains
       if (.not. answer%by_gaps) st%mean_gap = total(6)/real(grid%np, dp)**2
       st%friction = total(5)
       st%contacts = nint(total(1))
-      st%above_hardness = nint(total(2))
+      st%n_above_hardness = nint(total(2))
       st%n_plastic = nint(total(3))
       st%plastic_volume = total(4)
       top(1) = -huge(1.0_dp)

@@ -15,21 +15,18 @@ module femcod_mpi_results
    use femcod_hdf5, only: h5_file, h5_create, h5_close, h5_group, h5_attribute
    use femcod_results, only: load_group
    use femcod_mpi_cg, only: distributed_grid, distributed_state
-   use femcod_shear_model, only: friction_coefficient
+   use femcod_result_schema, only: run_info, run_boundary
+   use femcod_state_record, only: state_attributes
    implicit none
    private
    public :: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, agree
 
-   !> What /run records of a distributed run.
-   type :: distributed_run_info
-      character(len=:), allocatable :: version, command_line, host, started, finished, label
+   !> What /run records of a distributed run: the run's record (io/femcod_result_schema:
+   !> version, command, times, which columns the states have), and the ranks'.
+   type, extends(run_info) :: distributed_run_info
+      character(len=:), allocatable :: label
       integer :: ranks = 1, threads = 1
       real(dp) :: wall_seconds = 0
-      !> With the shear model: each load group gets friction_nN and friction_coefficient.
-      logical :: friction = .false.
-      !> With a tangential step: each load group gets its attributes and maps (the serial
-      !> writer's: femcod_results_hdf5's write_tangential).
-      logical :: tangential = .false.
       !> Peak resident memory of each rank (MB).
       real(dp), allocatable :: peak_mb(:)
    end type distributed_run_info
@@ -57,39 +54,7 @@ contains
             g = load_group(k, size(states))
             associate(s => states(k))
                call h5_group(file, g, status)
-               call h5_attribute(file, g, "index", k, status)
-               call h5_attribute(file, g, "load_nN", s%load, status)
-               call h5_attribute(file, g, "approach_nm", s%approach, status)
-               call h5_attribute(file, g, "contacts", s%contacts, status)
-               call h5_attribute(file, g, "area_nm2", s%contacts*grid%pixel**2, status)
-               call h5_attribute(file, g, "max_pressure_GPa", s%max_pressure, status)
-               call h5_attribute(file, g, "cg_iterations", s%cg%iterations, status)
-               call h5_attribute(file, g, "cg_residual", s%cg%residual, status)
-               call h5_attribute(file, g, "cg_penetration_nm", s%cg%penetration, status)
-               call h5_attribute(file, g, "cg_contact_gap_nm", s%cg%contact_gap, status)
-               call h5_attribute(file, g, "cg_load_error", s%cg%load_error, status)
-               call h5_attribute(file, g, "approach_error_bound_nm", s%cg%approach_bound, status)
-               call h5_attribute(file, g, "n_above_hardness", s%above_hardness, status)
-               call h5_attribute(file, g, "n_plastic", s%n_plastic, status)
-               call h5_attribute(file, g, "plastic_volume_nm3", s%plastic_volume, status)
-               call h5_attribute(file, g, "patches_4", s%patches_4, status)
-               call h5_attribute(file, g, "patches_8", s%patches_8, status)
-               if (info%friction) then
-                  call h5_attribute(file, g, "friction_nN", s%friction, status)
-                  call h5_attribute(file, g, "friction_coefficient", &
-                     friction_coefficient(s%friction, s%load, s%contacts), status)
-               end if
-               if (info%tangential) then
-                  call h5_attribute(file, g, "tangential_force_nN", s%tangential_force(1), status)
-                  call h5_attribute(file, g, "tangential_force_y_nN", s%tangential_force(2), status)
-                  call h5_attribute(file, g, "tangential_shift_nm", s%tangential_shift(1), status)
-                  call h5_attribute(file, g, "tangential_shift_y_nm", s%tangential_shift(2), status)
-                  call h5_attribute(file, g, "stick_contacts", s%stick_contacts, status)
-                  call h5_attribute(file, g, "stick_area_nm2", s%stick_contacts*grid%pixel**2, status)
-                  call h5_attribute(file, g, "gross_sliding", merge(1, 0, s%sliding), status)
-                  call h5_attribute(file, g, "tangential_iterations", s%tangential_iterations, status)
-                  call h5_attribute(file, g, "tangential_residual", s%tangential_residual, status)
-               end if
+               call state_attributes(file, g, k, s%state_values, grid%pixel, grid%np, info%run_info, s%cg, status)
             end associate
          end do
          call h5_group(file, "/run", status)
@@ -98,8 +63,8 @@ contains
          call h5_attribute(file, "/run", "host", info%host, status)
          call h5_attribute(file, "/run", "started", info%started, status)
          call h5_attribute(file, "/run", "finished", info%finished, status)
-         call h5_attribute(file, "/run", "solver", "cg (femcod-mpi)", status)
-         call h5_attribute(file, "/run", "boundary", trim(merge("periodic", "free    ", grid%periodic)), status)
+         call h5_attribute(file, "/run", "solver", info%solver, status)
+         call h5_attribute(file, "/run", "boundary", run_boundary(info%run_info), status)
          call h5_attribute(file, "/run", "mpi_ranks", info%ranks, status)
          call h5_attribute(file, "/run", "threads_per_rank", info%threads, status)
          call h5_attribute(file, "/run", "wall_time_s", info%wall_seconds, status)

@@ -20,7 +20,7 @@ module femcod_mpi_shear
    use femcod_problem, only: contact_problem
    use femcod_cerruti, only: tangential_table_column, periodic_tangential_spectra_rows
    use femcod_shear_operator, only: shear_operator
-   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential_on
+   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential_on, keep_tangential_answer
    use femcod_observer, only: solver_observer
    use femcod_strings, only: int_str, sig_str
    use femcod_mpi_slab_transform, only: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, &
@@ -245,17 +245,10 @@ contains
                status%message = "state "//int_str(k)//" (load "//sig_str(s%load, 6)//" nN): "//status%message
                exit
             end if
-            call move_alloc(answer%tx, s%shear_x)
-            call move_alloc(answer%ty, s%shear_y)
-            call move_alloc(answer%stick, s%stick)
-            sticking = count(s%stick)
+            call keep_tangential_answer(answer, s%state_values)
+            sticking = s%stick_contacts
             call op%sum_over_grid(sticking)
             s%stick_contacts = nint(sticking(1))
-            s%tangential_shift = answer%shift
-            s%tangential_force = answer%force
-            s%sliding = answer%sliding
-            s%tangential_iterations = answer%iterations
-            s%tangential_residual = answer%residual
          end associate
       end do
       call distributed_shear_free(op)

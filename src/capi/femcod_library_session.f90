@@ -12,9 +12,9 @@ module femcod_library_session
    use femcod_clock, only: wall_clock
    use femcod_memory, only: available_memory
    use femcod_problem, only: contact_problem
-   use femcod_contact_result, only: contact_result, cg_work, cg_state_diagnostics
-   use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, OPTION_NAMES, IN_HISTORY
-   use femcod_shear_model, only: friction_coefficient
+   use femcod_contact_result, only: contact_result, state_values, cg_work, cg_state_diagnostics
+   use femcod_state_record, only: state_field, state_fields, run_info_of
+   use femcod_solver_options, only: contact_options, BOUNDARY_PERIODIC, OPTION_NAMES, IN_HISTORY
    use femcod_observer, only: solver_observer
    use femcod_solver, only: solve_contact, run_warnings
    use femcod_maps, only: load_maps, state_maps, tangential_step_maps
@@ -163,81 +163,47 @@ contains
       end do
    end function library_options
 
-   !> The names of the state values the last solve has (comma-separated).
+   !> The names of the state values the last solve has (comma-separated): whether the
+   !> state was reached, then its fields (io/femcod_state_record, as in PREFIX.h5).
    function state_value_names(session) result(names)
       type(library_session), intent(in) :: session
       character(len=:), allocatable :: names
-      names = "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
-         "plastic_volume_nm3,reached,patches_4,patches_8"
-      associate(o => session%options)
-         if (o%adhesion /= LAW_HARD_WALL) names = names//",attractive_pixels,attractive_load_nN,jump"
-         if (o%solver == SOLVER_CG) names = names//",mean_gap_nm,cg_iterations,cg_residual,cg_penetration_nm,"// &
-            "cg_contact_gap_nm,cg_load_error,approach_error_bound_nm"
-         if (o%shear) names = names//",friction_nN,friction_coefficient"
-         if (o%tangential) names = names//",tangential_force_nN,tangential_force_y_nN,tangential_shift_nm,"// &
-            "tangential_shift_y_nm,gross_sliding,tangential_iterations,tangential_residual,stick_contacts,stick_area_nm2"
-      end associate
+      type(state_field), allocatable :: f(:)
+      integer :: m
+      f = state_fields(state_values(), session%problem%pixel, max(session%problem%np, 1), &
+         run_info_of(session%options), cg_state_diagnostics())
+      names = "reached"
+      do m = 1, size(f)
+         names = names//","//f(m)%name
+      end do
    end function state_value_names
 
-   !> State k's value `name` (as femcod run's loads.csv and PREFIX.h5 compute it).
+   !> State k's value `name` (as femcod run's PREFIX.h5 has it; 1 or 0 for a flag).
    subroutine state_value(session, k, name, value, st)
       type(library_session), intent(in) :: session
       integer, intent(in) :: k
       character(len=*), intent(in) :: name
       real(c_double), intent(out) :: value
       type(status_type), intent(inout) :: st
-      real(dp) :: area_pixel, region
-      type(cg_state_diagnostics) :: work
-      real(dp), allocatable :: stick(:, :, :)
+      type(state_field), allocatable :: f(:)
+      integer :: m
       value = 0
       if (index(","//state_value_names(session)//",", ","//name//",") == 0) then
          call set_error(st, STATUS_USAGE, "no state value '"//name//"' in this result (it has: "// &
             state_value_names(session)//")")
          return
       end if
-      area_pixel = session%problem%pixel**2
-      region = session%problem%np**2*area_pixel
-      work = cg_work(session%res, k)
       associate(s => session%res%states(k))
-         select case (name)
-         case ("load_nN"); value = s%load
-         case ("approach_nm"); value = s%approach
-         case ("contacts"); value = s%contacts
-         case ("area_nm2"); value = s%contacts*area_pixel
-         case ("area_fraction"); value = s%contacts*area_pixel/region
-         case ("max_pressure_GPa"); value = s%max_pressure
-         case ("n_above_hardness"); value = s%n_above_hardness
-         case ("n_plastic"); value = s%n_plastic
-         case ("plastic_volume_nm3"); value = s%plastic_volume
-         case ("reached"); value = merge(1, 0, s%reached)
-         case ("patches_4"); value = session%maps(k)%patches%count4
-         case ("patches_8"); value = session%maps(k)%patches%count8
-         case ("attractive_pixels"); value = s%attractive
-         case ("attractive_load_nN"); value = s%attractive_load
-         case ("mean_gap_nm"); value = s%mean_gap
-         case ("jump"); value = s%jump
-         case ("friction_nN"); value = s%friction
-         case ("friction_coefficient"); value = friction_coefficient(s%friction, s%load, s%contacts)
-         case ("tangential_force_nN"); value = s%tangential_force(1)
-         case ("tangential_force_y_nN"); value = s%tangential_force(2)
-         case ("tangential_shift_nm"); value = s%tangential_shift(1)
-         case ("tangential_shift_y_nm"); value = s%tangential_shift(2)
-         case ("gross_sliding"); value = merge(1, 0, s%sliding)
-         case ("tangential_iterations"); value = s%tangential_iterations
-         case ("tangential_residual"); value = s%tangential_residual
-         case ("stick_contacts", "stick_area_nm2")
-            ! As femcod run's PREFIX.h5 has them: from the stick map.
-            stick = tangential_step_maps(session%problem%np, session%problem%pixel, s)
-            value = int(sum(stick(:, :, 3)))
-            if (name == "stick_area_nm2") value = sum(stick(:, :, 3))*session%problem%pixel**2
-         case ("cg_iterations"); value = work%iterations
-         case ("cg_residual"); value = work%residual
-         case ("cg_penetration_nm"); value = work%penetration
-         case ("cg_contact_gap_nm"); value = work%contact_gap
-         case ("cg_load_error"); value = work%load_error
-         case ("approach_error_bound_nm"); value = work%approach_bound
-         end select
+         if (name == "reached") then
+            value = merge(1, 0, s%reached)
+            return
+         end if
+         f = state_fields(s%state_values, session%problem%pixel, session%problem%np, run_info_of(session%options), &
+            cg_work(session%res, k))
       end associate
+      do m = 1, size(f)
+         if (f(m)%name == name) value = f(m)%value
+      end do
    end subroutine state_value
 
    !> The names of the maps the last solve has.

@@ -22,10 +22,9 @@ module femcod_run
    use femcod_deck, only: read_deck
    use femcod_heights, only: load_scene, height_file_path, looks_like_height_matrix
    use femcod_contact_result, only: contact_result, STOP_INTERRUPTED
-   use femcod_solver_options, only: contact_options, requested_states, history_options, SOLVER_CG, BOUNDARY_PERIODIC, &
-      solver_name, boundary_name, law_name, run_shear_model
-   use femcod_shear_model, only: shear_model
+   use femcod_solver_options, only: contact_options, requested_states, history_options, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_cerruti, only: second_dundurs_constant
+   use femcod_state_record, only: run_info_of
    use femcod_incremental_state, only: incremental_state
    use femcod_solver, only: solve_contact, model_notes, run_warnings
    use femcod_maps, only: load_maps, state_maps
@@ -323,7 +322,6 @@ contains
       type(incremental_state) :: resume
       type(state_maps), allocatable :: maps(:)
       type(run_info) :: info
-      type(shear_model) :: shear
       character(len=:), allocatable :: fingerprint, started
       type(string_type), allocatable :: digests(:), warnings(:)
       logical :: resuming, ok, have_checkpoint, complete, interrupted
@@ -392,22 +390,9 @@ contains
          if (st%code == 0 .and. options%solver == SOLVER_CG .and. len(settings%wisdom) > 0) &
             call save_wisdom(settings%wisdom, st)
          if (st%code /= 0) return
+         info = run_info_of(options)
          info%version = FEMCOD_VERSION
-         info%solver = solver_name(options%solver)
-         info%boundary = boundary_name(options%boundary)
-         info%adhesion = law_name(options%adhesion)
-         info%work = options%work
-         info%range = options%range
-         info%friction = options%shear
-         info%tangential = options%tangential
-         info%coulomb = options%friction
          info%beta = second_dundurs_constant(problem%young(1:2), problem%poisson(1:2))
-         if (options%shear) then
-            shear = run_shear_model(options)
-            info%shear_strength = shear%tau0
-            info%shear_slope = shear%alpha
-            info%shear_cap = shear%tau_max
-         end if
          info%options = settings%command_line
          info%figures = settings%figures
          info%command_line = "femcod run "//settings%command_line

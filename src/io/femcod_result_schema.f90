@@ -61,6 +61,9 @@ module femcod_result_schema
       !> columns, attributes and maps.
       logical :: tangential = .false.
       real(dp) :: coulomb = 0, beta = 0
+      !> A solver of the cg family (femcod run --solver cg, femcod-mpi): each state has
+      !> the iteration's work (cg_* attributes) and the mean gap.
+      logical :: cg = .false.
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
       !> The input files, one line each: the deck, or what each height file gave

@@ -98,7 +98,7 @@ contains
       call write_text(temps(size(temps))%s, contacts_csv(deck, res), status)
       if (size(res%states) > 0) then
          call add(".loads.csv")
-         call write_text(temps(size(temps))%s, loads_csv(deck, res, maps, info%friction, info%tangential), status)
+         call write_text(temps(size(temps))%s, loads_csv(deck, res, info), status)
       end if
       call add(".xdmf")
       call write_text(temps(size(temps))%s, xdmf_text(base_name(prefix)//".h5", deck, res, info%tangential), status)

@@ -5,11 +5,10 @@ module femcod_results_csv
    use femcod_kinds, only: dp, i8
    use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, text_builder, add_line, built_text, format_real, format_reals, integer_text
-   use femcod_contact_result, only: contact_result, load_state
-   use femcod_maps, only: state_maps
+   use femcod_contact_result, only: contact_result
+   use femcod_state_record, only: loads_csv_header, loads_csv_row
    use femcod_shear_model, only: friction_coefficient
-   use femcod_result_schema, only: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, &
-      TANGENTIAL_COLUMNS, PATCH_COLUMNS, step_plastic
+   use femcod_result_schema, only: run_info, HISTORY_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, step_plastic
    implicit none
    private
    public :: history_csv, contacts_csv, loads_csv
@@ -47,22 +46,6 @@ contains
       text = ""
       if (friction) text = ","//format_real(force)//","//format_real(friction_coefficient(force, load, contacts))
    end function friction_fields
-
-   !> ",Q,delta,stick,stick_fraction" of a state's tangential step (x components; "" when
-   !> the state has none).
-   function tangential_fields(s, tangential) result(text)
-      type(load_state), intent(in) :: s
-      logical, intent(in) :: tangential
-      character(len=:), allocatable :: text
-      text = ""
-      if (.not. tangential) return
-      if (.not. allocated(s%stick)) then
-         text = ",0,0,0,nan"
-         return
-      end if
-      text = ","//format_real(s%tangential_force(1))//","//format_real(s%tangential_shift(1))//","// &
-         int_str(count(s%stick))//","//format_real(real(count(s%stick), dp)/max(size(s%stick), 1))
-   end function tangential_fields
 
    !> PREFIX.contacts.csv: the contact pixels and their forces at the reported load.
    function contacts_csv(deck, res) result(text)
@@ -113,31 +96,18 @@ contains
       end function digits_of
    end function contacts_csv
 
-   !> PREFIX.loads.csv: the states at the requested loads that were reached; with
-   !> `friction`, the shear model's columns.
-   function loads_csv(deck, res, maps, friction, tangential) result(text)
+   !> PREFIX.loads.csv: the states at the requested loads that were reached
+   !> (io/femcod_state_record's rows).
+   function loads_csv(deck, res, info) result(text)
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
-      type(state_maps), intent(in) :: maps(:)
-      logical, intent(in) :: friction, tangential
+      type(run_info), intent(in) :: info
       character(len=:), allocatable :: text
       type(text_builder) :: b
       integer :: k
-      real(dp) :: area_pixel, region
-      area_pixel = deck%pixel**2
-      region = deck%np**2*area_pixel
-      call add_line(b, LOADS_HEADER//trim(merge(FRICTION_COLUMNS, repeat(" ", len(FRICTION_COLUMNS)), friction))// &
-         trim(merge(TANGENTIAL_COLUMNS, repeat(" ", len(TANGENTIAL_COLUMNS)), tangential))//PATCH_COLUMNS)
+      call add_line(b, loads_csv_header(info))
       do k = 1, size(res%states)
-         if (.not. res%states(k)%reached) cycle
-         associate(s => res%states(k))
-            call add_line(b, format_real(s%load)//","//format_real(s%approach)//","// &
-               int_str(s%contacts)//","//format_real(s%contacts*area_pixel)//","// &
-               format_real(s%contacts*area_pixel/region)//","//format_real(s%max_pressure)//","// &
-               int_str(s%n_above_hardness)//","//int_str(s%n_plastic)//","//format_real(s%plastic_volume)// &
-               friction_fields(friction, s%friction, s%load, s%contacts)//tangential_fields(s, tangential)// &
-               ","//int_str(maps(k)%patches%count4)//","//int_str(maps(k)%patches%count8))
-         end associate
+         if (res%states(k)%reached) call add_line(b, loads_csv_row(res%states(k)%state_values, deck%pixel, deck%np, info))
       end do
       text = built_text(b)
    end function loads_csv

@@ -7,12 +7,13 @@ module femcod_results_hdf5
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, xml_escape
    use femcod_contact_result, only: contact_result, load_state, stop_reason_text, event_path_diagnostics, &
-      legacy_diagnostics, cg_state_diagnostics, event_checks, legacy_checks, cg_work
+      legacy_diagnostics, event_checks, legacy_checks, cg_work
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
       h5_read_string_attribute, h5_flat_view
    use femcod_maps, only: state_maps, tangential_step_maps
    use femcod_patches, only: contact_patches, perimeter_area_fit
    use femcod_shear_model, only: friction_coefficient
+   use femcod_state_record, only: state_attributes
    use femcod_result_schema, only: run_info, TANGENTIAL_MAPS, TANGENTIAL_UNITS, result_name, step_plastic, area_fit, &
       load_group, run_boundary, has_adhesion
    implicit none
@@ -33,7 +34,6 @@ contains
       type(status_type) :: local
       character(len=:), allocatable :: g, scene
       real(dp) :: area_pixel, region, exponent, prefactor
-      type(cg_state_diagnostics) :: work
       integer :: k, n
       if (status%code /= 0) return
       n = res%nsteps
@@ -82,35 +82,8 @@ contains
          g = load_group(k, size(res%states))
          associate(s => res%states(k))
             call h5_group(file, g, local)
-            call h5_attribute(file, g, "index", k, local)
-            call h5_attribute(file, g, "load_nN", s%load, local)
-            call h5_attribute(file, g, "approach_nm", s%approach, local)
-            call h5_attribute(file, g, "contacts", s%contacts, local)
-            call h5_attribute(file, g, "area_nm2", s%contacts*area_pixel, local)
-            call h5_attribute(file, g, "max_pressure_GPa", s%max_pressure, local)
-            call h5_attribute(file, g, "n_above_hardness", s%n_above_hardness, local)
-            call h5_attribute(file, g, "n_plastic", s%n_plastic, local)
-            call h5_attribute(file, g, "plastic_volume_nm3", s%plastic_volume, local)
-            if (info%solver == "cg") then
-               work = cg_work(res, k)
-               call h5_attribute(file, g, "cg_iterations", work%iterations, local)
-               call h5_attribute(file, g, "cg_residual", work%residual, local)
-               call h5_attribute(file, g, "cg_penetration_nm", work%penetration, local)
-               call h5_attribute(file, g, "cg_contact_gap_nm", work%contact_gap, local)
-               call h5_attribute(file, g, "cg_load_error", work%load_error, local)
-               call h5_attribute(file, g, "approach_error_bound_nm", work%approach_bound, local)
-            end if
+            call state_attributes(file, g, k, s%state_values, deck%pixel, deck%np, info, cg_work(res, k), local)
             if (info%tangential) call write_tangential(file, g, deck, s, local)
-            if (info%friction) then
-               call h5_attribute(file, g, "friction_nN", s%friction, local)
-               call h5_attribute(file, g, "friction_coefficient", friction_coefficient(s%friction, s%load, s%contacts), local)
-            end if
-            if (has_adhesion(info)) then
-               call h5_attribute(file, g, "attractive_pixels", s%attractive, local)
-               call h5_attribute(file, g, "attractive_load_nN", s%attractive_load, local)
-               call h5_attribute(file, g, "mean_gap_nm", s%mean_gap, local)
-               call h5_attribute(file, g, "jump", s%jump, local)
-            end if
             call write_patches(file, g, maps(k)%patches, local)
             call h5_write(file, g//"/pressure", maps(k)%pressure, "GPa", local, &
                compress=mostly_zero(maps(k)%pressure))
@@ -219,8 +192,7 @@ contains
       end do
    end subroutine write_mesh
 
-   !> A state's tangential step in its load group: the shift (nm, x and y), the force (nN),
-   !> the sticking pixels, gross sliding, the iterations and residual as attributes; the
+   !> A state's tangential step in its load group (its attributes: state_attributes): the
    !> traction maps tau_x, tau_y (GPa) and the stick and slip maps (1 where the contact
    !> sticks, or slips; 0 elsewhere).
    subroutine write_tangential(file, g, deck, s, status)
@@ -231,15 +203,6 @@ contains
       type(status_type), intent(inout) :: status
       real(dp), allocatable :: map(:, :, :)
       map = tangential_step_maps(deck%np, deck%pixel, s)
-      call h5_attribute(file, g, "tangential_force_nN", s%tangential_force(1), status)
-      call h5_attribute(file, g, "tangential_force_y_nN", s%tangential_force(2), status)
-      call h5_attribute(file, g, "tangential_shift_nm", s%tangential_shift(1), status)
-      call h5_attribute(file, g, "tangential_shift_y_nm", s%tangential_shift(2), status)
-      call h5_attribute(file, g, "stick_contacts", int(sum(map(:, :, 3))), status)
-      call h5_attribute(file, g, "stick_area_nm2", sum(map(:, :, 3))*deck%pixel**2, status)
-      call h5_attribute(file, g, "gross_sliding", merge(1, 0, s%sliding), status)
-      call h5_attribute(file, g, "tangential_iterations", s%tangential_iterations, status)
-      call h5_attribute(file, g, "tangential_residual", s%tangential_residual, status)
       call h5_write(file, g//"/shear_x", map(:, :, 1), "GPa", status, compress=mostly_zero(map(:, :, 1)))
       call h5_write(file, g//"/shear_y", map(:, :, 2), "GPa", status, compress=mostly_zero(map(:, :, 2)))
       call h5_write(file, g//"/stick", map(:, :, 3), "1", status, compress=mostly_zero(map(:, :, 3)))
@@ -257,7 +220,8 @@ contains
    !> /run's datasets of the solver's checks: the event path's (zeros for cg) and the
    !> legacy solver's conditioning (its defaults, pivot loss 1 and condition 0, for the
    !> others), the same datasets for every solver.
-   !> A load group's contact patches: the counts and the perimeter-area fit as attributes,
+   !> A load group's contact patches (their counts: state_attributes): the perimeter-area
+   !> fit as an attribute,
    !> each patch's area and perimeter as datasets (when there are patches).
    subroutine write_patches(file, g, patches, local)
       type(h5_file), intent(inout) :: file
@@ -265,8 +229,6 @@ contains
       type(contact_patches), intent(in) :: patches
       type(status_type), intent(inout) :: local
       real(dp) :: exponent, prefactor
-      call h5_attribute(file, g, "patches_4", patches%count4, local)
-      call h5_attribute(file, g, "patches_8", patches%count8, local)
       call perimeter_area_fit(patches%area4, patches%perimeter4, exponent, prefactor)
       call h5_attribute(file, g, "patch_perimeter_exponent", exponent, local)
       if (patches%count4 > 0) then

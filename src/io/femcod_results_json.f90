@@ -4,15 +4,15 @@ module femcod_results_json
    use femcod_memory, only: peak_resident_bytes
    use femcod_problem, only: contact_problem
    use femcod_strings, only: int_str, json_string, json_number
-   use femcod_contact_result, only: contact_result, load_state, stop_reason_text, event_path_diagnostics, &
+   use femcod_contact_result, only: contact_result, stop_reason_text, event_path_diagnostics, &
       legacy_diagnostics, cg_diagnostics, cg_state_diagnostics, event_checks, cg_work
    use femcod_maps, only: state_maps
    use femcod_patches, only: contact_patches, perimeter_area_fit
-   use femcod_shear_model, only: friction_coefficient
-   use femcod_result_schema, only: run_info, area_fit, load_group, run_boundary, has_adhesion
+   use femcod_state_record, only: state_json
+   use femcod_result_schema, only: run_info, area_fit, run_boundary, has_adhesion
    implicit none
    private
-   public :: summary_json
+   public :: summary_json, run_header_json
 
 contains
 
@@ -28,60 +28,22 @@ contains
       real(dp), intent(in) :: write_seconds(2)
       character(len=:), allocatable :: j
       character(len=1), parameter :: nl = new_line("a")
-      character(len=:), allocatable :: loads
+      character(len=:), allocatable :: loads, detail
       real(dp) :: area_pixel, exponent, prefactor
       type(event_path_diagnostics) :: checks
-      type(cg_state_diagnostics) :: work
       integer :: k, last
       checks = event_checks(res)
       area_pixel = deck%pixel**2
       last = res%nsteps
       loads = ""
       do k = 1, size(res%states)
-         associate(s => res%states(k))
-            loads = loads//'    {"load_nN": '//json_number(s%load)//', "reached": '// &
-               trim(merge("true ", "false", s%reached))
-            if (s%reached) loads = loads//', "approach_nm": '//json_number(s%approach)//', "contacts": '// &
-               int_str(s%contacts)//', "area_nm2": '//json_number(s%contacts*area_pixel)//', "area_fraction": '// &
-               json_number(s%contacts/real(deck%np, dp)**2)//', "max_pressure_GPa": '//json_number(s%max_pressure)// &
-               ', "n_above_hardness": '//int_str(s%n_above_hardness)//', "n_plastic": '// &
-               int_str(s%n_plastic)//', "plastic_volume_nm3": '//json_number(s%plastic_volume)//', "hdf5_group": '// &
-               json_string(load_group(k, size(res%states)))
-            if (s%reached) loads = loads//patch_fields(maps(k)%patches)
-            work = cg_work(res, k)
-            if (s%reached .and. work%approach_bound >= 0) loads = loads//', "approach_error_bound_nm": '// &
-               json_number(work%approach_bound)
-            if (s%reached .and. info%tangential) loads = loads//', "tangential_force_nN": '// &
-               json_number(s%tangential_force(1))//', "tangential_shift_nm": '//json_number(s%tangential_shift(1))// &
-               ', "stick_contacts": '//int_str(stick_count(s))//', "stick_area_nm2": '// &
-               json_number(stick_count(s)*area_pixel)//', "gross_sliding": '//trim(merge("true ", "false", s%sliding))
-            if (s%reached .and. info%friction) loads = loads//', "friction_nN": '//json_number(s%friction)// &
-               ', "friction_coefficient": '//json_number(friction_coefficient(s%friction, s%load, s%contacts))
-            if (s%reached .and. (has_adhesion(info) .or. info%solver == "cg")) loads = loads//', "mean_gap_nm": '// &
-               json_number(s%mean_gap)
-            if (s%reached .and. has_adhesion(info)) loads = loads//', "attractive_pixels": '// &
-               int_str(s%attractive)//', "attractive_load_nN": '//json_number(s%attractive_load)// &
-               ', "jump": '//int_str(s%jump)
-            loads = loads//'}'//trim(merge(",", " ", k < size(res%states)))//nl
-         end associate
+         detail = ""
+         if (res%states(k)%reached) detail = patch_detail(maps(k)%patches)
+         loads = loads//'    '//state_json(res%states(k)%state_values, k, size(res%states), deck%pixel, deck%np, info, &
+            cg_work(res, k), detail, "")//trim(merge(",", " ", k < size(res%states)))//nl
       end do
       call area_fit(deck, res, exponent, prefactor)
-      j = '{'//nl// &
-         '  "femcod_version": '//json_string(info%version)//','//nl// &
-         '  "command_line": '//json_string(text_or_empty(info%command_line))//','//nl// &
-         '  "host": '//json_string(text_or_empty(info%host))//','//nl// &
-         '  "started": '//json_string(text_or_empty(info%started))//','//nl// &
-         '  "finished": '//json_string(text_or_empty(info%finished))//','//nl// &
-         '  "results": '//json_string(prefix)//','//nl// &
-         '  "scene": {"label": '//json_string(deck%label)//', "NP": '//int_str(deck%np)//', "pixel_nm": '// &
-         json_number(deck%pixel)//', "MAXCONT": '//int_str(deck%maxcont)//','//nl// &
-         '    "young_GPa": {"lower": '//json_number(deck%young(1))//', "upper": '//json_number(deck%young(2))// &
-         ', "contact": '//json_number(deck%young(3))//'},'//nl// &
-         '    "poisson": {"lower": '//json_number(deck%poisson(1))//', "upper": '//json_number(deck%poisson(2))// &
-         ', "contact": '//json_number(deck%poisson(3))//'}},'//nl// &
-         '  "solver": '//json_string(info%solver)//','//nl// &
-         '  "boundary": '//json_string(run_boundary(info))//','//nl// &
-         adhesion_json(info)// &
+      j = run_header_json(prefix, deck, info)// &
          '  "steps": '//int_str(last)//','//nl// &
          '  "stopped": '//json_string(stop_reason_text(res%stop_reason))//','//nl
       if (last > 0) then
@@ -131,23 +93,43 @@ contains
          end select
       end function solver_details
 
-      !> The patches of a state: counts, the largest, the perimeter-area exponent.
-      function patch_fields(patches) result(t)
+      !> A state's patches beyond their counts: the largest, the perimeter-area exponent.
+      function patch_detail(patches) result(t)
          type(contact_patches), intent(in) :: patches
          character(len=:), allocatable :: t
          real(dp) :: e, p
          call perimeter_area_fit(patches%area4, patches%perimeter4, e, p)
-         t = ', "patches_4": '//int_str(patches%count4)//', "patches_8": '//int_str(patches%count8)// &
-            ', "largest_patch_pixels": '//int_str(maxval([0, patches%area8]))// &
+         t = ', "largest_patch_pixels": '//int_str(maxval([0, patches%area8]))// &
             ', "patch_perimeter_exponent": '//json_number(e)
-      end function patch_fields
-      function text_or_empty(t) result(r)
-         character(len=:), allocatable, intent(in) :: t
-         character(len=:), allocatable :: r
-         r = ""
-         if (allocated(t)) r = t
-      end function text_or_empty
+      end function patch_detail
    end function summary_json
+
+   !> The summary file's opening: '{', then the program, the command, the machine and the
+   !> times, the results' prefix, the scene (from `deck`: label, grid, materials), the
+   !> solver, the boundary and the adhesion law, a line each.
+   function run_header_json(prefix, deck, info) result(j)
+      character(len=*), intent(in) :: prefix
+      type(contact_problem), intent(in) :: deck
+      type(run_info), intent(in) :: info
+      character(len=:), allocatable :: j
+      character(len=1), parameter :: nl = new_line("a")
+      j = '{'//nl// &
+         '  "femcod_version": '//json_string(info%version)//','//nl// &
+         '  "command_line": '//json_string(text_or_empty(info%command_line))//','//nl// &
+         '  "host": '//json_string(text_or_empty(info%host))//','//nl// &
+         '  "started": '//json_string(text_or_empty(info%started))//','//nl// &
+         '  "finished": '//json_string(text_or_empty(info%finished))//','//nl// &
+         '  "results": '//json_string(prefix)//','//nl// &
+         '  "scene": {"label": '//json_string(deck%label)//', "NP": '//int_str(deck%np)//', "pixel_nm": '// &
+         json_number(deck%pixel)//', "MAXCONT": '//int_str(deck%maxcont)//','//nl// &
+         '    "young_GPa": {"lower": '//json_number(deck%young(1))//', "upper": '//json_number(deck%young(2))// &
+         ', "contact": '//json_number(deck%young(3))//'},'//nl// &
+         '    "poisson": {"lower": '//json_number(deck%poisson(1))//', "upper": '//json_number(deck%poisson(2))// &
+         ', "contact": '//json_number(deck%poisson(3))//'}},'//nl// &
+         '  "solver": '//json_string(info%solver)//','//nl// &
+         '  "boundary": '//json_string(run_boundary(info))//','//nl// &
+         adhesion_json(info)
+   end function run_header_json
 
    !> The summary file's adhesion fields (a line each, with the comma), or nothing.
    function adhesion_json(info) result(text)
@@ -159,10 +141,11 @@ contains
          new_line("a")
    end function adhesion_json
 
-   !> The contacts that stick after a state's tangential step (0 without one).
-   pure integer function stick_count(s)
-      type(load_state), intent(in) :: s
-      stick_count = 0
-      if (allocated(s%stick)) stick_count = count(s%stick)
-   end function stick_count
+   !> The text, or "" when it is not there.
+   function text_or_empty(t) result(r)
+      character(len=:), allocatable, intent(in) :: t
+      character(len=:), allocatable :: r
+      r = ""
+      if (allocated(t)) r = t
+   end function text_or_empty
 end module femcod_results_json

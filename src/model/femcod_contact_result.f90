@@ -11,7 +11,7 @@ module femcod_contact_result
    use femcod_shear_model, only: shear_model, friction_force
    implicit none
    private
-   public :: contact_result, load_state, append_step, visit_result, record_approach_states
+   public :: contact_result, state_values, load_state, append_step, visit_result, record_approach_states
    public :: solver_diagnostics, event_path_diagnostics, legacy_diagnostics, cg_diagnostics, cg_state_diagnostics, &
       event_checks, legacy_checks, cg_work, visit_event_checks, cg_iterations_in_all, largest_cg_residual
    public :: STOP_MAXCONT, STOP_LOADS, STOP_NO_CONTACT, STOP_INTERRUPTED, stop_reason_text, record_load_states, finish_contacts, &
@@ -21,8 +21,9 @@ module femcod_contact_result
    !> states before it are kept (a partial run), the others not reached.
    integer, parameter :: STOP_MAXCONT = 1, STOP_LOADS = 2, STOP_NO_CONTACT = 3, STOP_INTERRUPTED = 4
 
-   !> The contact state at one requested load.
-   type :: load_state
+   !> One requested state's values, the same for every program that solves it (femcod run,
+   !> femcod-mpi, the C and Python libraries): what the result files write of a state.
+   type :: state_values
       real(dp) :: load = 0, approach = 0
       integer :: contacts = 0
       real(dp) :: max_pressure = 0
@@ -42,17 +43,25 @@ module femcod_contact_result
       !> the friction force (nN), the sum of tau(p) d^2 over the contacts.
       real(dp) :: friction = 0
       !> With a tangential step (--tangential, --slip; solvers/femcod_tangential): the
-      !> contacts' tangential forces (nN, in the order of i, j) and whether each sticks,
-      !> the rigid tangential shift (nm, x and y: the tangential approach) and the total
+      !> contacts' tangential forces (nN, in the order of the contact pixels; on ranks,
+      !> this rank's) and whether each sticks, the sticking contacts (of all ranks), the
+      !> rigid tangential shift (nm, x and y: the tangential approach) and the total
       !> tangential force (nN), gross sliding (Q >= mu P), and the iteration's count and
       !> relative residual.
       real(dp), allocatable :: shear_x(:), shear_y(:)
       logical, allocatable :: stick(:)
+      integer :: stick_contacts = 0
       real(dp) :: tangential_shift(2) = 0, tangential_force(2) = 0
       logical :: sliding = .false.
       integer :: tangential_iterations = 0
       real(dp) :: tangential_residual = 0
+      !> The contact patches, 4- and 8-connected (model/femcod_patches; with the maps).
+      integer :: patches_4 = 0, patches_8 = 0
       logical :: reached = .false.
+   end type state_values
+
+   !> The contact state at one requested load: its values and its contact pixels.
+   type, extends(state_values) :: load_state
       !> The contact pixels (row, column) and their forces (nN) at this load.
       integer, allocatable :: i(:), j(:)
       real(dp), allocatable :: force(:)

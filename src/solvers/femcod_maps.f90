@@ -19,7 +19,8 @@ module femcod_maps
 
 contains
 
-   !> For every reached state: pressure(i, j) (GPa) = contact force / pixel area;
+   !> For every reached state: its contact patches (kept in the state's values too);
+   !> pressure(i, j) (GPa) = contact force / pixel area;
    !> gap(i, j) (nm) = separation of the deformed surfaces, g0 - approach + c (I * F),
    !> from the elastic operator's zero-padded FFT convolution (cyclic on a periodic cell),
    !> and 0 at the contacts (where the penalty springs' compression s F is the only
@@ -49,6 +50,8 @@ contains
          if (.not. states(s)%reached) cycle
          maps(s)%pressure = state_pressure_map(np, problem%pixel, states(s))
          call find_patches(np, states(s)%i, states(s)%j, cyclic, maps(s)%patches)
+         states(s)%patches_4 = maps(s)%patches%count4
+         states(s)%patches_8 = maps(s)%patches%count8
          if (handed(s)) call move_alloc(states(s)%gap, maps(s)%gap)
       end do
       if (all(handed .or. .not. states%reached)) return

@@ -25,8 +25,8 @@ module femcod_solver
    use femcod_shear_model, only: shear_model
    use femcod_cerruti, only: second_dundurs_constant
    use femcod_clock, only: wall_clock
-   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential_on, tangential_storage_bytes, &
-      tangential_request_of
+   use femcod_tangential, only: tangential_request, tangential_answer, solve_tangential_on, keep_tangential_answer, &
+      tangential_storage_bytes, tangential_request_of
    use femcod_shear_operator, only: grid_shear_operator, grid_shear_setup, grid_shear_free
    implicit none
    private
@@ -230,14 +230,7 @@ contains
                call grid_shear_free(op)
                return
             end if
-            call move_alloc(answer%tx, s%shear_x)
-            call move_alloc(answer%ty, s%shear_y)
-            call move_alloc(answer%stick, s%stick)
-            s%tangential_shift = answer%shift
-            s%tangential_force = answer%force
-            s%sliding = answer%sliding
-            s%tangential_iterations = answer%iterations
-            s%tangential_residual = answer%residual
+            call keep_tangential_answer(answer, s%state_values)
          end associate
       end do
       call grid_shear_free(op)

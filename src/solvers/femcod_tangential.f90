@@ -38,11 +38,12 @@ module femcod_tangential
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: contact_options, BOUNDARY_PERIODIC
    use femcod_shear_operator, only: shear_operator, grid_shear_operator, grid_shear_setup, grid_shear_free
+   use femcod_contact_result, only: state_values
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    implicit none
    private
    public :: tangential_request, tangential_answer, solve_tangential, solve_tangential_on, tangential_storage_bytes, &
-      tangential_request_of
+      tangential_request_of, keep_tangential_answer
 
    !> What a tangential step asks: the friction coefficient, the load (nN) or, with
    !> `by_slip`, the rigid shift (nm), both along x; the relative residual to reach and
@@ -101,6 +102,23 @@ contains
       request%tol = options%tangential_tol
       request%periodic = options%boundary == BOUNDARY_PERIODIC
    end function tangential_request_of
+
+   !> A state's tangential step from its answer (the tractions and stick flags moved, not
+   !> copied); stick_contacts counts this process's sticking contacts (on ranks, the
+   !> caller sums them).
+   subroutine keep_tangential_answer(answer, s)
+      type(tangential_answer), intent(inout) :: answer
+      type(state_values), intent(inout) :: s
+      call move_alloc(answer%tx, s%shear_x)
+      call move_alloc(answer%ty, s%shear_y)
+      call move_alloc(answer%stick, s%stick)
+      s%stick_contacts = count(s%stick)
+      s%tangential_shift = answer%shift
+      s%tangential_force = answer%force
+      s%sliding = answer%sliding
+      s%tangential_iterations = answer%iterations
+      s%tangential_residual = answer%residual
+   end subroutine keep_tangential_answer
 
    !> The tangential state of contact pixels (ci, cj) with normal forces f (nN) of
    !> `problem` under `request`, on one process (its own operator, made and freed here).
