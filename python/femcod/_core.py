@@ -58,9 +58,10 @@ class Deck:
 
 @dataclass
 class State:
-    """The contact state at one requested load or approach. A state the solve did not
-    reach (``state.reached`` False; a warning says why) keeps only what was asked, its
-    other values NaN, and no maps."""
+    """The contact state at one requested load or approach. ``values`` by their names in
+    PREFIX.h5 (units in the names): counts are ints, flags bools, the others floats. A
+    state the solve did not reach (``state.reached`` False; a warning says why) keeps
+    only what was asked, its other values NaN, and no maps."""
     values: dict
     maps: dict = field(default_factory=dict)
 
@@ -71,13 +72,7 @@ class State:
         maps = self.__dict__.get("maps", {})
         key = short.get(name, name)
         if key in values:
-            v = values[key]
-            if key in ("contacts", "n_above_hardness", "n_plastic", "attractive_pixels", "jump", "cg_iterations",
-                       "tangential_iterations", "patches_4", "patches_8"):
-                return int(v)
-            if key in ("reached", "gross_sliding"):
-                return bool(v)
-            return v
+            return values[key]
         if name in maps:
             return maps[name]
         raise AttributeError(name)
@@ -120,6 +115,21 @@ class Result:
     @property
     def areas(self):
         return self.column("area_nm2")
+
+    def to_dataframe(self):
+        """The states as a pandas.DataFrame (pandas must be installed): a row per state,
+        a column per value (counts as integers where every state was reached; a state
+        not reached has NaN)."""
+        try:
+            import pandas as pd
+        except ImportError as e:  # optional, never required
+            raise ImportError("to_dataframe needs pandas (pip install pandas)") from e
+        names = []
+        for s in self.states:
+            names += [n for n in s.values if n not in names]
+        frame = pd.DataFrame([{n: s.values.get(n, math.nan) for n in names} for s in self.states], columns=names)
+        frame.index = pd.RangeIndex(1, len(self.states) + 1, name="state")
+        return frame
 
     def to_xarray(self):
         """The result as an xarray.Dataset (xarray must be installed): the maps over
@@ -349,6 +359,8 @@ def _result(session, solver, options):
     count = ctypes.c_int()
     session.check(lib.femcod_state_count(session.handle, ctypes.byref(count)))
     value_names = [n for n in session.text(lib.femcod_value_names, 0).split(",") if n]
+    # Each value's kind (the library's field table): counts as ints, flags as bools.
+    kinds = dict(zip(value_names, session.text(lib.femcod_value_names, 3).split(",")))
     map_names = [n for n in session.text(lib.femcod_value_names, 1).split(",") if n]
     columns = [n for n in session.text(lib.femcod_value_names, 2).split(",") if n]
     deck = _get_deck(session)
@@ -359,7 +371,7 @@ def _result(session, solver, options):
         values = {}
         for name in value_names:
             session.check(lib.femcod_state_value(session.handle, k, name.encode(), ctypes.byref(value)))
-            values[name] = value.value
+            values[name] = _typed(value.value, kinds.get(name))
         if not values["reached"]:
             # Not an answer: only what was asked (the load or the approach) is kept.
             asked = "approach_nm" if any(o == "--approach" for o, _ in options) else "load_nN"
@@ -379,6 +391,15 @@ def _result(session, solver, options):
         session.check(lib.femcod_history(session.handle, name.encode(), _pointer(h), steps.value))
         history[name] = h
     return Result(states, history, deck, solver, dict(options))
+
+
+def _typed(value, kind):
+    """A state value as its kind says: count -> int, flag -> bool, number -> float."""
+    if kind == "count":
+        return int(value)
+    if kind == "flag":
+        return bool(value)
+    return value
 
 
 def _get_deck(session):

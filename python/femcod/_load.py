@@ -16,6 +16,9 @@ import numpy as np
 from ._core import Deck, Result, State, read_deck
 
 #: History datasets and the names femcod.solve gives the same columns.
+# The state values that are flags (io/femcod_state_record's FIELD_FLAG), stored in
+# PREFIX.h5 as 1 or 0; test_schema.py keeps this set equal to the library's kinds.
+FLAGS = {"gross_sliding"}
 _HISTORY = {"step": "step", "contacts": "contacts", "load": "load_nN", "approach": "approach_nm", "area": "area_nm2",
             "area_fraction": "area_fraction", "n_above_hardness": "n_above_hardness", "n_plastic": "n_plastic",
             "friction": "friction_nN", "friction_coefficient": "friction_coefficient"}
@@ -94,10 +97,13 @@ def _run_result(f, path):
     if "loads" in f:
         for name in sorted(f["loads"].keys()):
             g = f["loads"][name]
-            values = {k: float(v) for k, v in _attributes(g).items() if isinstance(v, (int, float))}
-            # as femcod run's loads.csv: contacts d^2 / (NP^2 d^2)
-            values["area_fraction"] = values["contacts"] * deck.pixel ** 2 / (deck.np ** 2 * deck.pixel ** 2)
-            values["reached"] = 1.0
+            # Integer attributes are counts (ints), or flags (1/0: bools); the others floats.
+            values = {k: (bool(v) if k in FLAGS else v) if isinstance(v, int) else float(v)
+                      for k, v in _attributes(g).items() if isinstance(v, (int, float)) and k != "index"}
+            if "area_fraction" not in values:
+                # a file from before 0.3: as femcod run's loads.csv, contacts d^2 / (NP^2 d^2)
+                values["area_fraction"] = values["contacts"] * deck.pixel ** 2 / (deck.np ** 2 * deck.pixel ** 2)
+            values["reached"] = True
             maps = {k: g[k][()] for k in g.keys() if g[k].ndim == 2}
             states.append(State(values, maps))
     history = {}

@@ -10,10 +10,12 @@ import json
 import os
 
 import h5py
+import numpy as np
 import pytest
 
 import femcod
 from conftest import REPO, run_femcod
+from femcod._load import FLAGS
 
 DECK = os.path.join(REPO, "input", "sphere_d1.deck")
 
@@ -63,3 +65,33 @@ def test_every_writer_names_a_state_alike(case, tmp_path):
             for name in set(row) & names:
                 assert float(row[name]) == float(attributes[name]), (name, row[name], attributes[name])
             assert len(set(row) & names) >= 11
+            # Counts are ints, flags bools (the library's kinds, the file's integers).
+            for name, value in state.values.items():
+                integral = name == "reached" or isinstance(attributes.get(name), (int, np.integer))
+                assert isinstance(value, (int, bool)) == integral, (name, value)
+                assert isinstance(value, bool) == (name == "reached" or name in FLAGS), (name, value)
+            assert isinstance(state.contacts, int) and isinstance(state.reached, bool)
+    read = femcod.load(f"{prefix}.h5")
+    for state, back in zip(library.states, read.states):
+        for name in set(state.values) & set(back.values):
+            assert type(state.values[name]) is type(back.values[name]), name
+            assert state.values[name] == back.values[name], name
+
+
+def test_the_file_reader_knows_every_flag():
+    """femcod.load types a file's flags from FLAGS: the library's flags, every physics on."""
+    r = femcod.solve(femcod.read_deck(DECK), loads=[500], tangential=40, friction=0.3, shear_strength=0.5,
+                     shear_slope=0.1)
+    flags = {name for name, v in r.states[0].values.items() if isinstance(v, bool)} - {"reached"}
+    assert flags == FLAGS and "gross_sliding" in flags
+
+
+def test_the_states_as_a_table():
+    """Result.to_dataframe: a row per state, the values as columns, counts as integers."""
+    pd = pytest.importorskip("pandas")
+    r = femcod.solve(femcod.read_deck(DECK), loads=[100, 400, 1000])
+    frame = r.to_dataframe()
+    assert list(frame.index) == [1, 2, 3] and frame.index.name == "state"
+    assert list(frame["load_nN"]) == [100, 400, 1000]
+    assert pd.api.types.is_integer_dtype(frame["contacts"]) and list(frame["contacts"]) == [s.contacts for s in r.states]
+    assert frame["contacts"].is_monotonic_increasing and frame["reached"].all()

@@ -79,7 +79,8 @@ int femcod_clear_options(femcod_session *s);
 int femcod_solve(femcod_session *s, femcod_progress progress, void *user);
 
 int femcod_state_count(femcod_session *s, int *count);
-/* Comma-separated names: kind 0 state values, 1 maps, 2 history columns. */
+/* Comma-separated names: kind 0 state values, 1 maps, 2 history columns; kind 3 the
+ * state values' kinds in the order of kind 0: number, count (an integer) or flag (1/0). */
 int femcod_value_names(femcod_session *s, int kind, char *text, size_t length);
 /* k from 1. */
 int femcod_state_value(femcod_session *s, int k, const char *name, double *value);

@@ -26,7 +26,7 @@ module femcod_capi
    use femcod_heights, only: load_scene
    use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
    !$ use omp_lib, only: omp_set_num_threads
-   use femcod_library_session, only: library_session, solve_session, state_value, state_value_names, &
+   use femcod_library_session, only: library_session, solve_session, state_value, state_value_names, state_value_kinds, &
       history_column, HISTORY_COLUMNS, map_of, map_names, library_options
    implicit none
    private
@@ -449,7 +449,8 @@ contains
    end function femcod_state_count
 
    !> The names (comma-separated) of what the last solve has: `kind` 0 the state values
-   !> (femcod_state_value), 1 the maps (femcod_state_map), 2 the history columns.
+   !> (femcod_state_value), 1 the maps (femcod_state_map), 2 the history columns; 3 the
+   !> state values' kinds in the order of 0: number, count (an integer) or flag (1 or 0).
    integer(c_int) function femcod_value_names(handle, kind, text, length) bind(C, name="femcod_value_names")
       type(c_ptr), value :: handle
       integer(c_int), value :: kind
@@ -478,8 +479,11 @@ contains
          femcod_value_names = copy_out(map_names(session), text_out, length)
       case (2)
          femcod_value_names = copy_out(HISTORY_COLUMNS, text_out, length)
+      case (3)
+         femcod_value_names = copy_out(state_value_kinds(session), text_out, length)
       case default
-         call set_error(st, STATUS_USAGE, "kind must be 0 (state values), 1 (maps) or 2 (history)")
+         call set_error(st, STATUS_USAGE, "kind must be 0 (state values), 1 (maps), 2 (history) or 3 (the kinds "// &
+            "of the state values)")
          femcod_value_names = finish(session, st)
       end select
    end function femcod_value_names

@@ -13,7 +13,7 @@ module femcod_library_session
    use femcod_memory, only: available_memory
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result, state_values, cg_work, cg_state_diagnostics
-   use femcod_state_record, only: state_field, state_fields, run_info_of
+   use femcod_state_record, only: state_field, state_fields, run_info_of, FIELD_COUNT, FIELD_FLAG
    use femcod_solver_options, only: contact_options, BOUNDARY_PERIODIC, OPTION_NAMES, IN_HISTORY
    use femcod_observer, only: solver_observer
    use femcod_solver, only: solve_contact, run_warnings
@@ -22,8 +22,8 @@ module femcod_library_session
    use femcod_run_options, only: run_table, run_settings, parse_run_arguments
    implicit none
    private
-   public :: library_session, solve_session, state_value, state_value_names, map_of, map_names, history_column, &
-      HISTORY_COLUMNS, library_options
+   public :: library_session, solve_session, state_value, state_value_names, state_value_kinds, map_of, map_names, &
+      history_column, HISTORY_COLUMNS, library_options
 
    !> The history's columns (femcod_history).
    character(len=*), parameter :: HISTORY_COLUMNS = "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,"// &
@@ -177,6 +177,28 @@ contains
          names = names//","//f(m)%name
       end do
    end function state_value_names
+
+   !> The kinds of the state values, in the order of state_value_names: "number",
+   !> "count" (an integer) or "flag" (1 or 0; `reached` first).
+   function state_value_kinds(session) result(kinds)
+      type(library_session), intent(in) :: session
+      character(len=:), allocatable :: kinds
+      type(state_field), allocatable :: f(:)
+      integer :: m
+      f = state_fields(state_values(), session%problem%pixel, max(session%problem%np, 1), &
+         run_info_of(session%options), cg_state_diagnostics())
+      kinds = "flag"
+      do m = 1, size(f)
+         select case (f(m)%kind)
+         case (FIELD_COUNT)
+            kinds = kinds//",count"
+         case (FIELD_FLAG)
+            kinds = kinds//",flag"
+         case default
+            kinds = kinds//",number"
+         end select
+      end do
+   end function state_value_kinds
 
    !> State k's value `name` (as femcod run's PREFIX.h5 has it; 1 or 0 for a flag).
    subroutine state_value(session, k, name, value, st)

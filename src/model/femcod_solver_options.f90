@@ -244,8 +244,8 @@ contains
    !> The one place where the combinations of options are checked: `femcod run` (and
    !> femcod-mpi, which shares its parser) after parsing, before any file is read or any
    !> lock taken, and solve_contact for every library caller, the benchmarks included. A
-   !> refused combination names both options (STATUS_USAGE, exit 2). Checks that need the deck (a load above the fully plastic capacity) are
-   !> the solvers' own.
+   !> refused combination names both options (STATUS_USAGE, exit 2). Checks that need the
+   !> deck (a load above the fully plastic capacity) are the solvers' own.
    subroutine validate_options(options, status)
       type(contact_options), intent(in) :: options
       type(status_type), intent(inout) :: status
