@@ -25,7 +25,7 @@ module test_friction
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read, h5_exists
    use femcod_status, only: STATUS_BAD_INPUT
    use test_support, only: scratch_path, read_text, contains_text, file_exists, condition_of
-   use test_results, only: csv_column
+   use test_results, only: csv_column, csv_named_column
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -288,9 +288,9 @@ contains
          code)
       call check(error, code, 0, "the run")
       if (allocated(error)) return
-      load = csv_column(prefix//".loads.csv", 1)
-      ft = csv_column(prefix//".loads.csv", 10)
-      mu = csv_column(prefix//".loads.csv", 11)
+      load = csv_named_column(prefix//".loads.csv", "load_nN")
+      ft = csv_named_column(prefix//".loads.csv", "friction_nN")
+      mu = csv_named_column(prefix//".loads.csv", "friction_coefficient")
       call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
       do k = 1, 2
          call h5_read(file, "/loads/00"//to_string(k)//"/pressure", pressure, st, STATUS_BAD_INPUT)

@@ -206,7 +206,7 @@ contains
       text = read_text(prefix//".loads.csv")
       call check(error, text(1:index(text, new_line("a")) - 1), &
          "load_nN,approach_nm,contacts,area_nm2,area_fraction,max_pressure_GPa,n_above_hardness,n_plastic,"// &
-         "plastic_volume_nm3,patches_4,patches_8")
+         "plastic_volume_nm3,kappa,patches_4,patches_8")
       if (allocated(error)) return
       ! Two requested loads: a header and two rows.
       call check(error, count([(text(code:code) == new_line("a"), code = 1, len(text))]), 3, "rows of loads.csv")

@@ -28,7 +28,7 @@
 module test_matrix
    use femcod_kinds, only: dp
    use test_support, only: scratch_path, read_text, file_exists, contains_text
-   use test_results, only: self_command, csv_column
+   use test_results, only: self_command, csv_column, csv_named_column
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -122,8 +122,8 @@ contains
                            call check(error, all(column == answers(:, s, b, p, l, m)), "femcod "//args// &
                               ": the tangential step changed the normal answer")
                            if (allocated(error)) return
-                           column = csv_column(prefix//".loads.csv", 10)
-                           contacts = csv_column(prefix//".loads.csv", 3)
+                           column = csv_named_column(prefix//".loads.csv", "tangential_force_nN")
+                           contacts = csv_named_column(prefix//".loads.csv", "contacts")
                            ! A state without contact (unloaded off it) carries no tangential force.
                            where (contacts == 0) column = 10
                            call check(error, all(abs(column - 10) <= 1.0e-12_dp*10), "femcod "//args// &
@@ -140,8 +140,8 @@ contains
                            call check(error, .not. (file_exists(prefix//".pressure_1.svg") .or. &
                               file_exists(prefix//".pressure_2.svg")), "femcod "//args//": --figures none wrote a figure")
                            if (allocated(error)) return
-                           column = csv_column(prefix//".loads.csv", 11)
-                           contacts = csv_column(prefix//".loads.csv", 3)
+                           column = csv_named_column(prefix//".loads.csv", "friction_coefficient")
+                           contacts = csv_named_column(prefix//".loads.csv", "contacts")
                            do k = 1, size(column)
                               ! No contact (unloaded off it): no coefficient, nan.
                               if (contacts(k) == 0) then

@@ -16,7 +16,7 @@ module test_results
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string, skip_test
    implicit none
    private
-   public :: collect_results, self_command, csv_column
+   public :: collect_results, self_command, csv_column, csv_named_column
 
 contains
 
@@ -54,6 +54,22 @@ contains
       call get_command_argument(0, cmd)
       cmd = cmd//" --femcod"
    end function self_command
+
+   !> The column named `name` in a CSV file's header, as numbers (by name, so that a
+   !> column added to a file moves no reader).
+   function csv_named_column(path, name) result(values)
+      character(len=*), intent(in) :: path, name
+      real(dp), allocatable :: values(:)
+      character(len=:), allocatable :: text, header
+      integer :: col, p, k
+      text = read_text(path)
+      header = ","//text(1:index(text, new_line("a")) - 1)//","
+      p = index(header, ","//name//",")
+      if (p == 0) error stop "csv_named_column: no column "//name//" in "//path
+      ! The commas up to the one before the name: the column's number.
+      col = count([(header(k:k) == ",", k = 1, p)])
+      values = csv_column(path, col)
+   end function csv_named_column
 
    !> Column `col` (1-based) of a CSV file without its header, as numbers.
    function csv_column(path, col) result(values)
@@ -173,8 +189,8 @@ contains
       text = read_text(out)
       call check(error, code, 0, "Python's json module reads the summary: "//text)
       if (allocated(error)) return
-      approach = csv_column(prefix//".loads.csv", 2)
-      contacts = csv_column(prefix//".loads.csv", 3)
+      approach = csv_named_column(prefix//".loads.csv", "approach_nm")
+      contacts = csv_named_column(prefix//".loads.csv", "contacts")
       do k = 1, 2
          call check(error, field("approach_"//to_string(k)), approach(k), "approach of load "//to_string(k))
          if (allocated(error)) return
@@ -607,7 +623,7 @@ contains
       call check(error, abs(shown - slope) < 6.0e-4_dp, "exponent shown "//to_string(shown)//", fitted here "// &
          to_string(slope))
       if (allocated(error)) return
-      pmax = csv_column(prefix//".loads.csv", 6)
+      pmax = csv_named_column(prefix//".loads.csv", "max_pressure_GPa")
       text = read_text(prefix//".pressure_2.svg")
       a = index(text, ">max ")
       call check(error, a > 0, "the colour bar states its maximum")

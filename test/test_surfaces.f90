@@ -8,7 +8,7 @@ module test_surfaces
       rms_height, sinusoid_surface, downsample_average, downsample_subsample
    use femcod_generate, only: scene_spec, build_problem, verification_spec, VERIFICATION_DECKS
    use femcod_heights, only: read_heights
-   use femcod_scene, only: initial_gaps, flip_upper
+   use femcod_scene, only: initial_gaps, flip_upper, rms_slope
    use femcod_random, only: random_stream, seed_stream, uniform, advance_stream
    use, intrinsic :: iso_fortran_env, only: int64
    use test_support, only: write_text, read_text, scratch_path, contains_text
@@ -31,6 +31,7 @@ contains
          new_unittest("plane removal and down-sampling", test_transforms), &
          new_unittest("ASCII matrix: comments, errors", test_matrix), &
          new_unittest("flip and initial gaps (Fig. B.1)", test_gaps), &
+         new_unittest("rms slope: a tilted plane and a sine, in closed form", test_rms_slope), &
          new_unittest("input/ decks are what mkdeck generates", test_input_decks), &
          new_unittest("input/ decks hold the thesis' scenes (closed forms, not the generator)", test_deck_scenes) &
          ]
@@ -193,6 +194,38 @@ contains
       call read_heights(scratch_path("m.txt"), z, status)
       call check(error, status%code == 3 .and. contains_text(status%message, ":2:"), "bad number: "//status%message)
    end subroutine test_matrix
+
+   !> kappa's slope scale (model/femcod_scene's rms_slope), against closed forms: a plane
+   !> tilted by s along the rows and t along the columns has forward differences s d and
+   !> t d at every pair, h'_rms = sqrt(s^2 + t^2) on the free surface; the sine
+   !> h = A sin(2 pi i / N) on a periodic cell has differences 2 A cos(...) sin(pi/N),
+   !> whose mean square over a period is 2 A^2 sin^2(pi/N): h'_rms = sqrt(2) A sin(pi/N)/d.
+   subroutine test_rms_slope(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: n = 24
+      real(dp), parameter :: d = 2.5_dp, s = 0.3_dp, t = -0.7_dp, a = 1.9_dp
+      real(dp) :: g(n, n), expected
+      integer :: i, j
+      do j = 1, n
+         do i = 1, n
+            g(i, j) = s*i*d + t*j*d
+         end do
+      end do
+      call check(error, abs(rms_slope(g, d, .false.) - sqrt(s**2 + t**2)) < 1e-13_dp, "tilted plane: "// &
+         to_string(rms_slope(g, d, .false.)))
+      if (allocated(error)) return
+      do j = 1, n
+         do i = 1, n
+            g(i, j) = a*sin(2*acos(-1.0_dp)*i/n)
+         end do
+      end do
+      expected = sqrt(2.0_dp)*a*sin(acos(-1.0_dp)/n)/d
+      call check(error, abs(rms_slope(g, d, .true.) - expected) < 1e-13_dp*expected, "periodic sine: "// &
+         to_string(rms_slope(g, d, .true.))//" against "//to_string(expected))
+      if (allocated(error)) return
+      ! The sine transposed: the same slope along the other direction.
+      call check(error, abs(rms_slope(transpose(g), d, .true.) - expected) < 1e-13_dp*expected, "transposed sine")
+   end subroutine test_rms_slope
 
    subroutine test_gaps(error)
       type(error_type), allocatable, intent(out) :: error

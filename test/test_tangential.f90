@@ -31,7 +31,7 @@ module test_tangential
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read
    use femcod_status, only: STATUS_BAD_INPUT
    use test_support, only: scratch_path, file_exists
-   use test_results, only: csv_column
+   use test_results, only: csv_named_column
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -527,13 +527,13 @@ contains
          n = nint(sum(stick))
          call check(error, n > 0 .and. n < count(p > 0), "partial slip at load "//to_string(k))
          if (allocated(error)) exit
-         column = csv_column(prefix//".loads.csv", 12)
+         column = csv_named_column(prefix//".loads.csv", "stick_contacts")
          call check(error, nint(column(k)), n, "stick_contacts of load "//to_string(k))
          if (allocated(error)) exit
       end do
       call h5_close(file, st)
       if (allocated(error)) return
-      column = csv_column(prefix//".loads.csv", 10)
+      column = csv_named_column(prefix//".loads.csv", "tangential_force_nN")
       call check(error, all(abs(column - 100) <= 1.0e-10_dp*100), "tangential_force_nN = Q")
       if (allocated(error)) return
       call run_femcod([string_type("run"), string_type("input/sphere_d05.deck"), string_type("--loads"), &
@@ -542,7 +542,7 @@ contains
          code)
       call check(error, code, 0, "the --slip run")
       if (allocated(error)) return
-      column = csv_column(prefix//".loads.csv", 11)
+      column = csv_named_column(prefix//".loads.csv", "tangential_shift_nm")
       call check(error, column(1), 0.05_dp, "tangential_shift_nm = S")
       if (allocated(error)) return
       refused(:, 1) = [character(len=24) :: "--friction", "0.3", "", "", ""]

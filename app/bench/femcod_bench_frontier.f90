@@ -21,8 +21,8 @@ module femcod_bench_frontier
    use femcod_files, only: write_file, file_part
    use femcod_svg, only: svg_series, add_series, svg_multi_plot
    use femcod_resolution_study, only: level_deck
-   use femcod_resolution, only: mccool_surface, mccool_area, mccool_parameters, composite_modulus
-   use femcod_love, only: love_influence, surface_compliance
+   use femcod_resolution, only: mccool_surface, mccool_area, mccool_parameters
+   use femcod_love, only: love_influence, surface_compliance, composite_modulus
    use femcod_spring, only: spring_stiffness
    use femcod_scene, only: flip_upper
    use femcod_sort, only: merge_sort_index

@@ -15,7 +15,7 @@ module femcod_bench_refine
    use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_solver, only: solve_contact
    use femcod_refine_study, only: refine_answer, refine_contact
-   use femcod_resolution, only: composite_modulus
+   use femcod_love, only: composite_modulus
    use femcod_strings, only: string_type, int_str, fixed_str, sig_str
    use femcod_help, only: help_requested
    use femcod_options, only: option_spec, parsed_options, integer_option, real_list_option, integer_list_option, &

@@ -41,7 +41,9 @@ program femcod_mpi
    use femcod_about, only: FEMCOD_VERSION
    use femcod_exit, only: exit_program
    use femcod_help, only: help_requested
-   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, scatter_problem, grid_setup
+   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, scatter_problem, grid_setup, &
+      distributed_rms_slope
+   use femcod_love, only: composite_modulus
    use femcod_cg, only: distributed_storage_bytes
    use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, &
       agree
@@ -69,7 +71,7 @@ program femcod_mpi
    type(signal_observer) :: observer
    type(string_type), allocatable :: warnings(:)
    character(len=:), allocatable :: prefix, notice, started, blocks_note
-   real(dp) :: t_start, t_read, t_solve, t_write, peak, read_peak, constants(4)
+   real(dp) :: t_start, t_read, t_solve, t_write, peak, read_peak, constants(4), slope
    real(dp), allocatable :: local(:, :), estimated_mb(:)
    type(string_type), allocatable :: outputs(:), inputs(:)
    integer(i8) :: estimated_rank_bytes
@@ -201,6 +203,9 @@ program femcod_mpi
    call grid_setup(grid, MPI_COMM_WORLD, np, block, local, constants(2), constants(3), constants(4), &
       settings%solve%cg, status, settings%solve%boundary == BOUNDARY_PERIODIC)
    deallocate(local)
+   ! kappa's slope scale: the initial gaps' rms slope, from every rank's columns.
+   slope = 0
+   if (status%code == 0) slope = distributed_rms_slope(grid)
    call wall_clock(t_read)
    if (status%code == 0) call solve_loads(grid, problem, targets(), settings%solve%cg, states, status, observer, &
       settings%solve%hardness, settings%solve%plastic, by_approach(), make_interface_law(settings%solve%adhesion, &
@@ -226,6 +231,8 @@ program femcod_mpi
    ! The run's record as femcod run's (its columns from the options), on the ranks.
    info%run_info = run_info_of(settings%solve)
    info%solver = "cg (femcod-mpi)"
+   info%rms_slope = slope
+   if (rank == 0) info%composite_modulus = composite_modulus(problem%young(1:2), problem%poisson(1:2))
    info%version = FEMCOD_VERSION
    info%command_line = "femcod-mpi "//settings%command_line
    info%host = host_name()

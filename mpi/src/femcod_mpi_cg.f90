@@ -49,6 +49,7 @@ module femcod_mpi_cg
       solve_target, ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
    use femcod_shear_model, only: shear_model, friction_force
+   use femcod_scene, only: slope_sums
    use femcod_contact_result, only: cg_state_diagnostics, state_values
    use femcod_mpi_gap_transform, only: distributed_gap_transform, gap_transform_setup, gap_transform_apply, &
       gap_transform_free
@@ -59,7 +60,7 @@ module femcod_mpi_cg
    private
    public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor, &
       gap_grid_setup
-   public :: distribute_problem, scatter_problem, distributed_convolve, problem_constants
+   public :: distribute_problem, scatter_problem, distributed_convolve, problem_constants, distributed_rms_slope
 
    !> One rank's part of the problem and of the distributed convolution: an elastic
    !> operator on this rank's columns (the parent type holds the grid side, the slab, the
@@ -812,4 +813,34 @@ contains
       call wall_clock(done)
       op%slab%communication_seconds = op%slab%communication_seconds + (done - start)
    end subroutine exchange_halo
+
+   !> The rms slope of the initial gaps over all ranks (model/femcod_scene's rms_slope of
+   !> the whole map): each slab's sums, and the pairs across its right edge with the next
+   !> rank's first column (across the cell's edge too on a periodic cell). Collective.
+   real(dp) function distributed_rms_slope(grid) result(slope)
+      class(distributed_grid), intent(inout) :: grid
+      real(dp) :: sums(2), pairs(2), total(4)
+      real(dp), allocatable :: next(:)
+      integer :: left, right
+      call slope_sums(grid%g0, grid%periodic, sums, pairs)
+      left = grid%rank - 1
+      right = grid%rank + 1
+      if (grid%periodic) then
+         left = modulo(left, grid%ranks)
+         right = modulo(right, grid%ranks)
+      else
+         if (left < 0) left = MPI_PROC_NULL
+         if (right >= grid%ranks) right = MPI_PROC_NULL
+      end if
+      allocate(next(grid%np))
+      call MPI_Sendrecv(grid%g0(:, 1), grid%np, MPI_DOUBLE_PRECISION, left, 3, next, grid%np, MPI_DOUBLE_PRECISION, &
+         right, 3, grid%comm, MPI_STATUS_IGNORE)
+      if (right /= MPI_PROC_NULL) then
+         sums(2) = sums(2) + sum((next - grid%g0(:, grid%nj))**2)
+         pairs(2) = pairs(2) + grid%np
+      end if
+      total = [sums, pairs]
+      call grid%sum_over_grid(total)
+      slope = sqrt(total(1)/max(total(3), 1.0_dp) + total(2)/max(total(4), 1.0_dp))/grid%pixel
+   end function distributed_rms_slope
 end module femcod_mpi_cg

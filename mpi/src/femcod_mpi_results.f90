@@ -65,6 +65,8 @@ contains
          call h5_attribute(file, "/run", "finished", info%finished, status)
          call h5_attribute(file, "/run", "solver", info%solver, status)
          call h5_attribute(file, "/run", "boundary", run_boundary(info%run_info), status)
+         call h5_attribute(file, "/run", "rms_slope", info%rms_slope, status)
+         call h5_attribute(file, "/run", "composite_modulus_GPa", info%composite_modulus, status)
          call h5_attribute(file, "/run", "mpi_ranks", info%ranks, status)
          call h5_attribute(file, "/run", "threads_per_rank", info%threads, status)
          call h5_attribute(file, "/run", "wall_time_s", info%wall_seconds, status)

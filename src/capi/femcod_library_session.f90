@@ -13,7 +13,8 @@ module femcod_library_session
    use femcod_memory, only: available_memory
    use femcod_problem, only: contact_problem
    use femcod_contact_result, only: contact_result, state_values, cg_work, cg_state_diagnostics
-   use femcod_state_record, only: state_field, state_fields, run_info_of, FIELD_COUNT, FIELD_FLAG
+   use femcod_result_schema, only: run_info
+   use femcod_state_record, only: state_field, state_fields, run_info_for, FIELD_COUNT, FIELD_FLAG
    use femcod_solver_options, only: contact_options, BOUNDARY_PERIODIC, OPTION_NAMES, IN_HISTORY
    use femcod_observer, only: solver_observer
    use femcod_solver, only: solve_contact, run_warnings
@@ -46,6 +47,8 @@ module femcod_library_session
       type(contact_options) :: options
       type(contact_result) :: res
       type(state_maps), allocatable :: maps(:)
+      !> The run record of the last solve (which state values it has, kappa's scales).
+      type(run_info) :: info
       logical :: solved = .false.
       !> The message of the last failure; what the last read of heights warned of.
       character(len=:), allocatable :: message, warnings
@@ -117,6 +120,7 @@ contains
       end if
       call load_maps(session%problem, session%res%states, session%maps, options%boundary == BOUNDARY_PERIODIC)
       session%options = options
+      session%info = run_info_for(session%problem, options)
       session%solved = .true.
       ! What `femcod run` prints as warnings (a requested state not reached, a tangential
       ! step without contact): femcod_warnings, one per line.
@@ -171,7 +175,7 @@ contains
       type(state_field), allocatable :: f(:)
       integer :: m
       f = state_fields(state_values(), session%problem%pixel, max(session%problem%np, 1), &
-         run_info_of(session%options), cg_state_diagnostics())
+         session%info, cg_state_diagnostics())
       names = "reached"
       do m = 1, size(f)
          names = names//","//f(m)%name
@@ -186,7 +190,7 @@ contains
       type(state_field), allocatable :: f(:)
       integer :: m
       f = state_fields(state_values(), session%problem%pixel, max(session%problem%np, 1), &
-         run_info_of(session%options), cg_state_diagnostics())
+         session%info, cg_state_diagnostics())
       kinds = "flag"
       do m = 1, size(f)
          select case (f(m)%kind)
@@ -220,7 +224,7 @@ contains
             value = merge(1, 0, s%reached)
             return
          end if
-         f = state_fields(s%state_values, session%problem%pixel, session%problem%np, run_info_of(session%options), &
+         f = state_fields(s%state_values, session%problem%pixel, session%problem%np, session%info, &
             cg_work(session%res, k))
       end associate
       do m = 1, size(f)

@@ -6,7 +6,9 @@ module femcod_refine_command
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE
-   use femcod_strings, only: string_type, int_str, sig_str, format_real, text_builder, add_line, built_text
+   use femcod_strings, only: string_type, int_str, sig_str, format_real, text_builder, add_line, built_text, &
+      json_string, json_number
+   use femcod_about, only: FEMCOD_VERSION
    use femcod_memory, only: available_memory
    use femcod_problem, only: contact_problem
    use femcod_deck, only: read_deck
@@ -108,7 +110,8 @@ contains
       call validate_options(options, status)
       if (status%code == 0 .and. is_height_file(deck)) call set_error(status, STATUS_USAGE, deck// &
          " is a height file: make a deck of it first (femcod mkdeck matrix --file ... --shape-on lower)")
-      names = [string_type(prefix//".refine.csv"), string_type(prefix//".refine.svg")]
+      names = [string_type(prefix//".refine.csv"), string_type(prefix//".refine.svg"), &
+         string_type(prefix//".refine.json")]
       if (status%code == 0) call check_outputs(names, deck, force, status)
       if (status%code == 0) then
          call read_deck(deck, problem, status)
@@ -121,9 +124,10 @@ contains
       options%memory_available = available_memory()
       if (status%code == 0) call refine_contact(problem, options, down_to, answer, status)
       if (status%code == 0) then
-         allocate(texts(2))
+         allocate(texts(3))
          texts(1)%s = refine_csv(answer, problem%pixel)
          texts(2)%s = refine_svg(answer, problem)
+         texts(3)%s = refine_json(deck, args, problem, boundary, down_to, answer)
          call write_file_set(names, texts, status)
       end if
       if (status%code /= 0) then
@@ -141,18 +145,70 @@ contains
       type(text_builder) :: b
       integer :: k, z
       call add_line(b, "load_nN,magnification,pixel_nm,area_fraction_solve,area_fraction_refined,"// &
-         "area_fraction_richardson,area_fraction_persson,area_fraction_refined_sqrt2,kappa")
+         "area_fraction_richardson,area_fraction_persson,area_fraction_refined_sqrt2,kappa,area_load_slope_solve,"// &
+         "area_load_slope_refined")
       do k = 1, size(answer%loads)
          do z = 1, size(answer%zeta)
             call add_line(b, format_real(answer%loads(k))//","//format_real(answer%zeta(z))//","// &
                format_real(pixel/answer%zeta(z))//","//format_real(answer%coarse(1, k))//","// &
                format_real(answer%refined(z, k))//","//format_real(answer%richardson(z, k))//","// &
                format_real(answer%persson(z, k))//","//format_real(answer%theory(z, k))//","// &
-               format_real(answer%kappa(k)))
+               format_real(answer%kappa(k))//","//format_real(answer%slope_solve(k))//","// &
+               format_real(answer%slope_refined(z, k)))
          end do
       end do
       text = built_text(b)
    end function refine_csv
+
+   !> PREFIX.refine.json (beside a run's PREFIX.summary.json of the same deck, not over it):
+   !> what refine prints and writes, as numbers whose names carry
+   !> their units: the scene, the spectrum's fit, and per load the solve's area fraction
+   !> and area-load slope with every magnification's refined, Richardson and Persson
+   !> area fractions and the refined slope.
+   function refine_json(deck, args, problem, boundary, down_to, answer) result(j)
+      character(len=*), intent(in) :: deck, boundary
+      type(string_type), intent(in) :: args(:)
+      type(contact_problem), intent(in) :: problem
+      real(dp), intent(in) :: down_to
+      type(refine_answer), intent(in) :: answer
+      character(len=:), allocatable :: j, line
+      character(len=1), parameter :: nl = new_line("a")
+      integer :: k, z
+      line = "femcod refine"
+      do k = 1, size(args)
+         line = line//" "//args(k)%s
+      end do
+      associate(s => answer%spectrum)
+         j = '{'//nl//'  "femcod_version": '//json_string(FEMCOD_VERSION)//','//nl// &
+            '  "command": "refine", "command_line": '//json_string(line)//','//nl// &
+            '  "deck": '//json_string(deck)//','//nl// &
+            '  "scene": {"label": '//json_string(problem%label)//', "NP": '//int_str(problem%np)//', "pixel_nm": '// &
+            json_number(problem%pixel)//', "composite_modulus_GPa": '//json_number(answer%estar)//'},'//nl// &
+            '  "boundary": '//json_string(boundary)//', "down_to_nm": '//json_number(down_to)//','//nl// &
+            '  "spectrum": {"prefactor_nm4": '//json_number(s%prefactor)//', "hurst": '//json_number(s%hurst)// &
+            ', "fit_from_per_nm": '//json_number(s%q_low)//', "fit_to_per_nm": '//json_number(s%q_high)// &
+            ', "bins": '//int_str(s%points)//', "r_squared": '//json_number(s%r_squared)// &
+            ', "rms_slope": '//json_number(sqrt(s%slope_variance))//'},'//nl// &
+            '  "rms_slope": '//json_number(answer%rms_slope)//','//nl//'  "loads": ['//nl
+      end associate
+      do k = 1, size(answer%loads)
+         j = j//'    {"load_nN": '//json_number(answer%loads(k))//', "area_fraction_solve": '// &
+            json_number(answer%coarse(1, k))//', "area_load_slope_solve": '//json_number(answer%slope_solve(k))// &
+            ', "kappa": '//json_number(answer%kappa(k))//', "magnifications": ['
+         do z = 1, size(answer%zeta)
+            j = j//nl//'      {"magnification": '//json_number(answer%zeta(z))//', "pixel_nm": '// &
+               json_number(problem%pixel/answer%zeta(z))//', "area_fraction_refined": '// &
+               json_number(answer%refined(z, k))//', "area_fraction_richardson": '// &
+               json_number(answer%richardson(z, k))//', "area_fraction_persson": '//json_number(answer%persson(z, k))// &
+               ', "area_fraction_refined_sqrt2": '//json_number(answer%theory(z, k))//', "area_load_slope_refined": '// &
+               json_number(answer%slope_refined(z, k))//'}'//trim(merge(",", " ", z < size(answer%zeta)))
+         end do
+         j = j//']}'//trim(merge(",", " ", k < size(answer%loads)))//nl
+      end do
+      j = j//'  ],'//nl//'  "timings_s": {"solve": '//json_number(answer%solve_seconds)//', "richardson_solves": '// &
+         json_number(answer%richardson_seconds)//', "spectrum_and_refinement": '// &
+         json_number(answer%refine_seconds)//'}'//nl//'}'//nl
+   end function refine_json
 
    function refine_svg(answer, problem) result(svg)
       type(refine_answer), intent(in) :: answer
@@ -199,10 +255,13 @@ contains
             " %, Richardson "//sig_str(100*answer%richardson(last, k), 4)//" %, Persson "// &
             sig_str(100*answer%persson(last, k), 4)//" % at "//format_real(down_to)//" nm (kappa "// &
             sig_str(answer%kappa(k), 4)//", Persson's sqrt(2) gives "//sig_str(100*answer%theory(last, k), 4)//" %)"
+         write(output_unit, '(a)') "              area-load slope (A/A0)/(p/(E* h'_rms)): the solve "// &
+            sig_str(answer%slope_solve(k), 4)//" (h'_rms "//sig_str(answer%rms_slope, 4)//" at the pixel), refined "// &
+            sig_str(answer%slope_refined(last, k), 4)//" (with the slope down to "//format_real(down_to)//" nm)"
       end do
       write(output_unit, '(a)') "  cost      : the solve "//sig_str(answer%solve_seconds, 3)//" s; spectrum, fit "// &
          "and refinement "//sig_str(answer%refine_seconds, 3)//" s; the solves at 2d and 4d (Richardson) "// &
          sig_str(answer%richardson_seconds, 3)//" s"
-      write(output_unit, '(a)') "  written   : "//prefix//".refine.csv, .refine.svg"
+      write(output_unit, '(a)') "  written   : "//prefix//".refine.csv, .refine.svg, .refine.json"
    end subroutine print_refine
 end module femcod_refine_command

@@ -24,7 +24,7 @@ module femcod_run
    use femcod_contact_result, only: contact_result, STOP_INTERRUPTED
    use femcod_solver_options, only: contact_options, requested_states, history_options, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_cerruti, only: second_dundurs_constant
-   use femcod_state_record, only: run_info_of
+   use femcod_state_record, only: run_info_for
    use femcod_incremental_state, only: incremental_state
    use femcod_solver, only: solve_contact, model_notes, run_warnings
    use femcod_maps, only: load_maps, state_maps
@@ -390,7 +390,7 @@ contains
          if (st%code == 0 .and. options%solver == SOLVER_CG .and. len(settings%wisdom) > 0) &
             call save_wisdom(settings%wisdom, st)
          if (st%code /= 0) return
-         info = run_info_of(options)
+         info = run_info_for(problem, options)
          info%version = FEMCOD_VERSION
          info%beta = second_dundurs_constant(problem%young(1:2), problem%poisson(1:2))
          info%options = settings%command_line

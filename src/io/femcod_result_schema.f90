@@ -21,7 +21,7 @@ module femcod_result_schema
    character(len=*), parameter :: HISTORY_HEADER = &
       "step,contacts,load_nN,approach_nm,area_nm2,area_fraction,n_above_hardness,n_plastic"
    character(len=*), parameter :: LOADS_HEADER = "load_nN,approach_nm,contacts,area_nm2,area_fraction,"// &
-      "max_pressure_GPa,n_above_hardness,n_plastic,plastic_volume_nm3"
+      "max_pressure_GPa,n_above_hardness,n_plastic,plastic_volume_nm3,kappa"
    character(len=*), parameter :: CONTACTS_HEADER = "i,j,step,force_nN,pressure_GPa"
    !> The columns every loads file ends with: the contact patches, 4- and 8-connected
    !> (model/femcod_patches).
@@ -64,6 +64,11 @@ module femcod_result_schema
       !> A solver of the cg family (femcod run --solver cg, femcod-mpi): each state has
       !> the iteration's work (cg_* attributes) and the mean gap.
       logical :: cg = .false.
+      !> The scales of the dimensionless area-load slope kappa = (A/A0) / (p/(E* h'_rms))
+      !> of each state (p = F/A0 the nominal pressure): the rms slope h'_rms (1) of the
+      !> composite surface at the pixel (model/femcod_scene's rms_slope of the initial
+      !> gaps) and the composite modulus E* (GPa); 0: not known (kappa NaN).
+      real(dp) :: rms_slope = 0, composite_modulus = 0
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
       !> The input files, one line each: the deck, or what each height file gave

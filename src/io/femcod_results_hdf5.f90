@@ -101,6 +101,8 @@ contains
       if (allocated(info%finished)) call h5_attribute(file, "/run", "finished", info%finished, local)
       call h5_attribute(file, "/run", "solver", info%solver, local)
       call h5_attribute(file, "/run", "boundary", run_boundary(info), local)
+      call h5_attribute(file, "/run", "rms_slope", info%rms_slope, local)
+      call h5_attribute(file, "/run", "composite_modulus_GPa", info%composite_modulus, local)
       if (has_adhesion(info)) then
          call h5_attribute(file, "/run", "adhesion", info%adhesion, local)
          call h5_attribute(file, "/run", "work_of_adhesion_J_m2", info%work, local)

@@ -128,6 +128,8 @@ contains
          ', "contact": '//json_number(deck%poisson(3))//'}},'//nl// &
          '  "solver": '//json_string(info%solver)//','//nl// &
          '  "boundary": '//json_string(run_boundary(info))//','//nl// &
+         '  "kappa_scale": {"rms_slope": '//json_number(info%rms_slope)//', "composite_modulus_GPa": '// &
+         json_number(info%composite_modulus)//'},'//nl// &
          adhesion_json(info)
    end function run_header_json
 

@@ -6,18 +6,23 @@
 !> optional fields a run has (the cg family's work, the tangential step, the shear model,
 !> adhesion) comes from its run_info (run_info_of: from the options).
 module femcod_state_record
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use femcod_kinds, only: dp
    use femcod_status, only: status_type
    use femcod_strings, only: int_str, format_real, json_string, json_number
    use femcod_contact_result, only: state_values, cg_state_diagnostics
    use femcod_shear_model, only: shear_model, friction_coefficient
-   use femcod_solver_options, only: contact_options, SOLVER_CG, solver_name, boundary_name, law_name, run_shear_model
+   use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC, solver_name, boundary_name, law_name, &
+      run_shear_model
+   use femcod_problem, only: contact_problem
+   use femcod_love, only: composite_modulus
+   use femcod_scene, only: initial_gap_map, rms_slope
    use femcod_hdf5, only: h5_file, h5_attribute
    use femcod_result_schema, only: run_info, LOADS_HEADER, FRICTION_COLUMNS, TANGENTIAL_COLUMNS, PATCH_COLUMNS, &
       load_group, has_adhesion
    implicit none
    private
-   public :: state_field, state_fields, FIELD_NUMBER, FIELD_COUNT, FIELD_FLAG, run_info_of
+   public :: state_field, state_fields, FIELD_NUMBER, FIELD_COUNT, FIELD_FLAG, run_info_of, run_info_for
    public :: loads_csv_header, loads_csv_row, state_json, state_attributes
 
    !> How a field is written: a number, a count (an integer), a flag (true/false in JSON,
@@ -56,6 +61,18 @@ contains
       end if
    end function run_info_of
 
+   !> The run record's columns for `options` on `problem`: run_info_of's, and the scales
+   !> of kappa (the rms slope of the initial gaps, the composite modulus of the bodies).
+   function run_info_for(problem, options) result(info)
+      type(contact_problem), intent(in) :: problem
+      type(contact_options), intent(in) :: options
+      type(run_info) :: info
+      info = run_info_of(options)
+      info%composite_modulus = composite_modulus(problem%young(1:2), problem%poisson(1:2))
+      if (allocated(problem%lower) .and. allocated(problem%upper)) info%rms_slope = &
+         rms_slope(initial_gap_map(problem%lower, problem%upper), problem%pixel, options%boundary == BOUNDARY_PERIODIC)
+   end function run_info_for
+
    !> The fields of a state on an NP x NP grid of pixel d (nm): the common ones, then the
    !> cg family's work (`work`), the tangential step's, the shear model's and the
    !> adhesion's where the run has them.
@@ -70,7 +87,7 @@ contains
          field("area_nm2", v%contacts*pixel**2), field("area_fraction", v%contacts*pixel**2/(real(np, dp)**2*pixel**2)), &
          field("max_pressure_GPa", v%max_pressure), count_of("n_above_hardness", v%n_above_hardness), &
          count_of("n_plastic", v%n_plastic), field("plastic_volume_nm3", v%plastic_volume), &
-         count_of("patches_4", v%patches_4), count_of("patches_8", v%patches_8)]
+         field("kappa", kappa(v, pixel, info)), count_of("patches_4", v%patches_4), count_of("patches_8", v%patches_8)]
       if (info%cg) f = [f, count_of("cg_iterations", work%iterations), field("cg_residual", work%residual), &
          field("cg_penetration_nm", work%penetration), field("cg_contact_gap_nm", work%contact_gap), &
          field("cg_load_error", work%load_error), field("approach_error_bound_nm", work%approach_bound)]
@@ -160,6 +177,18 @@ contains
       end do
    end subroutine state_attributes
 
+   !> A state's dimensionless area-load slope kappa = (A/A0) / (p/(E* h'_rms)) =
+   !> A E* h'_rms / F (A = contacts d^2 the pixel-counted area, F the load, nN; E* GPa);
+   !> NaN at F <= 0 or without the run's slope and modulus.
+   pure real(dp) function kappa(v, pixel, info)
+      type(state_values), intent(in) :: v
+      real(dp), intent(in) :: pixel
+      type(run_info), intent(in) :: info
+      kappa = ieee_value(kappa, ieee_quiet_nan)
+      if (v%load > 0 .and. info%rms_slope > 0 .and. info%composite_modulus > 0) &
+         kappa = v%contacts*pixel**2*info%composite_modulus*info%rms_slope/v%load
+   end function kappa
+
    !> The header of PREFIX.loads.csv: the common columns, the shear model's and the
    !> tangential step's where the run has them, the patches.
    function loads_csv_header(info) result(text)
@@ -183,7 +212,7 @@ contains
       text = format_real(v%load)//","//format_real(v%approach)//","//int_str(v%contacts)//","// &
          format_real(v%contacts*area_pixel)//","//format_real(v%contacts*area_pixel/(real(np, dp)**2*area_pixel))// &
          ","//format_real(v%max_pressure)//","//int_str(v%n_above_hardness)//","//int_str(v%n_plastic)//","// &
-         format_real(v%plastic_volume)
+         format_real(v%plastic_volume)//","//format_real(kappa(v, pixel, info))
       if (info%friction) text = text//","//format_real(v%friction)//","// &
          format_real(friction_coefficient(v%friction, v%load, v%contacts))
       if (info%tangential) then

@@ -18,13 +18,20 @@ module femcod_love
    use femcod_kinds, only: dp
    implicit none
    private
-   public :: love_influence, love_influence_exact, love_influence_far, offset_table, surface_compliance
+   public :: love_influence, love_influence_exact, love_influence_far, offset_table, surface_compliance, &
+      composite_modulus
    public :: FAR_FIELD_RADIUS
 
    !> Offsets (in pixels) from which the far-field expansion is used.
    real(dp), parameter :: FAR_FIELD_RADIUS = 20
 
 contains
+
+   !> Composite modulus E* of two elastic bodies: 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (GPa).
+   pure real(dp) function composite_modulus(young, poisson)
+      real(dp), intent(in) :: young(2), poisson(2)
+      composite_modulus = 1/((1 - poisson(1)**2)/young(1) + (1 - poisson(2)**2)/young(2))
+   end function composite_modulus
 
    !> Surface compliance factor (1 - nu**2)/(pi E d) in nm/nN for E in GPa, d in nm.
    pure real(dp) function surface_compliance(young, poisson, pixel)

@@ -8,12 +8,12 @@ module femcod_refine_study
    use femcod_strings, only: format_real
    use femcod_clock, only: wall_clock
    use femcod_problem, only: contact_problem
-   use femcod_scene, only: initial_gap_map
+   use femcod_scene, only: initial_gap_map, rms_slope
    use femcod_surfaces, only: block_average
-   use femcod_resolution, only: composite_modulus
+   use femcod_love, only: composite_modulus
    use femcod_maps, only: state_pressure_map
    use femcod_contact_result, only: contact_result
-   use femcod_solver_options, only: contact_options, SOLVER_CG
+   use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_solver, only: solve_contact
    use femcod_refine, only: surface_spectrum, surface_spectrum_of, fit_spectrum, subpixel_slope_variance, &
       refined_fraction, persson_fraction, richardson_area, magnifications, calibrate_kappa
@@ -42,6 +42,13 @@ module femcod_refine_study
       !> The refinement with Persson's own constant sqrt(2) in place of the measured one
       !> (zeta, load), and the measured constant kappa per load.
       real(dp), allocatable :: theory(:, :), kappa(:)
+      !> The dimensionless area-load slope (A/A0) / (p/(E* h'_rms)) (doc/studies.md, "The
+      !> area-load slope kappa"): of the solve at d with the image's h'_rms at the pixel
+      !> (rms_slope: forward differences, as every run reports it), and of the refined
+      !> area with the slope down to each magnification's length, h'_rms^2 + the
+      !> spectrum's slope variance from q_d to zeta q_d (zeta, load).
+      real(dp) :: rms_slope = 0
+      real(dp), allocatable :: slope_solve(:), slope_refined(:, :)
       !> Wall seconds: the solve at d; the solves at 2d and 4d; the spectrum, fit and refinement.
       real(dp) :: solve_seconds = 0, richardson_seconds = 0, refine_seconds = 0
    end type refine_answer
@@ -56,6 +63,7 @@ contains
       type(refine_answer), intent(out) :: answer
       type(status_type), intent(inout) :: status
       type(pressure_set), allocatable :: at_d(:), at_2d(:), none(:)
+      real(dp), allocatable :: g0(:, :)
       real(dp) :: t0, t1, t2
       if (status%code /= 0) return
       if (options%solver /= SOLVER_CG .or. size(options%loads) == 0) then
@@ -71,7 +79,10 @@ contains
       answer%loads = options%loads
       answer%zeta = magnifications(problem%pixel/down_to)
       call wall_clock(t0)
-      call surface_spectrum_of(initial_gap_map(problem%lower, problem%upper), problem%pixel, answer%spectrum)
+      g0 = initial_gap_map(problem%lower, problem%upper)
+      answer%rms_slope = rms_slope(g0, problem%pixel, options%boundary == BOUNDARY_PERIODIC)
+      call surface_spectrum_of(g0, problem%pixel, answer%spectrum)
+      deallocate(g0)
       call fit_spectrum(answer%spectrum, status)
       if (status%code /= 0) return
       call wall_clock(t1)
@@ -107,8 +118,10 @@ contains
       nz = size(answer%zeta)
       nl = size(answer%loads)
       allocate(answer%refined(nz, nl), answer%theory(nz, nl), answer%persson(nz, nl), answer%richardson(nz, nl), &
-         answer%kappa(nl))
+         answer%kappa(nl), answer%slope_refined(nz, nl), answer%slope_solve(nl))
       answer%refined = ieee_value(1.0_dp, ieee_quiet_nan)
+      answer%slope_refined = answer%refined
+      answer%slope_solve = ieee_value(1.0_dp, ieee_quiet_nan)
       answer%theory = answer%refined
       answer%persson = answer%refined
       answer%richardson = answer%refined
@@ -121,10 +134,13 @@ contains
       do k = 1, nl
          if (.not. allocated(at_d(k)%p)) cycle
          p0 = answer%loads(k)/side**2
+         if (p0 > 0) answer%slope_solve(k) = answer%coarse(1, k)*answer%estar*answer%rms_slope/p0
          do z = 1, nz
             m2 = subpixel_slope_variance(answer%spectrum, q_d, answer%zeta(z)*q_d)
             answer%refined(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, answer%kappa(k))
             answer%theory(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, sqrt(2.0_dp))
+            if (p0 > 0) answer%slope_refined(z, k) = answer%refined(z, k)*answer%estar* &
+               sqrt(answer%rms_slope**2 + m2)/p0
             answer%persson(z, k) = persson_fraction(p0, answer%estar, answer%spectrum%slope_variance + m2)
             answer%richardson(z, k) = richardson_area(answer%coarse(1, k), answer%coarse(2, k), answer%coarse(3, k), &
                problem%pixel, problem%pixel/answer%zeta(z))

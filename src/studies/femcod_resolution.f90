@@ -9,7 +9,7 @@ module femcod_resolution
    implicit none
    private
    public :: uncoupled_curve, mccool_parameters, mccool_surface, mccool_area, interpolate_area, &
-      richardson_area, composite_modulus, gw_integral
+      richardson_area, gw_integral
 
    real(dp), parameter :: pi = acos(-1.0_dp)
 
@@ -26,12 +26,6 @@ module femcod_resolution
    end type mccool_parameters
 
 contains
-
-   !> Composite modulus E* of two elastic bodies: 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (GPa).
-   pure real(dp) function composite_modulus(young, poisson)
-      real(dp), intent(in) :: young(2), poisson(2)
-      composite_modulus = 1/((1 - poisson(1)**2)/young(1) + (1 - poisson(2)**2)/young(2))
-   end function composite_modulus
 
    !> The uncoupled voxel model (thesis Fig. 4.17, dashed): a rigid substrate under
    !> independent voxel springs of compliance `compliance` (nm/nN, the single-pixel

@@ -8,7 +8,7 @@ module femcod_resolution_study
    use femcod_problem, only: contact_problem, validate_problem
    use femcod_surfaces, only: downsample_subsample, downsample_average
    use femcod_scene, only: initial_gaps, flip_upper
-   use femcod_love, only: surface_compliance, love_influence
+   use femcod_love, only: surface_compliance, love_influence, composite_modulus
    use femcod_spring, only: spring_stiffness
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options
@@ -17,7 +17,7 @@ module femcod_resolution_study
    use femcod_solver, only: solve_contact
    use femcod_richardson, only: power_law_fit
    use femcod_resolution, only: uncoupled_curve, mccool_parameters, mccool_surface, mccool_area, &
-      richardson_area, composite_modulus
+      richardson_area
    use femcod_strings, only: int_str
    implicit none
    private
