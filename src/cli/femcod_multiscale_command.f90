@@ -12,7 +12,7 @@ module femcod_multiscale_command
    use femcod_multiscale, only: roughness_template, multiscale_result, multiscale_hertz, check_growth
    use femcod_help, only: print_lines
    use femcod_options, only: parsed_options, option_help, get_option, option_given
-   use femcod_studies, only: surface_options, check_outputs, study_heights, surface_table, parse_surface_options, &
+   use femcod_studies, only: surface_options, check_outputs, study_json, study_heights, surface_table, parse_surface_options, &
       fail_with
    implicit none
    private
@@ -78,7 +78,8 @@ contains
       call get_option(parsed, "--min-length", min_length)
       call get_option(parsed, "--scales", scales)
       call get_option(parsed, "--template-size", tsize)
-      names = [string_type(opts%prefix//".multiscale.csv"), string_type(opts%prefix//".multiscale.svg")]
+      names = [string_type(opts%prefix//".multiscale.csv"), string_type(opts%prefix//".multiscale.svg"), &
+         string_type(opts%prefix//".multiscale.json")]
       ! A deck gives its materials: E* is the deck's, and --estar next to it would be a
       ! second answer to one question.
       if (option_given(parsed, "--estar") .and. .not. (opts%pixel > 0 .or. is_height_file(opts%input))) then
@@ -157,10 +158,11 @@ contains
                result%area, dashed=kc == 2)
          end do
       end do
-      allocate(texts(2))
+      allocate(texts(3))
       texts(1)%s = built_text(b)
       texts(2)%s = svg_multi_plot("true contact area against the smallest length scale (thesis Fig. 3.10)", &
          "smallest length scale (nm)", "true contact area (nm^2)", series, .true., .true.)
+      texts(3)%s = study_json("multiscale", args, opts%input, opts%prefix, names, texts(1:2))
       call write_file_set(names, texts, status)
       if (status%code /= 0) then
          call fail_with("multiscale", status, code)

@@ -18,7 +18,7 @@ module femcod_resolution_command
    use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, scene_options, flag_option, &
       real_option, text_option, choice_option, integer_list_option, get_option, option_given, refuse_options
-   use femcod_studies, only: fitted_exponent, surface_scene, study_deck, check_outputs
+   use femcod_studies, only: fitted_exponent, surface_scene, study_deck, check_outputs, study_json
    implicit none
    private
    public :: resolution_command, resolution_table
@@ -142,7 +142,8 @@ contains
          string_type(prefix//".estimates.csv"), string_type(prefix//".hardness.csv"), &
          string_type(prefix//".load_displacement.svg"), string_type(prefix//".area_displacement.svg"), &
          string_type(prefix//".area_pressure.svg"), string_type(prefix//".richardson.svg"), &
-         string_type(prefix//".hardness.svg"), string_type(prefix//".hardness_capped.csv")]
+         string_type(prefix//".hardness.svg"), string_type(prefix//".hardness_capped.csv"), &
+         string_type(prefix//".resolution.json")]
       ! The outputs are checked before the input is read: an input is never an output.
       call check_outputs(names, input, force, status)
       if (status%code /= 0) then
@@ -202,6 +203,7 @@ contains
       end do
       call extrapolate_levels(levels)
       texts = resolution_texts(levels, method, deck%np*deck%pixel, friction)
+      texts = [texts, string_type(study_json("resolution", args, input, prefix, names, texts))]
       call write_file_set(names, texts, status)
       if (status%code /= 0) then
          call fail(status)
@@ -219,7 +221,7 @@ contains
          end do
          if (friction) call print_common_friction(levels, shear(2))
          write(output_unit, '(a)') "  wrote "//prefix//".resolution.csv, .powerlaw.csv, .estimates.csv, .hardness.csv, "// &
-            ".hardness_capped.csv and 5 SVG figures"
+            ".hardness_capped.csv, .resolution.json (the tables) and 5 SVG figures"
       end if
    contains
       subroutine usage(message)

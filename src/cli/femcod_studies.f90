@@ -8,7 +8,8 @@ module femcod_studies
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
-   use femcod_strings, only: string_type, int_str, sig_str
+   use femcod_strings, only: string_type, int_str, sig_str, parse_real, json_string, json_number
+   use femcod_about, only: FEMCOD_VERSION
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, read_height_map, height_map, is_height_file, height_file_path, &
       looks_like_height_matrix
@@ -24,7 +25,7 @@ module femcod_studies
    implicit none
    private
    public :: surface_options, summit_plot, fitted_exponent, surface_scene, study_deck, check_outputs, study_heights, &
-      surface_table, parse_surface_options, fail_with
+      surface_table, parse_surface_options, fail_with, study_json
 
    !> Options shared by `summits` and `multiscale`.
    type :: surface_options
@@ -292,5 +293,94 @@ contains
       write(error_unit, '(a)') "femcod "//command//": "//status%message
       code = status%code
    end subroutine fail_with
+
+   !> A study's tables as one JSON file (PREFIX.<command>.json): the program, the command
+   !> line, the input, and each CSV file of the set (names(k) ending in .csv, its text
+   !> texts(k)) as a list of rows keyed by its columns, whose names carry the units,
+   !> under the file's name between PREFIX. and .csv: numbers as numbers (nan and empty
+   !> fields null), other fields as strings. Made from the tables' own text, it says what
+   !> they say.
+   function study_json(command, args, input, prefix, names, texts) result(j)
+      character(len=*), intent(in) :: command, input, prefix
+      type(string_type), intent(in) :: args(:), names(:), texts(:)
+      character(len=:), allocatable :: j, line, tables
+      character(len=1), parameter :: nl = new_line("a")
+      integer :: k, n
+      line = "femcod "//command
+      do k = 1, size(args)
+         line = line//" "//args(k)%s
+      end do
+      tables = ""
+      n = len(names(1)%s)
+      do k = 1, size(names)
+         n = len(names(k)%s)
+         if (n < 5 .or. k > size(texts)) cycle
+         if (names(k)%s(n - 3:) /= ".csv") cycle
+         if (len(tables) > 0) tables = tables//","//nl
+         tables = tables//'    '//json_string(names(k)%s(len(prefix) + 2:n - 4))//': '//csv_json(texts(k)%s)
+      end do
+      j = '{'//nl//'  "femcod_version": '//json_string(FEMCOD_VERSION)//','//nl//'  "command": '// &
+         json_string(command)//', "command_line": '//json_string(line)//','//nl//'  "input": '// &
+         json_string(input)//','//nl//'  "tables": {'//nl//tables//nl//'  }'//nl//'}'//nl
+   end function study_json
+
+   !> A CSV text (a header line, then rows) as a JSON list of objects, one per row.
+   function csv_json(text) result(j)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: j
+      type(string_type), allocatable :: header(:), cells(:)
+      integer :: a, b, c
+      j = '['
+      a = 1
+      b = index(text, new_line("a"))
+      if (b == 0) b = len(text) + 1
+      header = fields(text(a:b - 1))
+      a = b + 1
+      do while (a <= len(text))
+         b = index(text(a:), new_line("a"))
+         if (b == 0) b = len(text) - a + 2
+         cells = fields(text(a:a + b - 2))
+         a = a + b
+         j = j//trim(merge(", ", "  ", len(j) > 1))//'{'
+         do c = 1, min(size(header), size(cells))
+            j = j//trim(merge(", ", "  ", c > 1))//json_string(header(c)%s)//': '//json_value(cells(c)%s)
+         end do
+         j = trim(j)//'}'
+      end do
+      j = j//']'
+   contains
+      function fields(row) result(f)
+         character(len=*), intent(in) :: row
+         type(string_type), allocatable :: f(:)
+         integer :: p, q
+         allocate(f(0))
+         p = 1
+         do
+            q = index(row(p:), ",")
+            if (q == 0) then
+               f = [f, string_type(row(p:))]
+               exit
+            end if
+            f = [f, string_type(row(p:p + q - 2))]
+            p = p + q
+         end do
+      end function fields
+      function json_value(cell) result(v)
+         character(len=*), intent(in) :: cell
+         character(len=:), allocatable :: v
+         real(dp) :: x
+         logical :: ok
+         if (len_trim(cell) == 0) then
+            v = "null"
+            return
+         end if
+         call parse_real(trim(cell), x, ok)
+         if (ok) then
+            v = json_number(x)
+         else
+            v = json_string(cell)
+         end if
+      end function json_value
+   end function csv_json
 end module femcod_studies
 

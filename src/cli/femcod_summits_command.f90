@@ -12,7 +12,7 @@ module femcod_summits_command
    use femcod_memory, only: available_memory, memory_text, usable_text
    use femcod_help, only: print_lines
    use femcod_options, only: parsed_options, option_help
-   use femcod_studies, only: surface_options, summit_plot, check_outputs, study_heights, surface_table, &
+   use femcod_studies, only: surface_options, summit_plot, check_outputs, study_json, study_heights, surface_table, &
       parse_surface_options, fail_with
    implicit none
    private
@@ -71,7 +71,8 @@ contains
          string_type(opts%prefix//".psd.csv"), string_type(opts%prefix//".structure.csv"), &
          string_type(opts%prefix//".fractal.csv"), string_type(opts%prefix//".summit_density.svg"), &
          string_type(opts%prefix//".summit_height.svg"), string_type(opts%prefix//".summit_radius.svg"), &
-         string_type(opts%prefix//".psd.svg"), string_type(opts%prefix//".structure.svg")]
+         string_type(opts%prefix//".psd.svg"), string_type(opts%prefix//".structure.svg"), &
+         string_type(opts%prefix//".summits.json")]
       ! The outputs are checked before the input is read: an input is never an output.
       call check_outputs(names, opts%input, opts%force, status)
       if (status%code == 0) call study_heights(opts%input, opts%pixel, opts%plane, z, d, status, opts%height_unit)
@@ -129,7 +130,7 @@ contains
          format_real(1/(4*d)))
       call add_line(b(5), "structure,"//fitted(dsf, nsf)//","//fitted(dsf + 1, nsf)//","//format_real(d)//","// &
          format_real(side/16))
-      allocate(texts(10))
+      allocate(texts(11))
       do k = 1, 5
          texts(k)%s = built_text(b(k))
       end do
@@ -151,6 +152,7 @@ contains
       call add_series(series, "structure function", tau, sf, markers=.false.)
       texts(10)%s = svg_multi_plot("structure function: D = "//said(dsf, nsf)//" (eq. 2.15)", "tau (nm)", &
          "S (nm^2)", series, .true., .true.)
+      texts(11)%s = study_json("summits", args, opts%input, opts%prefix, names, texts(1:10))
       call write_file_set(names, texts, status)
       if (status%code /= 0) then
          call fail_with("summits", status, code)
@@ -165,7 +167,7 @@ contains
          write(output_unit, '(a)') "  fractal dimension of a profile: "//said(dpsd, npsd)//" (PSD), "//said(dsf, nsf)// &
             " (structure function); surface: +1"
          write(output_unit, '(a)') "  wrote "//opts%prefix//".summits.csv, .summit_exponents.csv, .psd.csv, .structure.csv, "// &
-            ".fractal.csv and 5 SVG figures"
+            ".fractal.csv, .summits.json (the tables) and 5 SVG figures"
       end if
    contains
       !> A fitted value for the CSV ("" when its range held fewer than two points).
