@@ -53,12 +53,12 @@ program femcod_mpi
    use femcod_interface_law, only: make_interface_law
    use femcod_solver_options, only: by_gap_variables, run_shear_model, &
       SOLVER_CG, BOUNDARY_PERIODIC
-   use femcod_shear_model, only: friction_coefficient
    use femcod_tangential, only: tangential_request_of, tangential_storage_bytes
    use femcod_mpi_shear, only: tangential_on_ranks
    use femcod_contact_result, only: stop_reason_text, STOP_LOADS
    use femcod_state_record, only: loads_csv_header, loads_csv_row, state_json, run_info_of
    use femcod_results_json, only: run_header_json
+   use femcod_run_summary, only: state_summary_lines
    implicit none
 
    type(string_type), allocatable :: args(:)
@@ -555,33 +555,24 @@ contains
    end function json_list
 
    subroutine print_summary()
-      character(len=:), allocatable :: bound_note, plastic_note
-      integer :: s
+      type(string_type), allocatable :: lines(:)
+      integer :: s, m
       write(output_unit, '(a)') "femcod-mpi: "//info%label
       write(output_unit, '(a)') "  grid "//int_str(np)//" x "//int_str(np)//", pixel "//format_real(grid%pixel)// &
          " nm, "//trim(merge("periodic cell", "free surface ", settings%solve%boundary == BOUNDARY_PERIODIC))//"; "// &
          int_str(ranks)//" MPI ranks x "//int_str(info%threads)//" threads"
       do s = 1, size(states)
+         ! femcod run's lines of a state (cli/femcod_run_summary), then the ranks' work on it.
+         lines = state_summary_lines(states%state_values, s, grid%pixel, settings%solve, states(s)%cg%approach_bound, "")
+         do m = 1, size(lines)
+            write(output_unit, '(a)') lines(m)%s
+         end do
          associate(st => states(s))
-            bound_note = ""
-            if (st%cg%approach_bound >= 0) bound_note = " (+- "//sig_str(st%cg%approach_bound, 2)//" nm)"
-            plastic_note = ""
-            if (settings%solve%plastic) plastic_note = ", "//int_str(st%n_plastic)//" at the hardness"
-            if (settings%solve%shear) plastic_note = plastic_note//", friction "//sig_str(st%friction, 6)// &
-               " nN (coefficient "//sig_str(friction_coefficient(st%friction, st%load, st%contacts), 6)//")"
-            write(output_unit, '(a)') "  load "//format_real(st%load)//" nN: approach "//sig_str(st%approach, 10)// &
-               " nm"//bound_note//", "//int_str(st%contacts)//" contacts ("// &
-               sig_str(100*real(st%contacts, dp)/real(np, dp)**2, 4)//" % of the area), max pressure "// &
-               sig_str(st%max_pressure, 4)//" GPa"//plastic_note
-            write(output_unit, '(a)') "    "//int_str(st%cg%iterations)//" iterations (+ "//int_str(st%cg%coarse_iterations)// &
-               " on coarser grids), "//int_str(st%cg%convolutions)//" fresh convolutions, residual "// &
-               sig_str(st%cg%residual, 2)//", "//sig_str(st%seconds, 3)//" s (rank 0: transforms "// &
-               sig_str(st%transform_seconds, 3)//" s, communication "//sig_str(st%communication_seconds, 3)//" s)"
-            if (settings%solve%tangential .and. st%contacts > 0) write(output_unit, '(a)') "    tangential "// &
-               sig_str(st%tangential_force(1), 6)//" nN, shift "//sig_str(st%tangential_shift(1), 6)//" nm"// &
-               trim(merge(" (gross sliding)", "                ", st%sliding))//"; "//int_str(st%stick_contacts)// &
-               " of "//int_str(st%contacts)//" contacts stick; "//int_str(st%tangential_iterations)// &
-               " iterations, residual "//sig_str(st%tangential_residual, 2)
+            write(output_unit, '(a)') "              "//int_str(st%cg%iterations)//" iterations (+ "// &
+               int_str(st%cg%coarse_iterations)//" on coarser grids), "//int_str(st%cg%convolutions)// &
+               " fresh convolutions, residual "//sig_str(st%cg%residual, 2)//", "//sig_str(st%seconds, 3)// &
+               " s (rank 0: transforms "//sig_str(st%transform_seconds, 3)//" s, communication "// &
+               sig_str(st%communication_seconds, 3)//" s)"
          end associate
       end do
       write(output_unit, '(a)') "  peak memory per rank: "//sig_str(maxval(info%peak_mb), 4)//" MB (largest), "// &

@@ -4,9 +4,10 @@
 module femcod_run_summary
    use, intrinsic :: iso_fortran_env, only: output_unit
    use femcod_kinds, only: dp
-   use femcod_strings, only: sig_str, int_str, format_real
+   use femcod_strings, only: string_type, sig_str, int_str, format_real
    use femcod_problem, only: contact_problem
-   use femcod_contact_result, only: contact_result, load_state, stop_reason_text, cg_state_diagnostics, cg_work
+   use femcod_contact_result, only: contact_result, state_values, stop_reason_text, cg_work, &
+      cg_state_diagnostics
    use femcod_solver_options, only: contact_options, SOLVER_CG, LAW_HARD_WALL, solver_name
    use femcod_shear_model, only: friction_coefficient
    use femcod_solver, only: report_lines, report_line
@@ -14,7 +15,7 @@ module femcod_run_summary
    use femcod_patches, only: contact_patches, perimeter_area_fit
    implicit none
    private
-   public :: print_summary
+   public :: print_summary, state_summary_lines
 
 contains
 
@@ -27,8 +28,9 @@ contains
       type(contact_result), intent(in) :: res
       type(state_maps), intent(in) :: maps(:)
       type(report_line), allocatable :: lines(:)
+      type(string_type), allocatable :: lines_of_state(:)
       type(cg_state_diagnostics) :: work
-      integer :: k, last
+      integer :: k, m, last
       last = res%nsteps
       if (deck_path /= "") then
          write(output_unit, '(a)') "femcod run "//deck_path//" (solver "//solver_name(options%solver)//")"
@@ -54,29 +56,11 @@ contains
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          work = cg_work(res, k)
-         write(output_unit, '(a)') "  at load   : "//sig_str(res%states(k)%load, 6)//" nN: approach "// &
-            sig_str(res%states(k)%approach, 6)//" nm"//trim(bound_text(work%approach_bound))//", "// &
-            int_str(res%states(k)%contacts)//" contacts ("// &
-            sig_str(res%states(k)%contacts*problem%pixel**2, 4)//" nm^2), max pressure "// &
-            sig_str(res%states(k)%max_pressure, 4)//" GPa"
-         call print_patches(maps(k)%patches)
-         if (options%plastic) write(output_unit, '(a)') "              "//int_str(res%states(k)%n_plastic)// &
-            " of them plastic (at the hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "// &
-            sig_str(res%states(k)%plastic_volume, 4)//" nm^3"
-         if (options%tangential) call print_tangential(res%states(k), problem%pixel)
-         if (options%shear) write(output_unit, '(a)') "              friction "// &
-            sig_str(res%states(k)%friction, 6)//" nN, coefficient "// &
-            sig_str(friction_coefficient(res%states(k)%friction, res%states(k)%load, res%states(k)%contacts), 6)//" (shear model)"
-         if (options%adhesion /= LAW_HARD_WALL) then
-            write(output_unit, '(a)') "              "//int_str(res%states(k)%attractive)//" pixels off contact within the "// &
-               "range ("//sig_str(res%states(k)%attractive*problem%pixel**2, 4)//" nm^2), load off contact "// &
-               sig_str(res%states(k)%attractive_load, 4)//" nN, mean gap "//sig_str(res%states(k)%mean_gap, 4)//" nm"
-            if (res%states(k)%jump /= 0 .and. k > 1) write(output_unit, '(a)') "              "// &
-               trim(merge("contact appears ", "contact vanishes", res%states(k)%jump > 0))//" since the approach "// &
-               sig_str(res%states(k - 1)%approach, 6)//" nm ("//int_str(res%states(k - 1)%contacts)//" -> "// &
-               int_str(res%states(k)%contacts)//" contact pixels, load "//sig_str(res%states(k - 1)%load, 4)// &
-               " -> "//sig_str(res%states(k)%load, 4)//" nN)"
-         end if
+         lines_of_state = state_summary_lines(res%states%state_values, k, problem%pixel, options, &
+            work%approach_bound, patch_detail(maps(k)%patches))
+         do m = 1, size(lines_of_state)
+            write(output_unit, '(a)') lines_of_state(m)%s
+         end do
       end do
       if (options%adhesion /= LAW_HARD_WALL) write(output_unit, '(a)') "  adhesion  : least load "// &
          sig_str(minval(res%states%load, mask=res%states%reached), 6)//" nN over the approaches (the pull-off force "// &
@@ -98,42 +82,72 @@ contains
       end do
    end subroutine print_summary
 
-   !> The patches line of the summary: the 4- and 8-connected counts, the largest patch
-   !> and the perimeter-area exponent.
-   subroutine print_patches(patches)
+   !> A reached state's lines in the summary (`femcod run`'s and femcod-mpi's): the load,
+   !> approach (with its bound where `bound` >= 0), contacts, area and largest pressure;
+   !> the patches (`detail`: what the program knows beyond their counts); and where the
+   !> run has them the plastic pixels, the tangential step, the shear model's friction,
+   !> the adhesion (with a jump since state k - 1).
+   function state_summary_lines(states, k, pixel, options, bound, detail) result(lines)
+      type(state_values), intent(in) :: states(:)
+      integer, intent(in) :: k
+      real(dp), intent(in) :: pixel, bound
+      type(contact_options), intent(in) :: options
+      character(len=*), intent(in) :: detail
+      type(string_type), allocatable :: lines(:)
+      character(len=*), parameter :: indent = "              "
+      associate(s => states(k))
+         lines = [string_type("  at load   : "//sig_str(s%load, 6)//" nN: approach "//sig_str(s%approach, 6)//" nm"// &
+            trim(bound_text(bound))//", "//int_str(s%contacts)//" contacts ("//sig_str(s%contacts*pixel**2, 4)// &
+            " nm^2), max pressure "//sig_str(s%max_pressure, 4)//" GPa"), &
+            string_type(indent//"patches "//int_str(s%patches_4)//" (4-connected), "//int_str(s%patches_8)// &
+            " (8-connected)"//detail)]
+         if (options%plastic) lines = [lines, string_type(indent//int_str(s%n_plastic)//" of them plastic (at the "// &
+            "hardness "//sig_str(options%hardness, 4)//" GPa), plastic volume "//sig_str(s%plastic_volume, 4)//" nm^3")]
+         if (options%tangential) lines = [lines, string_type(indent//tangential_text(s, pixel))]
+         if (options%shear) lines = [lines, string_type(indent//"friction "//sig_str(s%friction, 6)//" nN, coefficient "// &
+            sig_str(friction_coefficient(s%friction, s%load, s%contacts), 6)//" (shear model)")]
+         if (options%adhesion /= LAW_HARD_WALL) then
+            lines = [lines, string_type(indent//int_str(s%attractive)//" pixels off contact within the range ("// &
+               sig_str(s%attractive*pixel**2, 4)//" nm^2), load off contact "//sig_str(s%attractive_load, 4)// &
+               " nN, mean gap "//sig_str(s%mean_gap, 4)//" nm")]
+            if (s%jump /= 0 .and. k > 1) lines = [lines, string_type(indent// &
+               trim(merge("contact appears ", "contact vanishes", s%jump > 0))//" since the approach "// &
+               sig_str(states(k - 1)%approach, 6)//" nm ("//int_str(states(k - 1)%contacts)//" -> "// &
+               int_str(s%contacts)//" contact pixels, load "//sig_str(states(k - 1)%load, 4)//" -> "// &
+               sig_str(s%load, 4)//" nN)")]
+         end if
+      end associate
+   end function state_summary_lines
+
+   !> ", the largest N pixels, perimeter ~ area^e": the patches beyond their counts.
+   function patch_detail(patches) result(text)
       type(contact_patches), intent(in) :: patches
+      character(len=:), allocatable :: text
       real(dp) :: exponent, prefactor
-      character(len=:), allocatable :: fit
       call perimeter_area_fit(patches%area4, patches%perimeter4, exponent, prefactor)
-      fit = ""
-      if (exponent == exponent) fit = ", perimeter ~ area^"//sig_str(exponent, 3)
-      write(output_unit, '(a)') "              patches "//int_str(patches%count4)//" (4-connected), "// &
-         int_str(patches%count8)//" (8-connected), the largest "//int_str(maxval([0, patches%area8]))// &
-         " pixels"//fit
-   end subroutine print_patches
+      text = ", the largest "//int_str(maxval([0, patches%area8]))//" pixels"
+      if (exponent == exponent) text = text//", perimeter ~ area^"//sig_str(exponent, 3)
+   end function patch_detail
 
    !> A state's tangential step in the summary: the force and shift along x, the stick
    !> area, or gross sliding.
-   subroutine print_tangential(s, pixel)
-      type(load_state), intent(in) :: s
+   function tangential_text(s, pixel) result(text)
+      type(state_values), intent(in) :: s
       real(dp), intent(in) :: pixel
-      integer :: stick
+      character(len=:), allocatable :: text
       if (.not. allocated(s%stick)) then
-         write(output_unit, '(a)') "              tangential: none (no contact carries it)"
-         return
-      end if
-      stick = count(s%stick)
-      if (s%sliding) then
-         write(output_unit, '(a)') "              tangential "//sig_str(s%tangential_force(1), 6)//" nN: gross "// &
-            "sliding, every contact at mu p (shift "//sig_str(s%tangential_shift(1), 6)//" nm at the onset)"
+         text = "tangential: none (no contact carries it)"
+      else if (s%sliding) then
+         text = "tangential "//sig_str(s%tangential_force(1), 6)//" nN: gross sliding, every contact at mu p (shift "// &
+            sig_str(s%tangential_shift(1), 6)//" nm at the onset)"
       else
-         write(output_unit, '(a)') "              tangential "//sig_str(s%tangential_force(1), 6)//" nN, shift "// &
-            sig_str(s%tangential_shift(1), 6)//" nm; "//int_str(stick)//" of "//int_str(size(s%stick))// &
-            " contacts stick ("//sig_str(stick*pixel**2, 4)//" nm^2, "// &
-            sig_str(100*real(stick, dp)/size(s%stick), 4)//" %); "//int_str(s%tangential_iterations)// &
+         text = "tangential "//sig_str(s%tangential_force(1), 6)//" nN, shift "//sig_str(s%tangential_shift(1), 6)// &
+            " nm; "//int_str(s%stick_contacts)//" of "//int_str(s%contacts)//" contacts stick ("// &
+            sig_str(s%stick_contacts*pixel**2, 4)//" nm^2, "// &
+            sig_str(100*real(s%stick_contacts, dp)/max(s%contacts, 1), 4)//" %); "//int_str(s%tangential_iterations)// &
             " iterations, residual "//sig_str(s%tangential_residual, 2)
       end if
-   end subroutine print_tangential
+   end function tangential_text
 
    !> " (+- B nm)" after an approach the solver bounds (B >= 0), "" otherwise.
    function bound_text(bound) result(text)
