@@ -289,8 +289,29 @@ contains
       svg = '<?xml version="1.0" encoding="UTF-8"?>'//nl// &
          '<svg '//namespaces//' width="'//fmt(w)//'" height="'//fmt(h)//'" viewBox="0 0 '// &
          fmt(w)//' '//fmt(h)//'">'//nl//'<rect width="100%" height="100%" fill="white"/>'//nl// &
-         text(w/2, 28.0_dp, xml_escape(shortened(title, 80)), "middle", 14)
+         title_lines(title)
    end function header
+
+   !> The title in the 640-pixel width: one line of at most TITLE_CHARACTERS characters
+   !> at 14 px, or, when longer, two lines at 12 px broken at the last space that fits
+   !> (the second shortened with an ellipsis): a deck's label is often longer than a
+   !> line, and was cut at 80 characters, past the figure's edge at 14 px.
+   function title_lines(title) result(svg)
+      character(len=*), intent(in) :: title
+      character(len=:), allocatable :: svg
+      !> Characters of a line: sans-serif takes about 0.55 em a character, so 72 at 14 px
+      !> and 88 at 12 px are about 555 and 580 px of the 640.
+      integer, parameter :: TITLE_CHARACTERS = 72, LONG_LINE = 88
+      integer :: cut
+      if (len(title) <= TITLE_CHARACTERS) then
+         svg = text(w/2, 28.0_dp, xml_escape(title), "middle", 14)
+         return
+      end if
+      cut = index(title(1:LONG_LINE), " ", back=.true.)
+      if (cut < LONG_LINE/2) cut = LONG_LINE
+      svg = text(w/2, 20.0_dp, xml_escape(title(1:cut)), "middle", 12)// &
+         text(w/2, 36.0_dp, xml_escape(shortened(adjustl(title(cut + 1:)), LONG_LINE)), "middle", 12)
+   end function title_lines
 
    !> Frame, ticks, grid and labels.
    function axes(x0, x1, y0, y1, xt, yt, logx, logy, xlabel, ylabel) result(svg)
