@@ -386,9 +386,9 @@ contains
    subroutine test_resolution_command(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix, text
-      character(len=*), parameter :: suffixes(10) = [character(len=22) :: ".resolution.csv", ".powerlaw.csv", &
+      character(len=*), parameter :: suffixes(11) = [character(len=22) :: ".resolution.csv", ".powerlaw.csv", &
          ".estimates.csv", ".hardness.csv", ".load_displacement.svg", ".area_displacement.svg", ".area_pressure.svg", &
-         ".richardson.svg", ".hardness.svg", ".hardness_capped.csv"]
+         ".richardson.svg", ".hardness.svg", ".hardness_capped.csv", ".resolution.json"]
       integer :: code, k
       prefix = scratch_path("resolution")
       do k = 1, size(suffixes)
@@ -432,9 +432,9 @@ contains
       character(len=16) :: np, method
       real(dp) :: load, approach, area, ft, mu
       integer :: code, k, p, q, ios, rows
-      character(len=*), parameter :: suffixes(10) = [character(len=22) :: ".resolution.csv", ".powerlaw.csv", &
+      character(len=*), parameter :: suffixes(11) = [character(len=22) :: ".resolution.csv", ".powerlaw.csv", &
          ".estimates.csv", ".hardness.csv", ".load_displacement.svg", ".area_displacement.svg", ".area_pressure.svg", &
-         ".richardson.svg", ".hardness.svg", ".hardness_capped.csv"]
+         ".richardson.svg", ".hardness.svg", ".hardness_capped.csv", ".resolution.json"]
       prefix = scratch_path("resolution_friction")
       do k = 1, size(suffixes)
          call remove_scratch(prefix//trim(suffixes(k)))

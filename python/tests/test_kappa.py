@@ -97,3 +97,26 @@ def test_refine_reports_the_runs_kappa(tmp_path):
         for key in ("area_fraction_refined", "area_fraction_persson", "area_load_slope_refined"):
             assert m[key] == float(row[key]), key
     assert summary["command"] == "refine" and summary["scene"]["NP"] == 128
+
+
+def test_refine_reads_a_height_file(tmp_path):
+    """femcod refine FILE --pixel D (issue 52: the maps without a deck first) gives what
+    it gives on the deck `femcod mkdeck matrix` makes of the same file: the same scene
+    (the heights on an elastic body against a rigid flat), the same table."""
+    import numpy as np
+    deck_path = tmp_path / "rough.deck"
+    run_femcod("mkdeck", "self-affine", "--np", "64", "--pixel", "4", "--hurst", "0.7", "--rms", "2",
+               "--seed", "5", "--shape-on", "lower", "-o", deck_path)
+    heights = tmp_path / "rough.txt"
+    np.savetxt(heights, femcod.read_deck(str(deck_path)).lower, fmt="%.17g")
+    made = tmp_path / "made.deck"
+    run_femcod("mkdeck", "matrix", "--file", heights, "--pixel", "4", "--shape-on", "lower", "-o", made)
+    run_femcod("refine", made, "--loads", "2e3,8e3", "-o", tmp_path / "d", "-q")
+    run_femcod("refine", heights, "--pixel", "4", "--loads", "2e3,8e3", "-o", tmp_path / "h", "-q")
+    with open(tmp_path / "d.refine.csv") as a, open(tmp_path / "h.refine.csv") as b:
+        assert a.read() == b.read()
+    # The height-file options belong to height files: refused next to a deck (exit 2).
+    import subprocess
+    got = subprocess.run(["femcod", "refine", str(made), "--loads", "10", "--remove-plane", "-o",
+                          str(tmp_path / "x")], capture_output=True, text=True)
+    assert got.returncode == 2 and "height file" in got.stderr and not list(tmp_path.glob("x.*"))

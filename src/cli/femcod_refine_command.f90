@@ -11,17 +11,17 @@ module femcod_refine_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_memory, only: available_memory
    use femcod_problem, only: contact_problem
-   use femcod_deck, only: read_deck
-   use femcod_heights, only: is_height_file, looks_like_height_matrix
+   use femcod_heights, only: is_height_file
    use femcod_solver_options, only: contact_options, validate_options, SOLVER_CG, boundary_from_name, &
       BOUNDARY_PERIODIC
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, flag_option, real_option, &
-      text_option, choice_option, real_list_option, get_option, option_given
+      text_option, choice_option, real_list_option, get_option, option_given, scene_options, refuse_options
    use femcod_help, only: help_requested, print_lines
    use femcod_results, only: write_file_set
    use femcod_svg, only: svg_series, add_series, svg_multi_plot
    use femcod_files, only: default_prefix
-   use femcod_studies, only: check_outputs
+   use femcod_studies, only: check_outputs, surface_scene, study_deck
+   use femcod_generate, only: scene_spec
    use femcod_refine_study, only: refine_answer, refine_contact
    implicit none
    private
@@ -43,12 +43,16 @@ contains
          real_option("--tol", "T", "the cg solver's tolerance (default 1e-8)", lower=0.0_dp, closed="()"), &
          text_option("--output", "PREFIX", "output prefix (default: the deck's name)", alias="-o"), &
          flag_option("--force", "replace the outputs of an earlier refine"), &
-         flag_option("--quiet", "no summary", alias="-q")]
+         flag_option("--quiet", "no summary", alias="-q"), &
+         scene_options("heights")]
    end function refine_table
 
    subroutine refine_help()
       write(output_unit, '(a)') &
          "usage: femcod refine DECK --loads F1,... [--down-to LENGTH] [--boundary free|periodic] [-o PREFIX]", &
+         "       femcod refine FILE --loads F1,... [--pixel D] [--young E] [--poisson NU] [--remove-plane] ...", &
+         "         (a height file: an ASCII matrix, HDF5, Gwyddion or NanoScope, with the units and pixel it", &
+         "         gives, on an elastic body against a rigid flat, as femcod run --lower)", &
          "", &
          "The thesis' third model (section 5.3): the deck solved at its resolution (cg), the surface's PSD", &
          "fitted by a power law over 4 q_L .. q_d/2, and each contact pixel refined below the pixel by", &
@@ -56,7 +60,7 @@ contains
          "constant (kappa) measured on the octave from 2d to d that the image resolves (doc/studies.md).", &
          "Beside it: Richardson's extrapolation from solves at 2d and 4d (section 4.5) and Persson's theory", &
          "of the whole surface. A surface whose PSD is not a power law (no scaling range) is refused.", ""
-      call print_lines(option_help(refine_table(), ""))
+      call print_lines(option_help(refine_table(), "heights"))
       write(output_unit, '(a)') "", &
          "outputs: PREFIX.refine.csv  load_nN,magnification,pixel_nm,area_fraction_solve,area_fraction_refined,", &
          "                            area_fraction_richardson,area_fraction_persson,", &
@@ -72,6 +76,7 @@ contains
       type(contact_problem) :: problem
       type(contact_options) :: options
       type(refine_answer) :: answer
+      type(scene_spec) :: spec
       type(string_type), allocatable :: names(:), texts(:)
       character(len=:), allocatable :: prefix, deck, boundary
       real(dp) :: down_to
@@ -83,7 +88,9 @@ contains
       end if
       call parse_options(refine_table(), args, parsed, status)
       if (status%code == 0 .and. size(parsed%positional) /= 1) call set_error(status, STATUS_USAGE, &
-         "refine needs one DECK")
+         "refine needs one DECK or height file")
+      if (status%code == 0) call refuse_options(parsed, merge("heights", "       ", option_given(parsed, "--pixel") .or. &
+         is_height_file(parsed%positional(1)%s)), "heights=to a height file (FILE [--pixel D]), not to a deck", status)
       if (status%code == 0 .and. .not. option_given(parsed, "--loads")) call set_error(status, STATUS_USAGE, &
          "refine needs --loads F1,... (nN)")
       if (status%code /= 0) then
@@ -108,19 +115,12 @@ contains
       call get_option(parsed, "--loads", options%loads)
       call get_option(parsed, "--tol", options%cg%tol)
       call validate_options(options, status)
-      if (status%code == 0 .and. is_height_file(deck)) call set_error(status, STATUS_USAGE, deck// &
-         " is a height file: make a deck of it first (femcod mkdeck matrix --file ... --shape-on lower)")
       names = [string_type(prefix//".refine.csv"), string_type(prefix//".refine.svg"), &
          string_type(prefix//".refine.json")]
       if (status%code == 0) call check_outputs(names, deck, force, status)
-      if (status%code == 0) then
-         call read_deck(deck, problem, status)
-         if (status%code /= 0 .and. looks_like_height_matrix(deck)) then
-            status%code = STATUS_USAGE
-            status%message = deck//" reads as a matrix of heights, not as a deck: make a deck of it first "// &
-               "(femcod mkdeck matrix --file "//deck//" --pixel D --shape-on lower -o DECK)"
-         end if
-      end if
+      ! A deck, or a height file on an elastic body against a rigid flat (the studies' scene).
+      call surface_scene(parsed, deck, spec)
+      if (status%code == 0) call study_deck(deck, spec, problem, status)
       options%memory_available = available_memory()
       if (status%code == 0) call refine_contact(problem, options, down_to, answer, status)
       if (status%code == 0) then
