@@ -172,14 +172,7 @@ contains
    function state_value_names(session) result(names)
       type(library_session), intent(in) :: session
       character(len=:), allocatable :: names
-      type(state_field), allocatable :: f(:)
-      integer :: m
-      f = state_fields(state_values(), session%problem%pixel, max(session%problem%np, 1), &
-         session%info, cg_state_diagnostics())
-      names = "reached"
-      do m = 1, size(f)
-         names = names//","//f(m)%name
-      end do
+      names = value_list(session, .false.)
    end function state_value_names
 
    !> The kinds of the state values, in the order of state_value_names: "number",
@@ -187,22 +180,31 @@ contains
    function state_value_kinds(session) result(kinds)
       type(library_session), intent(in) :: session
       character(len=:), allocatable :: kinds
+      kinds = value_list(session, .true.)
+   end function state_value_kinds
+
+   !> `reached`, then the field table's names (or, with `kinds`, their kinds), by commas.
+   function value_list(session, kinds) result(list)
+      type(library_session), intent(in) :: session
+      logical, intent(in) :: kinds
+      character(len=:), allocatable :: list
       type(state_field), allocatable :: f(:)
       integer :: m
       f = state_fields(state_values(), session%problem%pixel, max(session%problem%np, 1), &
          session%info, cg_state_diagnostics())
-      kinds = "flag"
+      list = trim(merge("flag   ", "reached", kinds))
       do m = 1, size(f)
-         select case (f(m)%kind)
-         case (FIELD_COUNT)
-            kinds = kinds//",count"
-         case (FIELD_FLAG)
-            kinds = kinds//",flag"
-         case default
-            kinds = kinds//",number"
-         end select
+         if (.not. kinds) then
+            list = list//","//f(m)%name
+         else if (f(m)%kind == FIELD_COUNT) then
+            list = list//",count"
+         else if (f(m)%kind == FIELD_FLAG) then
+            list = list//",flag"
+         else
+            list = list//",number"
+         end if
       end do
-   end function state_value_kinds
+   end function value_list
 
    !> State k's value `name` (as femcod run's PREFIX.h5 has it; 1 or 0 for a flag).
    subroutine state_value(session, k, name, value, st)
