@@ -233,6 +233,9 @@ program femcod_mpi
    info%solver = "cg (femcod-mpi)"
    info%rms_slope = slope
    if (rank == 0) info%composite_modulus = composite_modulus(problem%young(1:2), problem%poisson(1:2))
+   ! The scene as the summary names it (rank 0 holds the deck's header; the grid is the ranks').
+   problem%np = np
+   problem%pixel = grid%pixel
    info%version = FEMCOD_VERSION
    info%command_line = "femcod-mpi "//settings%command_line
    info%host = host_name()
@@ -514,8 +517,6 @@ contains
       character(len=:), allocatable :: text
       character(len=1), parameter :: nl = new_line('a')
       integer :: s
-      problem%np = np
-      problem%pixel = grid%pixel
       text = run_header_json(prefix, problem, info%run_info)//'  "steps": 0,'//nl//'  "stopped": '// &
          json_string(stop_reason_text(STOP_LOADS))//','//nl//'  "loads": ['//nl
       do s = 1, size(states)

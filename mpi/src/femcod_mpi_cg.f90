@@ -96,7 +96,6 @@ module femcod_mpi_cg
       procedure :: start_forces => coarse_start
    end type distributed_grid
 
-   !> What the solver reached at one load (the same quantities as femcod_cg's residuals).
    !> One requested state on the ranks: its values (model/femcod_contact_result: the
    !> totals over all ranks, the tangential tractions and stick flags of this rank's
    !> contacts), and this rank's columns of the fields.

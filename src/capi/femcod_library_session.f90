@@ -216,22 +216,20 @@ contains
       type(state_field), allocatable :: f(:)
       integer :: m
       value = 0
-      if (index(","//state_value_names(session)//",", ","//name//",") == 0) then
-         call set_error(st, STATUS_USAGE, "no state value '"//name//"' in this result (it has: "// &
-            state_value_names(session)//")")
+      f = state_fields(session%res%states(k)%state_values, session%problem%pixel, session%problem%np, session%info, &
+         cg_work(session%res, k))
+      if (name == "reached") then
+         value = merge(1, 0, session%res%states(k)%reached)
          return
       end if
-      associate(s => session%res%states(k))
-         if (name == "reached") then
-            value = merge(1, 0, s%reached)
+      do m = 1, size(f)
+         if (f(m)%name == name) then
+            value = f(m)%value
             return
          end if
-         f = state_fields(s%state_values, session%problem%pixel, session%problem%np, session%info, &
-            cg_work(session%res, k))
-      end associate
-      do m = 1, size(f)
-         if (f(m)%name == name) value = f(m)%value
       end do
+      call set_error(st, STATUS_USAGE, "no state value '"//name//"' in this result (it has: "// &
+         state_value_names(session)//")")
    end subroutine state_value
 
    !> The names of the maps the last solve has.

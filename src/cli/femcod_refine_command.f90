@@ -20,7 +20,7 @@ module femcod_refine_command
    use femcod_results, only: write_file_set
    use femcod_svg, only: svg_series, add_series, svg_multi_plot
    use femcod_files, only: default_prefix
-   use femcod_studies, only: check_outputs, surface_scene, study_deck
+   use femcod_studies, only: check_outputs, surface_scene, study_deck, command_text
    use femcod_generate, only: scene_spec
    use femcod_refine_study, only: refine_answer, refine_contact
    implicit none
@@ -174,10 +174,7 @@ contains
       character(len=:), allocatable :: j, line
       character(len=1), parameter :: nl = new_line("a")
       integer :: k, z
-      line = "femcod refine"
-      do k = 1, size(args)
-         line = line//" "//args(k)%s
-      end do
+      line = command_text("refine", args)
       associate(s => answer%spectrum)
          j = '{'//nl//'  "femcod_version": '//json_string(FEMCOD_VERSION)//','//nl// &
             '  "command": "refine", "command_line": '//json_string(line)//','//nl// &

@@ -8,7 +8,7 @@ module femcod_studies
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT, STATUS_IO
    use femcod_deck, only: read_deck
    use femcod_problem, only: contact_problem
-   use femcod_strings, only: string_type, int_str, sig_str, parse_real, json_string, json_number
+   use femcod_strings, only: string_type, int_str, sig_str, parse_real, json_string, json_number, split_list
    use femcod_about, only: FEMCOD_VERSION
    use femcod_generate, only: scene_spec
    use femcod_heights, only: load_scene, read_height_map, height_map, is_height_file, height_file_path, &
@@ -25,7 +25,7 @@ module femcod_studies
    implicit none
    private
    public :: surface_options, summit_plot, fitted_exponent, surface_scene, study_deck, check_outputs, study_heights, &
-      surface_table, parse_surface_options, fail_with, study_json
+      surface_table, parse_surface_options, fail_with, study_json, command_text
 
    !> Options shared by `summits` and `multiscale`.
    type :: surface_options
@@ -306,12 +306,8 @@ contains
       character(len=:), allocatable :: j, line, tables
       character(len=1), parameter :: nl = new_line("a")
       integer :: k, n
-      line = "femcod "//command
-      do k = 1, size(args)
-         line = line//" "//args(k)%s
-      end do
+      line = command_text(command, args)
       tables = ""
-      n = len(names(1)%s)
       do k = 1, size(names)
          n = len(names(k)%s)
          if (n < 5 .or. k > size(texts)) cycle
@@ -324,6 +320,18 @@ contains
          json_string(input)//','//nl//'  "tables": {'//nl//tables//nl//'  }'//nl//'}'//nl
    end function study_json
 
+   !> The command as typed: "femcod COMMAND ARG ...".
+   function command_text(command, args) result(line)
+      character(len=*), intent(in) :: command
+      type(string_type), intent(in) :: args(:)
+      character(len=:), allocatable :: line
+      integer :: k
+      line = "femcod "//command
+      do k = 1, size(args)
+         line = line//" "//args(k)%s
+      end do
+   end function command_text
+
    !> A CSV text (a header line, then rows) as a JSON list of objects, one per row.
    function csv_json(text) result(j)
       character(len=*), intent(in) :: text
@@ -334,12 +342,12 @@ contains
       a = 1
       b = index(text, new_line("a"))
       if (b == 0) b = len(text) + 1
-      header = fields(text(a:b - 1))
+      header = split_list(text(a:b - 1))
       a = b + 1
       do while (a <= len(text))
          b = index(text(a:), new_line("a"))
          if (b == 0) b = len(text) - a + 2
-         cells = fields(text(a:a + b - 2))
+         cells = split_list(text(a:a + b - 2))
          a = a + b
          j = j//trim(merge(", ", "  ", len(j) > 1))//'{'
          do c = 1, min(size(header), size(cells))
@@ -349,22 +357,6 @@ contains
       end do
       j = j//']'
    contains
-      function fields(row) result(f)
-         character(len=*), intent(in) :: row
-         type(string_type), allocatable :: f(:)
-         integer :: p, q
-         allocate(f(0))
-         p = 1
-         do
-            q = index(row(p:), ",")
-            if (q == 0) then
-               f = [f, string_type(row(p:))]
-               exit
-            end if
-            f = [f, string_type(row(p:p + q - 2))]
-            p = p + q
-         end do
-      end function fields
       function json_value(cell) result(v)
          character(len=*), intent(in) :: cell
          character(len=:), allocatable :: v

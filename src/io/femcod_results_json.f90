@@ -29,11 +29,10 @@ contains
       character(len=:), allocatable :: j
       character(len=1), parameter :: nl = new_line("a")
       character(len=:), allocatable :: loads, detail
-      real(dp) :: area_pixel, exponent, prefactor
+      real(dp) :: exponent, prefactor
       type(event_path_diagnostics) :: checks
       integer :: k, last
       checks = event_checks(res)
-      area_pixel = deck%pixel**2
       last = res%nsteps
       loads = ""
       do k = 1, size(res%states)
