@@ -39,11 +39,10 @@ contains
       type(status_type) :: status
       type(contact_options) :: options
       type(contact_result) :: res
-      type(cg_state_diagnostics) :: work
       type(parsed_options) :: parsed
       real(dp) :: tol, estar, slope, pressure, load, length, peak
       integer :: i, n, k, np
-      logical :: loaded
+      logical :: loaded, approach_rows
       character(len=512) :: line
       character(len=*), parameter :: peers(2) = [character(len=16) :: "aspher", "contactmechanics"]
       sizes = [512, 1024]
@@ -58,7 +57,9 @@ contains
             "5 um square, E = 200 GPa, nu = 0.25, against a rigid flat (seed 1), at each NP of --np. The mean", &
             "pressure for a contact fraction f (percent) is f/100 * E* h'rms / 2 (the linear law with", &
             "kappa = 2, h'rms the surface's own rms slope); the fraction reached is printed. Each load is", &
-            "solved from a cold start. The peers (aspher at every NP, contactmechanics at NP <= 512) run on", &
+            "solved from a cold start. Each is solved again under displacement control at the approach it", &
+            "reached (--approach, cold start; the load it gives against the requested one, and its wall time", &
+            "against the load solve's). The peers (aspher at every NP, contactmechanics at NP <= 512) run on", &
             "the same gaps, pressures and tolerance. --fftw-wisdom: the first run on a size pays the planning", &
             "inside its wall time.", ""
          call print_lines(option_help(bench_cg_table(), ""))
@@ -75,6 +76,8 @@ contains
       call get_option(parsed, "--tol", tol)
       call get_option(parsed, "--peers", python)
       call get_option(parsed, "--fftw-wisdom", wisdom)
+      approach_rows = .true.
+      if (option_given(parsed, "--approach")) approach_rows = switch("--approach")
       call require_peers(python, "cg", code)
       ! The wisdom file is read and brought up to date: it must be FFTW wisdom if it exists.
       if (len(wisdom) > 0) call guard_bench_files([string_type(wisdom), string_type(wisdom//".float32")], &
@@ -134,14 +137,9 @@ contains
                status = status_type()
                cycle
             end if
-            work = cg_work(res, 1)
-            write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fractions(k), 1)//" | femcod cg | "// &
-               fixed_str(res%wall_seconds, 2)//" | "//int_str(work%iterations)//" (+"// &
-               int_str(work%coarse_iterations)//" coarse, "//int_str(work%convolutions)// &
-               " fresh, "//int_str(work%split_corrections)//" split) | "// &
-               real_str(work%residual, 2)//" | "// &
-               fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)//" | "//fixed_str(peak, 0)//" | converged |"
+            write(output_unit, '(a)') solver_row(np, fractions(k), "femcod cg", res, peak, "converged")
             flush(output_unit)
+            if (approach_rows) call approach_row(deck, options, np, fractions(k), res)
             if (len(python) == 0) cycle
             do i = 1, size(peers)
                if (trim(peers(i)) == "contactmechanics" .and. np > 512) cycle
@@ -161,6 +159,55 @@ contains
       end function switch
    end subroutine bench_cg
 
+   !> The state of `loaded` (one load) solved again at its approach from a cold start (
+   !> displacement control): a row with its wall time and iterations, and in the status
+   !> column its load's relative difference from the load asked and its wall time over the
+   !> load solve's.
+   subroutine approach_row(deck, options, np, fraction, loaded)
+      type(contact_problem), intent(in) :: deck
+      type(contact_options), intent(in) :: options
+      integer, intent(in) :: np
+      real(dp), intent(in) :: fraction
+      type(contact_result), intent(in) :: loaded
+      type(contact_options) :: by_approach
+      type(contact_result) :: res
+      type(status_type) :: status
+      real(dp) :: peak
+      by_approach = options
+      deallocate(by_approach%loads)
+      by_approach%approaches = [loaded%states(1)%approach]
+      call reset_peak()
+      call solve_contact(deck, by_approach, res, status)
+      peak = peak_mb()
+      if (status%code /= 0) then
+         write(output_unit, '(a)') "| "//int_str(np)//" | "//fixed_str(fraction, 1)//" | femcod cg --approach "// &
+            "| | | | | | "//status%message//" |"
+         return
+      end if
+      write(output_unit, '(a)') solver_row(np, fraction, "femcod cg --approach", res, peak, "load "// &
+         real_str(abs(res%states(1)%load/options%loads(1) - 1), 2)//" off, wall x"// &
+         fixed_str(res%wall_seconds/loaded%wall_seconds, 2)//" the load solve's")
+      flush(output_unit)
+   end subroutine approach_row
+
+   !> A table row of one solve of `res` (one state) on the NP^2 surface at the target
+   !> `fraction` (percent): wall time, iterations (coarse grids, fresh convolutions and
+   !> split corrections beside), residual, contact percent, peak RSS (MB), `remark`.
+   function solver_row(np, fraction, solver, res, peak, remark) result(row)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: fraction, peak
+      character(len=*), intent(in) :: solver, remark
+      type(contact_result), intent(in) :: res
+      character(len=:), allocatable :: row
+      type(cg_state_diagnostics) :: work
+      work = cg_work(res, 1)
+      row = "| "//int_str(np)//" | "//fixed_str(fraction, 1)//" | "//solver//" | "//fixed_str(res%wall_seconds, 2)// &
+         " | "//int_str(work%iterations)//" (+"//int_str(work%coarse_iterations)//" coarse, "// &
+         int_str(work%convolutions)//" fresh, "//int_str(work%split_corrections)//" split) | "// &
+         real_str(work%residual, 2)//" | "//fixed_str(100*res%states(1)%contacts/real(np, dp)**2, 2)//" | "// &
+         fixed_str(peak, 0)//" | "//remark//" |"
+   end function solver_row
+
    !> The options of `femcod bench cg`.
    function bench_cg_table() result(table)
       type(option_spec), allocatable :: table(:)
@@ -172,6 +219,7 @@ contains
             "the source tree: run from its root)"), &
          text_option("--fftw-wisdom", "FILE", "measured FFTW plans kept in FILE"), &
          choice_option("--nested", "on|off", "nested coarse-grid start (default on)"), &
+         choice_option("--approach", "on|off", "each state solved again at its approach (default on)"), &
          integer_option("--coarsest", "N", "coarsest grid (default 64)", lower=2), &
          real_option("--coarse-tol", "T", "tolerance of the coarse grids (default 1e-4)", lower=0.0_dp, closed="()"), &
          real_option("--single-until", "R", "float32 transforms above this residual (default 1e-5; 0: never)", &

@@ -44,7 +44,7 @@ module femcod_mpi_cg
    use femcod_spring, only: spring_stiffness
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: cg_settings
-   use femcod_elastic_operator, only: elastic_operator, spread_load
+   use femcod_elastic_operator, only: elastic_operator, spread_load, cg_constraint
    use femcod_cg, only: coarse_start_forces, materials_of, approach_error_bound, cg_session, cg_answer, session_start, &
       solve_target, ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
@@ -631,10 +631,10 @@ contains
    !> The coarse start (the elastic operator's start_forces): the gaps averaged over f x f
    !> blocks (f = grid%block; in femcod_cg's order for f = 2), gathered on rank 0, solved
    !> there by femcod_cg's nested start to how%coarse_tol, and each coarse force split
-   !> equally over its f^2 pixels. With f = 1, the load spread near the first touch.
-   subroutine coarse_start(op, total_load, how, p, coarse_iterations, status, observer)
+   !> equally over its f^2 pixels. With f = 1, spread_load.
+   subroutine coarse_start(op, target, how, p, coarse_iterations, status, observer)
       class(distributed_grid), intent(inout) :: op
-      real(dp), intent(in) :: total_load
+      type(cg_constraint), intent(in) :: target
       type(cg_settings), intent(in) :: how
       real(dp), intent(out) :: p(:, :)
       integer, intent(inout) :: coarse_iterations
@@ -646,7 +646,7 @@ contains
       character(len=512) :: message
       f = op%block
       if (f <= 1) then
-         call spread_load(op, total_load, p)
+         call spread_load(op, target, p)
          return
       end if
       n = op%np/f
@@ -673,7 +673,7 @@ contains
       end if
       call MPI_Gatherv(local, n*nl, MPI_DOUBLE_PRECISION, whole, counts, displs, MPI_DOUBLE_PRECISION, 0, op%comm)
       iterations = 0
-      if (op%rank == 0) call coarse_start_forces(whole, op%materials, f*op%pixel, total_load, how, op%periodic, forces, &
+      if (op%rank == 0) call coarse_start_forces(whole, op%materials, f*op%pixel, target, how, op%periodic, forces, &
          iterations, status, observer)
       ! The coarse solve's outcome, the same on every rank.
       code = status%code

@@ -34,6 +34,7 @@ module femcod_elastic_operator
    implicit none
    private
    public :: elastic_operator, grid_operator, grid_operator_setup, grid_operator_free, truncate_table, spread_load
+   public :: cg_constraint
    public :: SPECTRUM_COMPLIANCE, SPECTRUM_STIFFNESS, TABLE_NONE, TABLE_SINGLE, TABLE_DOUBLE
 
    !> Which Love table a grid operator keeps besides its convolution (grid_operator_setup's
@@ -41,6 +42,14 @@ module femcod_elastic_operator
    !> corrections and kernel split, or the double one for the event solvers' exact
    !> evaluations.
    integer, parameter :: TABLE_NONE = 0, TABLE_SINGLE = 1, TABLE_DOUBLE = 2
+
+   !> What a constrained solve holds fixed (solvers/femcod_constrained_cg): the total load
+   !> `value` (nN), or with `by_approach` the approach `value` (nm, from the first touch,
+   !> where the lowest initial gap is 0): load or displacement control.
+   type :: cg_constraint
+      real(dp) :: value = 0
+      logical :: by_approach = .false.
+   end type cg_constraint
 
    !> What every elastic operator has and does (module header).
    type, abstract :: elastic_operator
@@ -80,7 +89,7 @@ module femcod_elastic_operator
       procedure :: correction_limits => no_corrections
       procedure :: add_direct => no_direct
       procedure :: split_correct => no_split
-      !> The forces (nN) a solve at a total load starts from (spread_load; femcod-mpi's
+      !> The forces (nN) a solve under a constraint starts from (spread_load; femcod-mpi's
       !> operator starts from a coarse solve).
       procedure :: start_forces => spread_start
       !> out = C in or K in (which: SPECTRUM_COMPLIANCE or SPECTRUM_STIFFNESS) on this
@@ -185,26 +194,32 @@ contains
       out = 0
    end subroutine no_spectrum
 
-   !> The start of a solve at total load P (nN): spread_load. `coarse_iterations`, the
+   !> The start of a solve under `target`: spread_load. `coarse_iterations`, the
    !> iterations a coarse solve took (none here), is added to.
-   subroutine spread_start(op, total_load, how, p, coarse_iterations, status, observer)
+   subroutine spread_start(op, target, how, p, coarse_iterations, status, observer)
       class(elastic_operator), intent(inout) :: op
-      real(dp), intent(in) :: total_load
+      type(cg_constraint), intent(in) :: target
       type(cg_settings), intent(in) :: how
       real(dp), intent(out) :: p(:, :)
       integer, intent(inout) :: coarse_iterations
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
-      call spread_load(op, total_load, p)
+      call spread_load(op, target, p)
    end subroutine spread_start
 
-   !> The load P (nN) spread evenly over the pixels within a tenth of the height range of
-   !> the first touch (the lowest gap of the whole grid).
-   subroutine spread_load(op, total_load, p)
+   !> A first guess of the forces (nN) under `target`. A load P: spread evenly over the
+   !> pixels within a tenth of the height range of the first touch (the lowest gap of the
+   !> whole grid). An approach A: each pixel that overlaps, g0 < A, pushed back by half
+   !> its own stiffness, (A - g0) / (2 (c I(0,0) + s)) (alone it would take the whole).
+   subroutine spread_load(op, target, p)
       class(elastic_operator), intent(inout) :: op
-      real(dp), intent(in) :: total_load
+      type(cg_constraint), intent(in) :: target
       real(dp), intent(out) :: p(:, :)
       real(dp) :: lowest(1), n(1)
+      if (target%by_approach) then
+         p = max(target%value - op%g0, 0.0_dp)/(2*(op%c*op%self + op%s))
+         return
+      end if
       lowest(1) = minval(op%g0)
       call op%min_over_grid(lowest)
       where (op%g0 <= lowest(1) + 0.1_dp*op%scale)
@@ -214,7 +229,7 @@ contains
       end where
       n(1) = sum(p)
       call op%sum_over_grid(n)
-      p = p*(total_load/n(1))
+      p = p*(target%value/n(1))
    end subroutine spread_load
 
    !> The grid operator for gaps g0 (nm) with pixel size `pixel` (nm) and the deck's

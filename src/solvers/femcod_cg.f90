@@ -74,7 +74,7 @@ module femcod_cg
    use femcod_scene, only: initial_gap_map
    use femcod_split_correction, only: split_hand_over
    use femcod_elastic_operator, only: elastic_operator, grid_operator, grid_operator_setup, grid_operator_free, &
-      spread_load
+      spread_load, cg_constraint
    use femcod_constrained_cg, only: constrained_cg, cg_residuals
    use femcod_gap_cg, only: gap_session, gap_session_start, gap_target, gap_solver_storage_bytes
    use femcod_interface_law, only: interface_law, make_interface_law, MAX_PLASTIC_ROUNDS
@@ -491,11 +491,8 @@ contains
       class(solver_observer), intent(inout) :: observer
       if (session%by_gaps) then
          call solve_by_gaps(grid, session, target, how, answer, status, observer)
-      else if (by_approach) then
-         call find_load(grid, session, target, how, answer, status, observer)
       else
-         answer%load = target
-         call solve_load(grid, session, target, how, answer, status, observer)
+         call solve_state(grid, session, cg_constraint(target, by_approach), how, answer, status, observer)
       end if
       answer%approach = session%approach
    end subroutine solve_target
@@ -542,114 +539,56 @@ contains
       end associate
    end subroutine solve_by_gaps
 
-   !> The state at `load` (nN): the forces (warm start: the session's, scaled by the
-   !> solver to the load) and the approach, into the session; the maps into `answer`.
-   subroutine solve_load(grid, session, load, how, answer, status, observer)
+   !> The state under `target`, a load (nN) or an approach (nm): the forces (warm start:
+   !> the session's, scaled by the solver to the load, or by the factor that minimises the
+   !> energy at the approach) and the approach into the session; the load and the maps
+   !> into `answer`. At no load, or at or below first touch (approach <= 0), the surfaces
+   !> do not touch: load 0, no contact. With the cap at a load: capped_solve (an approach
+   !> with the cap is solved in the gap variables).
+   subroutine solve_state(grid, session, target, how, answer, status, observer)
       class(elastic_operator), intent(inout) :: grid
       type(cg_session), intent(inout) :: session
-      real(dp), intent(in) :: load
+      type(cg_constraint), intent(in) :: target
       type(cg_settings), intent(in) :: how
       type(cg_answer), intent(inout) :: answer
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
       real(dp) :: total(1)
-      if (load <= 0) then
+      answer%load = target%value
+      if (target%value <= 0) then
          session%p = 0
          total(1) = minval(grid%g0)
          call grid%min_over_grid(total)
          session%approach = -total(1)
+         if (target%by_approach) session%approach = target%value
          if (session%plastic) session%capped = .false.
+         answer%load = 0
       else if (session%plastic) then
-         call capped_solve(grid, session, load, how, answer, status, observer)
+         call capped_solve(grid, session, target%value, how, answer, status, observer)
       else
          total(1) = sum(session%p)
          call grid%sum_over_grid(total)
          if (.not. total(1) > 0) then
-            call start_forces(grid, load, how, .true., session%p, answer%rep, status, observer)
+            call start_forces(grid, target, how, .true., session%p, answer%rep, status, observer)
             if (status%code /= 0) return
          end if
-         call constrained_cg(grid, load, how%tol, how%max_iterations, how, session%p, session%approach, answer%rep, &
+         call constrained_cg(grid, target, how%tol, how%max_iterations, how, session%p, session%approach, answer%rep, &
             status, observer, answer%gap)
-      end if
-   end subroutine solve_load
-
-   !> Displacement control: the load at which the approach is `target` (nm), by the
-   !> Illinois variant of regula falsi on A(P) - target (A increases with P), each A(P) a
-   !> fixed-load solve warm-started from the last; to |A - target| <= tol times the
-   !> height range, the fixed-load solver's own accuracy. At or below first touch
-   !> (target <= 0) the state has no load and no contact. The load is the answer
-   !> (answer%load); answer%rep counts the iterations of every solve.
-   subroutine find_load(grid, session, target, how, answer, status, observer)
-      class(elastic_operator), intent(inout) :: grid
-      type(cg_session), intent(inout) :: session
-      real(dp), intent(in) :: target
-      type(cg_settings), intent(in) :: how
-      type(cg_answer), intent(inout) :: answer
-      type(status_type), intent(inout) :: status
-      class(solver_observer), intent(inout) :: observer
-      integer, parameter :: MAX_SOLVES = 100
-      real(dp) :: lo, alo, hi, ahi, trial, accuracy, total(1)
-      integer :: solve, side
-      accuracy = how%tol*max(grid%scale, abs(target))
-      if (target <= 0) then
-         answer%load = 0
-         call solve_load(grid, session, 0.0_dp, how, answer, status, observer)
-         session%approach = target
-         return
-      end if
-      lo = 0
-      alo = 0
-      hi = -1
-      ahi = 0
-      side = 0
-      ! First trial: the last solution's load scaled as Hertz (P ~ A^1.5), or one pixel's
-      ! stiffness.
-      total(1) = sum(session%p)
-      call grid%sum_over_grid(total)
-      if (total(1) > 0 .and. session%approach > 0) then
-         trial = total(1)*(target/session%approach)**1.5_dp
-      else
-         trial = target/(grid%c*grid%self + grid%s)
-      end if
-      do solve = 1, MAX_SOLVES
-         call solve_load(grid, session, trial, how, answer, status, observer)
-         if (status%code /= 0) return
-         if (abs(session%approach - target) <= accuracy) exit
-         ! Illinois: an end kept twice in a row has its residual halved.
-         if (session%approach < target) then
-            lo = trial
-            alo = session%approach
-            if (side == -1) ahi = target + (ahi - target)/2
-            side = -1
-         else
-            hi = trial
-            ahi = session%approach
-            if (side == 1) alo = target - (target - alo)/2
-            side = 1
+         if (target%by_approach) then
+            total(1) = sum(session%p)
+            call grid%sum_over_grid(total)
+            answer%load = total(1)
          end if
-         if (hi < 0) then
-            ! No bracket yet: the load grows as Hertz would have it, at least doubled.
-            trial = lo*max(2.0_dp, (target/max(alo, tiny(1.0_dp)))**1.5_dp)
-         else
-            trial = lo + (hi - lo)*(target - alo)/(ahi - alo)
-            if (.not. (trial > lo .and. trial < hi)) trial = (lo + hi)/2
-         end if
-      end do
-      if (solve > MAX_SOLVES) then
-         call set_error(status, STATUS_NUMERICAL, "cg --approach: no load found for the approach "// &
-            format_real(target)//" nm in "//int_str(MAX_SOLVES)//" solves")
-         return
       end if
-      answer%load = trial
-   end subroutine find_load
+   end subroutine solve_state
 
-   !> The forces (nN) a solve at total load P starts from: with `coarse`, as the operator
+   !> The forces (nN) a solve under `target` starts from: with `coarse`, as the operator
    !> starts (nested coarser grids on one process, a coarse solve on rank 0 in femcod-mpi;
-   !> the load spread near the first touch by default), else the load spread near the
-   !> first touch.
-   subroutine start_forces(grid, total_load, how, coarse, p, rep, status, observer)
+   !> spread_load by default), else spread_load (a load spread near the first touch, or
+   !> the pixels that overlap at an approach).
+   subroutine start_forces(grid, target, how, coarse, p, rep, status, observer)
       class(elastic_operator), intent(inout) :: grid
-      real(dp), intent(in) :: total_load
+      type(cg_constraint), intent(in) :: target
       type(cg_settings), intent(in) :: how
       logical, intent(in) :: coarse
       real(dp), intent(out) :: p(:, :)
@@ -657,17 +596,16 @@ contains
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
       if (coarse) then
-         call grid%start_forces(total_load, how, p, rep%coarse_iterations, status, observer)
+         call grid%start_forces(target, how, p, rep%coarse_iterations, status, observer)
       else
-         call spread_load(grid, total_load, p)
+         call spread_load(grid, target, p)
       end if
    end subroutine start_forces
 
-   !> The nested grid operator's start: nested_start with how%nested, else the load spread
-   !> near the first touch.
-   subroutine nested_grid_start(op, total_load, how, p, coarse_iterations, status, observer)
+   !> The nested grid operator's start: nested_start with how%nested, else spread_load.
+   subroutine nested_grid_start(op, target, how, p, coarse_iterations, status, observer)
       class(nested_grid_operator), intent(inout) :: op
-      real(dp), intent(in) :: total_load
+      type(cg_constraint), intent(in) :: target
       type(cg_settings), intent(in) :: how
       real(dp), intent(out) :: p(:, :)
       integer, intent(inout) :: coarse_iterations
@@ -675,11 +613,11 @@ contains
       class(solver_observer), intent(inout) :: observer
       type(cg_residuals) :: rep
       if (.not. how%nested) then
-         call spread_load(op, total_load, p)
+         call spread_load(op, target, p)
          return
       end if
       rep%coarse_iterations = coarse_iterations
-      call nested_start(op, op%materials, total_load, how, p, rep, status, observer)
+      call nested_start(op, op%materials, target, how, p, rep, status, observer)
       coarse_iterations = rep%coarse_iterations
    end subroutine nested_grid_start
 
@@ -730,11 +668,11 @@ contains
          end if
          left = load - ncap*fmax
          if (.not. total(2) > 0) then
-            call start_forces(grid, left, how, ncap == 0, p, answer%rep, status, observer)
+            call start_forces(grid, cg_constraint(left, .false.), how, ncap == 0, p, answer%rep, status, observer)
             if (status%code /= 0) exit
          end if
-         call constrained_cg(grid, left, how%tol, how%max_iterations, how, p, session%approach, answer%rep, status, &
-            observer, answer%gap)
+         call constrained_cg(grid, cg_constraint(left, .false.), how%tol, how%max_iterations, how, p, &
+            session%approach, answer%rep, status, observer, answer%gap)
          if (status%code /= 0) exit
          ! The gaps of all forces together, from one fresh double-precision convolution.
          force = merge(fmax, p, capped)
@@ -764,13 +702,14 @@ contains
       end associate
    end subroutine capped_solve
 
-   !> The first load's start from nested grids: halve while the side stays even and at
+   !> The first target's start from nested grids: halve while the side stays even and at
    !> least 2 * coarsest; solve the coarsest from the first guess, then each finer grid
    !> from the coarser solution, to coarse_tol; return the forces on the finest grid.
-   recursive subroutine nested_start(grid, problem, total_load, how, p, rep, status, observer)
+   !> An approach is measured on each grid from its own first touch (coarse_target).
+   recursive subroutine nested_start(grid, problem, target, how, p, rep, status, observer)
       class(grid_operator), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
-      real(dp), intent(in) :: total_load
+      type(cg_constraint), intent(in) :: target
       type(cg_settings), intent(in) :: how
       real(dp), intent(out) :: p(:, :)
       type(cg_residuals), intent(inout) :: rep
@@ -783,16 +722,16 @@ contains
       integer :: n, i, j
       n = grid%np
       if (mod(n, 2) /= 0 .or. n < 2*how%coarsest) then
-         call spread_load(grid, total_load, p)
+         call spread_load(grid, coarse_target(target, grid%g0), p)
          return
       end if
       n = n/2
       call grid_operator_setup(coarse, (grid%g0(1::2, 1::2) + grid%g0(2::2, 1::2) + grid%g0(1::2, 2::2) + &
          grid%g0(2::2, 2::2))/4, problem, 2*grid%pixel, how, grid%periodic)
       allocate(pc(n, n))
-      call nested_start(coarse, problem, total_load, how, pc, rep, status, observer)
-      if (status%code == 0) call constrained_cg(coarse, total_load, how%coarse_tol, 10000, how, pc, approach, &
-         coarse_rep, status, observer)
+      call nested_start(coarse, problem, target, how, pc, rep, status, observer)
+      if (status%code == 0) call constrained_cg(coarse, coarse_target(target, coarse%g0), how%coarse_tol, 10000, how, &
+         pc, approach, coarse_rep, status, observer)
       call split_hand_over(coarse%split, grid%split)
       call grid_operator_free(coarse)
       if (status%code /= 0) return
@@ -809,10 +748,11 @@ contains
    !> how%coarse_tol: the start that the distributed solver (femcod-mpi) hands down to its
    !> finer grid, as nested_start does here. `iterations`: on this grid and all coarser
    !> ones.
-   subroutine coarse_start_forces(g0, problem, pixel, total_load, how, periodic, p, iterations, status, observer)
+   subroutine coarse_start_forces(g0, problem, pixel, target, how, periodic, p, iterations, status, observer)
       real(dp), intent(in) :: g0(:, :)
       type(contact_problem), intent(in) :: problem
-      real(dp), intent(in) :: pixel, total_load
+      type(cg_constraint), intent(in) :: target
+      real(dp), intent(in) :: pixel
       type(cg_settings), intent(in) :: how
       logical, intent(in) :: periodic
       real(dp), intent(out) :: p(:, :)
@@ -824,13 +764,25 @@ contains
       real(dp) :: approach
       call grid_operator_setup(grid, g0, problem, pixel, how, periodic)
       if (how%nested) then
-         call nested_start(grid, problem, total_load, how, p, rep, status, observer)
+         call nested_start(grid, problem, target, how, p, rep, status, observer)
       else
-         call spread_load(grid, total_load, p)
+         call spread_load(grid, coarse_target(target, g0), p)
       end if
-      if (status%code == 0) call constrained_cg(grid, total_load, how%coarse_tol, 10000, how, p, approach, rep, &
-         status, observer)
+      if (status%code == 0) call constrained_cg(grid, coarse_target(target, g0), how%coarse_tol, 10000, how, p, &
+         approach, rep, status, observer)
       call grid_operator_free(grid)
       iterations = rep%iterations + rep%coarse_iterations
    end subroutine coarse_start_forces
+
+   !> `target` on a coarser grid of gaps g0 (nm, this process's whole grid): a load as it
+   !> is; an approach A (from the finest grid's first touch) moved to the same depth below
+   !> this grid's own first touch, A + min g0 (averaging the heights raises the lowest
+   !> gap, and the coarse solution is only a start).
+   pure function coarse_target(target, g0) result(coarse)
+      type(cg_constraint), intent(in) :: target
+      real(dp), intent(in) :: g0(:, :)
+      type(cg_constraint) :: coarse
+      coarse = target
+      if (target%by_approach) coarse%value = target%value + minval(g0)
+   end function coarse_target
 end module femcod_cg

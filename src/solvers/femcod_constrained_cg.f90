@@ -1,5 +1,5 @@
 !> The constrained conjugate-gradient iteration of Polonsky and Keer (Wear 231, 1999,
-!> 206-219) at one total load, written once against the elastic operator
+!> 206-219) at one total load or at one approach, written once against the elastic operator
 !> (model/femcod_elastic_operator): every loop runs over this process's columns, every sum
 !> and maximum over the grid goes through the operator's reductions, so femcod-mpi runs
 !> this same iteration on its slabs. What the iteration does and why each acceleration
@@ -15,7 +15,7 @@ module femcod_constrained_cg
    use, intrinsic :: iso_fortran_env, only: int8
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED
-   use femcod_elastic_operator, only: elastic_operator
+   use femcod_elastic_operator, only: elastic_operator, cg_constraint
    use femcod_solver_options, only: cg_settings
    use femcod_observer, only: solver_observer
    use femcod_strings, only: count_text, int_str
@@ -79,6 +79,8 @@ module femcod_constrained_cg
       !> The load balance alpha (forces and displacements are alpha times p and w until
       !> the next step writes them scaled), the contacts' mean gap, the (preconditioned)
       !> gradient norms and their cross term, beta, the direction's mean, the step.
+      !> Under displacement control (by_approach) gbar is the approach, and alpha the
+      !> balance that puts the contacts' mean gap there.
       real(dp) :: alpha = 1, gbar = 0, big_g = 0, big_g_old = 1, cross = 0, beta = 0, zbar = 0, tau = 0
       !> An entering pixel's share of a lone pixel's preconditioned step; the forces' sum.
       real(dp) :: entry = 1, psum = 0
@@ -91,6 +93,7 @@ module femcod_constrained_cg
       !> The error bound (nm) of the split corrections since the last fresh convolution.
       real(dp) :: split_error = 0
       integer :: it = 0
+      logical :: by_approach = .false.
       logical :: restart = .true., single = .false., fresh = .true., fresh_double = .false., stalled = .false., &
          keep_old = .false., kept_old = .false.
    end type cg_iteration
@@ -102,9 +105,12 @@ module femcod_constrained_cg
    integer, parameter :: SUM_BLOCK = 4096
 contains
 
-   !> Polonsky-Keer constrained CG on the operator `grid` at total load P from the forces
-   !> p (nN, any positive start; returned: the solution). `approach` (nm) is the mean gap
-   !> of the contact pixels before the rigid shift, i.e. the approach from first touch.
+   !> Polonsky-Keer constrained CG on the operator `grid` under `target` from the forces
+   !> p (nN, any positive start; returned: the solution). At a total load P, `approach`
+   !> (nm) is the mean gap of the contact pixels before the rigid shift, i.e. the approach
+   !> from first touch. At an approach A the same iteration runs with A for that mean and
+   !> the load balance alpha chosen to match it (contact_gaps): the load, sum p, is the
+   !> answer.
    !>
    !> Only two things need every pixel in each iteration: the convolution, and one pass
    !> that moves the displacements by the step and lets overlapping pixels enter. All else
@@ -116,9 +122,10 @@ contains
    !> test compares with (tol, single_until, or at the last iteration): above it the
    !> residual is above the threshold whatever the penetration, so every decision is the
    !> one the full residual would give.
-   subroutine constrained_cg(grid, total_load, tol, max_iterations, how, p, approach, rep, status, observer, final_gap)
+   subroutine constrained_cg(grid, target, tol, max_iterations, how, p, approach, rep, status, observer, final_gap)
       class(elastic_operator), intent(inout) :: grid
-      real(dp), intent(in) :: total_load, tol
+      type(cg_constraint), intent(in) :: target
+      real(dp), intent(in) :: tol
       integer, intent(in) :: max_iterations
       type(cg_settings), intent(in) :: how
       real(dp), intent(inout) :: p(:, :)
@@ -132,7 +139,7 @@ contains
       !> convolution of its own.
       real(dp), allocatable, intent(out), optional :: final_gap(:, :)
       type(cg_iteration) :: st
-      call iteration_start(st, grid, how, p, total_load)
+      call iteration_start(st, grid, how, p, target)
       do
          if (grid%any_over_grid(observer%stop_requested())) then
             call set_error(status, STATUS_INTERRUPTED, "stopped after "//count_text(st%it, "iteration")//" on the "// &
@@ -182,19 +189,25 @@ contains
          call take_step(st, grid, how, p, status)
          if (status%code /= 0) return
          call correct_displacements(st, grid, how, rep)
-         st%alpha = total_load/st%psum
+         ! The step wrote the forces scaled: the next balance from them.
+         if (st%by_approach) then
+            st%alpha = 1
+         else
+            st%alpha = target%value/st%psum
+         end if
       end do
-      call iteration_finish(st, grid, p, total_load, rep, final_gap)
+      call iteration_finish(st, grid, p, target, rep, final_gap)
    end subroutine constrained_cg
 
-   !> The state for a solve from the forces p at total load P: the arrays, the start's
-   !> contacts (the direction is zero off the contacts throughout) and the load balance.
-   subroutine iteration_start(st, grid, how, p, total_load)
+   !> The state for a solve from the forces p under `target`: the arrays, the start's
+   !> contacts (the direction is zero off the contacts throughout) and the load balance
+   !> (1 at an approach, which fixes gbar instead).
+   subroutine iteration_start(st, grid, how, p, target)
       type(cg_iteration), intent(inout) :: st
       class(elastic_operator), intent(inout) :: grid
       type(cg_settings), intent(in) :: how
       real(dp), intent(in) :: p(:, :)
-      real(dp), intent(in) :: total_load
+      type(cg_constraint), intent(in) :: target
       real(dp) :: total(1)
       integer :: np, nj, i, j
       np = grid%np
@@ -231,7 +244,13 @@ contains
       call list_contacts(st)
       total(1) = sum(p)
       call grid%sum_over_grid(total)
-      st%alpha = total_load/total(1)
+      st%by_approach = target%by_approach
+      if (st%by_approach) then
+         st%alpha = 1
+         st%gbar = target%value
+      else
+         st%alpha = target%value/total(1)
+      end if
       st%single = how%single_until > 0
    end subroutine iteration_start
 
@@ -244,7 +263,7 @@ contains
       class(elastic_operator), intent(inout) :: grid
       real(dp), intent(in) :: p(:, :)
       type(status_type), intent(inout) :: status
-      real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, s, sums(2), lift, own
+      real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, s, sums(4), pair(2), lift, own
       real(dp), allocatable :: part(:, :)
       integer :: q, i, j, nc, b, nb
       logical :: take_old
@@ -258,23 +277,34 @@ contains
       allocate(part(4, nb))
       !$omp parallel do private(q, i, j)
       do b = 1, nb
-         part(1, b) = 0
+         part(1:3, b) = 0
          do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, nc)
             i = st%contact(1, q)
             j = st%contact(2, q)
             part(1, b) = part(1, b) + (grid%g0(i, j) + alpha*(st%w(i, j) + s*p(i, j)))
+            part(2, b) = part(2, b) + grid%g0(i, j)
+            part(3, b) = part(3, b) + (st%w(i, j) + s*p(i, j))
          end do
       end do
-      gbar = sum(part(1, :))
-      sums = [gbar, real(nc, dp)]
+      sums = [sum(part(1, :)), sum(part(2, :)), sum(part(3, :)), real(nc, dp)]
       call grid%sum_over_grid(sums)
-      st%nc_all = sums(2)
+      st%nc_all = sums(4)
       if (.not. st%nc_all > 0) then
          call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
          return
       end if
-      gbar = sums(1)/st%nc_all
-      st%gbar = gbar
+      if (st%by_approach) then
+         ! Displacement control: the load balance that puts the contacts' mean gap at the
+         ! approach, mean(g0 + alpha (w + s p)) = A (kept where it would not be positive),
+         ! so the directions, which keep the load, need not find the mean (the slowest
+         ! mode) themselves.
+         if (sums(3) > 0 .and. st%gbar*sums(4) - sums(2) > 0) st%alpha = (st%gbar*sums(4) - sums(2))/sums(3)
+         alpha = st%alpha
+         gbar = st%gbar
+      else
+         gbar = sums(1)/st%nc_all
+         st%gbar = gbar
+      end if
       ! A pixel's own displacement per nN: the convolution's round-off scales with the
       ! forces, and on a periodic cell a uniform pressure displaces nothing, so the
       ! scale holds this too (a periodic flat with 1e-12 nm ripples stalled at 1.2e-6).
@@ -306,14 +336,14 @@ contains
       big_g = sum(part(1, :))
       cross = sum(part(2, :))
       st%kept_old = st%keep_old
-      sums = [big_g, cross]
-      call grid%sum_over_grid(sums)
-      st%big_g = sums(1)
-      st%cross = sums(2)
-      sums = [contact_gap, lift]
-      call grid%max_over_grid(sums)
-      st%contact_gap = sums(1)
-      st%scale = max(grid%scale, sums(2))
+      pair = [big_g, cross]
+      call grid%sum_over_grid(pair)
+      st%big_g = pair(1)
+      st%cross = pair(2)
+      pair = [contact_gap, lift]
+      call grid%max_over_grid(pair)
+      st%contact_gap = pair(1)
+      st%scale = max(grid%scale, pair(2))
    end subroutine contact_gaps
 
    !> The relative residual max(contact gap, penetration) / scale (the height range, or
@@ -533,11 +563,11 @@ contains
    !> The answer: the forces with the load balance applied, the residuals reached, and
    !> the gap map (formed in t's storage and handed over: no further NP x NP array at
    !> the peak).
-   subroutine iteration_finish(st, grid, p, total_load, rep, final_gap)
+   subroutine iteration_finish(st, grid, p, target, rep, final_gap)
       type(cg_iteration), intent(inout) :: st
       class(elastic_operator), intent(inout) :: grid
       real(dp), intent(inout) :: p(:, :)
-      real(dp), intent(in) :: total_load
+      type(cg_constraint), intent(in) :: target
       type(cg_residuals), intent(inout) :: rep
       real(dp), allocatable, intent(out), optional :: final_gap(:, :)
       real(dp) :: total(1), alpha, gbar
@@ -556,7 +586,9 @@ contains
       rep%penetration = st%penetration
       total(1) = sum(p)
       call grid%sum_over_grid(total)
-      rep%load_error = abs(total(1) - total_load)/total_load
+      ! At an approach the load is the answer: no constraint on it to miss.
+      rep%load_error = 0
+      if (.not. st%by_approach) rep%load_error = abs(total(1) - target%value)/target%value
       if (.not. present(final_gap)) return
       if (allocated(st%r)) deallocate(st%r)
       if (allocated(st%r32)) deallocate(st%r32)
