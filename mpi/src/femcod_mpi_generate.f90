@@ -12,13 +12,10 @@
 !>
 !> No I/O and no stop: errors come back in a status, the same on every rank.
 module femcod_mpi_generate
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_double_complex, c_intptr_t, c_int, c_f_pointer, c_associated, &
-      c_size_t
    use mpi_f08
-   use femcod_fftw_mpi, only: fftw_mpi_local_size_many, fftw_mpi_plan_many_dft, fftw_mpi_execute_dft, fftw_alloc_complex, &
-      fftw_free, fftw_destroy_plan, FFTW_ESTIMATE, FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK
+   use femcod_mpi_slab_transform, only: slab_dft, slab_dft_setup, slab_dft_backward, slab_dft_free
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL
+   use femcod_status, only: status_type, set_error, STATUS_USAGE
    use femcod_problem, only: contact_problem
    use femcod_generate, only: scene_spec, scene_header
    use femcod_surfaces, only: self_affine_spectrum
@@ -84,38 +81,19 @@ contains
       integer, intent(in) :: first(0:), count(0:)
       real(dp), allocatable, intent(out) :: z(:, :)
       type(status_type), intent(inout) :: status
-      type(c_ptr) :: plan, in_mem, out_mem
-      complex(c_double_complex), pointer :: spectrum(:, :), field(:, :)
-      integer(c_intptr_t) :: alloc, local_n0, start
+      type(slab_dft) :: dft
       real(dp) :: sums(2), lowest(1), n2, mean, rms
       integer :: rank, np, nj
       call MPI_Comm_rank(comm, rank)
       np = spec%np
       nj = count(rank)
-      alloc = fftw_mpi_local_size_many(2_c_int, [integer(c_intptr_t) :: np, np], 1_c_intptr_t, &
-         int(count(0), c_intptr_t), comm%MPI_VAL, local_n0, start)
-      if (int(local_n0) /= nj .or. int(start) /= first(rank)) then
-         call set_error(status, STATUS_NUMERICAL, "FFTW-MPI splits the generated surface otherwise than the solver")
-         return
+      call slab_dft_setup(dft, comm, np, first(rank), nj, count(0), status)
+      if (status%code == 0) then
+         call self_affine_spectrum(np, spec%pixel, spec%hurst, spec%seed, first(rank), nj, dft%input)
+         call slab_dft_backward(dft)
+         z = real(dft%output, dp)
       end if
-      in_mem = fftw_alloc_complex(int(max(alloc, int(np, c_intptr_t)*nj, 1_c_intptr_t), c_size_t))
-      out_mem = fftw_alloc_complex(int(max(alloc, int(np, c_intptr_t)*nj, 1_c_intptr_t), c_size_t))
-      call c_f_pointer(in_mem, spectrum, [np, nj])
-      call c_f_pointer(out_mem, field, [np, nj])
-      plan = fftw_mpi_plan_many_dft(2_c_int, [integer(c_intptr_t) :: np, np], 1_c_intptr_t, &
-         int(count(0), c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, spectrum, field, comm%MPI_VAL, FFTW_BACKWARD, &
-         FFTW_ESTIMATE)
-      if (.not. c_associated(plan)) then
-         call set_error(status, STATUS_NUMERICAL, "FFTW-MPI made no plan for the "//int_str(np)//"^2 surface")
-      else
-         call self_affine_spectrum(np, spec%pixel, spec%hurst, spec%seed, first(rank), nj, spectrum)
-         ! An MPI plan's new-array execute is FFTW-MPI's (the serial one does nothing).
-         call fftw_mpi_execute_dft(plan, spectrum, field)
-         z = real(field, dp)
-         call fftw_destroy_plan(plan)
-      end if
-      call fftw_free(in_mem)
-      call fftw_free(out_mem)
+      call slab_dft_free(dft)
       if (status%code /= 0) return
       ! As self_affine_surface: z - mean, then scaled by rms / rms_height(z), whose mean
       ! is taken again (round-off).

@@ -12,6 +12,10 @@
 !> oddly (a kernel table placed at the offsets -(NP-1) .. NP-1, each rank from its own
 !> columns).
 !>
+!> Besides, the complex 2-D backward transform of a field in the same column slabs
+!> (slab_dft: femcod_mpi_generate's surface spectrum), so that every plan femcod-mpi makes
+!> is made here.
+!>
 !> No I/O and no stop: errors come back in a status.
 module femcod_mpi_slab_transform
    use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_float, c_float_complex, &
@@ -20,7 +24,8 @@ module femcod_mpi_slab_transform
    use femcod_fftw_mpi, only: fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, fftw_mpi_execute_r2r, &
       fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
       fftw_execute_dft, fftw_alloc_complex, fftw_free, fftw_destroy_plan, FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, &
-      FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK, fftwf_mpi_plan_many_transpose, fftwf_mpi_execute_r2r, &
+      FFTW_BACKWARD, FFTW_MPI_DEFAULT_BLOCK, fftw_mpi_local_size_many, fftw_mpi_plan_many_dft, fftw_mpi_execute_dft, &
+      fftwf_mpi_plan_many_transpose, fftwf_mpi_execute_r2r, &
       fftwf_plan_many_dft_r2c, fftwf_plan_many_dft_c2r, fftwf_plan_many_dft, fftwf_execute_dft_r2c, &
       fftwf_execute_dft_c2r, fftwf_execute_dft, fftwf_destroy_plan
    use femcod_kinds, only: dp, sp
@@ -32,6 +37,7 @@ module femcod_mpi_slab_transform
    public :: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, slab_backward, &
       slab_forward_single, slab_backward_single, slab_permute
    public :: PAD_ZEROS, EXTEND_EVEN, EXTEND_ODD
+   public :: slab_dft, slab_dft_setup, slab_dft_backward, slab_dft_free
 
    !> How the transposed rows of NP become rows of M (module header).
    integer, parameter :: PAD_ZEROS = 0, EXTEND_EVEN = 1, EXTEND_ODD = -1
@@ -67,6 +73,13 @@ module femcod_mpi_slab_transform
       !> P-th value of a transposed row; not allocated: the grid's own order.
       integer, allocatable :: natural(:)
    end type slab_transform
+
+   !> The complex 2-D backward DFT of an NP x NP field in column slabs: this rank's columns
+   !> of the input and of the output (np, nj; FFTW's memory), and the plan between them.
+   type :: slab_dft
+      type(c_ptr) :: input_memory = c_null_ptr, output_memory = c_null_ptr, plan = c_null_ptr
+      complex(c_double_complex), pointer :: input(:, :) => null(), output(:, :) => null()
+   end type slab_dft
 
 contains
 
@@ -413,4 +426,46 @@ contains
          end do
       end do
    end subroutine compress_rows
+
+   !> The backward DFT of the NP x NP field whose columns j0 + 1 .. j0 + nj this rank
+   !> holds (every rank's block_columns, but the last ranks'): the buffers, then
+   !> dft%input filled by the caller, slab_dft_backward, dft%output read. An error when
+   !> FFTW-MPI would split the columns otherwise or makes no plan. Collective over `comm`.
+   subroutine slab_dft_setup(dft, comm, np, j0, nj, block_columns, status)
+      type(slab_dft), intent(inout) :: dft
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: np, j0, nj, block_columns
+      type(status_type), intent(inout) :: status
+      integer(c_intptr_t) :: alloc, local_n0, start, n(2)
+      n = [integer(c_intptr_t) :: np, np]
+      alloc = fftw_mpi_local_size_many(2_c_int, n, 1_c_intptr_t, int(block_columns, c_intptr_t), comm%MPI_VAL, &
+         local_n0, start)
+      if (int(local_n0) /= nj .or. int(start) /= j0) then
+         call set_error(status, STATUS_NUMERICAL, "FFTW-MPI splits the generated surface otherwise than the solver")
+         return
+      end if
+      dft%input_memory = fftw_alloc_complex(int(max(alloc, int(np, c_intptr_t)*nj, 1_c_intptr_t), c_size_t))
+      dft%output_memory = fftw_alloc_complex(int(max(alloc, int(np, c_intptr_t)*nj, 1_c_intptr_t), c_size_t))
+      call c_f_pointer(dft%input_memory, dft%input, [np, nj])
+      call c_f_pointer(dft%output_memory, dft%output, [np, nj])
+      dft%plan = fftw_mpi_plan_many_dft(2_c_int, n, 1_c_intptr_t, int(block_columns, c_intptr_t), &
+         FFTW_MPI_DEFAULT_BLOCK, dft%input, dft%output, comm%MPI_VAL, FFTW_BACKWARD, FFTW_ESTIMATE)
+      if (.not. c_associated(dft%plan)) &
+         call set_error(status, STATUS_NUMERICAL, "FFTW-MPI made no plan for the "//int_str(np)//"^2 surface")
+   end subroutine slab_dft_setup
+
+   !> dft%output = the backward DFT of dft%input (unnormalised, as FFTW's).
+   subroutine slab_dft_backward(dft)
+      type(slab_dft), intent(inout) :: dft
+      ! An MPI plan's new-array execute is FFTW-MPI's (the serial one does nothing).
+      call fftw_mpi_execute_dft(dft%plan, dft%input, dft%output)
+   end subroutine slab_dft_backward
+
+   subroutine slab_dft_free(dft)
+      type(slab_dft), intent(inout) :: dft
+      if (c_associated(dft%plan)) call fftw_destroy_plan(dft%plan)
+      if (c_associated(dft%input_memory)) call fftw_free(dft%input_memory)
+      if (c_associated(dft%output_memory)) call fftw_free(dft%output_memory)
+      dft = slab_dft()
+   end subroutine slab_dft_free
 end module femcod_mpi_slab_transform
