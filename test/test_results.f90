@@ -30,6 +30,8 @@ contains
          new_unittest("SVG: complete documents, fitted exponent and pressure scale", test_svg), &
          new_unittest("pressure figure: its PNG holds the map's 64 levels (decoded by Python)", test_png_levels), &
          new_unittest("pressure figure of a 2100^2 map: 3 x 3 blocks keep a one-pixel contact", test_png_blocks), &
+         new_unittest("gap, plastic and stick/slip figures: their PNGs hold the HDF5 maps; y up, row 0 at the top", &
+            test_map_figures), &
          new_unittest("a plot of 200000 steps stays small and keeps its ends", test_long_plot), &
          new_unittest("summary.json: valid JSON, the CSV's numbers, timings within the command", test_summary_json), &
          new_unittest("cg's memory estimate (checked before the solve) against the peak the system measured", &
@@ -540,6 +542,64 @@ contains
       call check(error, levels(700, 1) == 64 .and. count(levels /= 0) == 1, "the one block, at the top level")
    end subroutine test_png_blocks
 
+   !> The map figures of a run with the plastic cap and a tangential step (sphere_d1, cg,
+   !> H = 5 GPa, Q = 100 nN, mu = 0.3): the PNG of PREFIX.gap_2.svg holds the HDF5 gap map
+   !> binned as doc/results.md says (level 1 + min(63, floor(64 max(g, 0) / g_max)),
+   !> contacts at level 1, none white), plastic_2's the plastic displacement (white where 0), and
+   !> stick_slip_2's 1 where /stick, 2 where /slip, 0 elsewhere; pixel (i, j) of the
+   !> image is row i, column j of the HDF5 map (row 1 at the top), and the y axis runs
+   !> from 0 at the bottom to NP d at the top (the XDMF mesh's y).
+   subroutine test_map_figures(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix, text
+      type(h5_file) :: file
+      type(status_type) :: st
+      real(dp), allocatable :: gap(:, :), plastic(:, :), stick(:, :), slip(:, :)
+      integer, allocatable :: levels(:, :), expected(:, :)
+      integer :: code
+      prefix = scratch_path("map-figures")
+      call execute_command_line("rm -f '"//prefix//"'.*")
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--solver"), string_type("cg"), string_type("--loads"), &
+         string_type("100,1000"), string_type("--plastic"), string_type("--hardness"), string_type("5"), &
+         string_type("--tangential"), string_type("100"), string_type("--friction"), string_type("0.3"), &
+         string_type("--quiet")], code)
+      call check(error, code, 0, "femcod run")
+      if (allocated(error)) return
+      call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/loads/002/gap", gap, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/loads/002/plastic_displacement", plastic, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/loads/002/stick", stick, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/loads/002/slip", slip, st, STATUS_BAD_INPUT)
+      call h5_close(file, st)
+      call check(error, st%code, 0, st%message)
+      if (allocated(error)) return
+      call check(error, count(plastic > 0) > 0 .and. count(slip > 0) > 0 .and. count(stick > 0) > 0, &
+         "the run has plastic, sticking and slipping pixels")
+      if (allocated(error)) return
+      call decode_png(prefix//".gap_2.svg", levels, error)
+      if (allocated(error) .or. .not. allocated(levels)) return
+      ! Capped pixels have a negative gap (minus their plastic displacement): level 1.
+      expected = 1 + min(63, max(0, int(64*gap/maxval(gap))))
+      call check(error, all(levels == expected), "gap levels: "//to_string(count(levels /= expected))//" differ")
+      if (allocated(error)) return
+      call decode_png(prefix//".plastic_2.svg", levels, error)
+      if (allocated(error)) return
+      expected = merge(1 + min(63, int(64*plastic/maxval(plastic))), 0, plastic > 0)
+      call check(error, all(levels == expected), "plastic levels: "//to_string(count(levels /= expected))//" differ")
+      if (allocated(error)) return
+      call decode_png(prefix//".stick_slip_2.svg", levels, error, palette=3)
+      if (allocated(error)) return
+      expected = merge(2, merge(1, 0, stick > 0), slip > 0)
+      call check(error, all(levels == expected), "stick/slip: "//to_string(count(levels /= expected))//" differ")
+      if (allocated(error)) return
+      ! The y axis: 0 at the image's bottom edge (y0 + side + 4 = 414 px), NP d at its top.
+      text = read_text(prefix//".gap_2.svg")
+      call check(error, contains_text(text, 'y="414.00" font-family="sans-serif" font-size="11" text-anchor="end">0<') &
+         .and. contains_text(text, 'y="54.00" font-family="sans-serif" font-size="11" text-anchor="end">30<'), &
+         "y from 0 at the bottom to NP d = 30 nm at the top")
+   end subroutine test_map_figures
+
    !> 200001 points on a line (a 4096^2 run to 1 % has about 170000 steps): the
    !> polyline keeps a point only where it moves by half a pixel, so the figure stays
    !> far below 1 MB; the first and the last point (the frame's corners, at 90,410 and
@@ -559,13 +619,15 @@ contains
    end subroutine test_long_plot
 
    !> The palette indices of the PNG in an SVG figure, by test/tools/png_levels.py;
-   !> unallocated (and no error) when python3 is missing.
-   subroutine decode_png(svg_path, levels, error)
+   !> unallocated (and no error) when python3 is missing. `palette`: the colours expected
+   !> (65 by default: white, then the 64 levels).
+   subroutine decode_png(svg_path, levels, error, palette)
       character(len=*), intent(in) :: svg_path
       integer, allocatable, intent(out) :: levels(:, :)
       type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: palette
       character(len=:), allocatable :: out
-      integer :: code, unit, ios, width, height, colours, white(3), i
+      integer :: code, unit, ios, width, height, colours, white(3), i, expected
       call execute_command_line("command -v python3 > /dev/null", exitstat=code)
       if (code /= 0) return
       out = scratch_path("png_levels.txt")
@@ -574,7 +636,10 @@ contains
       if (allocated(error)) return
       open(newunit=unit, file=out, action="read", status="old")
       read(unit, *, iostat=ios) width, height, colours, white
-      call check(error, ios == 0 .and. colours == 65 .and. all(white == 255), "65 colours, the first white")
+      expected = 65
+      if (present(palette)) expected = palette
+      call check(error, ios == 0 .and. colours == expected .and. all(white == 255), to_string(expected)// &
+         " colours, the first white")
       if (allocated(error)) then
          close(unit)
          return

@@ -133,7 +133,10 @@ class Result:
 
     def to_xarray(self):
         """The result as an xarray.Dataset (xarray must be installed): the maps over
-        (state, i, j) with x, y in nm, the state values over (state)."""
+        (state, i, j), the state values over (state). x_nm and y_nm are the pixels'
+        centres as the XDMF mesh and the figures place them: x = (j + 1/2) d to the
+        right, y = (NP - i - 1/2) d upward, row i = 0 at the top (doc/results.md,
+        "Coordinates")."""
         try:
             import xarray as xr
         except ImportError as e:  # optional, never required
@@ -141,7 +144,8 @@ class Result:
         n = self.deck.np
         reached = [s for s in self.states if s.values.get("reached", 1)]
         coords = {"state": np.arange(1, len(reached) + 1), "i": np.arange(n), "j": np.arange(n),
-                  "y_nm": ("i", np.arange(n) * self.deck.pixel), "x_nm": ("j", np.arange(n) * self.deck.pixel)}
+                  "y_nm": ("i", (n - np.arange(n) - 0.5) * self.deck.pixel),
+                  "x_nm": ("j", (np.arange(n) + 0.5) * self.deck.pixel)}
         data = {}
         for name in (reached[0].maps if reached else {}):
             data[name] = (("state", "i", "j"), np.stack([s.maps[name] for s in reached]))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import femcod
-from conftest import REPO
+from conftest import REPO, run_femcod
 
 
 def paraboloid(n, pixel, radius):
@@ -162,6 +162,30 @@ def test_to_xarray_where_installed():
     r = femcod.solve(paraboloid(16, 1.0, 50.0), pixel=1.0, loads=[50.0, 100.0])
     ds = r.to_xarray()
     assert isinstance(ds, xr.Dataset) and ds["pressure"].shape == (2, 16, 16)
+
+
+def test_coordinates_are_the_meshs(tmp_path):
+    """to_xarray's x_nm, y_nm are the centres of the XDMF mesh's cells (PREFIX.h5
+    /mesh: each cell's four nodes, read here with h5py), cell i * NP + j being pixel
+    (i, j); and the figures' y axis runs from 0 at the bottom to NP d at the top, so row
+    0, drawn at the top, is at y = NP d there as on the mesh."""
+    pytest.importorskip("xarray")
+    h5py = pytest.importorskip("h5py")
+    prefix = str(tmp_path / "c")
+    run_femcod("run", os.path.join(REPO, "input", "sphere_d1.deck"), "-o", prefix, "--loads", "100", "--quiet")
+    r = femcod.load(prefix + ".h5")
+    ds = r.to_xarray()
+    with h5py.File(prefix + ".h5", "r") as f:
+        nodes = f["/mesh/nodes_xy"][()]
+        quads = f["/mesh/quadrilaterals"][()]
+    n = r.deck.np
+    centres = nodes[quads].mean(axis=1).reshape(n, n, 2)
+    assert np.allclose(centres[:, :, 0], ds["x_nm"].values[None, :], atol=1e-12)
+    assert np.allclose(centres[:, :, 1], ds["y_nm"].values[:, None], atol=1e-12)
+    svg = open(prefix + ".pressure_1.svg").read()
+    side = n * r.deck.pixel
+    assert 'y="414.00" font-family="sans-serif" font-size="11" text-anchor="end">0<' in svg
+    assert 'y="54.00" font-family="sans-serif" font-size="11" text-anchor="end">%g<' % side in svg
 
 
 class StandInTopography:

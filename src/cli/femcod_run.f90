@@ -31,7 +31,8 @@ module femcod_run
    use femcod_checkpoint, only: read_checkpoint
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_output_guard, only: guard_outputs, OUTPUT_WISDOM, OUTPUT_RESULT
-   use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, pressure_figure_wanted
+   use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, pressure_figure_wanted, &
+      MAP_FIGURES, figure_name
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested
    use femcod_run_options, only: run_table, run_settings, parse_run_arguments, run_help, deck_label
@@ -436,17 +437,27 @@ contains
       character(len=*), intent(in) :: prefix
       type(contact_result), intent(in) :: res
       character(len=*), intent(in) :: figures
-      integer :: k, nloads
+      integer :: k, m, nloads
       nloads = 0
       if (allocated(res%states)) nloads = size(res%states)
       ! The figures this run did not write (an unreached state, --figures), and those of
       ! states beyond its own.
       do k = 1, nloads
-         if (.not. pressure_figure_wanted(res, k, figures)) call remove_file(prefix//".pressure_"//int_str(k)//".svg")
+         if (pressure_figure_wanted(res, k, figures)) then
+            ! The kinds this run has not (an earlier run's plastic or tangential maps).
+            if (.not. allocated(res%states(k)%plastic)) call remove_file(figure_name(prefix, "plastic", k))
+            if (.not. allocated(res%states(k)%stick)) call remove_file(figure_name(prefix, "stick_slip", k))
+         else
+            do m = 1, size(MAP_FIGURES)
+               call remove_file(figure_name(prefix, MAP_FIGURES(m), k))
+            end do
+         end if
       end do
       k = nloads + 1
-      do while (path_exists(prefix//".pressure_"//int_str(k)//".svg"))
-         call remove_file(prefix//".pressure_"//int_str(k)//".svg")
+      do while (any([(path_exists(figure_name(prefix, MAP_FIGURES(m), k)), m = 1, size(MAP_FIGURES))]))
+         do m = 1, size(MAP_FIGURES)
+            call remove_file(figure_name(prefix, MAP_FIGURES(m), k))
+         end do
          k = k + 1
       end do
       if (nloads == 0) call remove_file(prefix//".loads.csv")

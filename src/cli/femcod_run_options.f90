@@ -32,7 +32,7 @@ module femcod_run_options
       !> wisdom file ("": none).
       character(len=:), allocatable :: prefix, outdir, wisdom
       logical :: quiet = .false., force = .false., restart = .false.
-      !> Which states get a pressure figure (--figures all|last|none|auto).
+      !> Which states get their map figures (--figures all|last|none|auto).
       character(len=:), allocatable :: figures
       !> The scene of --lower/--upper (kind "matrix").
       type(scene_spec) :: scene
@@ -68,7 +68,8 @@ contains
             "a capped pixel carries H d^2 and interpenetrates (its plastic displacement, in PREFIX.h5)", &
             mode="cg|incremental"), &
          flag_option("--quiet", "no summary on standard output, no progress lines on standard error", alias="-q"), &
-         choice_option("--figures", "auto|all|last|none", "which states get a pressure figure PREFIX.pressure_<k>.svg "// &
+         choice_option("--figures", "auto|all|last|none", "which states get their map figures PREFIX.pressure_<k>.svg, "// &
+            ".gap_<k>.svg (and .plastic_<k>.svg, .stick_slip_<k>.svg with --plastic, the tangential step) "// &
             "(default auto: every state up to "// &
             int_str(FIGURES_AUTO_LIMIT)//" asked, beyond that the last reached one only; the maps are in "// &
             "PREFIX.h5 either way)"), &
@@ -164,7 +165,8 @@ contains
          "         PREFIX.h5 (everything, with the pressure and gap", &
          "         maps at each requested load; doc/results.md), PREFIX.xdmf (the maps on a mesh for", &
          "         ParaView and meshio), PREFIX.summary.json (the summary as numbers with units),", &
-         "         PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg.", &
+         "         PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg and the", &
+         "         other map figures of --figures (doc/results.md).", &
          "         PREFIX.lock exists while a run writes the prefix; another run is refused.", &
          "signals: SIGTERM, SIGINT and SIGUSR1 stop the run at the next step; the incremental solver", &
          "         writes its checkpoint (continue with --restart), no result file is left half written.", &

@@ -72,8 +72,8 @@ contains
             sig_str(res%wall_seconds/max(last, 1), 3)//" s per step"
       end if
       write(output_unit, '(a)') "  written   : "//prefix//".h5, .xdmf, .summary.json, .history.csv, .contacts.csv, "// &
-         ".load_approach.svg, .area_load.svg"//trim(merge(", .loads.csv, .pressure_<k>.svg", &
-         repeat(" ", 31), size(res%states) > 0))
+         ".load_approach.svg, .area_load.svg"//trim(merge(", .loads.csv, .pressure_<k>.svg, .gap_<k>.svg", &
+         repeat(" ", 45), size(res%states) > 0))
       ! The solver's own account last.
       lines = report_lines(problem, options, res)
       do k = 1, size(lines)

@@ -36,14 +36,14 @@ module femcod_result_schema
       "stick_fraction"
 
    !> What the run was, for /run in the HDF5 file.
-   !> With --figures auto (the default) a pressure figure of every state up to this many
+   !> With --figures auto (the default) the map figures of every state up to this many
    !> requested states, beyond it of the last reached one only (1001 loads wrote 17 MB of
-   !> figures).
-   integer, parameter :: FIGURES_AUTO_LIMIT = 20
+   !> figures): at most 40 map files (2 to 4 a state).
+   integer, parameter :: FIGURES_AUTO_LIMIT = 10
 
    type :: run_info
       character(len=:), allocatable :: version, solver, options
-      !> Which states get a pressure figure (--figures): "all", "last", "none", or "auto"
+      !> Which states get their map figures (--figures): "all", "last", "none", or "auto"
       !> (unallocated too: all up to FIGURES_AUTO_LIMIT states, else the last).
       character(len=:), allocatable :: figures
       !> The lateral boundary, "free" or "periodic" (--boundary).

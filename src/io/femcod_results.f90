@@ -6,7 +6,8 @@
 !>   PREFIX.h5            /deck /surfaces /history /contacts /loads/<kkk> /mesh /run
 !>   PREFIX.xdmf          the maps of PREFIX.h5 on a quadrilateral mesh (ParaView, meshio)
 !>   PREFIX.summary.json  what the summary prints, as numbers with units
-!>   PREFIX.load_approach.svg, PREFIX.area_load.svg, PREFIX.pressure_<k>.svg
+!>   PREFIX.load_approach.svg, PREFIX.area_load.svg, and per state (--figures) the map
+!>   figures PREFIX.pressure_<k>.svg, .gap_<k>.svg, .plastic_<k>.svg, .stick_slip_<k>.svg
 module femcod_results
    use femcod_kinds, only: dp
    use femcod_clock, only: wall_clock
@@ -15,8 +16,8 @@ module femcod_results
    use femcod_strings, only: string_type, int_str, sig_str
    use femcod_files, only: atomic_rename, remove_file, temporary_name, write_bytes
    use femcod_contact_result, only: contact_result
-   use femcod_maps, only: state_maps
-   use femcod_svg, only: svg_plot, svg_pressure_map
+   use femcod_maps, only: state_maps, tangential_step_maps
+   use femcod_svg, only: svg_plot, svg_pressure_map, svg_map, svg_stick_slip_map, BLOCK_SMALLEST, BLOCK_LARGEST
    use femcod_result_schema, only: run_info, FIGURES_AUTO_LIMIT, HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, &
       FRICTION_COLUMNS, TANGENTIAL_COLUMNS, PATCH_COLUMNS, result_name, area_fit, load_group
    use femcod_results_csv, only: history_csv, contacts_csv, loads_csv
@@ -25,28 +26,46 @@ module femcod_results
    implicit none
    private
    public :: write_results, run_info, result_files, write_file_set, stored_fingerprint, load_group
-   public :: pressure_figure_wanted, FIGURES_AUTO_LIMIT
+   public :: pressure_figure_wanted, FIGURES_AUTO_LIMIT, MAP_FIGURES, figure_name
    public :: HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, FRICTION_COLUMNS, TANGENTIAL_COLUMNS, PATCH_COLUMNS
 
+   !> The map figures of a state k, PREFIX.<kind>_<k>.svg: its pressure and gap maps,
+   !> and with the plastic cap and the tangential step the plastic displacement and the
+   !> stick and slip maps (doc/results.md).
+   character(len=*), parameter :: MAP_FIGURES(4) = [character(len=10) :: "pressure", "gap", "plastic", "stick_slip"]
+
 contains
+
+   !> PREFIX.<kind>_<k>.svg.
+   function figure_name(prefix, kind, k) result(name)
+      character(len=*), intent(in) :: prefix, kind
+      integer, intent(in) :: k
+      character(len=:), allocatable :: name
+      name = prefix//"."//trim(kind)//"_"//int_str(k)//".svg"
+   end function figure_name
 
    !> The names of every file a run writes for `prefix` (with `nloads` requested loads).
    function result_files(prefix, nloads) result(names)
       character(len=*), intent(in) :: prefix
       integer, intent(in) :: nloads
       type(string_type), allocatable :: names(:)
-      integer :: k
+      integer :: k, m
+      character(len=:), allocatable :: name
       allocate(names(0))
       names = [string_type(prefix//".history.csv"), string_type(prefix//".contacts.csv"), &
          string_type(prefix//".h5"), string_type(prefix//".xdmf"), string_type(prefix//".load_approach.svg"), &
          string_type(prefix//".area_load.svg"), string_type(prefix//".summary.json")]
       if (nloads > 0) names = [names, string_type(prefix//".loads.csv")]
       do k = 1, nloads
-         names = [names, string_type(prefix//".pressure_"//int_str(k)//".svg")]
+         do m = 1, size(MAP_FIGURES)
+            ! (A named temporary: gfortran 12 fails on the function in the constructor.)
+            name = figure_name(prefix, MAP_FIGURES(m), k)
+            names = [names, string_type(name)]
+         end do
       end do
    end function result_files
 
-   !> Whether state k gets its pressure figure PREFIX.pressure_<k>.svg under --figures
+   !> Whether state k gets its map figures (MAP_FIGURES, those its run has) under --figures
    !> `figures` (all, last, none, auto): only a reached state has one; "last" is the last
    !> reached state in the order asked; "auto" is all up to FIGURES_AUTO_LIMIT requested
    !> states, else last.
@@ -108,12 +127,7 @@ contains
       call add(".area_load.svg")
       call write_text(temps(size(temps))%s, area_load_svg(deck, res), status)
       do k = 1, size(res%states)
-         if (.not. pressure_figure_wanted(res, k, figures)) cycle
-         call add(".pressure_"//int_str(k)//".svg")
-         call write_text(temps(size(temps))%s, svg_pressure_map("contact pressure at "// &
-            sig_str(res%states(k)%load, 6)//" nN (approach "//sig_str(res%states(k)%approach, 4)//" nm, "// &
-            int_str(res%states(k)%contacts)//" contacts)", &
-            maps(k)%pressure, deck%np*deck%pixel), status)
+         if (pressure_figure_wanted(res, k, figures)) call write_map_figures(k)
       end do
       call wall_clock(t2)
       call add(".summary.json")
@@ -126,6 +140,34 @@ contains
          names = [names, string_type(prefix//suffix)]
          temps = [temps, string_type(temporary_name(prefix//suffix))]
       end subroutine add
+
+      !> State k's map figures (MAP_FIGURES): pressure and gap, plastic displacement with
+      !> the cap, stick and slip with the tangential step.
+      subroutine write_map_figures(k)
+         integer, intent(in) :: k
+         character(len=:), allocatable :: at
+         real(dp), allocatable :: step(:, :, :)
+         real(dp) :: side
+         side = deck%np*deck%pixel
+         at = " at "//sig_str(res%states(k)%load, 6)//" nN (approach "//sig_str(res%states(k)%approach, 4)//" nm, "// &
+            int_str(res%states(k)%contacts)//" contacts)"
+         call add(".pressure_"//int_str(k)//".svg")
+         call write_text(temps(size(temps))%s, svg_pressure_map("contact pressure"//at, maps(k)%pressure, side), status)
+         call add(".gap_"//int_str(k)//".svg")
+         call write_text(temps(size(temps))%s, svg_map("gap"//at, maps(k)%gap, side, "nm", "gap", BLOCK_SMALLEST, &
+            .false.), status)
+         if (allocated(res%states(k)%plastic)) then
+            call add(".plastic_"//int_str(k)//".svg")
+            call write_text(temps(size(temps))%s, svg_map("plastic displacement"//at, res%states(k)%plastic, side, &
+               "nm", "plastic displacement", BLOCK_LARGEST, .true.), status)
+         end if
+         if (allocated(res%states(k)%stick)) then
+            step = tangential_step_maps(deck%np, deck%pixel, res%states(k))
+            call add(".stick_slip_"//int_str(k)//".svg")
+            call write_text(temps(size(temps))%s, svg_stick_slip_map("stick and slip"//at, step(:, :, 3), &
+               step(:, :, 4), side), status)
+         end if
+      end subroutine write_map_figures
    end subroutine write_results
 
    !> Rename every temporary into place, in order; if anything failed before or a

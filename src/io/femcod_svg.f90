@@ -1,6 +1,7 @@
 !> SVG figures written by femcod itself (no plotting dependency): x-y plots on linear
-!> or logarithmic axes with an optional fitted power law, and a pressure map with a
-!> colour bar, in the manner of the thesis' figures 4.16-4.19. Each function returns
+!> or logarithmic axes with an optional fitted power law, and maps (pressure, gap,
+!> plastic displacement, stick and slip) with a colour bar, in the manner of the
+!> thesis' figures 4.16-4.19. Each function returns
 !> the whole document as a string; writing it is the caller's business.
 module femcod_svg
    use femcod_kinds, only: dp
@@ -8,7 +9,12 @@ module femcod_svg
    use femcod_png, only: png_indexed, base64
    implicit none
    private
-   public :: svg_plot, svg_pressure_map, nice_ticks, svg_series, svg_multi_plot, add_series
+   public :: svg_plot, svg_pressure_map, svg_map, svg_stick_slip_map, nice_ticks, svg_series, svg_multi_plot, add_series
+   public :: BLOCK_LARGEST, BLOCK_SMALLEST
+
+   !> How a map larger than its picture is shown by blocks (svg_map): each block's
+   !> largest value, or its smallest.
+   integer, parameter :: BLOCK_LARGEST = 1, BLOCK_SMALLEST = 2
 
    !> One curve of a multi-series plot: legend label, points, dashed line, markers.
    type :: svg_series
@@ -190,66 +196,51 @@ contains
       svg = svg//"</svg>"//nl
    end function svg_multi_plot
 
-   !> The pressure map: a raster image (PNG, embedded as base64) on the 64-level
-   !> perceptual scale from 0 to the maximum, white off contact, with the axes, labels and
-   !> colour bar as vectors. Maps larger than 1024 x 1024 are shown by blocks of f x f
-   !> pixels (f = ceiling(NP/1024)), each with the largest pressure of its block, so no
-   !> contact spot disappears; the file stays near 1 MB or below at any NP (the full map
-   !> is in PREFIX.h5).
+   !> The pressure map (GPa): svg_map, white off contact, each block its largest pressure.
    function svg_pressure_map(title, values, side) result(svg)
       character(len=*), intent(in) :: title
       real(dp), intent(in) :: values(:, :)
       real(dp), intent(in) :: side
       character(len=:), allocatable :: svg
-      integer, parameter :: levels = 64, max_image = 1024
-      integer :: np, i, j, k, f, m, ii, jj, palette(3, 0:levels)
-      real(dp) :: vmax, size_px, x0, y0, largest
-      real(dp), allocatable :: ticks(:)
+      svg = svg_map(title, values, side, "GPa", "pressure", BLOCK_LARGEST, .true.)
+   end function svg_pressure_map
+
+   !> A map of `values` (in `unit`) over the NP x NP grid of side `side` (nm): a raster
+   !> image (PNG, embedded as base64) on the 64-level perceptual scale from 0 to the
+   !> maximum, with the axes, labels and colour bar as vectors. Row i = 0 at the top and
+   !> column j = 0 at the left, the axes x = j d to the right and y = (NP - i) d upward
+   !> from the bottom-left corner: as the XDMF mesh and femcod.Result.to_xarray place
+   !> them (doc/results.md, "Coordinates"). With `blank_zero` a value <= 0 is white
+   !> (pressure or plastic displacement: off contact, not plastic). Maps larger than 1024
+   !> x 1024 are shown by blocks of f x f pixels (f = ceiling(NP/1024)), each with the
+   !> largest value of its block (`rule` BLOCK_LARGEST: no contact spot disappears) or
+   !> its smallest (BLOCK_SMALLEST, for gaps: no contact disappears), so the file stays
+   !> near 1 MB or below at any NP (the full map is in PREFIX.h5). `quantity` names the
+   !> value in that note.
+   function svg_map(title, values, side, unit, quantity, rule, blank_zero) result(svg)
+      character(len=*), intent(in) :: title, unit, quantity
+      real(dp), intent(in) :: values(:, :)
+      real(dp), intent(in) :: side
+      integer, intent(in) :: rule
+      logical, intent(in) :: blank_zero
+      character(len=:), allocatable :: svg
+      integer, parameter :: levels = 64
+      integer :: k, f, palette(3, 0:levels)
+      real(dp) :: vmax, size_px, x0, y0
+      real(dp), allocatable :: ticks(:), block(:, :)
       integer, allocatable :: bin(:, :)
-      character(len=:), allocatable :: png
-      logical :: ok
-      np = size(values, 1)
       vmax = maxval(values)
-      size_px = h - mt - mb
-      x0 = ml
-      y0 = mt
-      f = (np + max_image - 1)/max_image
-      m = (np + f - 1)/f
-      ! Each block's largest value and its colour, on all threads (no strings here).
-      allocate(bin(m, m))
-      !$omp parallel do private(i, ii, jj, largest)
-      do j = 1, m
-         do i = 1, m
-            largest = -huge(largest)
-            do jj = (j - 1)*f + 1, min(np, j*f)
-               do ii = (i - 1)*f + 1, min(np, i*f)
-                  largest = max(largest, values(ii, jj))
-               end do
-            end do
-            bin(i, j) = 0
-            if (vmax > 0 .and. largest > 0) bin(i, j) = 1 + min(levels - 1, int(largest/vmax*levels))
-         end do
-      end do
+      call block_values(values, rule, f, block)
+      allocate(bin(size(block, 1), size(block, 2)))
+      bin = 1
+      if (vmax > 0) bin = 1 + min(levels - 1, max(0, int(block/vmax*levels)))
+      if (blank_zero) where (.not. block > 0) bin = 0
       palette(:, 0) = 255
       do k = 1, levels
          palette(:, k) = colour_rgb((k - 0.5_dp)/levels)
       end do
-      svg = header(title, xlink=.true.)
-      svg = svg//'<rect x="'//fmt(x0)//'" y="'//fmt(y0)//'" width="'//fmt(size_px)//'" height="'//fmt(size_px)// &
-         '" fill="white" stroke="black"/>'//nl
-      png = png_indexed(bin, palette, ok)
-      if (ok) svg = svg//'<image x="'//fmt(x0)//'" y="'//fmt(y0)//'" width="'//fmt(size_px)//'" height="'// &
-         fmt(size_px)//'" preserveAspectRatio="none" style="image-rendering:pixelated" '// &
-         'xlink:href="data:image/png;base64,'//base64(png)//'"/>'//nl
-      if (f > 1) svg = svg//text(x0 + size_px/2, y0 - 8, "shown by "//int_str(f)//" x "//int_str(f)// &
-         " blocks (largest pressure of each); the full map is in the .h5 file", "middle", 10)
-      ! Axes in nm and a colour bar in GPa.
-      svg = svg//text(x0 + size_px/2, h - mb + 40, "x (nm), column j", "middle", 13)
-      svg = svg//'<text x="'//fmt(x0 - 55)//'" y="'//fmt(y0 + size_px/2)//'" font-family="sans-serif" '// &
-         'font-size="13" text-anchor="middle" transform="rotate(-90 '//fmt(x0 - 55)//' '//fmt(y0 + size_px/2)// &
-         ')">y (nm), row i</text>'//nl
-      svg = svg//text(x0, h - mb + 18, "0", "middle", 11)//text(x0 + size_px, h - mb + 18, sig_str(side, 4), "middle", 11)
-      svg = svg//text(x0 - 6, y0 + 4, "0", "end", 11)//text(x0 - 6, y0 + size_px + 4, sig_str(side, 4), "end", 11)
+      svg = map_frame(title, bin, palette, side, f, merge("largest ", "smallest", rule == BLOCK_LARGEST)//" "// &
+         quantity, x0, y0, size_px)
       do k = 0, levels - 1
          svg = svg//'<rect x="'//fmt(x0 + size_px + 40)//'" y="'//fmt(y0 + size_px*(1 - real(k + 1, dp)/levels))// &
             '" width="20" height="'//fmt(size_px/levels + 0.5_dp)//'" fill="'//colour((k + 0.5_dp)/levels)//'"/>'//nl
@@ -263,10 +254,95 @@ contains
             svg = svg//text(x0 + size_px + 66, y0 + size_px*(1 - ticks(k)/vmax) + 4, sig_str(ticks(k), 4), "start", 11)
          end do
       end if
-      svg = svg//text(x0 + size_px + 50, y0 - 10, "GPa", "middle", 12)
+      svg = svg//text(x0 + size_px + 50, y0 - 10, unit, "middle", 12)
       svg = svg//text(x0 + size_px + 50, h - mb + 18, "max "//sig_str(vmax, 4), "middle", 11)
       svg = svg//"</svg>"//nl
-   end function svg_pressure_map
+   end function svg_map
+
+   !> The stick and slip map of a tangential step: the contacts that stick (blue) and
+   !> slip (orange), white elsewhere, on svg_map's axes; blocks of a large map show slip
+   !> where any of their pixels slips, else stick where any sticks.
+   function svg_stick_slip_map(title, stick, slip, side) result(svg)
+      character(len=*), intent(in) :: title
+      real(dp), intent(in) :: stick(:, :), slip(:, :)
+      real(dp), intent(in) :: side
+      character(len=:), allocatable :: svg
+      integer, parameter :: palette(3, 0:2) = reshape([255, 255, 255, 49, 104, 176, 235, 125, 38], [3, 3])
+      character(len=*), parameter :: names(2) = [character(len=5) :: "stick", "slip"]
+      real(dp) :: size_px, x0, y0
+      real(dp), allocatable :: block(:, :)
+      integer, allocatable :: bin(:, :)
+      integer :: f, k
+      call block_values(merge(2.0_dp, merge(1.0_dp, 0.0_dp, stick > 0), slip > 0), BLOCK_LARGEST, f, block)
+      bin = nint(block)
+      svg = map_frame(title, bin, palette, side, f, "slip, else stick,", x0, y0, size_px)
+      do k = 1, 2
+         svg = svg//'<rect x="'//fmt(x0 + size_px + 30)//'" y="'//fmt(y0 + 24*(k - 1))//'" width="16" height="16" '// &
+            'fill="'//rgb_hex(palette(:, k))//'" stroke="black"/>'//nl
+         svg = svg//text(x0 + size_px + 52, y0 + 24*(k - 1) + 13, trim(names(k)), "start", 12)
+      end do
+      svg = svg//text(x0 + size_px + 30, y0 + 66, int_str(count(stick > 0))//" stick", "start", 11)
+      svg = svg//text(x0 + size_px + 30, y0 + 82, int_str(count(slip > 0))//" slip", "start", 11)
+      svg = svg//"</svg>"//nl
+   end function svg_stick_slip_map
+
+   !> The map by blocks of f x f pixels, f = ceiling(NP/1024) (f = 1: the map itself):
+   !> each block's largest or smallest value (`rule`), on all threads.
+   subroutine block_values(values, rule, f, block)
+      real(dp), intent(in) :: values(:, :)
+      integer, intent(in) :: rule
+      integer, intent(out) :: f
+      real(dp), allocatable, intent(out) :: block(:, :)
+      integer, parameter :: max_image = 1024
+      integer :: np, m, i, j
+      np = size(values, 1)
+      f = (np + max_image - 1)/max_image
+      m = (np + f - 1)/f
+      allocate(block(m, m))
+      !$omp parallel do private(i)
+      do j = 1, m
+         do i = 1, m
+            associate(cells => values((i - 1)*f + 1:min(np, i*f), (j - 1)*f + 1:min(np, j*f)))
+               if (rule == BLOCK_LARGEST) then
+                  block(i, j) = maxval(cells)
+               else
+                  block(i, j) = minval(cells)
+               end if
+            end associate
+         end do
+      end do
+   end subroutine block_values
+
+   !> A map's document up to its legend: the title, the image of palette colours `bin`
+   !> (row 1 at the top), the note on blocks of f x f pixels (each its `shown`), and the
+   !> axes x = j d to the right and y = (NP - i) d upward, 0 to `side` (nm). The image's
+   !> corner (x0, y0) and side (px) for the legend.
+   function map_frame(title, bin, palette, side, f, shown, x0, y0, size_px) result(svg)
+      character(len=*), intent(in) :: title, shown
+      integer, intent(in) :: bin(:, :), palette(:, 0:), f
+      real(dp), intent(in) :: side
+      real(dp), intent(out) :: x0, y0, size_px
+      character(len=:), allocatable :: svg, png
+      logical :: ok
+      size_px = h - mt - mb
+      x0 = ml
+      y0 = mt
+      svg = header(title, xlink=.true.)
+      svg = svg//'<rect x="'//fmt(x0)//'" y="'//fmt(y0)//'" width="'//fmt(size_px)//'" height="'//fmt(size_px)// &
+         '" fill="white" stroke="black"/>'//nl
+      png = png_indexed(bin, palette, ok)
+      if (ok) svg = svg//'<image x="'//fmt(x0)//'" y="'//fmt(y0)//'" width="'//fmt(size_px)//'" height="'// &
+         fmt(size_px)//'" preserveAspectRatio="none" style="image-rendering:pixelated" '// &
+         'xlink:href="data:image/png;base64,'//base64(png)//'"/>'//nl
+      if (f > 1) svg = svg//text(x0 + size_px/2, y0 - 8, "shown by "//int_str(f)//" x "//int_str(f)// &
+         " blocks ("//shown//" of each); the full map is in the .h5 file", "middle", 10)
+      svg = svg//text(x0 + size_px/2, h - mb + 40, "x (nm), column j to the right", "middle", 13)
+      svg = svg//'<text x="'//fmt(x0 - 55)//'" y="'//fmt(y0 + size_px/2)//'" font-family="sans-serif" '// &
+         'font-size="13" text-anchor="middle" transform="rotate(-90 '//fmt(x0 - 55)//' '//fmt(y0 + size_px/2)// &
+         ')">y (nm), row i = 0 at the top</text>'//nl
+      svg = svg//text(x0, h - mb + 18, "0", "middle", 11)//text(x0 + size_px, h - mb + 18, sig_str(side, 4), "middle", 11)
+      svg = svg//text(x0 - 6, y0 + size_px + 4, "0", "end", 11)//text(x0 - 6, y0 + 4, sig_str(side, 4), "end", 11)
+   end function map_frame
 
    !> Plot coordinates (px) of the data point (xv, yv) in the frame x0..x1, y0..y1
    !> (`frame`, axis units: decades on a log axis).
@@ -402,6 +478,13 @@ contains
          ticks(k - k0 + 1) = k*step
       end do
    end function nice_ticks
+
+   !> "#rrggbb" of 0-255 RGB.
+   function rgb_hex(rgb) result(hex)
+      integer, intent(in) :: rgb(3)
+      character(len=7) :: hex
+      write(hex, '("#", 3z2.2)') rgb
+   end function rgb_hex
 
    !> A colour on a viridis-like scale, t in [0, 1].
    function colour(t) result(hex)
