@@ -2,7 +2,8 @@
 !> compressed by zlib (Debian's zlib1g, the library HDF5 already uses), and its base64
 !> text for embedding in an SVG `<image>`. The format is the W3C PNG specification
 !> (second edition): signature, IHDR, PLTE, IDAT (zlib stream of the scanlines, each
-!> with filter byte 0), IEND; each chunk with its length and CRC-32 (zlib's crc32).
+!> with its filter byte: 0 for the first, 2 (Up) for the others), IEND; each chunk with
+!> its length and CRC-32 (zlib's crc32).
 module femcod_png
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long
    use, intrinsic :: iso_fortran_env, only: int64
@@ -27,21 +28,32 @@ contains
       integer :: rows, cols, i, j, k
       rows = size(image, 1)
       cols = size(image, 2)
-      ! The scanlines: a filter byte (0, none), then one palette index per pixel.
+      ! The scanlines: a filter byte, then one byte per pixel: the first row its palette
+      ! indices (filter 0, none), every other row their differences from the row above
+      ! modulo 256 (filter 2, "Up"): a smooth map (a gap map) becomes runs of small
+      ! values. Deflated at level 1: three 1024^2 gap and pressure figures took 0.21 s
+      ! and 320 + 180 kB, against 0.40 s and 300 + 130 kB at level 6 without the filter.
       ! Rows on all threads (into an array of bytes: gfortran 12 cannot share a
       ! deferred-length string between threads).
       allocate(raw(rows*(cols + 1)))
       !$omp parallel do private(j, k)
       do i = 1, rows
          k = (i - 1)*(cols + 1) + 1
-         raw(k) = achar(0)
-         do j = 1, cols
-            raw(k + j) = achar(image(i, j))
-         end do
+         if (i == 1) then
+            raw(k) = achar(0)
+            do j = 1, cols
+               raw(k + j) = achar(image(i, j))
+            end do
+         else
+            raw(k) = achar(2)
+            do j = 1, cols
+               raw(k + j) = achar(modulo(image(i, j) - image(i - 1, j), 256))
+            end do
+         end if
       end do
       packed_len = c_compress_bound(int(size(raw), c_long))
       allocate(character(len=packed_len) :: packed)
-      ok = c_compress2(packed, packed_len, raw, int(size(raw), c_long), 6_c_int) == 0
+      ok = c_compress2(packed, packed_len, raw, int(size(raw), c_long), 1_c_int) == 0
       png = ""
       if (.not. ok) return
       allocate(character(len=3*size(palette, 2)) :: plte)

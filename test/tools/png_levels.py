@@ -1,6 +1,7 @@
 """Decode the PNG embedded in a femcod pressure figure, independently of femcod:
 Python's standard library only (base64, zlib, struct). Checks the PNG signature, every
-chunk's CRC-32, IHDR (8-bit palette, no interlace) and each scanline's filter byte, and
+chunk's CRC-32, IHDR (8-bit palette, no interlace) and each scanline's filter byte (None
+or Up, the two femcod writes), and
 prints the image's size and then its palette indices, one row per line.
 
     python3 test/tools/png_levels.py FIGURE.svg > levels.txt
@@ -41,11 +42,17 @@ def main(path):
     if len(raw) != height * (width + 1):
         sys.exit("wrong amount of image data")
     print(width, height, len(palette) // 3, palette[0], palette[1], palette[2])
+    prior = bytes(width)
     for row in range(height):
         line = raw[row * (width + 1):(row + 1) * (width + 1)]
-        if line[0] != 0:
-            sys.exit("unexpected filter type")
-        print(" ".join(str(v) for v in line[1:]))
+        if line[0] == 0:  # None
+            values = bytes(line[1:])
+        elif line[0] == 2:  # Up: each byte plus the one above it, modulo 256
+            values = bytes((a + b) % 256 for a, b in zip(line[1:], prior))
+        else:
+            sys.exit("unexpected filter type %d" % line[0])
+        prior = values
+        print(" ".join(str(v) for v in values))
 
 
 if __name__ == "__main__":
