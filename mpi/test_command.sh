@@ -78,6 +78,24 @@ if [ "$(head -1 "$work/mpi.loads.csv")" = "$(head -1 "$work/serial.loads.csv")" 
 else
   echo "  FAILED   loads.csv or the figures"; failed=1
 fi
+# The gap figure of each load: its image (decoded by test/tools/png_levels.py) is the
+# serial run's (whose levels test_results checks against its HDF5 gap map), the gaps
+# agreeing to 1e-12 of the height range: no level differs by more than one, and at most
+# one pixel in a thousand by one (a gap on a level's edge).
+gaps_ok=1
+for k in 1 2 3; do
+  python3 ../test/tools/png_levels.py "$work/mpi.gap_$k.svg" > "$work/mpi_gap.txt" 2>&1 || gaps_ok=0
+  python3 ../test/tools/png_levels.py "$work/serial.gap_$k.svg" > "$work/serial_gap.txt" 2>&1 || gaps_ok=0
+  python3 - "$work/mpi_gap.txt" "$work/serial_gap.txt" <<'PY' || gaps_ok=0
+import sys
+a, b = ([[int(v) for v in line.split()] for line in open(p).read().splitlines()[1:]] for p in sys.argv[1:])
+assert len(a) == len(b) and all(len(x) == len(y) for x, y in zip(a, b))
+d = [abs(u - v) for x, y in zip(a, b) for u, v in zip(x, y)]
+assert max(d) <= 1 and sum(1 for v in d if v) <= len(d) // 1000, (max(d), sum(1 for v in d if v))
+PY
+done
+if [ "$gaps_ok" = 1 ]; then echo "  passed   a gap figure per load, the serial run's image"
+else echo "  FAILED   the gap figures against the serial run's"; head -3 "$work/mpi_gap.txt"; failed=1; fi
 # An HDF5 deck: every rank reads its own columns; the same answer, byte for byte, as the
 # text deck streamed by rank 0 in slabs (the same gaps, formed on the ranks).
 "$femcod" mkdeck convert "$deck" "$work/deck.h5" >/dev/null

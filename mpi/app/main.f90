@@ -47,7 +47,7 @@ program femcod_mpi
    use femcod_cg, only: distributed_storage_bytes
    use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, &
       agree
-   use femcod_svg, only: svg_pressure_map
+   use femcod_svg, only: svg_pressure_map, svg_map, BLOCK_SMALLEST
    use femcod_maps, only: state_maps
    use femcod_gap_cg, only: gap_solver_storage_bytes
    use femcod_interface_law, only: make_interface_law
@@ -246,12 +246,16 @@ program femcod_mpi
    if (.not. allocated(info%label)) info%label = ""
    info%wall_seconds = t_solve - t_start
    call write_distributed_results(prefix//".h5.part", grid, states, info, status)
-   ! The figures: each load's pressure map as the serial writer draws it (largest
-   ! pressure of each block, at most 1024 blocks per side), gathered block by block.
+   ! The figures: each load's pressure and gap maps as the serial writer draws them (largest
+   ! pressure of each block, at most 1024 blocks per side; the gap's smallest), gathered
+   ! block by block.
    figure = figure_block(np)
    allocate(figures(size(states)))
    do k = 1, size(states)
       call gather_block_maxima(grid, states(k)%force/grid%pixel**2, figure, figures(k)%pressure)
+      ! The gap map by each block's smallest gap (no contact disappears): -(largest of -gap).
+      call gather_block_maxima(grid, -states(k)%gap, figure, figures(k)%gap)
+      figures(k)%gap = -figures(k)%gap
    end do
    if (rank == 0) then
       if (status%code == 0) call atomic_rename(prefix//".h5.part", prefix//".h5", status)
@@ -264,6 +268,10 @@ program femcod_mpi
             "contact pressure at "//sig_str(states(k)%load, 6)//" nN (approach "//sig_str(states(k)%approach, 4)// &
             " nm, "//int_str(states(k)%contacts)//" contacts"//blocks_note//")", figures(k)%pressure, &
             np*grid%pixel), status)
+         if (status%code == 0) call write_file(prefix//".gap_"//int_str(k)//".svg", svg_map("gap at "// &
+            sig_str(states(k)%load, 6)//" nN (approach "//sig_str(states(k)%approach, 4)//" nm, "// &
+            int_str(states(k)%contacts)//" contacts"//blocks_note//")", figures(k)%gap, np*grid%pixel, "nm", "gap", &
+            BLOCK_SMALLEST, .false.), status)
       end do
       call wall_clock(t_write)
       if (status%code == 0) call write_file(prefix//".summary.json", summary_json(), status)
@@ -273,6 +281,7 @@ program femcod_mpi
          call remove_file(prefix//".loads.csv")
          do k = 1, size(states)
             call remove_file(prefix//".pressure_"//int_str(k)//".svg")
+            call remove_file(prefix//".gap_"//int_str(k)//".svg")
          end do
       end if
       if (status%code == 0 .and. .not. settings%quiet) call print_summary()
@@ -440,18 +449,20 @@ contains
          "arrays and what they hold already), a node may use "//memory_text(may)//"; give more nodes")
    end subroutine check_node_memory
 
-   !> The files this run writes (PREFIX.h5, .summary.json, .loads.csv, a figure per load)
+   !> The files this run writes (PREFIX.h5, .summary.json, .loads.csv, a pressure and a
+   !> gap figure per load)
    !> and the files it reads (the deck, or the height files); filled element by element.
    subroutine output_and_input_names(outputs, inputs)
       type(string_type), allocatable, intent(out) :: outputs(:), inputs(:)
       integer :: j, nloads
       nloads = size(targets())
-      allocate(outputs(3 + nloads))
+      allocate(outputs(3 + 2*nloads))
       outputs(1)%s = prefix//".h5"
       outputs(2)%s = prefix//".summary.json"
       outputs(3)%s = prefix//".loads.csv"
       do j = 1, nloads
-         outputs(3 + j)%s = prefix//".pressure_"//int_str(j)//".svg"
+         outputs(2 + 2*j)%s = prefix//".pressure_"//int_str(j)//".svg"
+         outputs(3 + 2*j)%s = prefix//".gap_"//int_str(j)//".svg"
       end do
       if (generating) then
          allocate(inputs(0))
@@ -581,7 +592,7 @@ contains
       write(output_unit, '(a)') "  wall time "//sig_str(t_write - t_start, 3)//" s: reading "// &
          sig_str(t_read - t_start, 3)//" s, solving "//sig_str(t_solve - t_read, 3)//" s, writing "// &
          sig_str(t_write - t_solve, 3)//" s"
-      write(output_unit, '(a)') "  results: "//prefix//".h5, .summary.json, .loads.csv, .pressure_<k>.svg"
+      write(output_unit, '(a)') "  results: "//prefix//".h5, .summary.json, .loads.csv, .pressure_<k>.svg, .gap_<k>.svg"
    end subroutine print_summary
 
    subroutine print_help()
