@@ -216,12 +216,12 @@ contains
       type(state_field), allocatable :: f(:)
       integer :: m
       value = 0
-      f = state_fields(session%res%states(k)%state_values, session%problem%pixel, session%problem%np, session%info, &
-         cg_work(session%res, k))
       if (name == "reached") then
          value = merge(1, 0, session%res%states(k)%reached)
          return
       end if
+      f = state_fields(session%res%states(k)%state_values, session%problem%pixel, session%problem%np, session%info, &
+         cg_work(session%res, k))
       do m = 1, size(f)
          if (f(m)%name == name) then
             value = f(m)%value

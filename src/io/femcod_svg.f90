@@ -490,7 +490,7 @@ contains
    function colour(t) result(hex)
       real(dp), intent(in) :: t
       character(len=7) :: hex
-      write(hex, '("#", 3z2.2)') colour_rgb(t)
+      hex = rgb_hex(colour_rgb(t))
    end function colour
 
    !> The perceptual scale (viridis through five anchors) at t in [0, 1], as 0-255 RGB.

@@ -540,8 +540,8 @@ contains
    end subroutine solve_by_gaps
 
    !> The state under `target`, a load (nN) or an approach (nm): the forces (warm start:
-   !> the session's, scaled by the solver to the load, or by the factor that minimises the
-   !> energy at the approach) and the approach into the session; the load and the maps
+   !> the session's, scaled by the solver's load balance to the load, or to the contacts'
+   !> mean gap at the approach) and the approach into the session; the load and the maps
    !> into `answer`. At no load, or at or below first touch (approach <= 0), the surfaces
    !> do not touch: load 0, no contact. With the cap at a load: capped_solve (an approach
    !> with the cap is solved in the gap variables).
@@ -560,9 +560,11 @@ contains
          total(1) = minval(grid%g0)
          call grid%min_over_grid(total)
          session%approach = -total(1)
-         if (target%by_approach) session%approach = target%value
          if (session%plastic) session%capped = .false.
-         answer%load = 0
+         if (target%by_approach) then
+            session%approach = target%value
+            answer%load = 0
+         end if
       else if (session%plastic) then
          call capped_solve(grid, session, target%value, how, answer, status, observer)
       else

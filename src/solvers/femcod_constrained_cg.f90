@@ -263,7 +263,7 @@ contains
       class(elastic_operator), intent(inout) :: grid
       real(dp), intent(in) :: p(:, :)
       type(status_type), intent(inout) :: status
-      real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, s, sums(4), pair(2), lift, own
+      real(dp) :: gbar, big_g, cross, contact_gap, gij, alpha, a, s, sums(3), pair(2), lift, own
       real(dp), allocatable :: part(:, :)
       integer :: q, i, j, nc, b, nb
       logical :: take_old
@@ -275,20 +275,22 @@ contains
       ! bits on any number of threads (the list is in column order, the blocks fixed).
       nb = (nc + SUM_BLOCK - 1)/SUM_BLOCK
       allocate(part(4, nb))
+      ! The contacts' gaps before the shift, g0 + alpha (w + s p), summed; at an approach
+      ! their two parts apart (a = 0: the g0 alone), for the balance below.
+      a = merge(0.0_dp, alpha, st%by_approach)
       !$omp parallel do private(q, i, j)
       do b = 1, nb
-         part(1:3, b) = 0
+         part(1:2, b) = 0
          do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, nc)
             i = st%contact(1, q)
             j = st%contact(2, q)
-            part(1, b) = part(1, b) + (grid%g0(i, j) + alpha*(st%w(i, j) + s*p(i, j)))
-            part(2, b) = part(2, b) + grid%g0(i, j)
-            part(3, b) = part(3, b) + (st%w(i, j) + s*p(i, j))
+            part(1, b) = part(1, b) + (grid%g0(i, j) + a*(st%w(i, j) + s*p(i, j)))
+            if (st%by_approach) part(2, b) = part(2, b) + (st%w(i, j) + s*p(i, j))
          end do
       end do
-      sums = [sum(part(1, :)), sum(part(2, :)), sum(part(3, :)), real(nc, dp)]
+      sums = [sum(part(1, :)), sum(part(2, :)), real(nc, dp)]
       call grid%sum_over_grid(sums)
-      st%nc_all = sums(4)
+      st%nc_all = sums(3)
       if (.not. st%nc_all > 0) then
          call set_error(status, STATUS_NUMERICAL, "cg: all forces vanished")
          return
@@ -298,7 +300,7 @@ contains
          ! approach, mean(g0 + alpha (w + s p)) = A (kept where it would not be positive),
          ! so the directions, which keep the load, need not find the mean (the slowest
          ! mode) themselves.
-         if (sums(3) > 0 .and. st%gbar*sums(4) - sums(2) > 0) st%alpha = (st%gbar*sums(4) - sums(2))/sums(3)
+         if (sums(2) > 0 .and. st%gbar*sums(3) - sums(1) > 0) st%alpha = (st%gbar*sums(3) - sums(1))/sums(2)
          alpha = st%alpha
          gbar = st%gbar
       else
