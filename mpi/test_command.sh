@@ -61,6 +61,11 @@ PY
 then echo "  passed   the serial summary's fields in femcod-mpi's"
 else echo "  FAILED   the serial summary's fields in femcod-mpi's"; failed=1; fi
 mkdir "$work/both" && cp "$work/serial.summary.json" "$work/mpi.summary.json" "$work/both/"
+# femcod report reads femcod-mpi's set (no /history: the states make the curves): each of
+# the three states' pressure and gap maps, the two curves, the patch count against load.
+if "$femcod" report "$work/mpi" -q && [ "$(grep -o '<svg' "$work/mpi.report.html" | wc -l)" -eq 9 ]; then
+  echo "  passed   femcod report of femcod-mpi's result set"
+else echo "  FAILED   femcod report of femcod-mpi's result set"; failed=1; fi
 if [ "$(python3 ../doc/cluster/collect.py "$work/both" | wc -l)" -eq 7 ]; then
   echo "  passed   doc/cluster/collect.py reads femcod run's and femcod-mpi's summaries"
 else

@@ -31,6 +31,7 @@ program tester
    use test_patches, only: collect_patches
    use test_refine, only: collect_refine
    use test_silent, only: collect_silent
+   use test_report, only: collect_report
    use femcod_exit, only: exit_program
    use femcod_cli, only: run_femcod, command_arguments
    use femcod_strings, only: string_type, parse_integer
@@ -52,6 +53,7 @@ program tester
       new_testsuite("silent", collect_silent), &
       new_testsuite("incremental", collect_incremental), &
       new_testsuite("results", collect_results), &
+      new_testsuite("report", collect_report), &
       new_testsuite("hostile", collect_hostile), &
       new_testsuite("stability", collect_stability), &
       new_testsuite("cg", collect_cg), &

@@ -12,7 +12,7 @@ module test_results
       h5_write
    use femcod_generate, only: scene_spec, build_problem
    use femcod_svg, only: svg_pressure_map, svg_plot
-   use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text
+   use test_support, only: scratch_path, read_text, file_exists, write_text, contains_text, occurrences
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string, skip_test
    implicit none
    private
@@ -424,7 +424,7 @@ contains
       call check(error, contains_text(text, '<Xdmf Version="3.0">') .and. contains_text(text, "</Xdmf>"), &
          "an XDMF 3 document")
       if (allocated(error)) return
-      call check(error, count_text(text, "<Grid ") == 1 .and. contains_text(text, 'GridType="Uniform"') .and. &
+      call check(error, occurrences(text, "<Grid ") == 1 .and. contains_text(text, 'GridType="Uniform"') .and. &
          contains_text(text, 'TopologyType="Quadrilateral"') .and. contains_text(text, 'GeometryType="XY"'), &
          "one uniform grid of quadrilaterals in the XY plane")
       if (allocated(error)) return
@@ -473,19 +473,6 @@ contains
             if (allocated(error)) return
          end do
       end do
-   contains
-      integer function count_text(t, what)
-         character(len=*), intent(in) :: t, what
-         integer :: p, q
-         count_text = 0
-         p = 1
-         do
-            q = index(t(p:), what)
-            if (q == 0) exit
-            count_text = count_text + 1
-            p = p + q
-         end do
-      end function count_text
    end subroutine test_xdmf
 
    !> The pressure map of the figure, decoded by test/tools/png_levels.py (Python's own

@@ -6,7 +6,7 @@ module test_support
       legacy_checks
    implicit none
    private
-   public :: write_text, read_text, scratch_path, contains_text, remove_scratch, file_exists
+   public :: write_text, read_text, scratch_path, contains_text, remove_scratch, file_exists, occurrences
    public :: pivot_loss_of, condition_of, missed_final_check_of, fft_steps_of
 
    character(len=*), parameter :: scratch_dir = "build/test-scratch"
@@ -33,6 +33,20 @@ contains
       write(unit) text
       close(unit)
    end subroutine write_text
+
+   !> How many times `piece` occurs in `text` (not overlapping).
+   pure integer function occurrences(text, piece) result(n)
+      character(len=*), intent(in) :: text, piece
+      integer :: start, k
+      n = 0
+      start = 1
+      do
+         k = index(text(start:), piece)
+         if (k == 0) return
+         n = n + 1
+         start = start + k - 1 + len(piece)
+      end do
+   end function occurrences
 
    !> The bytes of a file ("" when it cannot be read).
    function read_text(path) result(text)

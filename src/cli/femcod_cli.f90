@@ -21,6 +21,7 @@ module femcod_cli
    use femcod_summits_command, only: summits_command
    use femcod_multiscale_command, only: multiscale_command
    use femcod_refine_command, only: refine_command
+   use femcod_report_command, only: report_command
    use femcod_about, only: FEMCOD_VERSION
    use femcod_verification, only: write_verification_report
    use femcod_help, only: help_requested, print_lines
@@ -91,6 +92,8 @@ contains
          call multiscale_command(args(2:), code)
       case ("refine")
          call refine_command(args(2:), code)
+      case ("report")
+         call report_command(args(2:), code)
       case ("verify")
          call verify_command(args(2:), code)
       case default
@@ -112,6 +115,7 @@ contains
          "  summits FILE [options]    summit search, PSD and structure function of chapter 3", &
          "  multiscale FILE [options] the multiscale Hertz model of section 3.3", &
          "  refine DECK --loads ...   the contact area below the pixel: the thesis' third model (section 5.3)", &
+         "  report PREFIX|DIR         one self-contained HTML page of results (femcod report --help)", &
          "  workspace NP MAXCONT      print the Appendix B memory map (Tables B.1, B.2)", &
          "  verify [-o FILE]          recompute the thesis checks, write doc/verification.md", &
          "  bench [--full]            speed against error, one table (use the release build)", &

@@ -12,9 +12,9 @@ module femcod_run
    use femcod_kinds, only: dp, i8
    use femcod_memory, only: available_memory, resident_bytes
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
-   use femcod_strings, only: string_type, int_str, format_real, append_string, count_text
+   use femcod_strings, only: string_type, int_str, format_real, append_string, count_text, json_string
    use femcod_files, only: remove_file, path_exists, path_is_directory, canonical_path, acquire_lock, release_lock, &
-      make_directories
+      make_directories, write_file
    use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
    use femcod_sha256, only: sha256_hex, file_digest, file_sha256_start, file_sha256_finish
    use femcod_clock, only: wall_clock
@@ -56,6 +56,7 @@ contains
       type(run_settings) :: settings
       type(status_type) :: status
       type(string_type), allocatable :: failed(:)
+      character(len=:), allocatable :: message
       integer :: d, rc, k
       code = 0
       if (help_requested(args)) then
@@ -99,7 +100,8 @@ contains
       ! Batch: every deck runs; a failed deck is reported and the others go on.
       allocate(failed(0))
       do d = 1, size(settings%decks)
-         call run_one(settings%decks(d)%s, settings%prefixes(d)%s, settings, rc)
+         call run_one(settings%decks(d)%s, settings%prefixes(d)%s, settings, rc, message)
+         if (size(settings%decks) > 1) call record_batch_outcome(settings%decks(d)%s, settings%prefixes(d)%s, rc, message)
          if (rc /= 0) then
             call append_string(failed, settings%decks(d)%s)
             if (code == 0) code = rc
@@ -125,10 +127,12 @@ contains
 
    !> One deck ("" for the height files): read, lock its prefix, solve, write, report.
    !> `rc` is its exit code.
-   subroutine run_one(deck_path, prefix, settings, rc)
+   subroutine run_one(deck_path, prefix, settings, rc, message)
       character(len=*), intent(in) :: deck_path, prefix
       type(run_settings), intent(in) :: settings
       integer, intent(out) :: rc
+      !> Why the deck failed ("" when it did not).
+      character(len=:), allocatable, intent(out) :: message
       type(contact_problem) :: problem
       type(status_type) :: st
       type(string_type), allocatable :: inputs(:), warnings(:), files(:)
@@ -137,6 +141,7 @@ contains
       real(dp) :: t0, read_seconds
       integer :: k
       rc = 0
+      message = ""
       call wall_clock(t0)
       if (deck_path == "") then
          call load_scene(settings%scene, problem, st, inputs, warnings)
@@ -182,6 +187,7 @@ contains
          hex = file_sha256_finish(pending(k))
       end do
       if (st%code /= 0) then
+         message = st%message
          if (st%code == STATUS_INTERRUPTED) then
             write(error_unit, '(a)') "femcod: "//signal_name(stop_signal())//": "//st%message
             rc = 128 + stop_signal()
@@ -191,6 +197,25 @@ contains
          end if
       end if
    end subroutine run_one
+
+   !> A batch deck's failure as PREFIX.failed.json (deck, exit code, message: what
+   !> `femcod report DIR` lists), written atomically; a deck that succeeds removes the
+   !> record an earlier batch left. A record that cannot be written is said, not fatal.
+   subroutine record_batch_outcome(deck_path, prefix, rc, message)
+      character(len=*), intent(in) :: deck_path, prefix, message
+      integer, intent(in) :: rc
+      type(status_type) :: st
+      character(len=1), parameter :: nl = new_line("a")
+      if (rc == 0) then
+         call remove_file(prefix//".failed.json")
+         return
+      end if
+      call write_file(prefix//".failed.json", "{"//nl//'  "deck": '//json_string(deck_path)//","//nl// &
+         '  "results": '//json_string(prefix)//","//nl//'  "exit_code": '//int_str(rc)//","//nl// &
+         '  "message": '//json_string(message)//","//nl//'  "femcod_version": '//json_string(FEMCOD_VERSION)//","// &
+         nl//'  "finished": '//json_string(local_time_iso())//nl//"}"//nl, st)
+      if (st%code /= 0) write(error_unit, '(a)') "femcod: warning: the batch's failure record: "//st%message
+   end subroutine record_batch_outcome
 
    !> --fftw-wisdom FILE, before any deck is read: FILE and FILE.float32 are neither an
    !> input nor a result file of this run, and each that exists is FFTW wisdom (it is
@@ -412,12 +437,13 @@ contains
          call load_maps(problem, res%states, maps, options%boundary == BOUNDARY_PERIODIC)
          call wall_clock(t1)
          info%maps_seconds = t1 - t0
+         warnings = run_warnings(options, res)
+         info%warnings = warnings
          call write_results(prefix, problem, res, maps, info, st)
          if (st%code /= 0) return
          ! The set is replaced as a whole: what an earlier run left beside it goes, and the
          ! checkpoint has served its purpose.
          call remove_stale_results(prefix, res, settings%figures)
-         warnings = run_warnings(options, res)
          do k = 1, size(warnings)
             write(error_unit, '(a)') "femcod: warning: "//warnings(k)%s
          end do

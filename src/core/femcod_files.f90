@@ -2,16 +2,16 @@
 !> atomic replacement of a file by a temporary one, removal, existence and kind.
 module femcod_files
    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_ptr, c_associated, c_f_pointer, c_size_t, &
-      c_loc
+      c_loc, c_long
    use femcod_kinds, only: i8
    use femcod_status, only: status_type, set_error, STATUS_IO, STATUS_BAD_INPUT
    use femcod_process, only: process_id, host_name, process_alive
-   use femcod_strings, only: int_str
+   use femcod_strings, only: int_str, string_type
    implicit none
    private
    public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, write_bytes, write_file
    public :: default_prefix, file_part, read_file, canonical_path, acquire_lock, release_lock, make_directories
-   public :: clear_write_error, write_error_cause, os_error_text, MAX_TEXT_BYTES
+   public :: clear_write_error, write_error_cause, os_error_text, MAX_TEXT_BYTES, directory_names
 
    !> The largest file read_file takes (bytes): 2 GiB less 64 KiB, so that positions in
    !> the text, and positions a few words past them, stay default integers.
@@ -43,6 +43,13 @@ module femcod_files
          integer(c_int), value :: code
          type(c_ptr) :: p
       end function c_strerror
+      function c_list_directory(path, buf, cap) bind(c, name="femcod_list_directory") result(used)
+         import :: c_char, c_long
+         character(kind=c_char), intent(in) :: path(*)
+         character(kind=c_char), intent(out) :: buf(*)
+         integer(c_long), value :: cap
+         integer(c_long) :: used
+      end function c_list_directory
       function c_rename(from, to) bind(c, name="rename") result(rc)
          import :: c_char, c_int
          character(kind=c_char), intent(in) :: from(*), to(*)
@@ -380,6 +387,48 @@ contains
          message = message//text(k)
       end do
    end function os_error_text
+
+   !> The names in directory `path` (not "." and ".."), sorted by byte value; an error
+   !> (STATUS_BAD_INPUT) when it cannot be read.
+   subroutine directory_names(path, names, status)
+      character(len=*), intent(in) :: path
+      type(string_type), allocatable, intent(out) :: names(:)
+      type(status_type), intent(inout) :: status
+      character(kind=c_char, len=:), allocatable :: buf
+      integer(c_long) :: used
+      integer :: start, k
+      type(string_type) :: swap
+      allocate(names(0))
+      if (status%code /= 0) return
+      allocate(character(kind=c_char, len=65536) :: buf)
+      used = c_list_directory(path//c_null_char, buf, int(len(buf), c_long))
+      if (used > len(buf)) then
+         deallocate(buf)
+         allocate(character(kind=c_char, len=used + 4096) :: buf)
+         used = c_list_directory(path//c_null_char, buf, int(len(buf), c_long))
+      end if
+      if (used < 0 .or. used > len(buf)) then
+         call set_error(status, STATUS_BAD_INPUT, path//": cannot list the directory ("//os_error_text()//")")
+         return
+      end if
+      start = 1
+      do k = 1, int(used)
+         if (buf(k:k) /= new_line("a")) cycle
+         names = [names, string_type(buf(start:k - 1))]
+         start = k + 1
+      end do
+      ! Insertion sort: a results directory holds hundreds of names, not millions.
+      do k = 2, size(names)
+         swap = names(k)
+         start = k - 1
+         do while (start >= 1)
+            if (.not. llt(swap%s, names(start)%s)) exit
+            names(start + 1) = names(start)
+            start = start - 1
+         end do
+         names(start + 1) = swap
+      end do
+   end subroutine directory_names
 
    !> Forget the C library's last error (errno = 0) before a write whose cause
    !> write_error_cause may have to tell.

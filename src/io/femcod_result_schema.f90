@@ -71,6 +71,9 @@ module femcod_result_schema
       real(dp) :: rms_slope = 0, composite_modulus = 0
       !> What the scene left out, one line each.
       type(string_type), allocatable :: scene(:)
+      !> What the run warns of (a requested state not reached, a tangential step without
+      !> contact), one line each (femcod run prints them on standard error).
+      type(string_type), allocatable :: warnings(:)
       !> The input files, one line each: the deck, or what each height file gave
       !> (format, channel, instrument, grid, scan and pixel size); each file's SHA-256;
       !> the fingerprint of the problem and options (a restart's check).

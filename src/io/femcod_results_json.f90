@@ -3,7 +3,7 @@ module femcod_results_json
    use femcod_kinds, only: dp
    use femcod_memory, only: peak_resident_bytes
    use femcod_problem, only: contact_problem
-   use femcod_strings, only: int_str, json_string, json_number
+   use femcod_strings, only: int_str, json_string, json_number, string_type
    use femcod_contact_result, only: contact_result, stop_reason_text, event_path_diagnostics, &
       legacy_diagnostics, cg_diagnostics, cg_state_diagnostics, event_checks, cg_work
    use femcod_maps, only: state_maps
@@ -47,7 +47,9 @@ contains
          '  "stopped": '//json_string(stop_reason_text(res%stop_reason))//','//nl
       if (last > 0) then
          j = j//'  "last_step": {"contacts": '//int_str(res%step_contacts(last))//', "load_nN": '// &
-            json_number(res%step_load(last))//', "approach_nm": '//json_number(res%step_approach(last))//'},'//nl
+            json_number(res%step_load(last))//', "approach_nm": '//json_number(res%step_approach(last))// &
+            ', "area_nm2": '//json_number(res%step_contacts(last)*deck%pixel**2)//', "area_fraction": '// &
+            json_number(res%step_contacts(last)*deck%pixel**2/(deck%np**2*deck%pixel**2))//'},'//nl
       end if
       j = j//'  "loads": ['//nl//loads//'  ],'//nl// &
          '  "area_load_fit": {"exponent": '//json_number(exponent)//', "prefactor_nm2": '// &
@@ -129,8 +131,25 @@ contains
          '  "boundary": '//json_string(run_boundary(info))//','//nl// &
          '  "kappa_scale": {"rms_slope": '//json_number(info%rms_slope)//', "composite_modulus_GPa": '// &
          json_number(info%composite_modulus)//'},'//nl// &
+         '  "model": '//string_list_json(info%scene)//','//nl// &
+         '  "warnings": '//string_list_json(info%warnings)//','//nl// &
          adhesion_json(info)
    end function run_header_json
+
+   !> A JSON array of the strings (unallocated: []).
+   function string_list_json(list) result(j)
+      type(string_type), allocatable, intent(in) :: list(:)
+      character(len=:), allocatable :: j
+      integer :: k
+      j = "["
+      if (allocated(list)) then
+         do k = 1, size(list)
+            j = j//json_string(list(k)%s)
+            if (k < size(list)) j = j//", "
+         end do
+      end if
+      j = j//"]"
+   end function string_list_json
 
    !> The summary file's adhesion fields (a line each, with the comma), or nothing.
    function adhesion_json(info) result(text)
