@@ -9,12 +9,12 @@ on numpy arrays, through the C library libfemcod.so (doc/python.md).
 
 Arrays are [i, j] = row i, column j, as in femcod's decks and HDF5 files. Units: nm, GPa, nN.
 """
-from ._core import (Deck, FemcodError, Result, State, Stopped, option_keywords, read_deck, read_heights, set_threads, solve,
-                    version, write_deck)
+from ._core import (Deck, FemcodError, Result, State, Stopped, option_keywords, read_deck, read_heights, report,
+                    set_threads, solve, version, write_deck)
 from ._load import load, read_table
 from ._topography import from_topography
 
-__all__ = ["solve", "load", "read_deck", "read_heights", "write_deck", "read_table", "from_topography", "set_threads", "version",
+__all__ = ["solve", "load", "report", "read_deck", "read_heights", "write_deck", "read_table", "from_topography", "set_threads", "version",
            "option_keywords", "Deck", "Result", "State", "FemcodError", "Stopped"]
 try:
     from importlib.metadata import PackageNotFoundError, version as _distribution_version

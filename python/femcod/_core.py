@@ -9,6 +9,7 @@ numpy converts it once); the library copies the heights once into its problem. E
 of the result is copied once, from the library into a new numpy array.
 """
 import ctypes
+import os
 import math
 import signal
 import threading
@@ -97,6 +98,9 @@ class Result:
     solver: str
     options: dict = field(default_factory=dict)
     summary: dict = None
+    #: The prefix of the result set on disk (femcod.load, or solve(output=...)); None: in
+    #: memory only.
+    source: str = None
 
     def column(self, name):
         """One value of every state as an array (``result.column("area_nm2")``); NaN for a
@@ -425,7 +429,7 @@ def _get_deck(session):
 
 def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=None, poisson=None, boundary="free",
           plastic=None, adhesion=None, approach=None, maxcont=None, final_check=True, threads=None, progress=None,
-          **options):
+          output=None, overwrite=False, **options):
     """Solve a contact problem; returns a Result.
 
     lower      the heights (nm, NP x NP, [i, j] row i column j; any real array), or a
@@ -445,6 +449,9 @@ def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=None, po
     threads    OpenMP threads for this and later solves (default: OMP_NUM_THREADS or all).
     progress   f(step, contacts, load_nN, seconds), called after each step or state and
                every 0.1 s while iterating; returning True stops the solve (femcod.Stopped).
+    output     a prefix: also write the result set `femcod run -o PREFIX` writes (PREFIX.h5,
+               .summary.json, CSV tables, figures; femcod.report makes its page). Existing
+               results there are replaced only with overwrite=True.
     Further keywords are femcod run's options that shape the answer, with _ for -
     (femcod.option_keywords(): hardness, tol, max_iterations, kernel_radius, max_contacts,
     event_search, work, range, shear_strength, shear_slope, tangential, slip, friction,
@@ -466,7 +473,38 @@ def solve(lower, pixel=None, loads=None, solver="cg", upper=None, young=None, po
     del kept
     for line in session.text(session.lib.femcod_warnings).splitlines():
         warnings.warn(f"femcod: {line}", stacklevel=2)
-    return _result(session, solver, opts)
+    result = _result(session, solver, opts)
+    if output is not None:
+        prefix = os.fspath(output)
+        session.check(session.lib.femcod_write_results(session.handle, prefix.encode(), int(bool(overwrite))))
+        result.source = prefix
+    return result
+
+
+def report(source, path=None, force=False):
+    """Write the HTML page `femcod report` writes and return its path.
+
+    source  a Result with its files (femcod.load, or solve(..., output=PREFIX)), a result
+            set's prefix (or its PREFIX.h5 or PREFIX.summary.json), a study's prefix, or a
+            directory of results (then one page of all of them, and each run's page).
+    path    the page (default PREFIX.report.html, DIR/report.html); an existing path is
+            replaced only with force=True.
+    """
+    if isinstance(source, Result):
+        if not source.source:
+            raise ValueError("femcod.report: this Result is in memory only; solve(..., output=PREFIX) writes the "
+                             "result set a report is made from (or femcod.load a set femcod run wrote)")
+        target = source.source
+    else:
+        target = os.fspath(source)
+        for suffix in (".h5", ".summary.json"):
+            if target.endswith(suffix) and os.path.isfile(target):
+                target = target[:-len(suffix)]
+    session = _Session()
+    page = ctypes.create_string_buffer(len(target.encode()) + len(os.fspath(path or "").encode()) + 4096)
+    session.check(session.lib.femcod_report(session.handle, target.encode(), os.fspath(path or "").encode(),
+                                            int(bool(force)), page, len(page)))
+    return page.value.decode()
 
 
 def read_deck(path):

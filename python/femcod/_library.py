@@ -90,6 +90,8 @@ def _declare(lib):
         "femcod_state_map": (c_int, [c_void_p, c_int, c_char_p, p_double, c_int64]),
         "femcod_history_length": (c_int, [c_void_p, p_int]),
         "femcod_history": (c_int, [c_void_p, c_char_p, p_double, c_int64]),
+        "femcod_write_results": (c_int, [c_void_p, c_char_p, c_int]),
+        "femcod_report": (c_int, [c_void_p, c_char_p, c_char_p, c_int, c_char_p, c_size_t]),
     }
     for name, (restype, argtypes) in table.items():
         f = getattr(lib, name)

@@ -116,4 +116,4 @@ def _run_result(f, path):
     if os.path.exists(stem + ".summary.json"):
         with open(stem + ".summary.json") as s:
             summary = json.load(s)
-    return Result(states, history, deck, run.get("solver", ""), run, summary)
+    return Result(states, history, deck, run.get("solver", ""), run, summary, stem)

@@ -75,7 +75,7 @@ def test_refused_combinations_come_back_as_exceptions():
     with pytest.raises(femcod.FemcodError, match="legacy") as e:
         femcod.solve(h, pixel=1.0, loads=[10.0], solver="legacy", boundary="periodic")
     with pytest.raises(TypeError, match="unexpected keyword"):
-        femcod.solve(h, pixel=1.0, loads=[10.0], output="x")
+        femcod.solve(h, pixel=1.0, loads=[10.0], outdir="x")
     with pytest.raises(femcod.FemcodError, match="(?i)pixel"):
         femcod.solve(h, pixel=1e9, loads=[10.0])
 

@@ -90,6 +90,16 @@ int femcod_state_map(femcod_session *s, int k, const char *name, double *out, in
 int femcod_history_length(femcod_session *s, int *steps);
 int femcod_history(femcod_session *s, const char *name, double *out, int64_t size);
 
+/* The last solve's result set under prefix: the files `femcod run -o PREFIX` writes (PREFIX.h5,
+ * .xdmf, .summary.json, CSV tables, figures), as one set; existing results are replaced only
+ * with force != 0, and only if femcod wrote them. */
+int femcod_write_results(femcod_session *s, const char *prefix, int force);
+/* `femcod report TARGET -o OUTPUT`: one self-contained HTML page of a result set (TARGET its
+ * prefix) or of a results directory; OUTPUT "": the default name (PREFIX.report.html,
+ * DIR/report.html). The page's path goes into page (capacity bytes with the NUL). */
+int femcod_report(femcod_session *s, const char *target, const char *output, int force, char *page,
+                  size_t capacity);
+
 #ifdef __cplusplus
 }
 #endif

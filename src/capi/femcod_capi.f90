@@ -24,7 +24,11 @@ module femcod_capi
    use femcod_generate, only: scene_spec, build_problem, rough_maxcont
    use femcod_deck, only: read_deck, write_deck
    use femcod_heights, only: load_scene
-   use femcod_output_guard, only: guard_outputs, OUTPUT_DECK
+   use femcod_output_guard, only: guard_outputs, OUTPUT_DECK, OUTPUT_RESULT
+   use femcod_results, only: write_results, result_files, run_info
+   use femcod_report_command, only: make_report
+   use femcod_solver, only: model_notes, run_warnings
+   use femcod_process, only: host_name, local_time_iso
    !$ use omp_lib, only: omp_set_num_threads
    use femcod_library_session, only: library_session, solve_session, state_value, state_value_names, state_value_kinds, &
       history_column, HISTORY_COLUMNS, map_of, map_names, library_options
@@ -34,7 +38,7 @@ module femcod_capi
       femcod_read_deck, femcod_write_deck, femcod_problem_size, femcod_get_problem, femcod_get_label, &
       femcod_set_option, femcod_clear_options, femcod_solve, femcod_state_count, femcod_state_value, &
       femcod_value_names, femcod_state_map, femcod_history_length, femcod_history, femcod_set_threads, &
-      femcod_read_heights, femcod_warnings, femcod_option_names
+      femcod_read_heights, femcod_warnings, femcod_option_names, femcod_write_results, femcod_report
 
    !> Longest C string read from a caller (a path, an option's value).
    integer, parameter :: MAX_C_STRING = 1048576
@@ -278,6 +282,70 @@ contains
       if (st%code == 0) call write_deck(name, session%problem, st)
       femcod_write_deck = finish(session, st)
    end function femcod_write_deck
+
+   !> Write the last solve's result set under `prefix`, the files `femcod run -o PREFIX`
+   !> writes (PREFIX.h5, .xdmf, .summary.json, the CSV tables and figures), atomically as
+   !> a set. Existing results are replaced only with `force` /= 0, and only if femcod
+   !> wrote them.
+   integer(c_int) function femcod_write_results(handle, prefix, force) bind(C, name="femcod_write_results")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(in) :: prefix(*)
+      integer(c_int), value :: force
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      type(run_info) :: info
+      character(len=:), allocatable :: name
+      femcod_write_results = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      name = from_c(prefix)
+      if (.not. session%solved) call set_error(st, STATUS_USAGE, "no result to write: solve first")
+      if (name == "") call set_error(st, STATUS_USAGE, "expected a prefix for the result files, found none")
+      if (st%code == 0) call guard_outputs(result_files(name, size(session%res%states)), [string_type :: ], force /= 0, &
+         OUTPUT_RESULT, st)
+      if (st%code == 0) then
+         info = session%info
+         info%version = VERSION_TEXT
+         info%command_line = "libfemcod (femcod_solve)"
+         info%host = host_name()
+         info%finished = local_time_iso()
+         info%scene = model_notes(session%problem, session%options)
+         info%warnings = run_warnings(session%options, session%res)
+         call write_results(name, session%problem, session%res, session%maps, info, st)
+      end if
+      femcod_write_results = finish(session, st)
+   end function femcod_write_results
+
+   !> `femcod report TARGET -o OUTPUT`: the HTML page of a result set's prefix or of a
+   !> results directory (OUTPUT "": the default name). The page's path is copied
+   !> into `page` (at most `capacity` bytes with the NUL). The session only keeps the
+   !> message of a failure.
+   integer(c_int) function femcod_report(handle, target, output, force, page, capacity) bind(C, name="femcod_report")
+      type(c_ptr), value :: handle
+      character(kind=c_char), intent(in) :: target(*), output(*)
+      integer(c_int), value :: force
+      character(kind=c_char), intent(out) :: page(*)
+      integer(c_size_t), value :: capacity
+      type(library_session), pointer :: session
+      type(status_type) :: st
+      type(string_type), allocatable :: written(:)
+      character(len=:), allocatable :: path
+      integer :: bytes, k
+      femcod_report = STATUS_USAGE
+      if (.not. c_associated(handle)) return
+      call c_f_pointer(handle, session)
+      path = from_c(output)
+      call make_report(from_c(target), path, force /= 0, written, bytes, st)
+      if (st%code == 0 .and. len(path) + 1 > capacity) call set_error(st, STATUS_USAGE, &
+         "the page's path needs "//int_str(len(path) + 1)//" bytes, the buffer has "//int_str(int(capacity)))
+      if (st%code == 0) then
+         do k = 1, len(path)
+            page(k) = path(k:k)
+         end do
+         page(len(path) + 1) = c_null_char
+      end if
+      femcod_report = finish(session, st)
+   end function femcod_report
 
    !> NP of the session's problem (0: none).
    integer(c_int) function femcod_problem_size(handle, np) bind(C, name="femcod_problem_size")
