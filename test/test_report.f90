@@ -146,6 +146,11 @@ contains
          contains_text(html, 'id="failed"'), "the failed deck and its message")
       if (allocated(error)) return
       call check(error, occurrences(html, "<svg"), 1, "one figure of every area-load curve")
+      if (allocated(error)) return
+      ! An event run without requested states: its curves and the last step's map.
+      html = read_text(dir//"/sphere_d4.report.html")
+      call check(error, occurrences(html, "<svg") == 3 .and. contains_text(html, "contact pressure at the last step"), &
+         "a run without states: two curves and the last step's pressure map")
    end subroutine test_batch_report
 
    !> The resolution study of the small rough deck: its page inlines every SVG file the

@@ -288,8 +288,9 @@ contains
       html = '<section id="states"><h2>States</h2>'//nl
       n = leaf_count(leaves, "loads")
       if (n == 0) then
-         html = html//"<p>No state was requested (--loads or --approach): the history above is the result.</p>"// &
-            nl//"</section>"//nl
+         html = html//"<p>No state was requested (--loads or --approach): the history above is the result, "// &
+            "and the last step's contacts (PREFIX.h5 /contacts) its map.</p>"//nl//last_step_map(file, leaves, status)// &
+            "</section>"//nl
          return
       end if
       html = html//array_table(leaves, "loads", .true.)
@@ -308,6 +309,33 @@ contains
       end do
       html = html//"</section>"//nl
    end function states_section
+
+   !> The pressure map of the last step's contacts (/contacts: 1-based rows and columns,
+   !> pressures in GPa), for a run without requested states.
+   function last_step_map(file, leaves, status) result(html)
+      type(h5_file), intent(in) :: file
+      type(json_leaf), intent(in) :: leaves(:)
+      type(status_type), intent(inout) :: status
+      character(len=:), allocatable :: html
+      integer, allocatable :: i(:), j(:)
+      real(dp), allocatable :: pressure(:), map(:, :)
+      integer :: np, k
+      html = ""
+      if (.not. h5_exists(file, "/contacts/pressure")) return
+      call h5_read(file, "/contacts/i", i, status, STATUS_BAD_INPUT)
+      call h5_read(file, "/contacts/j", j, status, STATUS_BAD_INPUT)
+      call h5_read(file, "/contacts/pressure", pressure, status, STATUS_BAD_INPUT)
+      if (status%code /= 0) return
+      np = nint(leaf_real(leaves, "scene.NP", 0.0_dp))
+      allocate(map(np, np), source=0.0_dp)
+      do k = 1, size(pressure)
+         if (min(i(k), j(k)) < 1 .or. max(i(k), j(k)) > np) cycle
+         map(i(k), j(k)) = pressure(k)
+      end do
+      html = '<div class="figures">'//inline_svg(svg_pressure_map("contact pressure at the last step, "// &
+         sig_str(leaf_real(leaves, "last_step.load_nN", 0.0_dp), 6)//" nN ("//leaf_text(leaves, "last_step.contacts")// &
+         " contacts)", map, np*leaf_real(leaves, "scene.pixel_nm", 0.0_dp)))//"</div>"//nl
+   end function last_step_map
 
    !> The maps of state `k` (0-based in loads[]): pressure and gap, plastic
    !> displacement and stick/slip where PREFIX.h5 has them.
