@@ -86,8 +86,8 @@ contains
    !> pressure, gap, plastic and stick/slip maps (8), two curves, three patch figures.
    subroutine test_run_report(error)
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: prefix, html
-      integer :: code
+      character(len=:), allocatable :: prefix, html, summary, load_text
+      integer :: code, at
       prefix = scratch_path("report-sphere")
       call run_femcod([string_type("run"), string_type("input/sphere_d2.deck"), string_type("-o"), &
          string_type(prefix), string_type("--solver"), string_type("cg"), string_type("--loads"), &
@@ -114,8 +114,15 @@ contains
       call check(error, .not. (contains_text(html, "http://") .or. contains_text(html, "https://") .or. &
          contains_text(html, " src=") .or. contains_text(html, "url(")), "no network or external reference")
       if (allocated(error)) return
-      call check(error, contains_text(html, 'data-path="loads[1].load_nN" data-value="3e3"'), &
-         "a state's load with its path and exact text (summary.json writes 3000 as 3e3)")
+      ! The second state's load as summary.json writes it (read here from the file, not
+      ! typed in): the page carries that exact text under its path.
+      summary = read_text(prefix//".summary.json")
+      at = index(summary, '"loads": [')
+      at = at + index(summary(at:), '{"load_nN": ') + len('{"load_nN": ') - 1
+      at = at + index(summary(at:), '{"load_nN": ') + len('{"load_nN": ') - 1
+      load_text = summary(at:at + index(summary(at:), ",") - 2)
+      call check(error, contains_text(html, 'data-path="loads[1].load_nN" data-value="'//load_text//'"'), &
+         "the second state's load with its path and the summary's exact text, "//load_text)
    end subroutine test_run_report
 
    !> Two decks and a broken one in a batch, then `femcod report DIR`.

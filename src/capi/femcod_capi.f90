@@ -330,19 +330,15 @@ contains
       type(status_type) :: st
       type(string_type), allocatable :: written(:)
       character(len=:), allocatable :: path
-      integer :: bytes, k
+      integer :: bytes
       femcod_report = STATUS_USAGE
       if (.not. c_associated(handle)) return
       call c_f_pointer(handle, session)
       path = from_c(output)
       call make_report(from_c(target), path, force /= 0, written, bytes, st)
-      if (st%code == 0 .and. len(path) + 1 > capacity) call set_error(st, STATUS_USAGE, &
-         "the page's path needs "//int_str(len(path) + 1)//" bytes, the buffer has "//int_str(int(capacity)))
       if (st%code == 0) then
-         do k = 1, len(path)
-            page(k) = path(k:k)
-         end do
-         page(len(path) + 1) = c_null_char
+         if (copy_out(path, page, capacity) /= 0) call set_error(st, STATUS_USAGE, "the page's path needs "// &
+            int_str(len(path) + 1)//" bytes, the buffer has "//int_str(int(capacity)))
       end if
       femcod_report = finish(session, st)
    end function femcod_report

@@ -6,7 +6,7 @@ module femcod_report_command
    use femcod_clock, only: wall_clock
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO
    use femcod_strings, only: string_type, int_str, sig_str
-   use femcod_files, only: path_exists, path_is_directory, write_file, directory_names
+   use femcod_files, only: path_exists, path_is_directory, write_file
    use femcod_report, only: report_page, batch_page
    use femcod_help, only: help_requested, print_lines
    use femcod_options, only: option_spec, parsed_options, parse_options, option_help, flag_option, text_option, &
@@ -113,9 +113,8 @@ contains
          output//": exists; femcod report replaces a FILE given by -o only with --force")
       if (status%code /= 0) return
       if (path_is_directory(target)) then
-         call directory_reports(target, written, status)
          if (output == "") output = target//"/report.html"
-         if (status%code == 0) call batch_page(target, written, html, status)
+         call batch_page(target, written, html, status)
       else
          if (output == "") output = target//".report.html"
          call report_page(target, html, status)
@@ -123,24 +122,4 @@ contains
       if (status%code == 0) call write_file(output, html, status)
       if (status%code == 0) bytes = len(html)
    end subroutine make_report
-
-   !> Each run's page in a results directory (PREFIX.report.html beside its results).
-   subroutine directory_reports(dir, written, status)
-      character(len=*), intent(in) :: dir
-      type(string_type), allocatable, intent(inout) :: written(:)
-      type(status_type), intent(inout) :: status
-      type(string_type), allocatable :: names(:)
-      character(len=:), allocatable :: prefix, html
-      integer :: k
-      call directory_names(dir, names, status)
-      do k = 1, size(names)
-         if (status%code /= 0) return
-         if (len(names(k)%s) <= len(".summary.json")) cycle
-         if (names(k)%s(len(names(k)%s) - len(".summary.json") + 1:) /= ".summary.json") cycle
-         prefix = dir//"/"//names(k)%s(1:len(names(k)%s) - len(".summary.json"))
-         call report_page(prefix, html, status)
-         if (status%code == 0) call write_file(prefix//".report.html", html, status)
-         if (status%code == 0) written = [written, string_type(prefix//".report.html")]
-      end do
-   end subroutine directory_reports
 end module femcod_report_command

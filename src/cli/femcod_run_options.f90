@@ -135,7 +135,8 @@ contains
          "", &
          "Contact history of each deck, step by step (thesis chapter 4, Appendix B). With several decks", &
          "(batch) each gets its own outputs named after it; a bad deck is reported and the others still", &
-         "run; the exit code is that of the first failure, and a final summary lists the failures.", &
+         "run; the exit code is that of the first failure, and a final summary lists the failures (each", &
+         "also as PREFIX.failed.json, its deck, exit code and message, for `femcod report DIR`).", &
          "Solvers: incremental (default): event-exact, condensed to the contacts, bordered Cholesky factor,", &
          "exact candidate bound, full-field FFT check at the end; legacy: the Appendix B program (skyline,", &
          "COLHT, TRFACT, POSTP); cg: the state at each requested load only, by constrained conjugate", &

@@ -10,7 +10,7 @@ module femcod_files
    implicit none
    private
    public :: atomic_rename, remove_file, path_exists, path_is_directory, temporary_name, write_bytes, write_file
-   public :: default_prefix, file_part, read_file, canonical_path, acquire_lock, release_lock, make_directories
+   public :: default_prefix, file_part, base_name, read_file, canonical_path, acquire_lock, release_lock, make_directories
    public :: clear_write_error, write_error_cause, os_error_text, MAX_TEXT_BYTES, directory_names
 
    !> The largest file read_file takes (bytes): 2 GiB less 64 KiB, so that positions in
@@ -163,6 +163,13 @@ contains
       character(len=:), allocatable :: tmp
       tmp = path//".part"
    end function temporary_name
+
+   !> The file name without its directory.
+   pure function base_name(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      name = path(index(path, "/", back=.true.) + 1:)
+   end function base_name
 
    !> The file part of `FILE.h5:/dataset` (the path itself for other files).
    function file_part(path) result(name)
@@ -388,8 +395,8 @@ contains
       end do
    end function os_error_text
 
-   !> The names in directory `path` (not "." and ".."), sorted by byte value; an error
-   !> (STATUS_BAD_INPUT) when it cannot be read.
+   !> The names in directory `path` (not "." and ".."), sorted by byte value (by
+   !> femcod_directory.c's scandir); an error (STATUS_BAD_INPUT) when it cannot be read.
    subroutine directory_names(path, names, status)
       character(len=*), intent(in) :: path
       type(string_type), allocatable, intent(out) :: names(:)
@@ -397,7 +404,6 @@ contains
       character(kind=c_char, len=:), allocatable :: buf
       integer(c_long) :: used
       integer :: start, k
-      type(string_type) :: swap
       allocate(names(0))
       if (status%code /= 0) return
       allocate(character(kind=c_char, len=65536) :: buf)
@@ -416,17 +422,6 @@ contains
          if (buf(k:k) /= new_line("a")) cycle
          names = [names, string_type(buf(start:k - 1))]
          start = k + 1
-      end do
-      ! Insertion sort: a results directory holds hundreds of names, not millions.
-      do k = 2, size(names)
-         swap = names(k)
-         start = k - 1
-         do while (start >= 1)
-            if (.not. llt(swap%s, names(start)%s)) exit
-            names(start + 1) = names(start)
-            start = start - 1
-         end do
-         names(start + 1) = swap
       end do
    end subroutine directory_names
 

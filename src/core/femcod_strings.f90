@@ -6,7 +6,7 @@ module femcod_strings
       parse_integer, is_digit, json_number, sig_str, without_trailing_zeros
    implicit none
    private
-   public :: count_text
+   public :: count_text, ends_with
    public :: string_type, int_str, real_str, fixed_str, split_list, text_builder, add_line, add_lines, add_text, built_text
    public :: without_trailing_zeros, xml_escape, json_string, json_number, sig_str, next_line
    public :: parse_real, parse_integer, parse_real_list, parse_integer_list, format_real, format_reals, is_digit, &
@@ -181,6 +181,13 @@ contains
    end function lower_case
 
    !> Text for XML content and attribute values: & < > " ' as entities.
+   !> True when `text` ends with `tail`.
+   pure logical function ends_with(text, tail)
+      character(len=*), intent(in) :: text, tail
+      ends_with = .false.
+      if (len(text) >= len(tail)) ends_with = text(len(text) - len(tail) + 1:) == tail
+   end function ends_with
+
    pure function xml_escape(s) result(e)
       character(len=*), intent(in) :: s
       character(len=:), allocatable :: e

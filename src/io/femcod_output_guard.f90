@@ -21,7 +21,7 @@
 module femcod_output_guard
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_BAD_INPUT
-   use femcod_strings, only: string_type, next_line
+   use femcod_strings, only: string_type, next_line, ends_with
    use femcod_files, only: canonical_path, path_exists, path_is_directory
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_read_string_attribute, h5_exists
    use femcod_deck_h5, only: is_deck_h5
@@ -253,12 +253,6 @@ contains
       start = 1
       if (.not. next_line(text, start, line)) line = ""
    end function first_line
-
-   pure logical function ends_with(text, tail)
-      character(len=*), intent(in) :: text, tail
-      ends_with = .false.
-      if (len(text) >= len(tail)) ends_with = text(len(text) - len(tail) + 1:) == tail
-   end function ends_with
 
    pure function kind_text(path, kind) result(text)
       character(len=*), intent(in) :: path

@@ -13,8 +13,9 @@
 module femcod_report
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT
-   use femcod_strings, only: string_type, int_str, sig_str, xml_escape, text_builder, add_text, built_text, count_text
-   use femcod_files, only: read_file, path_exists, directory_names
+   use femcod_strings, only: string_type, int_str, sig_str, xml_escape, text_builder, add_text, built_text, count_text, &
+      ends_with
+   use femcod_files, only: read_file, path_exists, directory_names, base_name, write_file
    use femcod_json_reader, only: json_leaf, read_json_leaves, leaf_text, leaf_real, leaf_count, leaf_index
    use femcod_html, only: html_page, inline_svg, leaf_cell, leaf_rows_table, members_table, array_table, &
       every_value_table, array_names
@@ -84,13 +85,6 @@ contains
       if (status%code /= 0) return
       call read_json_leaves(text, path, leaves, status)
    end subroutine json_file_leaves
-
-   !> The file name of a path (after its last '/').
-   pure function base_name(path) result(name)
-      character(len=*), intent(in) :: path
-      character(len=:), allocatable :: name
-      name = path(index(path, "/", back=.true.) + 1:)
-   end function base_name
 
    subroutine run_page(prefix, html, status)
       character(len=*), intent(in) :: prefix
@@ -540,20 +534,22 @@ contains
       end function listed
    end subroutine outer_paths
 
-   !> A results directory at a glance: each run's row (its report linked), the area-load
+   !> A results directory at a glance: each run's row (its own page written beside its
+   !> results as PREFIX.report.html, listed in `written`, and linked), the area-load
    !> curves of all in one figure, and the failed decks with their messages.
-   subroutine batch_page(dir, reports, html, status)
+   subroutine batch_page(dir, written, html, status)
       character(len=*), intent(in) :: dir
-      type(string_type), intent(in) :: reports(:)
+      type(string_type), allocatable, intent(out) :: written(:)
       character(len=:), allocatable, intent(out) :: html
       type(status_type), intent(inout) :: status
       type(string_type), allocatable :: names(:)
       type(json_leaf), allocatable :: leaves(:)
       type(svg_series), allocatable :: series(:)
       type(text_builder) :: rows, failed
-      character(len=:), allocatable :: base, link
-      integer :: k, m, nrun, nfailed
+      character(len=:), allocatable :: base, page
+      integer :: k, nrun, nfailed
       html = ""
+      allocate(written(0))
       call directory_names(dir, names, status)
       if (status%code /= 0) return
       nrun = 0
@@ -561,16 +557,14 @@ contains
       do k = 1, size(names)
          if (ends_with(names(k)%s, ".summary.json")) then
             base = names(k)%s(1:len(names(k)%s) - len(".summary.json"))
+            call report_page(dir//"/"//base, page, status)
+            call write_file(dir//"/"//base//".report.html", page, status)
             call json_file_leaves(dir//"/"//names(k)%s, leaves, status)
             if (status%code /= 0) return
+            written = [written, string_type(dir//"/"//base//".report.html")]
             nrun = nrun + 1
-            link = xml_escape(base)
-            do m = 1, size(reports)
-               if (reports(m)%s == dir//"/"//base//".report.html") &
-                  link = '<a href="'//xml_escape(base)//'.report.html">'//xml_escape(base)//"</a>"
-            end do
-            call add_text(rows, '<tr><td data-value="'//xml_escape(base)//'">'//link//"</td>"// &
-               batch_cells(leaves)//"</tr>"//nl)
+            call add_text(rows, '<tr><td data-value="'//xml_escape(base)//'"><a href="'//xml_escape(base)// &
+               '.report.html">'//xml_escape(base)//"</a></td>"//batch_cells(leaves)//"</tr>"//nl)
             call add_curve(dir//"/"//base//".h5", base, leaves, series, status)
             if (status%code /= 0) return
          else if (ends_with(names(k)%s, ".failed.json")) then
@@ -661,10 +655,4 @@ contains
       call add_series(series, label, load, area, dashed=n >= 8)
    end subroutine add_curve
 
-   pure logical function ends_with(s, tail)
-      character(len=*), intent(in) :: s, tail
-      ends_with = .false.
-      if (len(s) < len(tail)) return
-      ends_with = s(len(s) - len(tail) + 1:) == tail
-   end function ends_with
 end module femcod_report

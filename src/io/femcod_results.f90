@@ -14,7 +14,7 @@ module femcod_results
    use femcod_status, only: status_type, set_error
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, int_str, sig_str
-   use femcod_files, only: atomic_rename, remove_file, temporary_name, write_bytes
+   use femcod_files, only: atomic_rename, remove_file, temporary_name, write_bytes, base_name
    use femcod_contact_result, only: contact_result
    use femcod_maps, only: state_maps, tangential_step_maps
    use femcod_svg, only: svg_plot, svg_pressure_map, svg_map, svg_stick_slip_map, BLOCK_SMALLEST, BLOCK_LARGEST
@@ -237,12 +237,5 @@ contains
             res%step_load(1:res%nsteps), area, .true., .true.)
       end if
    end function area_load_svg
-
-   !> The file name without its directory.
-   function base_name(path) result(name)
-      character(len=*), intent(in) :: path
-      character(len=:), allocatable :: name
-      name = path(index(path, "/", back=.true.) + 1:)
-   end function base_name
 end module femcod_results
 
