@@ -7,11 +7,11 @@ program femcod_main
    use femcod_bench, only: bench_command
    use femcod_strings, only: string_type
    use femcod_exit, only: exit_program
-   use femcod_blas_core, only: select_blas_core
+   use femcod_start_environment, only: prepare_environment
    implicit none
    type(string_type), allocatable :: args(:)
    integer :: code
-   call select_blas_core()
+   call prepare_environment()
    args = command_arguments()
    code = 0
    if (size(args) >= 1) then

@@ -17,7 +17,7 @@ PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_d
 
 
 def _blas_environment():
-    """What the femcod program sets before OpenBLAS loads (app/femcod_blas_core.f90), so
+    """What the femcod program sets before OpenBLAS loads (app/femcod_start_environment.f90), so
     that a solve here runs the same BLAS kernels as on the command line and gives its
     answer to the last bit: the core from the CPU's flags (avx512f: SkylakeX, avx2:
     Haswell) and a short wait of idle BLAS threads. A user's own values are kept."""

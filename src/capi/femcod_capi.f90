@@ -28,7 +28,7 @@ module femcod_capi
    use femcod_results, only: write_results, result_files, run_info
    use femcod_report_command, only: make_report
    use femcod_solver, only: model_notes, run_warnings
-   use femcod_process, only: host_name, local_time_iso
+   use femcod_process, only: host_name, openmp_threads, wait_policy_text, local_time_iso
    !$ use omp_lib, only: omp_set_num_threads
    use femcod_library_session, only: library_session, solve_session, state_value, state_value_names, state_value_kinds, &
       history_column, HISTORY_COLUMNS, map_of, map_names, library_options
@@ -308,6 +308,8 @@ contains
          info%version = VERSION_TEXT
          info%command_line = "libfemcod (femcod_solve)"
          info%host = host_name()
+         info%threads = openmp_threads()
+         info%wait_policy = wait_policy_text()
          info%finished = local_time_iso()
          info%scene = model_notes(session%problem, session%options)
          info%warnings = run_warnings(session%options, session%res)

@@ -15,7 +15,8 @@ module femcod_run
    use femcod_strings, only: string_type, int_str, format_real, append_string, count_text, json_string
    use femcod_files, only: remove_file, path_exists, path_is_directory, canonical_path, acquire_lock, release_lock, &
       make_directories, write_file
-   use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso
+   use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, &
+      openmp_threads, wait_policy_text, local_time_iso
    use femcod_sha256, only: sha256_hex, file_digest, file_sha256_start, file_sha256_finish
    use femcod_clock, only: wall_clock
    use femcod_problem, only: contact_problem
@@ -423,6 +424,8 @@ contains
          info%figures = settings%figures
          info%command_line = "femcod run "//settings%command_line
          info%host = host_name()
+         info%threads = openmp_threads()
+         info%wait_policy = wait_policy_text()
          info%started = started
          info%finished = local_time_iso()
          info%scene = model_notes(problem, options)

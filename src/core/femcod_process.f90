@@ -7,9 +7,11 @@
 module femcod_process
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_size_t, c_null_char, c_funptr, c_funloc
    use, intrinsic :: iso_fortran_env, only: int64
+   !$ use omp_lib, only: omp_get_max_threads
    implicit none
    private
-   public :: process_id, host_name, process_alive, catch_stop_signals, stop_signal, signal_name, local_time_iso
+   public :: process_id, host_name, openmp_threads, wait_policy_text, process_alive, catch_stop_signals, &
+      stop_signal, signal_name, local_time_iso
    public :: SIGINT, SIGTERM, SIGUSR1
 
    !> Linux signal numbers.
@@ -56,6 +58,37 @@ contains
       if (k == 0) k = len(buf) + 1
       name = buf(1:k - 1)
    end function host_name
+
+   !> The OpenMP threads a parallel region runs on (1 without OpenMP).
+   integer function openmp_threads()
+      openmp_threads = 1
+      !$ openmp_threads = omp_get_max_threads()
+   end function openmp_threads
+
+   !> How idle OpenMP threads wait: OMP_WAIT_POLICY's value ("default" when unset: libgomp
+   !> spins, then sleeps), and why when the femcod program chose it at start
+   !> (FEMCOD_BUSY_AT_START, app/femcod_start_environment.f90).
+   function wait_policy_text() result(text)
+      character(len=:), allocatable :: text
+      text = environment_value("OMP_WAIT_POLICY")
+      if (text == "") text = "default"
+      if (environment_value("FEMCOD_BUSY_AT_START") /= "") &
+         text = text//" (chosen by femcod: "//environment_value("FEMCOD_BUSY_AT_START")//")"
+   end function wait_policy_text
+
+   !> An environment variable's value ("" when unset).
+   function environment_value(name) result(value)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: value
+      integer :: length, status
+      call get_environment_variable(name, length=length, status=status)
+      if (status /= 0 .or. length == 0) then
+         value = ""
+         return
+      end if
+      allocate(character(len=length) :: value)
+      call get_environment_variable(name, value)
+   end function environment_value
 
    !> Whether process `pid` runs on this machine (Linux: /proc/PID/stat exists and its
    !> state is not Z, a zombie, or X, dead: a killed process whose parent is gone stays a

@@ -82,6 +82,9 @@ module femcod_result_schema
       !> The command as typed (femcod run ...), the machine, and when the run started
       !> and its results were written (ISO 8601 with the UTC offset).
       character(len=:), allocatable :: command_line, host, started, finished
+      !> The OpenMP threads and how idle ones wait (femcod_process's wait_policy_text).
+      integer :: threads = 0
+      character(len=:), allocatable :: wait_policy
       !> Wall seconds of the parts of the run before the writing: reading the inputs,
       !> their digests, the maps of the reached loads (the solve is the result's own).
       real(dp) :: read_seconds = 0, digest_seconds = 0, maps_seconds = 0

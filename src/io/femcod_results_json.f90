@@ -118,6 +118,8 @@ contains
          '  "femcod_version": '//json_string(info%version)//','//nl// &
          '  "command_line": '//json_string(text_or_empty(info%command_line))//','//nl// &
          '  "host": '//json_string(text_or_empty(info%host))//','//nl// &
+         '  "openmp": {"threads": '//int_str(info%threads)//', "wait_policy": '// &
+         json_string(text_or_empty(info%wait_policy))//'},'//nl// &
          '  "started": '//json_string(text_or_empty(info%started))//','//nl// &
          '  "finished": '//json_string(text_or_empty(info%finished))//','//nl// &
          '  "results": '//json_string(prefix)//','//nl// &
