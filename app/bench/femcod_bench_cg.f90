@@ -18,7 +18,7 @@ module femcod_bench_cg
    use femcod_wisdom, only: load_wisdom, save_wisdom
    use femcod_output_guard, only: OUTPUT_WISDOM
    use femcod_bench_common, only: guard_bench_files, bench_arguments, surface_for_peers, require_peers, &
-      remove_file_quietly, peer_line, peer_row, reset_peak, peak_mb, BENCH_LENGTH, options_refused
+      remove_file_quietly, peer_line, peer_row, reset_peak, peak_mb, BENCH_LENGTH, options_refused, bare_pair_seconds
    implicit none
    private
    public :: bench_cg
@@ -40,8 +40,10 @@ contains
       type(contact_options) :: options
       type(contact_result) :: res
       type(parsed_options) :: parsed
-      real(dp) :: tol, estar, slope, pressure, load, length, peak
+      real(dp) :: tol, estar, slope, pressure, load, length, peak, pair
       integer :: i, n, k, np
+      type(string_type), allocatable :: limit_rows(:)
+      character(len=:), allocatable :: row
       logical :: loaded, approach_rows
       character(len=512) :: line
       character(len=*), parameter :: peers(2) = [character(len=16) :: "aspher", "contactmechanics"]
@@ -113,9 +115,11 @@ contains
       write(output_unit, '(a)') "| NP | target % | solver | wall (s) | iterations | residual | contact % "// &
          "| peak RSS (MB) | status |"
       write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|"
+      allocate(limit_rows(0))
       do n = 1, size(sizes)
          np = sizes(n)
          length = BENCH_LENGTH
+         pair = bare_pair_seconds(2*np, measure=.true., repeat=5)
          call surface_for_peers(np, "bench cg", python, deck, estar, slope, path, status)
          if (status%code /= 0) then
             write(error_unit, '(a)') "femcod bench cg: "//status%message
@@ -139,6 +143,9 @@ contains
             end if
             write(output_unit, '(a)') solver_row(np, fractions(k), "femcod cg", res, peak, "converged")
             flush(output_unit)
+            ! (gfortran 12 cannot take the function's text inside the array constructor.)
+            row = limit_row(np, fractions(k), res, pair)
+            limit_rows = [limit_rows, string_type(row)]
             if (approach_rows) call approach_row(deck, options, np, fractions(k), res)
             if (len(python) == 0) cycle
             do i = 1, size(peers)
@@ -149,6 +156,13 @@ contains
          end do
          if (len(python) > 0) call remove_file_quietly(path)
       end do
+      write(output_unit, '(a)') "", "The solves above against one bare pair of FFTs of their transform grid "// &
+         "((2NP)^2: FFTW's threaded 2-D r2c and c2r in double, measured plans, the planning not timed):", "", &
+         "| NP | target % | wall (s) | bare pair (s) | solve in bare pairs | fine iterations + fresh "// &
+         "| bare pairs a fine iteration (coarse grids in) |", "|---|---|---|---|---|---|---|"
+      do k = 1, size(limit_rows)
+         write(output_unit, '(a)') limit_rows(k)%s
+      end do
    contains
       logical function switch(name)
          character(len=*), intent(in) :: name
@@ -158,6 +172,22 @@ contains
          switch = v == "on"
       end function switch
    end subroutine bench_cg
+
+   !> A row of the table against the bare pair: the solve of `res` in pairs of `pair` seconds
+   !> and per finest-grid iteration and fresh convolution.
+   function limit_row(np, fraction, res, pair) result(row)
+      integer, intent(in) :: np
+      real(dp), intent(in) :: fraction, pair
+      type(contact_result), intent(in) :: res
+      character(len=:), allocatable :: row
+      type(cg_state_diagnostics) :: work
+      integer :: fine
+      work = cg_work(res, 1)
+      fine = max(1, work%iterations + work%convolutions)
+      row = "| "//int_str(np)//" | "//fixed_str(fraction, 1)//" | "//fixed_str(res%wall_seconds, 2)//" | "// &
+         fixed_str(pair, 4)//" | "//fixed_str(res%wall_seconds/pair, 1)//" | "//int_str(work%iterations)//" + "// &
+         int_str(work%convolutions)//" | "//fixed_str(res%wall_seconds/pair/fine, 2)//" |"
+   end function limit_row
 
    !> The state of `loaded` (one load) solved again at its approach from a cold start (
    !> displacement control): a row with its wall time and iterations, and in the status

@@ -15,8 +15,11 @@ module femcod_bench_common
    use femcod_files, only: path_exists, canonical_path, path_is_directory, make_directories
    use femcod_solver_options, only: contact_options, validate_options, requested_states
    use femcod_output_guard, only: guard_outputs
+   use femcod_convolution, only: transform_pair, transform_pair_setup, transform_pair_apply, transform_pair_free
+   use femcod_clock, only: wall_clock
    implicit none
    private
+   public :: bare_pair_seconds
    public :: bench_arguments, bad_arguments, benchmark_surface, linear_law, self_path, peers_script, require_peers, &
       require_program, prepare_directory, guard_bench_files, options_refused, surface_for_peers, &
       json_value, read_text_file, write_peer_gaps, remove_file_quietly, peer_line, peer_row, row, segedin, &
@@ -361,4 +364,25 @@ contains
       end do
       close(unit)
    end function peak_mb
+
+   !> Seconds per bare pair of FFTs on M x M (femcod_convolution's transform_pair: FFTW's
+   !> threaded 2-D r2c and c2r in double), the yardstick of a convolution: the mean of
+   !> `repeat` after one untimed, with FFTW_MEASURE plans when `measure`, else
+   !> FFTW_ESTIMATE; the planning is not timed.
+   real(dp) function bare_pair_seconds(m, measure, repeat) result(seconds)
+      integer, intent(in) :: m, repeat
+      logical, intent(in) :: measure
+      type(transform_pair) :: pair
+      real(dp) :: t0, t1
+      integer :: k
+      call transform_pair_setup(pair, m, measure)
+      call transform_pair_apply(pair)
+      call wall_clock(t0)
+      do k = 1, repeat
+         call transform_pair_apply(pair)
+      end do
+      call wall_clock(t1)
+      seconds = (t1 - t0)/repeat
+      call transform_pair_free(pair)
+   end function bare_pair_seconds
 end module femcod_bench_common

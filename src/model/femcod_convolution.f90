@@ -33,7 +33,8 @@
 !> Every FFTW plan of the serial library is made here: the convolution's, the gap-
 !> variable iteration's transform grid (gap_transform), and the one-off transforms of the
 !> periodic table (inverse_half_spectrum), the self-affine generator
-!> (inverse_complex_transform) and the profiles' spectra (line_transform). FFTW-MPI's
+!> (inverse_complex_transform), the profiles' spectra (line_transform) and the bare pair
+!> the benchmarks measure a convolution against (transform_pair). FFTW-MPI's
 !> plans are femcod-mpi's (mpi/src).
 module femcod_convolution
    use, intrinsic :: iso_c_binding, only: c_ptr, c_double, c_float, c_double_complex, c_float_complex, c_int, &
@@ -57,6 +58,7 @@ module femcod_convolution
       line_transform_apply, line_transform_free
    public :: shear_transform, shear_transform_setup, shear_transform_setup_periodic, shear_transform_apply, &
       shear_transform_free
+   public :: transform_pair, transform_pair_setup, transform_pair_apply, transform_pair_free
 
    !> Which operator gap_transform_apply applies: the compliance C = c (I * .) + s or the
    !> stiffness K = C^-1.
@@ -126,6 +128,16 @@ module femcod_convolution
       complex(c_double_complex), pointer :: spectrum(:, :) => null()
       complex(dp), allocatable :: along_x(:, :)
    end type shear_transform
+
+   !> A bare pair of transforms, the yardstick of a convolution's speed (femcod bench): one
+   !> M x M real field to its half spectrum and back (FFTW's threaded 2-D r2c and c2r, on
+   !> OpenMP's threads), with nothing between them.
+   type :: transform_pair
+      integer :: m = 0
+      type(c_ptr) :: forward, backward, real_mem, complex_mem
+      real(c_double), pointer :: field(:, :) => null()
+      complex(c_double_complex), pointer :: spectrum(:, :) => null()
+   end type transform_pair
 
    !> Real-to-complex transforms of lines of one length (the profiles of femcod_summits):
    !> one plan, made on the caller's line and spectrum and executed on them.
@@ -558,12 +570,19 @@ contains
    !> An M x M real field and its half spectrum on FFTW's aligned memory, with the 2-D
    !> r2c and c2r plans between them on OpenMP's threads (FFTW's threaded plans); plans
    !> made after these are single-threaded again, as the convolution's blocks expect.
-   subroutine threaded_2d_plans(m, real_mem, complex_mem, field, spectrum, forward, backward)
+   !> FFTW_ESTIMATE's plans, or FFTW_MEASURE's with `measure` true.
+   subroutine threaded_2d_plans(m, real_mem, complex_mem, field, spectrum, forward, backward, measure)
       integer, intent(in) :: m
       type(c_ptr), intent(out) :: real_mem, complex_mem, forward, backward
       real(c_double), pointer, intent(out) :: field(:, :)
       complex(c_double_complex), pointer, intent(out) :: spectrum(:, :)
+      logical, intent(in), optional :: measure
       integer :: threads
+      integer(c_int) :: flags
+      flags = FFTW_ESTIMATE
+      if (present(measure)) then
+         if (measure) flags = FFTW_MEASURE
+      end if
       real_mem = fftw_alloc_real(int(m, c_size_t)**2)
       complex_mem = fftw_alloc_complex(int(m/2 + 1, c_size_t)*int(m, c_size_t))
       call c_f_pointer(real_mem, field, [m, m])
@@ -572,10 +591,36 @@ contains
       !$ threads = omp_get_max_threads()
       if (fftw_init_threads() == 0) threads = 1
       call fftw_plan_with_nthreads(int(threads, c_int))
-      forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), field, spectrum, FFTW_ESTIMATE)
-      backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), spectrum, field, FFTW_ESTIMATE)
+      forward = fftw_plan_dft_r2c_2d(int(m, c_int), int(m, c_int), field, spectrum, flags)
+      backward = fftw_plan_dft_c2r_2d(int(m, c_int), int(m, c_int), spectrum, field, flags)
       call fftw_plan_with_nthreads(1_c_int)
    end subroutine threaded_2d_plans
+
+   !> The pair's plans on M x M (`measure`: FFTW_MEASURE instead of FFTW_ESTIMATE) and a
+   !> field of zeros.
+   subroutine transform_pair_setup(pair, m, measure)
+      type(transform_pair), intent(inout) :: pair
+      integer, intent(in) :: m
+      logical, intent(in) :: measure
+      pair%m = m
+      call threaded_2d_plans(m, pair%real_mem, pair%complex_mem, pair%field, pair%spectrum, pair%forward, &
+         pair%backward, measure)
+      pair%field = 0
+   end subroutine transform_pair_setup
+
+   !> The field to its half spectrum and back (unnormalised: the field comes back M^2
+   !> times itself).
+   subroutine transform_pair_apply(pair)
+      type(transform_pair), intent(inout) :: pair
+      call fftw_execute_dft_r2c(pair%forward, pair%field, pair%spectrum)
+      call fftw_execute_dft_c2r(pair%backward, pair%spectrum, pair%field)
+   end subroutine transform_pair_apply
+
+   subroutine transform_pair_free(pair)
+      type(transform_pair), intent(inout) :: pair
+      if (.not. associated(pair%field)) return
+      call free_2d_plans(pair%real_mem, pair%complex_mem, pair%field, pair%spectrum, pair%forward, pair%backward)
+   end subroutine transform_pair_free
 
    !> Undo threaded_2d_plans: the plans destroyed, FFTW's memory freed.
    subroutine free_2d_plans(real_mem, complex_mem, field, spectrum, forward, backward)
