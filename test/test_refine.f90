@@ -10,7 +10,8 @@ module test_refine
    use femcod_contact_result, only: contact_result
    use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_solver, only: solve_contact
-   use femcod_refine, only: surface_spectrum, surface_spectrum_of, fit_spectrum, subpixel_slope_variance
+   use femcod_refine, only: surface_spectrum, surface_spectrum_of, fit_spectrum, subpixel_slope_variance, kappa_decay, &
+      kappa_drift, band_kappa
    use femcod_refine_study, only: refine_answer, refine_contact
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -33,7 +34,8 @@ contains
          new_unittest("refined 64^2 -> 256^2 pixel: far nearer the 256^2 solve than the 64^2 solve", test_refined), &
          new_unittest("Persson's theory: the code's column against the formula with the slopes taken here", &
             test_persson), &
-         new_unittest("a surface with no scaling range is refused", test_no_scaling) &
+         new_unittest("a surface with no scaling range is refused", test_no_scaling), &
+         new_unittest("the constant's power law in the octaves, against values worked by hand", test_octave_law) &
          ]
    end subroutine collect_refine
 
@@ -50,6 +52,45 @@ contains
       allocate(p%upper(p%np, p%np))
       p%upper = 0
    end function problem_of
+
+   !> kappa(N) = sqrt 2 + (kappa_1 - sqrt 2) max(N, 1)^-alpha drift^N, alpha =
+   !> log2((kappa_1 - sqrt 2) / (kappa_2 - sqrt 2)), drift = (kappa_1 - sqrt 2) /
+   !> (kappa_c - sqrt 2), worked by hand. Excesses of 1 over one octave and 1/2 over two:
+   !> alpha = 1; without drift 1/4 over four octaves (zeta = 16) and 1/3 over three. Excesses
+   !> 1 and 1/sqrt 2: alpha = 1/2, 1/2 over four octaves. A one-octave excess of 1 at 2d -> d
+   !> and 5/4 at 4d -> 2d: drift 4/5, so with alpha = 1 four octaves give (1/4)(4/5)^4 =
+   !> 64/625 and one octave 4/5; half an octave, (4/5)^(1/2). Without a measured fall or
+   !> change (kappa_2 above kappa_1, either at or below sqrt 2), alpha = 0 and drift = 1.
+   subroutine test_octave_law(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), parameter :: R2 = sqrt(2.0_dp), TOL = 1e-13_dp
+      call check(error, abs(kappa_decay(R2 + 1, R2 + 0.5_dp) - 1) < TOL, "alpha of excesses 1 and 1/2")
+      if (allocated(error)) return
+      call check(error, abs(band_kappa(R2 + 1, 1.0_dp, 1.0_dp, 16.0_dp) - (R2 + 0.25_dp)) < TOL, "four octaves, alpha 1")
+      if (allocated(error)) return
+      call check(error, abs(band_kappa(R2 + 1, 1.0_dp, 1.0_dp, 8.0_dp) - (R2 + 1/3.0_dp)) < TOL, "three octaves, alpha 1")
+      if (allocated(error)) return
+      call check(error, abs(kappa_decay(R2 + 1, R2 + 1/R2) - 0.5_dp) < TOL, "alpha of excesses 1 and 1/sqrt 2")
+      if (allocated(error)) return
+      call check(error, abs(band_kappa(R2 + 1, 0.5_dp, 1.0_dp, 16.0_dp) - (R2 + 0.5_dp)) < TOL, "four octaves, alpha 1/2")
+      if (allocated(error)) return
+      call check(error, abs(kappa_drift(R2 + 1, R2 + 1.25_dp) - 0.8_dp) < TOL, "drift of excesses 1 and 5/4")
+      if (allocated(error)) return
+      call check(error, abs(band_kappa(R2 + 1, 1.0_dp, 0.8_dp, 16.0_dp) - (R2 + 64/625.0_dp)) < TOL, &
+         "four octaves, alpha 1, drift 4/5")
+      if (allocated(error)) return
+      call check(error, abs(band_kappa(R2 + 1, 1.0_dp, 0.8_dp, 2.0_dp) - (R2 + 0.8_dp)) < TOL .and. &
+         abs(band_kappa(R2 + 1, 1.0_dp, 0.8_dp, sqrt(2.0_dp)) - (R2 + sqrt(0.8_dp))) < TOL, &
+         "one octave and half an octave, drift 4/5")
+      if (allocated(error)) return
+      call check(error, kappa_decay(2.7_dp, 2.9_dp) == 0 .and. kappa_decay(2.7_dp, R2) == 0 .and. &
+         kappa_decay(2.7_dp, 1.0_dp) == 0 .and. kappa_drift(2.7_dp, 1.0_dp) == 1 .and. kappa_drift(1.2_dp, 2.7_dp) == 1, &
+         "nothing measured: alpha 0, drift 1")
+      if (allocated(error)) return
+      call check(error, band_kappa(2.7_dp, 0.0_dp, 1.0_dp, 16.0_dp) == 2.7_dp .and. &
+         band_kappa(1.2_dp, 1.0_dp, 0.8_dp, 16.0_dp) == 1.2_dp .and. band_kappa(2.7_dp, 1.0_dp, 0.8_dp, 1.0_dp) == 2.7_dp, &
+         "alpha 0 and drift 1, kappa_1 below sqrt 2, or no band: kappa_1")
+   end subroutine test_octave_law
 
    !> 4 x 4 block means, written here.
    function averaged(z) result(w)

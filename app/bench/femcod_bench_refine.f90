@@ -39,6 +39,7 @@ contains
             closed="()"), &
          real_list_option("--contact", "F1,...", "about these contact fractions (default 0.01,0.03,0.1)", &
             lower=0.0_dp, upper=1.0_dp, closed="()"), &
+         integer_option("--seed", "S", "the surfaces' random seed (default 1)", lower=1), &
          text_option("--svg", "FILE", "write the figure: area against magnification, one case")]
    end function bench_refine_table
 
@@ -46,7 +47,7 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(parsed_options) :: parsed
-      integer :: np, h, c, k
+      integer :: np, h, c, k, seed
       integer, allocatable :: coarse(:)
       real(dp), allocatable :: hursts(:), fractions(:), z(:, :), truth(:)
       real(dp) :: fine_seconds, t0, t1, pixel
@@ -59,7 +60,7 @@ contains
       code = 0
       if (help_requested(args)) then
          write(output_unit, '(a)') "usage: femcod bench refine [--np 2048] [--coarse 512,256] [--hurst 0.5,0.7,0.9]", &
-            "                          [--contact 0.01,0.03,0.1] [--svg FILE]", &
+            "                          [--contact 0.01,0.03,0.1] [--seed 1] [--svg FILE]", &
             "The refinement below the pixel (femcod refine) against full-resolution solves (doc/studies.md)."
          return
       end if
@@ -72,6 +73,8 @@ contains
       hursts = [0.5_dp, 0.7_dp, 0.9_dp]
       fractions = [0.01_dp, 0.03_dp, 0.1_dp]
       svg_path = ""
+      seed = 1
+      call get_option(parsed, "--seed", seed)
       call get_option(parsed, "--np", np)
       call get_option(parsed, "--coarse", coarse)
       call get_option(parsed, "--hurst", hursts)
@@ -83,16 +86,17 @@ contains
          return
       end if
       pixel = 1
-      write(output_unit, '(a)') "femcod bench refine: self-affine surfaces (rms 3 nm, seed 1), "//int_str(np)//"^2 "// &
+      write(output_unit, '(a)') "femcod bench refine: self-affine surfaces (rms 3 nm, seed "//int_str(seed)//"), "// &
+         int_str(np)//"^2 "// &
          "pixels of "//fixed_str(pixel, 1)//" nm, periodic, E* = 213.3 GPa; the truth: cg at "//int_str(np)//"^2; "// &
          "each method's area fraction error against it (signed, relative), refined down to "//fixed_str(pixel, 1)//" nm"
       write(output_unit, '(a)') "| H | load (nN) | truth | coarse NP | solve | Richardson | Persson | refined "// &
-         "(sqrt 2) | refined (kappa) | kappa | cost / full solve |"
+         "(sqrt 2) | refined (kappa) | kappa: 2d-d, 4d-2d, 4d-d, the band's | cost / full solve |"
       write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|---|---|"
       allocate(series(0))
       do h = 1, size(hursts)
          allocate(z(np, np))
-         call self_affine_surface(np, pixel, hursts(h), 3.0_dp, 1, z)
+         call self_affine_surface(np, pixel, hursts(h), 3.0_dp, seed, z)
          fine = periodic_problem(z, pixel)
          deallocate(z)
          call wall_clock(t0)
@@ -171,7 +175,8 @@ contains
             fixed_str(truth(k), 5)//" | "//int_str(np)//" | "//signed(answer%coarse(1, k)/truth(k) - 1)//" | "// &
             signed(answer%richardson(last, k)/truth(k) - 1)//" | "//signed(answer%persson(last, k)/truth(k) - 1)// &
             " | "//signed(answer%theory(last, k)/truth(k) - 1)//" | "//signed(answer%refined(last, k)/truth(k) - 1)// &
-            " | "//fixed_str(answer%kappa(k), 2)//" | "//sig_str(cost, 3)//" |"
+            " | "//fixed_str(answer%kappa(k), 2)//", "//fixed_str(answer%kappa_coarse, 2)//", "// &
+            fixed_str(answer%kappa_two, 2)//", "//fixed_str(answer%band(last), 2)//" | "//sig_str(cost, 3)//" |"
       end do
    end subroutine print_rows
 

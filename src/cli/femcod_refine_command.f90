@@ -56,15 +56,17 @@ contains
          "", &
          "The thesis' third model (section 5.3): the deck solved at its resolution (cg), the surface's PSD", &
          "fitted by a power law over 4 q_L .. q_d/2, and each contact pixel refined below the pixel by", &
-         "Persson's erf of its own mean pressure over the roughness the power law continues, with one", &
-         "constant (kappa) measured on the octave from 2d to d that the image resolves (doc/studies.md).", &
+         "Persson's erf of its own mean pressure over the roughness the power law continues, with a", &
+         "constant (kappa) measured on the image over the octaves 2d to d, 4d to 2d and 4d to d, and for", &
+         "the band below the pixel its law in the band's octaves and scale (doc/studies.md).", &
          "Beside it: Richardson's extrapolation from solves at 2d and 4d (section 4.5) and Persson's theory", &
          "of the whole surface. A surface whose PSD is not a power law (no scaling range) is refused.", ""
       call print_lines(option_help(refine_table(), "heights"))
       write(output_unit, '(a)') "", &
          "outputs: PREFIX.refine.csv  load_nN,magnification,pixel_nm,area_fraction_solve,area_fraction_refined,", &
          "                            area_fraction_richardson,area_fraction_persson,", &
-         "                            area_fraction_refined_sqrt2 (Persson's constant in place of kappa),kappa", &
+         "                            area_fraction_refined_sqrt2 (Persson's constant in place of kappa),", &
+         "                            kappa (the constant of that magnification's band)", &
          "         PREFIX.refine.svg  area fraction against magnification, one curve per method and load"
    end subroutine refine_help
 
@@ -153,7 +155,7 @@ contains
                format_real(pixel/answer%zeta(z))//","//format_real(answer%coarse(1, k))//","// &
                format_real(answer%refined(z, k))//","//format_real(answer%richardson(z, k))//","// &
                format_real(answer%persson(z, k))//","//format_real(answer%theory(z, k))//","// &
-               format_real(answer%kappa(k))//","//format_real(answer%slope_solve(k))//","// &
+               format_real(answer%band(z))//","//format_real(answer%slope_solve(k))//","// &
                format_real(answer%slope_refined(z, k)))
          end do
       end do
@@ -191,10 +193,14 @@ contains
       do k = 1, size(answer%loads)
          j = j//'    {"load_nN": '//json_number(answer%loads(k))//', "area_fraction_solve": '// &
             json_number(answer%coarse(1, k))//', "area_load_slope_solve": '//json_number(answer%slope_solve(k))// &
-            ', "kappa": '//json_number(answer%kappa(k))//', "magnifications": ['
+            ', "kappa_one_octave": '//json_number(answer%kappa(k))//', "kappa_coarser_octave": '// &
+            json_number(answer%kappa_coarse)//', "kappa_two_octaves": '//json_number(answer%kappa_two)// &
+            ', "kappa_decay": '//json_number(answer%decay)//', "kappa_drift": '//json_number(answer%drift)// &
+            ', "magnifications": ['
          do z = 1, size(answer%zeta)
             j = j//nl//'      {"magnification": '//json_number(answer%zeta(z))//', "pixel_nm": '// &
-               json_number(problem%pixel/answer%zeta(z))//', "area_fraction_refined": '// &
+               json_number(problem%pixel/answer%zeta(z))//', "kappa": '//json_number(answer%band(z))// &
+               ', "area_fraction_refined": '// &
                json_number(answer%refined(z, k))//', "area_fraction_richardson": '// &
                json_number(answer%richardson(z, k))//', "area_fraction_persson": '//json_number(answer%persson(z, k))// &
                ', "area_fraction_refined_sqrt2": '//json_number(answer%theory(z, k))//', "area_load_slope_refined": '// &
@@ -246,12 +252,17 @@ contains
       end associate
       write(output_unit, '(a)') "  down to   : "//format_real(down_to)//" nm, magnification "// &
          sig_str(answer%zeta(last), 4)
+      write(output_unit, '(a)') "  kappa     : "//sig_str(answer%kappa(1), 4)//" over the octave 2d to d, "// &
+         sig_str(answer%kappa_coarse, 4)//" over 4d to 2d, "//sig_str(answer%kappa_two, 4)//" over 4d to d: "// &
+         "N^-"//sig_str(answer%decay, 3)//" in a band's octaves N, x "//sig_str(answer%drift, 3)// &
+         " an octave finer; "//sig_str(answer%band(last), 4)//" over the "// &
+         sig_str(log(answer%zeta(last))/log(2.0_dp), 3)//" octaves refined"
       do k = 1, size(answer%loads)
          write(output_unit, '(a)') "  at load   : "//sig_str(answer%loads(k), 6)//" nN: the solve "// &
             sig_str(100*answer%coarse(1, k), 4)//" %; refined "//sig_str(100*answer%refined(last, k), 4)// &
             " %, Richardson "//sig_str(100*answer%richardson(last, k), 4)//" %, Persson "// &
             sig_str(100*answer%persson(last, k), 4)//" % at "//format_real(down_to)//" nm (kappa "// &
-            sig_str(answer%kappa(k), 4)//", Persson's sqrt(2) gives "//sig_str(100*answer%theory(last, k), 4)//" %)"
+            sig_str(answer%band(last), 4)//", Persson's sqrt(2) gives "//sig_str(100*answer%theory(last, k), 4)//" %)"
          write(output_unit, '(a)') "              area-load slope (A/A0)/(p/(E* h'_rms)): the solve "// &
             sig_str(answer%slope_solve(k), 4)//" (h'_rms "//sig_str(answer%rms_slope, 4)//" at the pixel), refined "// &
             sig_str(answer%slope_refined(last, k), 4)//" (with the slope down to "//format_real(down_to)//" nm)"

@@ -17,6 +17,10 @@
 !>   in contact:
 !>       f_i(zeta) = erf( sqrt(2) p_i / (E* sqrt(m2(zeta))) ),
 !>   so the real area is d^2 sum_i f_i(zeta). At zeta = 1, f_i = 1: the solve's own area.
+!>   The refinement puts a constant kappa measured on the image in place of sqrt(2): over
+!>   the octaves 2d -> d and 4d -> 2d and the two octaves 4d -> d (the solves at 2d and 4d
+!>   carried to the areas at d and 2d: calibrate_kappa), and for the band of N octaves
+!>   below d their law in N and in the band's scale (kappa_decay, kappa_drift, band_kappa).
 !> - Assumptions: the interaction between sub-pixel contacts of different pixels is that
 !>   of their mean pressures (already in the solve); a pixel out of contact stays out
 !>   (its sub-pixel peaks do not reach across its gap); the material stays elastic.
@@ -36,7 +40,8 @@ module femcod_refine
    implicit none
    private
    public :: surface_spectrum_of, fit_spectrum, subpixel_slope_variance, refined_fraction, persson_fraction, &
-      richardson_area, magnifications, calibrate_kappa, MIN_R_SQUARED, MIN_FIT_RATIO
+      richardson_area, magnifications, calibrate_kappa, kappa_decay, kappa_drift, band_kappa, &
+      MIN_R_SQUARED, MIN_FIT_RATIO
 
    real(dp), parameter :: PI = acos(-1.0_dp)
    !> A power law is accepted when log C against log q fits a line with r^2 at least this,
@@ -218,6 +223,41 @@ contains
          end do
       end function mismatch
    end function calibrate_kappa
+
+   !> How the refinement's constant falls with the octaves of its band, measured on the
+   !> image: alpha = log2((kappa_1 - sqrt 2) / (kappa_2 - sqrt 2)) from the constant over one
+   !> octave (kappa_1: the solve at 2d carried to the area at d) and over two (kappa_2: 4d
+   !> to d). 0 (no fall) when kappa_2 is not between sqrt 2 and kappa_1.
+   pure real(dp) function kappa_decay(kappa_1, kappa_2) result(alpha)
+      real(dp), intent(in) :: kappa_1, kappa_2
+      alpha = 0
+      if (kappa_2 > sqrt(2.0_dp) .and. kappa_2 < kappa_1) &
+         alpha = log((kappa_1 - sqrt(2.0_dp))/(kappa_2 - sqrt(2.0_dp)))/log(2.0_dp)
+   end function kappa_decay
+
+   !> How the one-octave constant changes an octave finer, measured on the image: the ratio
+   !> (kappa_1 - sqrt 2) / (kappa_c - sqrt 2) of the octave 2d -> d to the octave 4d -> 2d
+   !> (kappa_c). 1 (no change) when either is not above sqrt 2.
+   pure real(dp) function kappa_drift(kappa_1, kappa_c) result(drift)
+      real(dp), intent(in) :: kappa_1, kappa_c
+      drift = 1
+      if (kappa_1 > sqrt(2.0_dp) .and. kappa_c > sqrt(2.0_dp)) drift = (kappa_1 - sqrt(2.0_dp))/(kappa_c - sqrt(2.0_dp))
+   end function kappa_drift
+
+   !> The refinement's constant for the band of N = log2(zeta) octaves below the pixel: its
+   !> excess over Persson's sqrt 2 falls as a power of the band's octaves and changes by
+   !> `drift` for each octave the band lies finer than the octave 2d -> d it was measured on
+   !> (doc/studies.md):
+   !>     kappa(N) = sqrt 2 + (kappa_1 - sqrt 2) max(N, 1)^-alpha drift^N.
+   !> kappa_1 when kappa_1 is not above sqrt 2.
+   elemental real(dp) function band_kappa(kappa_1, alpha, drift, zeta) result(kappa)
+      real(dp), intent(in) :: kappa_1, alpha, drift, zeta
+      real(dp) :: octaves
+      kappa = kappa_1
+      if (.not. (kappa_1 > sqrt(2.0_dp) .and. zeta > 1)) return
+      octaves = log(zeta)/log(2.0_dp)
+      kappa = sqrt(2.0_dp) + (kappa_1 - sqrt(2.0_dp))*max(octaves, 1.0_dp)**(-alpha)*drift**octaves
+   end function band_kappa
 
    !> Persson's area fraction at nominal pressure p0 (GPa) over roughness of mean square
    !> slope m2: erf(sqrt(2) p0 / (E* sqrt(m2))).

@@ -16,7 +16,8 @@ module femcod_refine_study
    use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_solver, only: solve_contact
    use femcod_refine, only: surface_spectrum, surface_spectrum_of, fit_spectrum, subpixel_slope_variance, &
-      refined_fraction, persson_fraction, richardson_area, magnifications, calibrate_kappa
+      refined_fraction, persson_fraction, richardson_area, magnifications, calibrate_kappa, kappa_decay, kappa_drift, &
+      band_kappa
    implicit none
    private
    public :: refine_answer, refine_contact
@@ -40,8 +41,15 @@ module femcod_refine_study
       real(dp), allocatable :: coarse(:, :)
       real(dp), allocatable :: refined(:, :), richardson(:, :), persson(:, :)
       !> The refinement with Persson's own constant sqrt(2) in place of the measured one
-      !> (zeta, load), and the measured constant kappa per load.
+      !> (zeta, load), and the measured constant kappa per load: over one octave (the solve
+      !> at 2d carried to the area at d; the same for every load: one fit over all).
       real(dp), allocatable :: theory(:, :), kappa(:)
+      !> The constant over two octaves (4d to d) and over the octave 4d to 2d, its fall with
+      !> the band's octaves (kappa_decay; 0: none measured) and its change an octave finer
+      !> (kappa_drift; 1: none measured), and the constant of each magnification's band
+      !> (band_kappa); kappa_two and kappa_coarse NaN when the grid has no 4d level.
+      real(dp) :: kappa_two = 0, kappa_coarse = 0, decay = 0, drift = 1
+      real(dp), allocatable :: band(:)
       !> The dimensionless area-load slope (A/A0) / (p/(E* h'_rms)) (doc/studies.md, "The
       !> area-load slope kappa"): of the solve at d with the image's h'_rms at the pixel
       !> (rms_slope: forward differences, as every run reports it), and of the refined
@@ -62,7 +70,7 @@ contains
       real(dp), intent(in) :: down_to
       type(refine_answer), intent(out) :: answer
       type(status_type), intent(inout) :: status
-      type(pressure_set), allocatable :: at_d(:), at_2d(:), none(:)
+      type(pressure_set), allocatable :: at_d(:), at_2d(:), at_4d(:)
       real(dp), allocatable :: g0(:, :)
       real(dp) :: t0, t1, t2
       if (status%code /= 0) return
@@ -95,24 +103,23 @@ contains
       if (status%code /= 0) return
       if (modulo(problem%np, 4) == 0 .and. problem%np >= 16) then
          call solve_level(problem, options, 2, answer%coarse(2, :), at_2d, status)
-         allocate(none(0))
-         if (status%code == 0) call solve_level(problem, options, 4, answer%coarse(3, :), none, status)
+         if (status%code == 0) call solve_level(problem, options, 4, answer%coarse(3, :), at_4d, status)
          call wall_clock(t0)
          answer%richardson_seconds = t0 - t2
          if (status%code /= 0) return
       end if
       call wall_clock(t0)
-      call refine_states(problem, answer, at_d, at_2d)
+      call refine_states(problem, answer, at_d, at_2d, at_4d)
       call wall_clock(t1)
       answer%refine_seconds = answer%refine_seconds + (t1 - t0)
    end subroutine refine_contact
 
    !> The refinement, Persson and Richardson at every load and magnification.
-   subroutine refine_states(problem, answer, at_d, at_2d)
+   subroutine refine_states(problem, answer, at_d, at_2d, at_4d)
       type(contact_problem), intent(in) :: problem
       type(refine_answer), intent(inout) :: answer
       type(pressure_set), intent(in) :: at_d(:)
-      type(pressure_set), allocatable, intent(in) :: at_2d(:)
+      type(pressure_set), allocatable, intent(in) :: at_2d(:), at_4d(:)
       real(dp) :: q_d, m2, p0, side
       integer :: k, z, nz, nl
       nz = size(answer%zeta)
@@ -126,18 +133,28 @@ contains
       answer%persson = answer%refined
       answer%richardson = answer%refined
       answer%kappa = sqrt(2.0_dp)
+      answer%kappa_two = ieee_value(1.0_dp, ieee_quiet_nan)
+      answer%kappa_coarse = answer%kappa_two
       q_d = PI/problem%pixel
       side = problem%np*problem%pixel
-      ! The one constant of the refinement, from the step 2d -> d the image resolves.
+      ! The refinement's constant, from the steps 2d -> d, 4d -> 2d and 4d -> d the image
+      ! resolves.
       if (allocated(at_2d)) answer%kappa = calibrated(answer, at_2d, subpixel_slope_variance(answer%spectrum, &
-         q_d/2, q_d))
+         q_d/2, q_d), 1)
+      if (allocated(at_4d)) then
+         answer%kappa_two = calibrated(answer, at_4d, subpixel_slope_variance(answer%spectrum, q_d/4, q_d), 1)
+         answer%kappa_coarse = calibrated(answer, at_4d, subpixel_slope_variance(answer%spectrum, q_d/4, q_d/2), 2)
+         answer%decay = kappa_decay(answer%kappa(1), answer%kappa_two)
+         answer%drift = kappa_drift(answer%kappa(1), answer%kappa_coarse)
+      end if
+      answer%band = band_kappa(answer%kappa(1), answer%decay, answer%drift, answer%zeta)
       do k = 1, nl
          if (.not. allocated(at_d(k)%p)) cycle
          p0 = answer%loads(k)/side**2
          if (p0 > 0) answer%slope_solve(k) = answer%coarse(1, k)*answer%estar*answer%rms_slope/p0
          do z = 1, nz
             m2 = subpixel_slope_variance(answer%spectrum, q_d, answer%zeta(z)*q_d)
-            answer%refined(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, answer%kappa(k))
+            answer%refined(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, answer%band(z))
             answer%theory(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, sqrt(2.0_dp))
             if (p0 > 0) answer%slope_refined(z, k) = answer%refined(z, k)*answer%estar* &
                sqrt(answer%rms_slope**2 + m2)/p0
@@ -148,29 +165,32 @@ contains
       end do
    end subroutine refine_states
 
-   !> kappa over the loads reached at both d and 2d (sqrt 2, Persson's, when none is).
-   function calibrated(answer, at_2d, m2) result(kappa)
+   !> kappa that carries the pressures `coarser` (of the solve at 2d or 4d) to the area
+   !> fractions of level `level` (answer%coarse: 1 the solve at d, 2 at 2d) over the loads
+   !> reached at both (m2 of the band between them); sqrt 2 (Persson's) when none is.
+   function calibrated(answer, coarser, m2, level) result(kappa)
       type(refine_answer), intent(in) :: answer
-      type(pressure_set), intent(in) :: at_2d(:)
+      type(pressure_set), intent(in) :: coarser(:)
       real(dp), intent(in) :: m2
+      integer, intent(in) :: level
       real(dp) :: kappa
       real(dp), allocatable :: p(:, :, :)
-      logical :: both(size(at_2d))
+      logical :: both(size(coarser))
       integer :: k, m, n
       kappa = sqrt(2.0_dp)
-      do k = 1, size(at_2d)
-         both(k) = allocated(at_2d(k)%p) .and. answer%coarse(1, k) == answer%coarse(1, k)
+      do k = 1, size(coarser)
+         both(k) = allocated(coarser(k)%p) .and. answer%coarse(level, k) == answer%coarse(level, k)
       end do
       if (.not. any(both)) return
-      n = size(at_2d(findloc(both, .true., 1))%p, 1)
+      n = size(coarser(findloc(both, .true., 1))%p, 1)
       allocate(p(n, n, count(both)))
       m = 0
-      do k = 1, size(at_2d)
+      do k = 1, size(coarser)
          if (.not. both(k)) cycle
          m = m + 1
-         p(:, :, m) = at_2d(k)%p
+         p(:, :, m) = coarser(k)%p
       end do
-      kappa = calibrate_kappa(p, answer%estar, m2, pack(answer%coarse(1, :), both))
+      kappa = calibrate_kappa(p, answer%estar, m2, pack(answer%coarse(level, :), both))
    end function calibrated
 
    !> The solve with both surfaces averaged in blocks of `block` x `block` pixels (1: as
