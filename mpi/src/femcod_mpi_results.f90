@@ -25,7 +25,8 @@ module femcod_mpi_results
    !> version, command, times, which columns the states have), and the ranks'.
    type, extends(run_info) :: distributed_run_info
       character(len=:), allocatable :: label
-      integer :: ranks = 1, threads = 1
+      !> The ranks (the threads per rank are the parent's `threads`).
+      integer :: ranks = 1
       real(dp) :: wall_seconds = 0
       !> Peak resident memory of each rank (MB).
       real(dp), allocatable :: peak_mb(:)
