@@ -35,7 +35,8 @@ program femcod_mpi
    use femcod_output_guard, only: guard_outputs, OUTPUT_RESULT
    use femcod_files, only: path_exists, remove_file, atomic_rename, write_file, acquire_lock, release_lock, &
       default_prefix
-   use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso, wait_policy_text
+   use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, local_time_iso, &
+      openmp_threads, wait_policy_text
    use femcod_mpi_observer, only: signal_observer
    use femcod_clock, only: wall_clock
    use femcod_about, only: FEMCOD_VERSION
@@ -242,7 +243,7 @@ program femcod_mpi
    info%started = started
    info%finished = local_time_iso()
    info%ranks = ranks
-   info%threads = omp_get_max_threads()
+   info%threads = openmp_threads()
    info%wait_policy = wait_policy_text()
    if (.not. allocated(info%label)) info%label = ""
    info%wall_seconds = t_solve - t_start

@@ -69,11 +69,11 @@ contains
    !> spins, then sleeps), and why when the femcod program chose it at start
    !> (FEMCOD_BUSY_AT_START, app/femcod_start_environment.f90).
    function wait_policy_text() result(text)
-      character(len=:), allocatable :: text
+      character(len=:), allocatable :: text, seen
       text = environment_value("OMP_WAIT_POLICY")
       if (text == "") text = "default"
-      if (environment_value("FEMCOD_BUSY_AT_START") /= "") &
-         text = text//" (chosen by femcod: "//environment_value("FEMCOD_BUSY_AT_START")//")"
+      seen = environment_value("FEMCOD_BUSY_AT_START")
+      if (seen /= "") text = text//" (chosen by femcod: "//seen//")"
    end function wait_policy_text
 
    !> An environment variable's value ("" when unset).
