@@ -27,6 +27,8 @@ contains
          new_unittest("sphere heights", test_sphere), &
          new_unittest("Weierstrass-Mandelbrot terms, eq. 3.7: 18 and 5", test_wm_terms), &
          new_unittest("self-affine surface: rms, mean, reproducible", test_self_affine), &
+         new_unittest("self-affine surface with a cutoff: no waves below it, the same ones above", &
+            test_self_affine_cutoff), &
          new_unittest("random stream: a jump of n is n draws (0 to 10^5 + 7)", test_stream_jump), &
          new_unittest("plane removal and down-sampling", test_transforms), &
          new_unittest("ASCII matrix: comments, errors", test_matrix), &
@@ -150,6 +152,50 @@ contains
       call self_affine_surface(64, 2.0_dp, 0.8_dp, 3.0_dp, 6, w)
       call check(error, any(z /= w), "another seed, another surface")
    end subroutine test_self_affine
+
+   !> A cutoff of 8 nm on 64 pixels of 2 nm: a discrete Fourier transform taken here (a
+   !> dense matrix product, not FFTW) has no power at |q| > 2 pi/8, and below it the same
+   !> coefficients as the surface without the cutoff up to one factor (the rms scaling).
+   subroutine test_self_affine_cutoff(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: N = 64
+      real(dp), parameter :: D = 2, CUT = 8, PI = acos(-1.0_dp)
+      real(dp) :: z(N, N), w(N, N), q, ratio
+      complex(dp) :: e(N, N), zc(N, N), wc(N, N)
+      integer :: i, j, fi, fj
+      logical :: kept(N, N)
+      call self_affine_surface(N, D, 0.8_dp, 3.0_dp, 5, z, cutoff=CUT)
+      call self_affine_surface(N, D, 0.8_dp, 3.0_dp, 5, w)
+      call check(error, rms_height(z), 3.0_dp, rel=.true., thr=1.0e-12_dp)
+      if (allocated(error)) return
+      do j = 1, N
+         do i = 1, N
+            e(i, j) = exp(cmplx(0.0_dp, -2*PI*(i - 1)*(j - 1)/real(N, dp), dp))
+         end do
+      end do
+      zc = matmul(e, matmul(cmplx(z, 0.0_dp, dp), transpose(e)))
+      wc = matmul(e, matmul(cmplx(w, 0.0_dp, dp), transpose(e)))
+      do j = 1, N
+         fj = j - 1
+         if (fj > N/2) fj = fj - N
+         do i = 1, N
+            fi = i - 1
+            if (fi > N/2) fi = fi - N
+            q = 2*PI*sqrt(real(fi**2 + fj**2, dp))/(N*D)
+            kept(i, j) = q <= 2*PI/CUT*(1 + 1.0e-12_dp) .and. (fi /= 0 .or. fj /= 0)
+            if (.not. kept(i, j) .and. (fi /= 0 .or. fj /= 0)) then
+               call check(error, abs(zc(i, j)) < 1.0e-10_dp*N*N, "a wave below the cutoff: |Z| "// &
+                  to_string(abs(zc(i, j)))//" at ("//to_string(fi)//", "//to_string(fj)//")")
+               if (allocated(error)) return
+            end if
+         end do
+      end do
+      call check(error, count(kept) > 100, "modes kept: "//to_string(count(kept)))
+      if (allocated(error)) return
+      ratio = abs(zc(2, 1))/abs(wc(2, 1))
+      call check(error, maxval(abs(zc - ratio*wc), mask=kept) < 1.0e-9_dp*maxval(abs(zc)), &
+         "the kept waves are the uncut surface's, scaled by "//to_string(ratio))
+   end subroutine test_self_affine_cutoff
 
    subroutine test_transforms(error)
       type(error_type), allocatable, intent(out) :: error

@@ -236,15 +236,18 @@ contains
    !> Self-affine Gaussian random surface by Fourier filtering: power spectrum
    !> C(q) ~ q**(-2(1+H)) for 2 pi/L <= |q| <= pi/d (L = NP d), zero elsewhere,
    !> Gaussian random complex amplitudes (reproducible from `seed`), inverse FFT
-   !> (FFTW), real part, mean removed, scaled to the rms height `rms` (nm).
-   subroutine self_affine_surface(np, pixel, hurst, rms, seed, z)
+   !> (FFTW), real part, mean removed, scaled to the rms height `rms` (nm). With `cutoff`
+   !> (nm, above 2 d), no roughness below that wavelength: |q| <= 2 pi/cutoff, the same
+   !> random amplitudes above it.
+   subroutine self_affine_surface(np, pixel, hurst, rms, seed, z, cutoff)
       use femcod_convolution, only: inverse_complex_transform
       integer, intent(in) :: np, seed
       real(dp), intent(in) :: pixel, hurst, rms
       real(dp), intent(out) :: z(np, np)
+      real(dp), intent(in), optional :: cutoff
       complex(c_double_complex), allocatable :: spec(:, :), field(:, :)
       allocate(spec(np, np), field(np, np))
-      call self_affine_spectrum(np, pixel, hurst, seed, 0, np, spec)
+      call self_affine_spectrum(np, pixel, hurst, seed, 0, np, spec, cutoff)
       ! FFTW is row-major: a Fortran (np, np) array is an (np, np) C array transposed,
       ! which a 2-D transform of a square grid does not mind.
       call inverse_complex_transform(spec, field)
@@ -257,11 +260,12 @@ contains
    !> spectrum (self_affine_surface), into spec(np, columns): the random stream of `seed`
    !> jumped ahead to the first of them (four uniforms per frequency: two normal
    !> deviates), so that each of femcod-mpi's ranks draws its own columns and together
-   !> they draw what one core draws.
-   pure subroutine self_affine_spectrum(np, pixel, hurst, seed, first_column, columns, spec)
+   !> they draw what one core draws. `cutoff` (nm): the shortest wavelength, when above 2 d.
+   pure subroutine self_affine_spectrum(np, pixel, hurst, seed, first_column, columns, spec, cutoff)
       integer, intent(in) :: np, seed, first_column, columns
       real(dp), intent(in) :: pixel, hurst
       complex(c_double_complex), intent(out) :: spec(:, :)
+      real(dp), intent(in), optional :: cutoff
       type(random_stream) :: stream
       real(dp) :: qx, qy, q, qmin, qmax, a, b, amp
       integer :: i, j, fi, fj
@@ -269,6 +273,9 @@ contains
       call advance_stream(stream, 4*int(np, int64)*first_column)
       qmin = 2*pi/(np*pixel)
       qmax = pi/pixel
+      if (present(cutoff)) then
+         if (cutoff > 2*pixel) qmax = 2*pi/cutoff
+      end if
       do j = first_column + 1, first_column + columns
          fj = j - 1
          if (fj > np/2) fj = fj - np
