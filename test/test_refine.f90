@@ -11,7 +11,7 @@ module test_refine
    use femcod_solver_options, only: contact_options, SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_solver, only: solve_contact
    use femcod_refine, only: surface_spectrum, surface_spectrum_of, fit_spectrum, subpixel_slope_variance, kappa_decay, &
-      kappa_drift, band_kappa
+      kappa_drift, band_kappa, band_edge
    use femcod_refine_study, only: refine_answer, refine_contact
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
@@ -35,7 +35,8 @@ contains
          new_unittest("Persson's theory: the code's column against the formula with the slopes taken here", &
             test_persson), &
          new_unittest("a surface with no scaling range is refused", test_no_scaling), &
-         new_unittest("the constant's power law in the octaves, against values worked by hand", test_octave_law) &
+         new_unittest("the constant's power law in the octaves, against values worked by hand", test_octave_law), &
+         new_unittest("the band's edges, against values worked by hand; the refined area inside them", test_band) &
          ]
    end subroutine collect_refine
 
@@ -91,6 +92,44 @@ contains
          band_kappa(1.2_dp, 1.0_dp, 0.8_dp, 16.0_dp) == 1.2_dp .and. band_kappa(2.7_dp, 1.0_dp, 0.8_dp, 1.0_dp) == 2.7_dp, &
          "alpha 0 and drift 1, kappa_1 below sqrt 2, or no band: kappa_1")
    end subroutine test_octave_law
+
+   !> The band's edges (band_edge) by hand: a one-octave excess of 1 carried to 1/2 (f =
+   !> 1/2) gives excesses from 1/4 to 1 (kappa_1 itself); carried up to 2 (f = 2), from 1 to
+   !> 4; carried to itself, no width. Without a trend the band runs from sqrt 2 to kappa_1,
+   !> either way round. And on the refine study of test_refined's surface, every refined
+   !> area lies between the band's (the area rises with kappa: erf is increasing).
+   subroutine test_band(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp), parameter :: R2 = sqrt(2.0_dp), TOL = 1e-13_dp
+      real(dp) :: z(FINE, FINE)
+      type(refine_answer) :: answer
+      type(status_type) :: st
+      call check(error, abs(band_edge(R2 + 1, R2 + 0.5_dp, .true., .false.) - (R2 + 0.25_dp)) < TOL .and. &
+         abs(band_edge(R2 + 1, R2 + 0.5_dp, .true., .true.) - (R2 + 1)) < TOL, "falling excess: 1/4 to 1")
+      if (allocated(error)) return
+      call check(error, abs(band_edge(R2 + 1, R2 + 2, .true., .false.) - (R2 + 1)) < TOL .and. &
+         abs(band_edge(R2 + 1, R2 + 2, .true., .true.) - (R2 + 4)) < TOL, "rising excess: 1 to 4")
+      if (allocated(error)) return
+      call check(error, band_edge(R2 + 1, R2 + 1, .true., .false.) == R2 + 1 .and. &
+         band_edge(R2 + 1, R2 + 1, .true., .true.) == R2 + 1, "no extrapolation: no width")
+      if (allocated(error)) return
+      call check(error, band_edge(2.7_dp, 2.7_dp, .false., .false.) == R2 .and. &
+         band_edge(2.7_dp, 2.7_dp, .false., .true.) == 2.7_dp .and. band_edge(1.2_dp, 1.2_dp, .false., .false.) == 1.2_dp &
+         .and. band_edge(1.2_dp, 1.2_dp, .false., .true.) == R2, "no trend: sqrt 2 to kappa_1")
+      if (allocated(error)) return
+      call self_affine_surface(FINE, PIXEL, 0.7_dp, 3.0_dp, 1, z)
+      call refine_contact(problem_of(averaged(z), PIXEL*FACTOR), options_at(loads_for(z, PIXEL)), PIXEL, answer, st)
+      call check(error, st%code == 0, st%message)
+      if (allocated(error)) return
+      call check(error, all(answer%band_low <= answer%band .and. answer%band <= answer%band_high), &
+         "the band's constants bracket the refinement's")
+      if (allocated(error)) return
+      call check(error, all(answer%refined_low <= answer%refined .and. answer%refined <= answer%refined_high), &
+         "the refined areas inside the band")
+      if (allocated(error)) return
+      call check(error, any(answer%refined_low < answer%refined .and. answer%refined < answer%refined_high), &
+         "a band of some width below the pixel")
+   end subroutine test_band
 
    !> 4 x 4 block means, written here.
    function averaged(z) result(w)

@@ -19,7 +19,7 @@ module femcod_bench_refine
    use femcod_strings, only: string_type, int_str, fixed_str, sig_str
    use femcod_help, only: help_requested
    use femcod_options, only: option_spec, parsed_options, integer_option, real_list_option, integer_list_option, &
-      text_option, get_option
+      text_option, real_option, get_option
    use femcod_clock, only: wall_clock
    use femcod_files, only: write_file
    use femcod_svg, only: svg_series, add_series, svg_multi_plot
@@ -40,6 +40,8 @@ contains
          real_list_option("--contact", "F1,...", "about these contact fractions (default 0.01,0.03,0.1)", &
             lower=0.0_dp, upper=1.0_dp, closed="()"), &
          integer_option("--seed", "S", "the surfaces' random seed (default 1)", lower=1), &
+         real_option("--cutoff", "L", "no roughness below the wavelength L (nm, above 2; default none: "// &
+            "self-affine down to the pixel)", lower=2.0_dp, closed="()"), &
          text_option("--svg", "FILE", "write the figure: area against magnification, one case")]
    end function bench_refine_table
 
@@ -47,10 +49,10 @@ contains
       type(string_type), intent(in) :: args(:)
       integer, intent(out) :: code
       type(parsed_options) :: parsed
-      integer :: np, h, c, k, seed
+      integer :: np, h, c, k, seed, tally(4)
       integer, allocatable :: coarse(:)
       real(dp), allocatable :: hursts(:), fractions(:), z(:, :), truth(:)
-      real(dp) :: fine_seconds, t0, t1, pixel
+      real(dp) :: fine_seconds, t0, t1, pixel, cutoff
       character(len=:), allocatable :: svg_path
       type(contact_problem) :: fine
       type(contact_result) :: res
@@ -60,7 +62,7 @@ contains
       code = 0
       if (help_requested(args)) then
          write(output_unit, '(a)') "usage: femcod bench refine [--np 2048] [--coarse 512,256] [--hurst 0.5,0.7,0.9]", &
-            "                          [--contact 0.01,0.03,0.1] [--seed 1] [--svg FILE]", &
+            "                          [--contact 0.01,0.03,0.1] [--seed 1] [--cutoff L] [--svg FILE]", &
             "The refinement below the pixel (femcod refine) against full-resolution solves (doc/studies.md)."
          return
       end if
@@ -80,23 +82,31 @@ contains
       call get_option(parsed, "--hurst", hursts)
       call get_option(parsed, "--contact", fractions)
       call get_option(parsed, "--svg", svg_path)
+      cutoff = 0
+      call get_option(parsed, "--cutoff", cutoff)
       if (any(modulo(np, coarse) /= 0) .or. any(coarse >= np)) then
          write(error_unit, '(a)') "femcod bench refine: every --coarse grid must divide --np and be smaller"
          code = 2
          return
       end if
       pixel = 1
-      write(output_unit, '(a)') "femcod bench refine: self-affine surfaces (rms 3 nm, seed "//int_str(seed)//"), "// &
+      write(output_unit, '(a)') "femcod bench refine: self-affine surfaces (rms 3 nm, seed "//int_str(seed)// &
+         trim(merge(", no roughness below "//fixed_str(cutoff, 1)//" nm", repeat(" ", 40), cutoff > 0))//"), "// &
          int_str(np)//"^2 "// &
          "pixels of "//fixed_str(pixel, 1)//" nm, periodic, E* = 213.3 GPa; the truth: cg at "//int_str(np)//"^2; "// &
          "each method's area fraction error against it (signed, relative), refined down to "//fixed_str(pixel, 1)//" nm"
       write(output_unit, '(a)') "| H | load (nN) | truth | coarse NP | solve | Richardson | Persson | refined "// &
-         "(sqrt 2) | refined (kappa) | kappa: 2d-d, 4d-2d, 4d-d, the band's | cost / full solve |"
-      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|---|---|"
+         "(sqrt 2) | refined (kappa) | its band | kappa: 2d-d, 4d-2d, 4d-d, the band's | cost / full solve |"
+      write(output_unit, '(a)') "|---|---|---|---|---|---|---|---|---|---|---|---|"
+      tally = 0
       allocate(series(0))
       do h = 1, size(hursts)
          allocate(z(np, np))
-         call self_affine_surface(np, pixel, hursts(h), 3.0_dp, seed, z)
+         if (cutoff > 0) then
+            call self_affine_surface(np, pixel, hursts(h), 3.0_dp, seed, z, cutoff)
+         else
+            call self_affine_surface(np, pixel, hursts(h), 3.0_dp, seed, z)
+         end if
          fine = periodic_problem(z, pixel)
          deallocate(z)
          call wall_clock(t0)
@@ -109,7 +119,7 @@ contains
             call refine_contact(periodic_problem(block_average(fine%lower, np/coarse(c)), pixel*np/coarse(c)), &
                options_at(loads_for(fine, fractions)), pixel, answer, status)
             if (status%code /= 0) exit
-            call print_rows(hursts(h), coarse(c), truth, answer, fine_seconds)
+            call print_rows(hursts(h), coarse(c), truth, answer, fine_seconds, tally)
             if (h == 1 .and. c == 1 .and. svg_path /= "") call figure_series(series, answer, truth)
          end do
          if (status%code /= 0) exit
@@ -119,6 +129,9 @@ contains
          code = status%code
          return
       end if
+      write(output_unit, '(a)') "Of "//int_str(tally(1))//" points: the refinement within 10 % at "// &
+         int_str(tally(2))//", nearer than Richardson at "//int_str(tally(3))//", the truth inside its band at "// &
+         int_str(tally(4))//"."
       if (svg_path /= "") then
          call write_file(svg_path, svg_multi_plot("femcod refine: H = "//fixed_str(hursts(1), 1)//", "// &
             int_str(coarse(1))//"^2 refined to the "//int_str(np)//"^2 pixel, about "// &
@@ -162,12 +175,16 @@ contains
       loads = real(nint(fractions*composite_modulus(p%young(1:2), p%poisson(1:2))*sqrt(slope2)/2*(p%np*p%pixel)**2/100)*100, dp)
    end function loads_for
 
-   subroutine print_rows(hurst, np, truth, answer, fine_seconds)
+   !> The table's rows of one coarse grid; tally counts the points, those within 10 %, those
+   !> nearer than Richardson (a Richardson without an answer counts as farther) and those
+   !> whose truth lies inside the band.
+   subroutine print_rows(hurst, np, truth, answer, fine_seconds, tally)
       real(dp), intent(in) :: hurst, truth(:), fine_seconds
       integer, intent(in) :: np
       type(refine_answer), intent(in) :: answer
+      integer, intent(inout) :: tally(4)
       integer :: k, last
-      real(dp) :: cost
+      real(dp) :: cost, err
       last = size(answer%zeta)
       cost = (answer%solve_seconds + answer%richardson_seconds + answer%refine_seconds)/fine_seconds
       do k = 1, size(truth)
@@ -175,8 +192,16 @@ contains
             fixed_str(truth(k), 5)//" | "//int_str(np)//" | "//signed(answer%coarse(1, k)/truth(k) - 1)//" | "// &
             signed(answer%richardson(last, k)/truth(k) - 1)//" | "//signed(answer%persson(last, k)/truth(k) - 1)// &
             " | "//signed(answer%theory(last, k)/truth(k) - 1)//" | "//signed(answer%refined(last, k)/truth(k) - 1)// &
-            " | "//fixed_str(answer%kappa(k), 2)//", "//fixed_str(answer%kappa_coarse, 2)//", "// &
+            " | "//signed(answer%refined_low(last, k)/truth(k) - 1)//" to "// &
+            signed(answer%refined_high(last, k)/truth(k) - 1)//" | "//fixed_str(answer%kappa(k), 2)//", "// &
+            fixed_str(answer%kappa_coarse, 2)//", "// &
             fixed_str(answer%kappa_two, 2)//", "//fixed_str(answer%band(last), 2)//" | "//sig_str(cost, 3)//" |"
+         err = abs(answer%refined(last, k)/truth(k) - 1)
+         tally(1) = tally(1) + 1
+         if (err <= 0.1_dp) tally(2) = tally(2) + 1
+         if (.not. (abs(answer%richardson(last, k)/truth(k) - 1) <= err)) tally(3) = tally(3) + 1
+         if (answer%refined_low(last, k) <= truth(k) .and. truth(k) <= answer%refined_high(last, k)) &
+            tally(4) = tally(4) + 1
       end do
    end subroutine print_rows
 

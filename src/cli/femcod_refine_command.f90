@@ -148,7 +148,7 @@ contains
       integer :: k, z
       call add_line(b, "load_nN,magnification,pixel_nm,area_fraction_solve,area_fraction_refined,"// &
          "area_fraction_richardson,area_fraction_persson,area_fraction_refined_sqrt2,kappa,area_load_slope_solve,"// &
-         "area_load_slope_refined")
+         "area_load_slope_refined,area_fraction_band_low,area_fraction_band_high,kappa_band_low,kappa_band_high")
       do k = 1, size(answer%loads)
          do z = 1, size(answer%zeta)
             call add_line(b, format_real(answer%loads(k))//","//format_real(answer%zeta(z))//","// &
@@ -156,7 +156,9 @@ contains
                format_real(answer%refined(z, k))//","//format_real(answer%richardson(z, k))//","// &
                format_real(answer%persson(z, k))//","//format_real(answer%theory(z, k))//","// &
                format_real(answer%band(z))//","//format_real(answer%slope_solve(k))//","// &
-               format_real(answer%slope_refined(z, k)))
+               format_real(answer%slope_refined(z, k))//","//format_real(answer%refined_low(z, k))//","// &
+               format_real(answer%refined_high(z, k))//","//format_real(answer%band_low(z))//","// &
+               format_real(answer%band_high(z)))
          end do
       end do
       text = built_text(b)
@@ -165,8 +167,8 @@ contains
    !> PREFIX.refine.json (beside a run's PREFIX.summary.json of the same deck, not over it):
    !> what refine prints and writes, as numbers whose names carry
    !> their units: the scene, the spectrum's fit, and per load the solve's area fraction
-   !> and area-load slope with every magnification's refined, Richardson and Persson
-   !> area fractions and the refined slope.
+   !> and area-load slope with every magnification's refined area fraction and its band,
+   !> the Richardson and Persson area fractions and the refined slope.
    function refine_json(deck, args, problem, boundary, down_to, answer) result(j)
       character(len=*), intent(in) :: deck, boundary
       type(string_type), intent(in) :: args(:)
@@ -204,7 +206,10 @@ contains
                json_number(answer%refined(z, k))//', "area_fraction_richardson": '// &
                json_number(answer%richardson(z, k))//', "area_fraction_persson": '//json_number(answer%persson(z, k))// &
                ', "area_fraction_refined_sqrt2": '//json_number(answer%theory(z, k))//', "area_load_slope_refined": '// &
-               json_number(answer%slope_refined(z, k))//'}'//trim(merge(",", " ", z < size(answer%zeta)))
+               json_number(answer%slope_refined(z, k))//', "kappa_band": ['//json_number(answer%band_low(z))// &
+               ', '//json_number(answer%band_high(z))//'], "area_fraction_band": ['// &
+               json_number(answer%refined_low(z, k))//', '//json_number(answer%refined_high(z, k))//']}'// &
+               trim(merge(",", " ", z < size(answer%zeta)))
          end do
          j = j//']}'//trim(merge(",", " ", k < size(answer%loads)))//nl
       end do
@@ -256,11 +261,14 @@ contains
          sig_str(answer%kappa_coarse, 4)//" over 4d to 2d, "//sig_str(answer%kappa_two, 4)//" over 4d to d: "// &
          "N^-"//sig_str(answer%decay, 3)//" in a band's octaves N, x "//sig_str(answer%drift, 3)// &
          " an octave finer; "//sig_str(answer%band(last), 4)//" over the "// &
-         sig_str(log(answer%zeta(last))/log(2.0_dp), 3)//" octaves refined"
+         sig_str(log(answer%zeta(last))/log(2.0_dp), 3)//" octaves refined (band "// &
+         sig_str(answer%band_low(last), 4)//" to "//sig_str(answer%band_high(last), 4)//")"
       do k = 1, size(answer%loads)
          write(output_unit, '(a)') "  at load   : "//sig_str(answer%loads(k), 6)//" nN: the solve "// &
             sig_str(100*answer%coarse(1, k), 4)//" %; refined "//sig_str(100*answer%refined(last, k), 4)// &
-            " %, Richardson "//sig_str(100*answer%richardson(last, k), 4)//" %, Persson "// &
+            " % (band "//sig_str(100*answer%refined_low(last, k), 3)//" to "// &
+            sig_str(100*answer%refined_high(last, k), 3)//" %), Richardson "// &
+            sig_str(100*answer%richardson(last, k), 4)//" %, Persson "// &
             sig_str(100*answer%persson(last, k), 4)//" % at "//format_real(down_to)//" nm (kappa "// &
             sig_str(answer%band(last), 4)//", Persson's sqrt(2) gives "//sig_str(100*answer%theory(last, k), 4)//" %)"
          write(output_unit, '(a)') "              area-load slope (A/A0)/(p/(E* h'_rms)): the solve "// &

@@ -40,7 +40,7 @@ module femcod_refine
    implicit none
    private
    public :: surface_spectrum_of, fit_spectrum, subpixel_slope_variance, refined_fraction, persson_fraction, &
-      richardson_area, magnifications, calibrate_kappa, kappa_decay, kappa_drift, band_kappa, &
+      richardson_area, magnifications, calibrate_kappa, kappa_decay, kappa_drift, band_kappa, band_edge, &
       MIN_R_SQUARED, MIN_FIT_RATIO
 
    real(dp), parameter :: PI = acos(-1.0_dp)
@@ -258,6 +258,34 @@ contains
       octaves = log(zeta)/log(2.0_dp)
       kappa = sqrt(2.0_dp) + (kappa_1 - sqrt(2.0_dp))*max(octaves, 1.0_dp)**(-alpha)*drift**octaves
    end function band_kappa
+
+   !> An edge of the refinement's uncertainty band (doc/studies.md, step 5). The band's
+   !> constant kappa_band comes from the one-octave kappa_1 by an extrapolation that moved
+   !> the excess over sqrt 2 by the factor f = (kappa_band - sqrt 2) / (kappa_1 - sqrt 2);
+   !> its uncertainty is taken as that step once more, either way: excesses from
+   !> (kappa_band - sqrt 2) min(f, 1/f) to (kappa_band - sqrt 2) max(f, 1/f), the upper edge
+   !> (`upper` true) being kappa_1 itself when the excess falls. When the octaves measured
+   !> give no trend (`trend` false: no 4d level) or no excess to extrapolate (kappa_1 or
+   !> kappa_band at or below sqrt 2), the band runs between sqrt 2 and kappa_1.
+   elemental real(dp) function band_edge(kappa_1, kappa_band, trend, upper) result(kappa)
+      real(dp), intent(in) :: kappa_1, kappa_band
+      logical, intent(in) :: trend, upper
+      real(dp) :: e1, eb, f
+      e1 = kappa_1 - sqrt(2.0_dp)
+      eb = kappa_band - sqrt(2.0_dp)
+      if (trend .and. e1 > 0 .and. eb > 0) then
+         f = eb/e1
+         if (upper) then
+            kappa = sqrt(2.0_dp) + eb*max(f, 1/f)
+         else
+            kappa = sqrt(2.0_dp) + eb*min(f, 1/f)
+         end if
+      else if (upper) then
+         kappa = max(kappa_1, sqrt(2.0_dp))
+      else
+         kappa = min(kappa_1, sqrt(2.0_dp))
+      end if
+   end function band_edge
 
    !> Persson's area fraction at nominal pressure p0 (GPa) over roughness of mean square
    !> slope m2: erf(sqrt(2) p0 / (E* sqrt(m2))).

@@ -17,7 +17,7 @@ module femcod_refine_study
    use femcod_solver, only: solve_contact
    use femcod_refine, only: surface_spectrum, surface_spectrum_of, fit_spectrum, subpixel_slope_variance, &
       refined_fraction, persson_fraction, richardson_area, magnifications, calibrate_kappa, kappa_decay, kappa_drift, &
-      band_kappa
+      band_kappa, band_edge
    implicit none
    private
    public :: refine_answer, refine_contact
@@ -50,6 +50,9 @@ module femcod_refine_study
       !> (band_kappa); kappa_two and kappa_coarse NaN when the grid has no 4d level.
       real(dp) :: kappa_two = 0, kappa_coarse = 0, decay = 0, drift = 1
       real(dp), allocatable :: band(:)
+      !> The uncertainty band (band_edge): its constants per magnification and the refined
+      !> area fractions they give (zeta, load); the refined answer lies between them.
+      real(dp), allocatable :: band_low(:), band_high(:), refined_low(:, :), refined_high(:, :)
       !> The dimensionless area-load slope (A/A0) / (p/(E* h'_rms)) (doc/studies.md, "The
       !> area-load slope kappa"): of the solve at d with the image's h'_rms at the pixel
       !> (rms_slope: forward differences, as every run reports it), and of the refined
@@ -125,8 +128,11 @@ contains
       nz = size(answer%zeta)
       nl = size(answer%loads)
       allocate(answer%refined(nz, nl), answer%theory(nz, nl), answer%persson(nz, nl), answer%richardson(nz, nl), &
-         answer%kappa(nl), answer%slope_refined(nz, nl), answer%slope_solve(nl))
+         answer%kappa(nl), answer%slope_refined(nz, nl), answer%slope_solve(nl), answer%refined_low(nz, nl), &
+         answer%refined_high(nz, nl))
       answer%refined = ieee_value(1.0_dp, ieee_quiet_nan)
+      answer%refined_low = answer%refined
+      answer%refined_high = answer%refined
       answer%slope_refined = answer%refined
       answer%slope_solve = ieee_value(1.0_dp, ieee_quiet_nan)
       answer%theory = answer%refined
@@ -148,6 +154,8 @@ contains
          answer%drift = kappa_drift(answer%kappa(1), answer%kappa_coarse)
       end if
       answer%band = band_kappa(answer%kappa(1), answer%decay, answer%drift, answer%zeta)
+      answer%band_low = band_edge(answer%kappa(1), answer%band, allocated(at_4d), .false.)
+      answer%band_high = band_edge(answer%kappa(1), answer%band, allocated(at_4d), .true.)
       do k = 1, nl
          if (.not. allocated(at_d(k)%p)) cycle
          p0 = answer%loads(k)/side**2
@@ -156,6 +164,8 @@ contains
             m2 = subpixel_slope_variance(answer%spectrum, q_d, answer%zeta(z)*q_d)
             answer%refined(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, answer%band(z))
             answer%theory(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, sqrt(2.0_dp))
+            answer%refined_low(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, answer%band_low(z))
+            answer%refined_high(z, k) = refined_fraction(at_d(k)%p, answer%estar, m2, answer%band_high(z))
             if (p0 > 0) answer%slope_refined(z, k) = answer%refined(z, k)*answer%estar* &
                sqrt(answer%rms_slope**2 + m2)/p0
             answer%persson(z, k) = persson_fraction(p0, answer%estar, answer%spectrum%slope_variance + m2)
