@@ -53,7 +53,7 @@ contains
       integer, allocatable :: coarse(:)
       real(dp), allocatable :: hursts(:), fractions(:), z(:, :), truth(:)
       real(dp) :: fine_seconds, t0, t1, pixel, cutoff
-      character(len=:), allocatable :: svg_path
+      character(len=:), allocatable :: svg_path, rolloff
       type(contact_problem) :: fine
       type(contact_result) :: res
       type(status_type) :: status
@@ -82,7 +82,7 @@ contains
       call get_option(parsed, "--hurst", hursts)
       call get_option(parsed, "--contact", fractions)
       call get_option(parsed, "--svg", svg_path)
-      cutoff = 0
+      cutoff = 0  ! none: self_affine_surface cuts only above 2 pixels
       call get_option(parsed, "--cutoff", cutoff)
       if (any(modulo(np, coarse) /= 0) .or. any(coarse >= np)) then
          write(error_unit, '(a)') "femcod bench refine: every --coarse grid must divide --np and be smaller"
@@ -90,9 +90,10 @@ contains
          return
       end if
       pixel = 1
+      rolloff = ""
+      if (cutoff > 0) rolloff = ", no roughness below "//fixed_str(cutoff, 1)//" nm"
       write(output_unit, '(a)') "femcod bench refine: self-affine surfaces (rms 3 nm, seed "//int_str(seed)// &
-         trim(merge(", no roughness below "//fixed_str(cutoff, 1)//" nm", repeat(" ", 40), cutoff > 0))//"), "// &
-         int_str(np)//"^2 "// &
+         rolloff//"), "//int_str(np)//"^2 "// &
          "pixels of "//fixed_str(pixel, 1)//" nm, periodic, E* = 213.3 GPa; the truth: cg at "//int_str(np)//"^2; "// &
          "each method's area fraction error against it (signed, relative), refined down to "//fixed_str(pixel, 1)//" nm"
       write(output_unit, '(a)') "| H | load (nN) | truth | coarse NP | solve | Richardson | Persson | refined "// &
@@ -102,11 +103,7 @@ contains
       allocate(series(0))
       do h = 1, size(hursts)
          allocate(z(np, np))
-         if (cutoff > 0) then
-            call self_affine_surface(np, pixel, hursts(h), 3.0_dp, seed, z, cutoff)
-         else
-            call self_affine_surface(np, pixel, hursts(h), 3.0_dp, seed, z)
-         end if
+         call self_affine_surface(np, pixel, hursts(h), 3.0_dp, seed, z, cutoff)
          fine = periodic_problem(z, pixel)
          deallocate(z)
          call wall_clock(t0)
