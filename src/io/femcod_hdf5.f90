@@ -427,35 +427,39 @@ contains
       call h5_attribute(file, name, "units", units, status)
    end subroutine finish_dataset
 
+   !> A new dataset `name` of HDF5 type `dtype` and shape `dims` (Fortran order; empty: a
+   !> scalar) from the contiguous values at `buffer`, with its units: every scalar and 1-D
+   !> write below.
+   subroutine write_plain(file, name, dtype, dims, buffer, units, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, units
+      integer(hid_t), intent(in) :: dtype
+      integer(hsize_t), intent(in) :: dims(:)
+      type(c_ptr), intent(in) :: buffer
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset
+      integer :: error
+      if (status%code /= 0) return
+      call create_dataset(file, name, dtype, dims, dset, status)
+      if (status%code /= 0) return
+      call h5dwrite_f(dset, dtype, buffer, error)
+      call finish_dataset(file, name, dset, error, units, status)
+   end subroutine write_plain
+
    subroutine write_real0(file, name, value, units, status)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, units
-      real(dp), intent(in) :: value
+      real(dp), intent(in), target :: value
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: dset
-      integer(hsize_t) :: none(0)
-      integer :: error
-      if (status%code /= 0) return
-      call create_dataset(file, name, H5T_NATIVE_DOUBLE, none, dset, status)
-      if (status%code /= 0) return
-      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, value, none, error)
-      call finish_dataset(file, name, dset, error, units, status)
+      call write_plain(file, name, H5T_NATIVE_DOUBLE, [integer(hsize_t) ::], c_loc(value), units, status)
    end subroutine write_real0
 
    subroutine write_real1(file, name, values, units, status)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, units
-      real(dp), intent(in) :: values(:)
+      real(dp), intent(in), target, contiguous :: values(:)
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: dset
-      integer(hsize_t) :: dims(1)
-      integer :: error
-      if (status%code /= 0) return
-      dims = size(values, kind=hsize_t)
-      call create_dataset(file, name, H5T_NATIVE_DOUBLE, dims, dset, status)
-      if (status%code /= 0) return
-      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, error)
-      call finish_dataset(file, name, dset, error, units, status)
+      call write_plain(file, name, H5T_NATIVE_DOUBLE, [size(values, kind=hsize_t)], c_loc(values), units, status)
    end subroutine write_real1
 
    !> A map(i, j) (row i, column j), stored so that C-order readers see [i, j].
@@ -508,32 +512,17 @@ contains
    subroutine write_int0(file, name, value, units, status)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, units
-      integer, intent(in) :: value
+      integer, intent(in), target :: value
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: dset
-      integer(hsize_t) :: none(0)
-      integer :: error
-      if (status%code /= 0) return
-      call create_dataset(file, name, H5T_NATIVE_INTEGER, none, dset, status)
-      if (status%code /= 0) return
-      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, value, none, error)
-      call finish_dataset(file, name, dset, error, units, status)
+      call write_plain(file, name, H5T_NATIVE_INTEGER, [integer(hsize_t) ::], c_loc(value), units, status)
    end subroutine write_int0
 
    subroutine write_int1(file, name, values, units, status)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, units
-      integer, intent(in) :: values(:)
+      integer, intent(in), target, contiguous :: values(:)
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: dset
-      integer(hsize_t) :: dims(1)
-      integer :: error
-      if (status%code /= 0) return
-      dims = size(values, kind=hsize_t)
-      call create_dataset(file, name, H5T_NATIVE_INTEGER, dims, dset, status)
-      if (status%code /= 0) return
-      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, error)
-      call finish_dataset(file, name, dset, error, units, status)
+      call write_plain(file, name, H5T_NATIVE_INTEGER, [size(values, kind=hsize_t)], c_loc(values), units, status)
    end subroutine write_int1
 
    subroutine write_int2(file, name, map, units, status, compress)
@@ -677,34 +666,36 @@ contains
       call h5tset_cset_f(stype, H5T_CSET_UTF8_F, error)
    end subroutine variable_string_type
 
+   !> A scalar attribute of HDF5 type `dtype` from the value at `buffer`.
+   subroutine attribute_plain(file, name, key, dtype, buffer, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name, key
+      integer(hid_t), intent(in) :: dtype
+      type(c_ptr), intent(in) :: buffer
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: object, attr
+      integer :: error
+      if (status%code /= 0) return
+      call create_attribute(file, name, key, dtype, object, attr, status)
+      if (status%code /= 0) return
+      call h5awrite_f(attr, dtype, buffer, error)
+      call close_attribute(file, name, key, object, attr, error, status)
+   end subroutine attribute_plain
+
    subroutine attribute_real(file, name, key, value, status)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, key
-      real(dp), intent(in) :: value
+      real(dp), intent(in), target :: value
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: object, attr
-      integer(hsize_t) :: none(0)
-      integer :: error
-      if (status%code /= 0) return
-      call create_attribute(file, name, key, H5T_NATIVE_DOUBLE, object, attr, status)
-      if (status%code /= 0) return
-      call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, none, error)
-      call close_attribute(file, name, key, object, attr, error, status)
+      call attribute_plain(file, name, key, H5T_NATIVE_DOUBLE, c_loc(value), status)
    end subroutine attribute_real
 
    subroutine attribute_int(file, name, key, value, status)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name, key
-      integer, intent(in) :: value
+      integer, intent(in), target :: value
       type(status_type), intent(inout) :: status
-      integer(hid_t) :: object, attr
-      integer(hsize_t) :: none(0)
-      integer :: error
-      if (status%code /= 0) return
-      call create_attribute(file, name, key, H5T_NATIVE_INTEGER, object, attr, status)
-      if (status%code /= 0) return
-      call h5awrite_f(attr, H5T_NATIVE_INTEGER, value, none, error)
-      call close_attribute(file, name, key, object, attr, error, status)
+      call attribute_plain(file, name, key, H5T_NATIVE_INTEGER, c_loc(value), status)
    end subroutine attribute_int
 
    !> Read a string attribute of at most `length` characters (variable or fixed length).
@@ -908,76 +899,74 @@ contains
          ": cannot read the dataset")
    end subroutine finish_read
 
+   !> The dataset `name`, checked to be of rank `rank`, read as HDF5 type `dtype` into the
+   !> contiguous memory at `buffer`; with no buffer (c_null_ptr), only its dims (Fortran
+   !> order) are returned, to size the buffer of a second call.
+   subroutine read_plain(file, name, rank, dtype, buffer, fdims, status, code)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: rank, code
+      integer(hid_t), intent(in) :: dtype
+      type(c_ptr), intent(in) :: buffer
+      integer(hsize_t), intent(out) :: fdims(7)
+      type(status_type), intent(inout) :: status
+      integer(hid_t) :: dset
+      type(c_ptr) :: into
+      integer :: error
+      fdims = 0
+      if (status%code /= 0) return
+      call read_checked(file, name, rank, dset, fdims, status, code)
+      if (status%code /= 0) return
+      error = 0
+      into = buffer
+      if (c_associated(into)) call h5dread_f(dset, dtype, into, error)
+      call finish_read(file, name, dset, error, status, code)
+   end subroutine read_plain
+
    subroutine read_real0(file, name, value, status, code)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name
-      real(dp), intent(out) :: value
+      real(dp), intent(out), target :: value
       type(status_type), intent(inout) :: status
       integer, intent(in) :: code
-      integer(hid_t) :: dset
       integer(hsize_t) :: fdims(7)
-      integer :: error
       value = 0
-      if (status%code /= 0) return
-      call read_checked(file, name, 0, dset, fdims, status, code)
-      if (status%code /= 0) return
-      call h5dread_f(dset, H5T_NATIVE_DOUBLE, value, fdims(1:0), error)
-      call finish_read(file, name, dset, error, status, code)
+      call read_plain(file, name, 0, H5T_NATIVE_DOUBLE, c_loc(value), fdims, status, code)
    end subroutine read_real0
 
    subroutine read_int0(file, name, value, status, code)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name
-      integer, intent(out) :: value
+      integer, intent(out), target :: value
       type(status_type), intent(inout) :: status
       integer, intent(in) :: code
-      integer(hid_t) :: dset
       integer(hsize_t) :: fdims(7)
-      integer :: error
       value = 0
-      if (status%code /= 0) return
-      call read_checked(file, name, 0, dset, fdims, status, code)
-      if (status%code /= 0) return
-      call h5dread_f(dset, H5T_NATIVE_INTEGER, value, fdims(1:0), error)
-      call finish_read(file, name, dset, error, status, code)
+      call read_plain(file, name, 0, H5T_NATIVE_INTEGER, c_loc(value), fdims, status, code)
    end subroutine read_int0
 
    subroutine read_real1(file, name, values, status, code)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name
-      real(dp), allocatable, intent(out) :: values(:)
+      real(dp), allocatable, target, intent(out) :: values(:)
       type(status_type), intent(inout) :: status
       integer, intent(in) :: code
-      integer(hid_t) :: dset
       integer(hsize_t) :: fdims(7)
-      integer :: error
-      allocate(values(0))
-      if (status%code /= 0) return
-      call read_checked(file, name, 1, dset, fdims, status, code)
-      if (status%code /= 0) return
-      deallocate(values)
+      call read_plain(file, name, 1, H5T_NATIVE_DOUBLE, c_null_ptr, fdims, status, code)
       allocate(values(fdims(1)))
-      call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, fdims(1:1), error)
-      call finish_read(file, name, dset, error, status, code)
+      if (size(values) > 0) call read_plain(file, name, 1, H5T_NATIVE_DOUBLE, c_loc(values), fdims, status, code)
    end subroutine read_real1
 
    subroutine read_int1(file, name, values, status, code)
       type(h5_file), intent(in) :: file
       character(len=*), intent(in) :: name
-      integer, allocatable, intent(out) :: values(:)
+      integer, allocatable, target, intent(out) :: values(:)
       type(status_type), intent(inout) :: status
       integer, intent(in) :: code
-      integer(hid_t) :: dset
       integer(hsize_t) :: fdims(7)
-      integer :: error
-      allocate(values(0))
-      if (status%code /= 0) return
-      call read_checked(file, name, 1, dset, fdims, status, code)
-      if (status%code /= 0) return
-      deallocate(values)
+      call read_plain(file, name, 1, H5T_NATIVE_INTEGER, c_null_ptr, fdims, status, code)
       allocate(values(fdims(1)))
-      call h5dread_f(dset, H5T_NATIVE_INTEGER, values, fdims(1:1), error)
-      call finish_read(file, name, dset, error, status, code)
+      if (size(values) > 0) call read_plain(file, name, 1, H5T_NATIVE_INTEGER, c_loc(values), fdims, status, code)
    end subroutine read_int1
 
    !> A 2-D dataset as map(i, j) with i the C-order first index (the row).
