@@ -62,8 +62,7 @@ contains
    subroutine femcod_destroy(handle) bind(C, name="femcod_destroy")
       type(c_ptr), value :: handle
       type(library_session), pointer :: session
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       deallocate(session)
    end subroutine femcod_destroy
 
@@ -107,8 +106,7 @@ contains
       end if
       call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_message = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       femcod_message = copy_out(session%message, text_out, length)
    end function femcod_message
 
@@ -128,8 +126,7 @@ contains
       type(status_type) :: st
       real(c_double), pointer :: top(:)
       femcod_set_heights = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       call forget_problem(session)
       if (np <= 0) call set_error(st, STATUS_BAD_INPUT, "np must be positive, found "//int_str(int(np)))
       if (st%code == 0) then
@@ -168,8 +165,7 @@ contains
       type(library_session), pointer :: session
       type(status_type) :: st
       femcod_set_problem = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       call forget_problem(session)
       if (np <= 0) then
          call set_error(st, STATUS_BAD_INPUT, "np must be positive, found "//int_str(int(np)))
@@ -197,8 +193,7 @@ contains
       type(library_session), pointer :: session
       type(status_type) :: st
       femcod_read_deck = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       call forget_problem(session)
       call read_deck(from_c(path), session%problem, st)
       femcod_read_deck = finish_problem(session, st)
@@ -220,8 +215,7 @@ contains
       type(string_type), allocatable :: notes(:), warnings(:)
       integer :: k
       femcod_read_heights = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       call forget_problem(session)
       spec%kind = "matrix"
       spec%matrix_file = from_c(path)
@@ -257,8 +251,7 @@ contains
       end if
       call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_warnings = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       if (.not. allocated(session%warnings)) session%warnings = ""
       femcod_warnings = copy_out(session%warnings, text_out, length)
    end function femcod_warnings
@@ -274,8 +267,7 @@ contains
       type(status_type) :: st
       character(len=:), allocatable :: name
       femcod_write_deck = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       name = from_c(path)
       if (.not. session%has_problem) call set_error(st, STATUS_USAGE, "no problem to write: set one first")
       call guard_outputs([string_type(name)], [string_type :: ], force /= 0, OUTPUT_DECK, st)
@@ -296,8 +288,7 @@ contains
       type(run_info) :: info
       character(len=:), allocatable :: name
       femcod_write_results = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       name = from_c(prefix)
       if (.not. session%solved) call set_error(st, STATUS_USAGE, "no result to write: solve first")
       if (name == "") call set_error(st, STATUS_USAGE, "expected a prefix for the result files, found none")
@@ -334,8 +325,7 @@ contains
       character(len=:), allocatable :: path
       integer :: bytes
       femcod_report = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       path = from_c(output)
       call make_report(from_c(target), path, force /= 0, written, bytes, st)
       if (st%code == 0) then
@@ -358,8 +348,7 @@ contains
       call c_f_pointer(np, np_out)
       np_out = 0
       femcod_problem_size = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       if (session%has_problem) np_out = session%problem%np
       femcod_problem_size = 0
    end function femcod_problem_size
@@ -393,8 +382,7 @@ contains
       call c_f_pointer(poisson, poisson_out, [3])
       call c_f_pointer(maxcont, maxcont_out)
       femcod_get_problem = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       if (.not. session%has_problem) then
          call set_error(st, STATUS_USAGE, "no problem: set one or read a deck first")
       else
@@ -426,8 +414,7 @@ contains
       end if
       call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_get_label = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       if (.not. session%has_problem) return
       femcod_get_label = copy_out(session%problem%label, text_out, length)
    end function femcod_get_label
@@ -442,8 +429,7 @@ contains
       type(status_type) :: st
       character(len=:), allocatable :: key, text
       femcod_set_option = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       key = from_c(name)
       text = from_c(value)
       session%args = [session%args, string_type(key)]
@@ -456,8 +442,7 @@ contains
       type(c_ptr), value :: handle
       type(library_session), pointer :: session
       femcod_clear_options = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       session%args = [string_type :: ]
       femcod_clear_options = 0
    end function femcod_clear_options
@@ -473,8 +458,7 @@ contains
       type(library_session), pointer :: session
       type(status_type) :: st
       femcod_solve = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       call solve_session(session, progress, user, st)
       femcod_solve = finish(session, st)
    end function femcod_solve
@@ -504,8 +488,7 @@ contains
       call c_f_pointer(count, count_out)
       count_out = 0
       femcod_state_count = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       if (.not. session%solved) then
          call set_error(st, STATUS_USAGE, "no result: solve first")
       else if (allocated(session%res%states)) then
@@ -531,8 +514,7 @@ contains
       end if
       call c_f_pointer(text, text_out, [max(1_c_size_t, length)])
       femcod_value_names = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       if (.not. session%solved) then
          call set_error(st, STATUS_USAGE, "no result: solve first")
          femcod_value_names = finish(session, st)
@@ -570,8 +552,7 @@ contains
       call c_f_pointer(value, value_out)
       value_out = 0
       femcod_state_value = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       call check_state(session, int(k), st)
       if (st%code == 0) call state_value(session, int(k), from_c(name), value_out, st)
       femcod_state_value = finish(session, st)
@@ -597,8 +578,7 @@ contains
       end if
       call c_f_pointer(out, out_out, [max(1_c_int64_t, size)])
       femcod_state_map = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       call check_state(session, int(k), st)
       if (st%code == 0) then
          n = session%problem%np
@@ -626,8 +606,7 @@ contains
       call c_f_pointer(steps, steps_out)
       steps_out = 0
       femcod_history_length = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       if (.not. session%solved) call set_error(st, STATUS_USAGE, "no result: solve first")
       if (st%code == 0) steps_out = session%res%nsteps
       femcod_history_length = finish(session, st)
@@ -650,8 +629,7 @@ contains
       end if
       call c_f_pointer(out, out_out, [max(1_c_int64_t, size)])
       femcod_history = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       if (.not. session%solved) call set_error(st, STATUS_USAGE, "no result: solve first")
       if (st%code == 0) call history_column(session, from_c(name), column, st)
       if (st%code == 0) then
@@ -665,6 +643,15 @@ contains
    end function femcod_history
 
    ! ---- helpers ----
+
+   !> The session behind `handle`; false (and no session) for NULL.
+   logical function session_of(handle, session)
+      type(c_ptr), intent(in) :: handle
+      type(library_session), pointer, intent(out) :: session
+      session => null()
+      session_of = c_associated(handle)
+      if (session_of) call c_f_pointer(handle, session)
+   end function session_of
 
    !> True when no address in `addresses` is NULL.
    logical function all_given(addresses)
@@ -683,8 +670,7 @@ contains
       character(len=*), intent(in) :: function_name, outputs
       type(library_session), pointer :: session
       null_argument = STATUS_USAGE
-      if (.not. c_associated(handle)) return
-      call c_f_pointer(handle, session)
+      if (.not. session_of(handle, session)) return
       session%message = function_name//": NULL given where its output goes ("//outputs//"); nothing was written"
    end function null_argument
 
