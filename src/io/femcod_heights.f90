@@ -11,6 +11,7 @@
 module femcod_heights
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use femcod_kinds, only: dp, i8
+   use femcod_arrays, only: grow
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_USAGE
    use femcod_strings, only: string_type, int_str, parse_real, format_real, append_string, sig_str, lower_case
    use femcod_surfaces, only: plane_tilt, block_average
@@ -528,7 +529,6 @@ contains
       real(dp), allocatable, intent(inout) :: vals(:)
       integer, intent(inout) :: n
       type(status_type), intent(inout) :: st
-      real(dp), allocatable :: grown(:)
       integer :: i, start, column
       real(dp) :: v
       logical :: ok
@@ -553,9 +553,7 @@ contains
             return
          end if
          if (n == size(vals)) then
-            allocate(grown(2*size(vals)))
-            grown(1:n) = vals(1:n)
-            call move_alloc(grown, vals)
+            call grow(vals, 2*size(vals))
          end if
          n = n + 1
          vals(n) = v

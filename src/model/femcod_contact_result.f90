@@ -6,6 +6,7 @@
 !> cg_diagnostics (per state: iterations, residuals, the approach's error bound).
 module femcod_contact_result
    use femcod_kinds, only: dp, i8
+   use femcod_arrays, only: grow
    use femcod_state_visitor, only: state_visitor
    use femcod_strings, only: int_str
    use femcod_shear_model, only: shear_model, friction_force
@@ -287,33 +288,19 @@ contains
    pure subroutine grow_history(res, m)
       type(contact_result), intent(inout) :: res
       integer, intent(in) :: m
-      integer, allocatable :: itmp(:)
-      real(dp), allocatable :: rtmp(:)
       integer :: cap
       if (.not. allocated(res%step_contacts)) then
          allocate(res%step_contacts(64), res%step_above_hardness(64), res%step_load(64), res%step_approach(64), &
             res%step_seconds(64), res%step_friction(64))
       end if
       do while (size(res%step_contacts) < m)
-         cap = size(res%step_contacts)
-         allocate(itmp(2*cap))
-         itmp(1:cap) = res%step_contacts
-         call move_alloc(itmp, res%step_contacts)
-         allocate(itmp(2*cap))
-         itmp(1:cap) = res%step_above_hardness
-         call move_alloc(itmp, res%step_above_hardness)
-         allocate(rtmp(2*cap))
-         rtmp(1:cap) = res%step_load
-         call move_alloc(rtmp, res%step_load)
-         allocate(rtmp(2*cap))
-         rtmp(1:cap) = res%step_approach
-         call move_alloc(rtmp, res%step_approach)
-         allocate(rtmp(2*cap))
-         rtmp(1:cap) = res%step_seconds
-         call move_alloc(rtmp, res%step_seconds)
-         allocate(rtmp(2*cap))
-         rtmp(1:cap) = res%step_friction
-         call move_alloc(rtmp, res%step_friction)
+         cap = 2*size(res%step_contacts)
+         call grow(res%step_contacts, cap)
+         call grow(res%step_above_hardness, cap)
+         call grow(res%step_load, cap)
+         call grow(res%step_approach, cap)
+         call grow(res%step_seconds, cap)
+         call grow(res%step_friction, cap)
       end do
    end subroutine grow_history
 

@@ -15,6 +15,7 @@
 !> Lengths nm, loads nN, E* GPa, areas nm^2. No I/O.
 module femcod_multiscale
    use femcod_kinds, only: dp
+   use femcod_arrays, only: grow
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_NUMERICAL, STATUS_BAD_INPUT
    use femcod_sort, only: merge_sort_index
    use femcod_strings, only: int_str, sig_str
@@ -187,15 +188,6 @@ contains
          if (k < scales) call check_growth(result%contacts(k - 1), result%contacts(k), k, scales, status)
          if (status%code /= 0) return
       end do
-   contains
-      pure subroutine grow(v, n_new)
-         real(dp), allocatable, intent(inout) :: v(:)
-         integer, intent(in) :: n_new
-         real(dp), allocatable :: t(:)
-         allocate(t(n_new))
-         t(1:size(v)) = v
-         call move_alloc(t, v)
-      end subroutine grow
    end subroutine multiscale_hertz
 
    !> How many of the tallest finer asperities (heights hs, radii rs) a host of contact

@@ -6,6 +6,7 @@
 module femcod_summits
    use, intrinsic :: iso_c_binding, only: c_double_complex
    use femcod_kinds, only: dp, i8
+   use femcod_arrays, only: grow
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_BAD_INPUT
    use femcod_richardson, only: power_law_fit
    use femcod_strings, only: int_str
@@ -153,14 +154,6 @@ contains
          call paraboloid_fit(z, rows(i), cols(i), n, pixel, rx(i), ry(i))
       end do
    contains
-      pure subroutine grow(a, n_new)
-         integer, allocatable, intent(inout) :: a(:)
-         integer, intent(in) :: n_new
-         integer, allocatable :: t(:)
-         allocate(t(n_new))
-         t(1:size(a)) = a
-         call move_alloc(t, a)
-      end subroutine grow
       !> Higher than the 8 neighbours; no equal height earlier in the box.
       logical function is_summit(i0, j0)
          integer, intent(in) :: i0, j0
