@@ -1,15 +1,16 @@
 !> Deck reading, writing and validation: every bad deck is refused with its file, line
 !> and what was expected (doc/deck-format.md).
 module test_deck
-   use femcod_kinds, only: dp
-   use femcod_status, only: status_type
+   use femcod_kinds, only: dp, i8
+   use femcod_status, only: status_type, set_error
    use femcod_deck, only: read_deck, write_deck
-   use femcod_deck_stream, only: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream
+   use femcod_deck_stream, only: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream, open_deck_range, &
+      count_deck_range, separator_at_or_after, binary_byte
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, format_real, format_reals, int_str, parse_real
    use femcod_cli, only: run_femcod
    use femcod_bytes, only: words_little_endian, first_control_byte, scan_tokens, count_tokens, eight_digits
-   use test_support, only: write_text, scratch_path, contains_text, file_exists
+   use test_support, only: write_text, scratch_path, contains_text, file_exists, read_text
    use testdrive, only: new_unittest, unittest_type, error_type, check, to_string
    implicit none
    private
@@ -64,7 +65,8 @@ contains
          new_unittest("a deck beyond the writer's limit is refused and not written", test_deck_limit), &
          new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck), &
          new_unittest("a UTF-8 byte order mark is not part of the label", test_bom), &
-         new_unittest("streamed in slabs (femcod-mpi): the same heights and messages, cut anywhere", test_stream) &
+         new_unittest("streamed in slabs: the same heights and messages, cut anywhere", test_stream), &
+         new_unittest("read by ranges of bytes (femcod-mpi's ranks): the same heights and messages", test_ranges) &
          ]
    end subroutine collect_deck
 
@@ -1018,4 +1020,121 @@ contains
          call close_deck_stream(stream)
       end subroutine stream_all
    end subroutine test_stream
+
+   !> femcod-mpi's ranks each read one range of a text deck's bytes (cut at a separator
+   !> at or after an even share), counting its heights and lines first so that each range
+   !> knows its first height's number and line: read range after range in 1 to 7 pieces,
+   !> the heights are read_deck's; a bad height anywhere gets the whole file's message
+   !> (the expected words are test_stream's bad cases'); every range's file is closed
+   !> after it (NEWUNIT numbers are negative: a check for a unit >= 0 never closed one).
+   subroutine test_ranges(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: pieces(5) = [1, 2, 3, 5, 7]
+      character(len=*), parameter :: decks(3) = [character(len=32) :: "input/sphere_d1.deck", &
+         "input/rough_selfaffine_32.deck", "input/square_punch_n27.deck"]
+      type(contact_problem) :: whole
+      type(status_type) :: status, whole_status
+      character(len=:), allocatable :: path, text, name, where, expected
+      real(dp), allocatable :: got(:)
+      integer :: d, p, k, at
+      do d = 1, size(decks)
+         call read_deck(trim(decks(d)), whole, status)
+         do p = 1, size(pieces)
+            call read_ranges(trim(decks(d)), pieces(p), got, status)
+            call check(error, status%code, 0, trim(decks(d))//": "//status%message)
+            if (allocated(error)) return
+            call check(error, all(got == [reshape(transpose(whole%lower), [whole%np**2]), &
+               reshape(transpose(whole%upper), [whole%np**2])]), trim(decks(d))//" in "//to_string(pieces(p))// &
+               " ranges: not read_deck's heights")
+            if (allocated(error)) return
+         end do
+      end do
+      path = scratch_path("ranges.deck")
+      ! The faults in the heights (a bad height, too many, a binary byte; and a binary
+      ! byte after a bad height, which read_deck tells first), each with read_deck's own
+      ! message; those of the header are rank 0's alone, and too few heights are told
+      ! from the counts (femcod-mpi's test_command.sh has both).
+      do k = 1, 23
+         if (all(k /= [3, 4, 5, 6, 20, 21, 23])) cycle
+         if (k <= 22) then
+            call bad_case(k, name, text, where, expected)
+         else
+            name = "a binary byte after a bad height"
+            text = read_text("input/sphere_d1.deck")
+            at = index(text, nl//"0 ")
+            text = text(1:at)//"x1"//text(at + 2:len(text)/2)//achar(1)//text(len(text)/2 + 1:)
+         end if
+         call write_text(path, text)
+         whole_status = status_type()
+         call read_deck(path, whole, whole_status)
+         do p = 1, size(pieces)
+            call read_ranges(path, pieces(p), got, status)
+            call check(error, status%code == 3 .and. status%message == whole_status%message, name//" in "// &
+               to_string(pieces(p))//" ranges: "//status%message//", but read_deck: "//whole_status%message)
+            if (allocated(error)) return
+         end do
+      end do
+   contains
+      !> The heights of `file` read range after range, its bytes cut in n ranges; the
+      !> first range's fault, as femcod-mpi's first failing rank.
+      subroutine read_ranges(file, n, heights, st)
+         character(len=*), intent(in) :: file
+         integer, intent(in) :: n
+         real(dp), allocatable, intent(out) :: heights(:)
+         type(status_type), intent(out) :: st
+         type(contact_problem) :: header
+         type(deck_stream) :: stream
+         integer(i8) :: bounds(0:n), tokens(n), lines(n), binary(3, n), first_byte, size, before, line, total
+         integer :: r, unit
+         logical :: open
+         allocate(heights(0))
+         call open_deck_stream(file, stream, header, st)
+         first_byte = stream%next
+         size = stream%size
+         line = stream%line0
+         call close_deck_stream(stream)
+         if (st%code /= 0) return
+         bounds(0) = first_byte
+         bounds(n) = size + 1
+         do r = 1, n - 1
+            call separator_at_or_after(file, first_byte + ((size - first_byte + 1)*r)/n, size, bounds(r), st)
+         end do
+         do r = 1, n
+            call count_deck_range(file, bounds(r - 1), bounds(r) - 1, tokens(r), lines(r), binary(:, r), st)
+         end do
+         ! A binary byte anywhere is told first, on its line (femcod-mpi: after the counts).
+         line = stream%line0
+         do r = 1, n
+            if (binary(1, r) > 0) then
+               call set_error(st, 3, binary_byte(file, int(line + binary(2, r)), int(binary(3, r)), binary(1, r)))
+               return
+            end if
+            line = line + lines(r)
+         end do
+         line = stream%line0
+         total = 2*int(header%np, i8)**2
+         deallocate(heights)
+         allocate(heights(total))
+         before = 0
+         do r = 1, n
+            if (st%code /= 0) return
+            if (before <= total) then
+               call open_deck_range(file, header%np, bounds(r - 1), bounds(r) - 1, int(line), before, stream, st)
+               unit = stream%unit
+               if (st%code == 0) call read_deck_heights(stream, heights(before + 1:min(total, before + tokens(r))), st)
+               call close_deck_stream(stream)
+               inquire(unit=unit, opened=open)
+               if (open) call set_bad(st, "the range's file is still open after close_deck_stream")
+            end if
+            before = before + tokens(r)
+            line = line + lines(r)
+         end do
+      end subroutine read_ranges
+      subroutine set_bad(st, message)
+         type(status_type), intent(inout) :: st
+         character(len=*), intent(in) :: message
+         st%code = 99
+         st%message = message
+      end subroutine set_bad
+   end subroutine test_ranges
 end module test_deck

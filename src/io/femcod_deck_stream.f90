@@ -18,6 +18,7 @@ module femcod_deck_stream
    implicit none
    private
    public :: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream, read_text_deck_header, CHUNK_BYTES
+   public :: open_deck_range, count_deck_range, separator_at_or_after, too_few_heights, binary_byte
 
    !> Bytes read from the file at a time (the buffer holds one chunk and the part of a
    !> token cut at its end).
@@ -136,9 +137,8 @@ contains
             call next_chunk(stream, status)
             if (status%code /= 0) return
             if (stream%ntok == 0) then
-               call set_error(status, STATUS_BAD_INPUT, stream%path//":"//int_str(stream%last_line)//": expected "// &
-                  int_str(total)//" heights (NP**2 = "//int_str(int(stream%np, i8)**2)//" lower, then as many "// &
-                  "upper), found "//int_str(stream%delivered)//" before the end of the file")
+               call set_error(status, STATUS_BAD_INPUT, too_few_heights(stream%path, stream%last_line, stream%np, &
+                  stream%delivered))
                return
             end if
          end if
@@ -156,6 +156,149 @@ contains
       if (stream%delivered == total) call expect_end(stream, status)
    end subroutine read_deck_heights
 
+   !> read_deck's message for a deck whose heights end early: `found` of the 2 NP^2, the
+   !> file's last line that holds anything at `line`.
+   function too_few_heights(path, line, np, found) result(message)
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: line, np
+      integer(i8), intent(in) :: found
+      character(len=:), allocatable :: message
+      message = path//":"//int_str(line)//": expected "//int_str(2*int(np, i8)**2)//" heights (NP**2 = "// &
+         int_str(int(np, i8)**2)//" lower, then as many upper), found "//int_str(found)//" before the end of the file"
+   end function too_few_heights
+
+   !> A stream over bytes first_byte .. last_byte of the text deck `path` (NP `np`), whose
+   !> header was read elsewhere: femcod-mpi's ranks each read their own range of the
+   !> heights, which starts after a separator and ends before one (or at the end of the
+   !> file). `line` is the file's line at first_byte and `before` the heights before it,
+   !> so that read_deck_heights gives read_deck's messages (line, row and column as in the
+   !> whole file) and, once the 2 NP^2 are given, checks that the range holds no more.
+   subroutine open_deck_range(path, np, first_byte, last_byte, line, before, stream, status)
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: np, line
+      integer(i8), intent(in) :: first_byte, last_byte, before
+      type(deck_stream), intent(out) :: stream
+      type(status_type), intent(inout) :: status
+      integer :: ios
+      stream%path = path
+      open(newunit=stream%unit, file=path, access="stream", form="unformatted", action="read", status="old", &
+         iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot open it ("//os_error_text()//")")
+         stream%unit = -1
+         return
+      end if
+      stream%np = np
+      stream%size = last_byte
+      stream%next = first_byte
+      stream%line0 = line
+      stream%last_line = line
+      stream%delivered = before
+      stream%carry = ""
+      stream%text = ""
+      stream%at_end = stream%next > stream%size
+   end subroutine open_deck_range
+
+   !> read_deck's message for a binary byte of code `code` at byte `at`, on line `line`.
+   function binary_byte(path, line, code, at) result(message)
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: line, code
+      integer(i8), intent(in) :: at
+      character(len=:), allocatable :: message
+      message = path//":"//int_str(line)//": expected a text deck, found a binary control character (code "// &
+         int_str(code)//") at byte "//int_str(at)
+   end function binary_byte
+
+   !> The tokens (heights or not) and the line ends in bytes first_byte .. last_byte of
+   !> `path` (a range as open_deck_range takes it), read a chunk at a time; `binary`:
+   !> the first binary control byte's place in the file (0: none), the line ends before
+   !> it in the range, and its code.
+   subroutine count_deck_range(path, first_byte, last_byte, tokens, line_ends, binary, status)
+      character(len=*), intent(in) :: path
+      integer(i8), intent(in) :: first_byte, last_byte
+      integer(i8), intent(out) :: tokens, line_ends, binary(3)
+      type(status_type), intent(inout) :: status
+      character(len=:), allocatable :: text
+      integer(i8) :: at
+      integer :: unit, ios, n, cut, count, ends, bad
+      tokens = 0
+      line_ends = 0
+      binary = 0
+      if (last_byte < first_byte) return
+      open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot open it ("//os_error_text()//")")
+         return
+      end if
+      at = first_byte
+      do while (at <= last_byte)
+         n = int(min(int(CHUNK_BYTES, i8), last_byte - at + 1))
+         if (allocated(text)) deallocate(text)
+         allocate(character(len=n) :: text)
+         read(unit, pos=at, iostat=ios) text
+         if (ios /= 0) then
+            call set_error(status, STATUS_IO, path//": cannot read it past byte "//int_str(at))
+            exit
+         end if
+         ! Cut after the chunk's last separator (the rest is read with the next chunk),
+         ! unless it is the range's end or holds none.
+         cut = n
+         if (at + n <= last_byte) then
+            do while (cut > 0)
+               if (iachar(text(cut:cut)) < 33 .or. text(cut:cut) == ",") exit
+               cut = cut - 1
+            end do
+            if (cut == 0) cut = n
+         end if
+         if (binary(1) == 0) then
+            bad = first_control(text(1:cut))
+            if (bad > 0) binary = [at + bad - 1, line_ends + count_line_ends(text(1:bad - 1)), &
+               int(iachar(text(bad:bad)), i8)]
+         end if
+         call scan_all(text(1:cut), 0, 0, count, ends)
+         tokens = tokens + count
+         line_ends = line_ends + ends
+         at = at + cut
+      end do
+      close(unit)
+   end subroutine count_deck_range
+
+   !> The first byte at or after `from` of `path` (of `size` bytes) that separates heights
+   !> (a blank, a control character or a comma); size + 1 if there is none.
+   subroutine separator_at_or_after(path, from, size, at, status)
+      character(len=*), intent(in) :: path
+      integer(i8), intent(in) :: from, size
+      integer(i8), intent(out) :: at
+      type(status_type), intent(inout) :: status
+      character(len=4096) :: window
+      integer :: unit, ios, n, k
+      at = size + 1
+      if (from > size) return
+      open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot open it ("//os_error_text()//")")
+         return
+      end if
+      at = from
+      do while (at <= size)
+         n = int(min(int(len(window), i8), size - at + 1))
+         read(unit, pos=at, iostat=ios) window(1:n)
+         if (ios /= 0) then
+            call set_error(status, STATUS_IO, path//": cannot read it past byte "//int_str(at))
+            exit
+         end if
+         do k = 1, n
+            if (iachar(window(k:k)) < 33 .or. window(k:k) == ",") then
+               at = at + k - 1
+               close(unit)
+               return
+            end if
+         end do
+         at = at + n
+      end do
+      close(unit)
+   end subroutine separator_at_or_after
+
    !> A text deck's header (label, NP, pixel, MAXCONT, materials; no heights), with
    !> read_deck's checks and messages: only its first lines are read.
    subroutine read_text_deck_header(path, deck, status)
@@ -170,7 +313,7 @@ contains
    !> The file closed (it may be closed twice).
    subroutine close_deck_stream(stream)
       type(deck_stream), intent(inout) :: stream
-      if (stream%unit >= 0) close(stream%unit)
+      if (stream%unit /= -1) close(stream%unit)
       stream%unit = -1
    end subroutine close_deck_stream
 
@@ -222,9 +365,8 @@ contains
       stream%text = stream%text(1:cut)
       bad = first_control(stream%text)
       if (bad > 0) then
-         call set_error(status, STATUS_BAD_INPUT, stream%path//":"//int_str(stream%line0 + &
-            count_line_ends(stream%text(1:bad - 1)))//": expected a text deck, found a binary control character "// &
-            "(code "//int_str(iachar(stream%text(bad:bad)))//") at byte "//int_str(stream%text_start + bad - 1))
+         call set_error(status, STATUS_BAD_INPUT, binary_byte(stream%path, stream%line0 + &
+            count_line_ends(stream%text(1:bad - 1)), iachar(stream%text(bad:bad)), stream%text_start + bad - 1))
          return
       end if
       call scan_all(stream%text, 0, stream%line0, count, ends)
