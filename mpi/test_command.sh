@@ -102,13 +102,14 @@ done
 if [ "$gaps_ok" = 1 ]; then echo "  passed   a gap figure per load, the serial run's image"
 else echo "  FAILED   the gap figures against the serial run's"; head -3 "$work/mpi_gap.txt"; failed=1; fi
 # An HDF5 deck: every rank reads its own columns; the same answer, byte for byte, as the
-# text deck streamed by rank 0 in slabs (the same gaps, formed on the ranks).
+# text deck read by the ranks, each its range of the bytes (the same gaps, formed on the
+# ranks).
 "$femcod" mkdeck convert "$deck" "$work/deck.h5" >/dev/null
 expect 0 "2 ranks on the HDF5 deck" mpirun_2 "$femcod_mpi" "$work/deck.h5" --loads 50,200,1000 --tol 1e-12 \
   -o "$work/mpih5" --quiet
 if cmp -s "$work/mpih5.loads.csv" "$work/mpi.loads.csv" && \
    grep -q '"input": "HDF5 deck, each rank its own columns"' "$work/mpih5.summary.json" && \
-   grep -q '"input": "text deck, streamed by rank 0 in slabs' "$work/mpi.summary.json"; then
+   grep -q '"input": "text deck, each rank its own range of the bytes' "$work/mpi.summary.json"; then
   echo "  passed   the HDF5 deck read by slabs: loads.csv as the text deck's, the input path in the summary"
 else
   echo "  FAILED   the HDF5 deck read by slabs"; failed=1
@@ -163,24 +164,67 @@ for est, peak in zip(d["estimated_peak_memory_MB_per_rank"], d["peak_memory_MB_p
 PY
 then echo "  passed   each rank's memory estimate against its measured peak"
 else echo "  FAILED   each rank's memory estimate against its measured peak"; failed=1; fi
-# The text deck streamed: rank 0 holds one slab besides its columns, so its peak is
+# The text deck read by the ranks: rank 0 holds no more than the others, so its peak is
 # within 20 % of the other rank's on the 1024^2 deck (it held the whole text and both
-# surfaces before: 21 MB of text, 16 MB of heights, 8 MB of gaps more).
+# surfaces once: 21 MB of text, 16 MB of heights, 8 MB of gaps more).
 if python3 - "$work/mem.summary.json" <<'PY'
 import json, sys
 peaks = json.load(open(sys.argv[1]))["peak_memory_MB_per_rank"]
 assert max(peaks) <= 1.2 * min(peaks), peaks
 PY
-then echo "  passed   rank 0's peak within 20 % of the other rank's (text deck streamed)"
+then echo "  passed   rank 0's peak within 20 % of the other rank's (text deck read by the ranks)"
 else echo "  FAILED   rank 0's peak against the other rank's"; failed=1; fi
-# A bad height in the text deck's last line: found while streaming, refused on every
-# rank with read_deck's message (file, line, row, column), no output.
+# A bad height in the text deck's last line: found by the last rank's range, refused on
+# every rank with read_deck's message (file, line, row, column), no output.
 sed '$ s/[^ ]*$/nan/' "$deck" >"$work/late.deck"
 got=0; mpirun_2 "$femcod_mpi" "$work/late.deck" --loads 10 -o "$work/bad" >"$work/late.out" 2>&1 || got=$?
 if [ "$got" -eq 3 ] && grep -q "late.deck:[0-9]*: expected an upper-surface height in nm (row 30, column 30)" \
    "$work/late.out" && ! ls "$work"/bad.* >/dev/null 2>&1; then
-  echo "  passed   a bad height in the last line of a streamed deck: exit 3, file and line, no output"
+  echo "  passed   a bad height in the last line of a text deck: exit 3, file and line, no output"
 else echo "  FAILED   a late bad height (exit $got)"; sed 's/^/           /' "$work/late.out" | head -3; failed=1; fi
+# Each rank reads its own range of a text deck's bytes: a fault anywhere gets femcod
+# run's message (read_deck's: file, line, row and column; the first in the file), and a
+# deck whose heights are wrapped anyhow (seven a line, commas) the same answer, on 2, 3
+# and 4 ranks (ranges that cut the surfaces and the lines at other places).
+python3 - "$deck" "$work" <<'PY'
+import sys
+text = open(sys.argv[1]).read()
+head, heights = text.split("\n", 5)[:5], text.split("\n", 5)[5]
+tokens = heights.split()
+w = sys.argv[2] + "/"
+def save(name, body): open(w + name, "w").write("\n".join(head) + "\n" + body)
+save("early.deck", heights.replace("0", "x1", 1))
+save("few.deck", heights[:heights.rstrip("\n").rfind("\n") + 1])
+save("many.deck", heights + " 7 8\n")
+cut = heights.index(" ", len(heights) * 2 // 3)
+save("control.deck", heights[:cut] + "\x01" + heights[cut:])
+save("both.deck", heights[:cut].replace("0", "x1", 1) + "\x01" + heights[cut:])
+save("reflow.deck", "\n".join(", ".join(tokens[k:k + 7]) for k in range(0, len(tokens), 7)) + "\n")
+PY
+faults_ok=1
+for name in early few many control both; do
+  serial=$("$femcod" run "$work/$name.deck" --solver cg --loads 10 -o "$work/bad" -q 2>&1 >/dev/null | head -1 || true)
+  for ranks in 2 3 4; do
+    got=0
+    OMP_NUM_THREADS=1 mpirun $FEMCOD_MPIRUN_FLAGS -np $ranks "$femcod_mpi" "$work/$name.deck" --loads 10 \
+      -o "$work/bad" -q >"$work/fault.out" 2>&1 || got=$?
+    if [ "$got" -ne 3 ] || [ "$(head -1 "$work/fault.out" | sed 's/^femcod-mpi: //')" != "${serial#femcod: }" ] || \
+       ls "$work"/bad.* >/dev/null 2>&1; then
+      echo "  FAILED   $name.deck on $ranks ranks (exit $got): $(head -1 "$work/fault.out") against: $serial"
+      faults_ok=0
+    fi
+  done
+done
+for ranks in 2 3 4; do
+  OMP_NUM_THREADS=1 mpirun $FEMCOD_MPIRUN_FLAGS -np $ranks "$femcod_mpi" "$work/reflow.deck" --loads 50,200,1000 \
+    --tol 1e-12 -o "$work/reflow$ranks" --quiet
+  OMP_NUM_THREADS=1 mpirun $FEMCOD_MPIRUN_FLAGS -np $ranks "$femcod_mpi" "$work/deck.h5" --loads 50,200,1000 \
+    --tol 1e-12 -o "$work/h5_$ranks" --quiet
+  cmp -s "$work/reflow$ranks.loads.csv" "$work/h5_$ranks.loads.csv" || { echo "  FAILED   reflowed deck on $ranks ranks"; faults_ok=0; }
+done
+if [ "$faults_ok" = 1 ]; then
+  echo "  passed   a text deck's faults as femcod run's messages, a reflowed deck as the HDF5 deck (2, 3, 4 ranks)"
+else failed=1; fi
 # The combination matrix on 2 ranks (issue 34): boundary x plastic cap x interface law x
 # question (loads, increasing, decreasing approaches) x (plain, --restart, the shear model
 # --shear-strength 0 --shear-slope 0.1: friction as serial too, a tangential step

@@ -4,9 +4,9 @@
 !>     mpirun -np 4 femcod-mpi --lower scan.h5:/heights --pixel 2 --loads F
 !>     mpirun -np 4 femcod-mpi DECK --boundary periodic --approach D1,D2 ...
 !>     mpirun -np 4 femcod-mpi --generate self-affine --np N --pixel D --loads F ...
-!> Rank 0 reads a text deck or the height files (one copy of the heights, on rank 0 only)
-!> and sends each rank its columns; of an HDF5 deck every rank reads its own columns
-!> (femcod_mpi_input); a generated surface each rank makes its own columns of
+!> Rank 0 reads height files (one copy of the heights, on rank 0 only) and sends each
+!> rank its columns; of a text deck every rank reads its own range of the bytes, of an
+!> HDF5 deck its own columns (femcod_mpi_input); a generated surface each rank makes its own columns of
 !> (femcod_mpi_generate); all ranks solve (femcod_cg's solve on the distributed
 !> elastic operator of femcod_mpi_cg) and write PREFIX.h5 together
 !> (femcod_mpi_results); rank 0 writes PREFIX.summary.json and prints the summary.
@@ -28,7 +28,7 @@ program femcod_mpi
    use femcod_run_options, only: run_settings, parse_run_arguments
    use femcod_problem, only: contact_problem
    use femcod_deck_h5, only: is_hdf5_file, read_deck_h5_header
-   use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, slab_rows, is_dataset_scene, &
+   use femcod_mpi_input, only: read_deck_columns, read_text_deck_columns, is_dataset_scene, &
       read_dataset_header, read_dataset_columns
    use femcod_deck_stream, only: read_text_deck_header
    use femcod_heights, only: load_scene, height_file_path
@@ -135,7 +135,7 @@ program femcod_mpi
          ! An HDF5 deck: its header here, its heights by every rank below.
          call read_deck_h5_header(settings%decks(1)%s, problem, status)
       else
-         ! A text deck: its header here, its heights streamed below.
+         ! A text deck: its header here, its heights read by the ranks below.
          call read_text_deck_header(settings%decks(1)%s, problem, status)
       end if
       ! femcod's rule for every file it writes: an input is never an output, and an
@@ -183,7 +183,7 @@ program femcod_mpi
       if (rank == 0) problem = header
       if (status%code /= 0) call finish(status%code, status%message)
    else if (slab_input) then
-      ! Rank 0 streams the text deck in slabs of rows, each scattered to the ranks' columns.
+      ! Every rank reads its range of the text deck's bytes; the heights go to their columns' ranks.
       call read_text_deck_columns(settings%decks(1)%s, MPI_COMM_WORLD, settings%solve%cg, header, local, &
          constants, block, status)
       if (rank == 0) problem = header
@@ -398,8 +398,7 @@ contains
       else if (hdf5_input) then
          text = "HDF5 deck, each rank its own columns"
       else if (slab_input) then
-         text = "text deck, streamed by rank 0 in slabs of "//int_str(slab_rows(np, ranks))//" row"// &
-            trim(merge("s", " ", slab_rows(np, ranks) /= 1))
+         text = "text deck, each rank its own range of the bytes, each height sent to its column's rank"
       else
          text = "rank 0 reads, sends columns"
       end if

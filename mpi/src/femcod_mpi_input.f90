@@ -1,9 +1,10 @@
 !> femcod-mpi's input by slabs: an HDF5 deck (femcod_deck_h5) read by every rank, each its
 !> own columns of both surfaces as hyperslabs of /lower and /upper, collectively (MPI-IO);
-!> a text deck streamed by rank 0 (femcod_deck_stream) in slabs of rows, each slab
-!> scattered to the ranks' columns as it is read. The composite gaps are formed on the
+!> a text deck read by every rank, its own range of the file's bytes (femcod_deck_stream),
+!> each height then sent to the rank of its column. The composite gaps are formed on the
 !> ranks (femcod_scene's initial gaps, element by element, with the two maxima over all
-!> ranks): no rank holds more than its columns, and rank 0 one slab besides. A height
+!> ranks): no rank holds more than its columns (and, while a text deck is read, its
+!> range's heights twice: read and packed). A height
 !> file that is an HDF5 dataset (`--lower FILE.h5:/DATASET`, and `--upper` likewise) is
 !> read by every rank, its own columns, with the height file's rules computed over the
 !> ranks (units, finite values, the least-squares plane: removed with --remove-plane,
@@ -23,7 +24,8 @@ module femcod_mpi_input
    use femcod_status, only: status_type, set_error, STATUS_BAD_INPUT, STATUS_IO, STATUS_USAGE
    use femcod_problem, only: contact_problem, MAX_HEIGHT
    use femcod_deck_h5, only: read_deck_h5_header, is_hdf5_file
-   use femcod_deck_stream, only: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream
+   use femcod_deck_stream, only: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream, open_deck_range, &
+      count_deck_range, separator_at_or_after, too_few_heights, binary_byte
    use femcod_generate, only: scene_spec, scene_header
    use femcod_heights, only: unit_in_nm
    use femcod_hdf5, only: h5_file, h5_open, h5_close, h5_rank_and_dims
@@ -33,12 +35,8 @@ module femcod_mpi_input
    use femcod_mpi_results, only: agree
    implicit none
    private
-   public :: read_deck_columns, read_text_deck_columns, slab_rows
+   public :: read_deck_columns, read_text_deck_columns
    public :: is_dataset_scene, read_dataset_header, read_dataset_columns
-
-   !> A text deck's slab: at most this many bytes of heights (and at most an eighth of a
-   !> rank's columns, so that rank 0 holds within 1/8 of what every rank holds).
-   integer, parameter :: SLAB_BYTES = 64*1024*1024
 
 contains
 
@@ -89,11 +87,13 @@ contains
    end subroutine read_deck_columns
 
    !> The text deck `path` on the ranks of `comm`, as read_deck_columns gives an HDF5
-   !> deck: rank 0 reads the header (in `problem`, on rank 0 only) and then the heights
-   !> in slabs of slab_rows rows, scattering each slab's columns to their ranks as it is
-   !> read; every rank forms its columns of the composite gaps. `constants` and `block`
-   !> on every rank. Every message is read_deck's (file, line, what was expected).
-   !> Collective.
+   !> deck, read by every rank: rank 0 reads the header (in `problem`, on rank 0 only);
+   !> the heights' bytes are cut in as many ranges as ranks, each at a separator, and each
+   !> rank counts the heights and lines of its range, then reads them (femcod_deck_stream,
+   !> with the file's line and height numbers), and an all-to-all takes each height to the
+   !> rank of its column. Every message is read_deck's (file, line, what was expected),
+   !> the first in the file if several ranks find one. `constants` and `block` on every
+   !> rank. Collective.
    subroutine read_text_deck_columns(path, comm, how, problem, local, constants, block, status)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
@@ -105,65 +105,229 @@ contains
       type(status_type), intent(inout) :: status
       type(deck_stream) :: stream
       integer, allocatable :: first(:), count(:)
-      real(dp), allocatable :: lower(:, :), upper(:, :)
+      real(dp), allocatable :: lower(:, :), upper(:, :), values(:)
+      !> file: the heights' first byte, the file's size, the line at that byte, the last
+      !> line of the header, 1 if the file ends with a line end. bytes: this rank's range.
+      !> mine, before, total: the heights and line ends of this range, of the ranges
+      !> before it, of all. taken: the heights read here, and the first one's number.
+      !> binary: this range's first binary byte (count_deck_range).
+      integer(i8) :: file(5), bytes(2), mine(2), before(2), total(2), taken(2), binary(3)
+      integer(i8), allocatable :: starts(:), takes(:)
       integer :: rank, ranks, np
       call MPI_Comm_rank(comm, rank)
       call MPI_Comm_size(comm, ranks)
       allocate(local(0, 0))
       constants = 0
       block = 1
+      file = 0
       if (rank == 0) then
          call open_deck_stream(path, stream, problem, status)
-         if (status%code == 0) constants = problem_constants(problem)
+         if (status%code == 0) then
+            constants = problem_constants(problem)
+            file = [stream%next, stream%size, int(stream%line0, i8), int(stream%last_line, i8), 0_i8]
+            if (last_byte_ends_line(stream)) file(5) = 1
+         end if
+         call close_deck_stream(stream)
       end if
       call agree(status, comm)
       if (status%code /= 0) return
       call MPI_Bcast(constants, 4, MPI_DOUBLE_PRECISION, 0, comm)
+      call MPI_Bcast(file, 5, MPI_INTEGER8, 0, comm)
       np = nint(constants(1))
       block = coarse_factor(np, ranks, how)
       call column_split(np, ranks, block, first, count)
-      allocate(lower(np, count(rank)), upper(np, count(rank)))
-      call scatter_surface(lower)
-      if (status%code == 0) call scatter_surface(upper)
-      if (rank == 0) call close_deck_stream(stream)
+      ! This rank's bytes, from the separator at or after its share's start to the byte
+      ! before the next rank's.
+      call range_start(rank, bytes(1))
+      call range_start(rank + 1, bytes(2))
+      bytes(2) = bytes(2) - 1
+      call count_deck_range(path, bytes(1), bytes(2), mine(1), mine(2), binary, status)
+      call first_failure(status, comm)
+      if (status%code /= 0) return
+      before = 0
+      call MPI_Exscan(mine, before, 2, MPI_INTEGER8, MPI_SUM, comm)
+      if (rank == 0) before = 0
+      call MPI_Allreduce(mine, total, 2, MPI_INTEGER8, MPI_SUM, comm)
+      ! A binary byte anywhere first (the file is no text deck), as read_deck.
+      if (binary(1) > 0) call set_error(status, STATUS_BAD_INPUT, binary_byte(path, int(file(3) + before(2) + &
+         binary(2)), int(binary(3)), binary(1)))
+      call first_failure(status, comm)
+      if (status%code /= 0) return
+      ! This range's heights up to the 2 NP^2th; the range that holds the one after it
+      ! (if any) reports it as read_deck does.
+      taken = [max(0_i8, min(mine(1), 2*int(np, i8)**2 - before(1))), before(1)]
+      allocate(values(taken(1)))
+      if (taken(1) > 0 .or. before(1) == 2*int(np, i8)**2) then
+         call open_deck_range(path, np, bytes(1), bytes(2), int(file(3) + before(2)), before(1), stream, status)
+         if (status%code == 0) call read_deck_heights(stream, values, status)
+         call close_deck_stream(stream)
+      end if
+      call first_failure(status, comm)
+      if (status%code /= 0) return
+      if (total(1) < 2*int(np, i8)**2) then
+         call set_error(status, STATUS_BAD_INPUT, too_few_heights(path, last_line(), np, total(1)))
+         return
+      end if
+      allocate(starts(0:ranks - 1), takes(0:ranks - 1))
+      call MPI_Allgather(taken(2), 1, MPI_INTEGER8, starts, 1, MPI_INTEGER8, comm)
+      call MPI_Allgather(taken(1), 1, MPI_INTEGER8, takes, 1, MPI_INTEGER8, comm)
+      call to_column_owners(values, starts, takes, np, first, count, comm, lower, upper, status)
       if (status%code /= 0) return
       call composite_gaps(lower, upper, comm, local)
    contains
-      !> One surface's NP^2 heights, row by row from the stream, slab by slab: rank 0
-      !> reads a slab of rows (r x NP), every rank receives its columns of it.
-      subroutine scatter_surface(map)
-         real(dp), intent(out) :: map(:, :)
-         real(dp), allocatable :: values(:), slab(:, :), mine(:, :)
-         integer :: i0, r, rows
-         rows = slab_rows(np, ranks)
-         do i0 = 1, np, rows
-            r = min(rows, np - i0 + 1)
-            if (rank == 0) then
-               allocate(values(r*np))
-               call read_deck_heights(stream, values, status)
-               ! slab(ii, j): row i0 + ii - 1, column j; each rank's columns contiguous.
-               slab = transpose(reshape(values, [np, r]))
-               deallocate(values)
-            else
-               allocate(slab(1, 1))
-            end if
-            call agree(status, comm)
-            if (status%code /= 0) return
-            allocate(mine(r, count(rank)))
-            call MPI_Scatterv(slab, r*count, r*first, MPI_DOUBLE_PRECISION, mine, r*count(rank), &
-               MPI_DOUBLE_PRECISION, 0, comm)
-            map(i0:i0 + r - 1, :) = mine
-            deallocate(slab, mine)
-         end do
-      end subroutine scatter_surface
+      !> The first byte of rank r's range (r = ranks: the byte after the file).
+      subroutine range_start(r, at)
+         integer, intent(in) :: r
+         integer(i8), intent(out) :: at
+         integer(i8) :: share
+         if (r == 0) then
+            at = file(1)
+         else if (r >= ranks) then
+            at = file(2) + 1
+         else
+            share = file(1) + ((file(2) - file(1) + 1)*r)/ranks
+            call separator_at_or_after(path, share, file(2), at, status)
+         end if
+      end subroutine range_start
+      !> The file's last line that holds anything (femcod_deck_stream's last_line).
+      integer function last_line()
+         last_line = int(file(4))
+         if (file(2) >= file(1)) last_line = int(file(3) + total(2) - file(5))
+      end function last_line
    end subroutine read_text_deck_columns
 
-   !> The rows of a text deck's slab on `ranks` ranks: at most SLAB_BYTES of heights and
-   !> at most an eighth of one rank's columns (NP / (8 ranks) rows), at least one row.
-   pure integer function slab_rows(np, ranks) result(rows)
-      integer, intent(in) :: np, ranks
-      rows = max(1, min(np, np/(8*ranks), int(SLAB_BYTES/(8_8*np))))
-   end function slab_rows
+   !> Whether the file's last byte is a line end.
+   logical function last_byte_ends_line(stream) result(ends)
+      type(deck_stream), intent(in) :: stream
+      character(len=1) :: last
+      integer :: ios
+      ends = .false.
+      if (stream%size < 1 .or. stream%unit == -1) return
+      read(stream%unit, pos=stream%size, iostat=ios) last
+      ends = ios == 0 .and. last == new_line("a")
+   end function last_byte_ends_line
+
+   !> The first failing rank's status on every rank (the ranks read the file in order,
+   !> so the first failing rank found the first fault in the file). Collective.
+   subroutine first_failure(status, comm)
+      type(status_type), intent(inout) :: status
+      type(MPI_Comm), intent(in) :: comm
+      integer :: rank, ranks, who, code
+      character(len=1024) :: message
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_size(comm, ranks)
+      who = merge(rank, ranks, status%code /= 0)
+      call MPI_Allreduce(MPI_IN_PLACE, who, 1, MPI_INTEGER, MPI_MIN, comm)
+      if (who == ranks) return
+      code = status%code
+      message = ""
+      if (rank == who) message = status%message
+      call MPI_Bcast(code, 1, MPI_INTEGER, who, comm)
+      call MPI_Bcast(message, len(message), MPI_CHARACTER, who, comm)
+      if (rank /= who) then
+         status%code = 0
+         call set_error(status, code, trim(message))
+      end if
+   end subroutine first_failure
+
+   !> The heights `values` (in file order: the lower surface's NP^2 row by row, then the
+   !> upper's; this rank's from number starts(rank) on, 0-based), each sent to the rank
+   !> of its column (columns first(r) + 1 .. first(r) + count(r) on rank r), and freed:
+   !> `lower` and `upper` (NP x count(rank)) from every rank's heights (starts, takes).
+   !> Each range is walked by rows (a row's columns of one rank are one slice); what a
+   !> rank receives, from the ranks in turn, is its columns of every row in file order.
+   !> Collective.
+   subroutine to_column_owners(values, starts, takes, np, first, count, comm, lower, upper, status)
+      real(dp), allocatable, intent(inout) :: values(:)
+      integer(i8), intent(in) :: starts(0:), takes(0:)
+      integer, intent(in) :: np, first(0:), count(0:)
+      type(MPI_Comm), intent(in) :: comm
+      real(dp), allocatable, intent(out) :: lower(:, :), upper(:, :)
+      type(status_type), intent(inout) :: status
+      real(dp), allocatable :: sent(:), received(:)
+      integer(i8), allocatable :: send_n(:), recv_n(:)
+      integer, allocatable :: send_counts(:), send_at(:), recv_counts(:), recv_at(:)
+      integer(i8) :: k, row, t0, t1
+      integer :: rank, ranks, r, ja, jb, lo, hi, n, i, i0, j
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_size(comm, ranks)
+      allocate(send_n(0:ranks - 1), recv_n(0:ranks - 1))
+      do r = 0, ranks - 1
+         send_n(r) = in_columns(starts(rank), takes(rank), first(r), count(r))
+         recv_n(r) = in_columns(starts(r), takes(r), first(rank), count(rank))
+      end do
+      if (max(sum(send_n), sum(recv_n)) >= int(huge(1), i8)) then
+         call set_error(status, STATUS_USAGE, "a text deck of "//int_str(np)//"^2 on "//int_str(ranks)// &
+            " ranks: more than 2^31 heights a rank; use more ranks or an HDF5 deck (femcod mkdeck convert)")
+      end if
+      call first_failure(status, comm)
+      if (status%code /= 0) return
+      allocate(send_counts(0:ranks - 1), recv_counts(0:ranks - 1), send_at(0:ranks - 1), recv_at(0:ranks - 1))
+      send_counts(:) = int(send_n)
+      recv_counts(:) = int(recv_n)
+      send_at(0) = 0
+      recv_at(0) = 0
+      do r = 1, ranks - 1
+         send_at(r) = send_at(r - 1) + send_counts(r - 1)
+         recv_at(r) = recv_at(r - 1) + recv_counts(r - 1)
+      end do
+      ! Packed for each rank in file order, row by row.
+      allocate(sent(sum(send_n)))
+      send_n = send_at
+      t0 = starts(rank)
+      t1 = t0 + takes(rank) - 1
+      do row = t0/np, t1/np
+         call row_columns(row, t0, t1, ja, jb)
+         do r = 0, ranks - 1
+            lo = max(ja, first(r) + 1)
+            hi = min(jb, first(r) + count(r))
+            if (hi < lo) cycle
+            k = row*np + lo - 1 - t0
+            sent(send_n(r) + 1:send_n(r) + hi - lo + 1) = values(k + 1:k + hi - lo + 1)
+            send_n(r) = send_n(r) + hi - lo + 1
+         end do
+      end do
+      deallocate(values)
+      allocate(received(sum(recv_n)))
+      call MPI_Alltoallv(sent, send_counts, send_at, MPI_DOUBLE_PRECISION, received, recv_counts, recv_at, &
+         MPI_DOUBLE_PRECISION, comm)
+      deallocate(sent)
+      ! From each rank in turn, in file order: this rank's columns of each row, row after
+      ! row (both surfaces' 2 NP rows), transposed by tiles of 64 rows.
+      allocate(lower(np, count(rank)), upper(np, count(rank)))
+      n = count(rank)
+      !$omp parallel do private(j, i)
+      do i0 = 1, np, 64
+         do j = 1, n
+            do i = i0, min(i0 + 63, np)
+               lower(i, j) = received(int(i - 1, i8)*n + j)
+               upper(i, j) = received(int(np + i - 1, i8)*n + j)
+            end do
+         end do
+      end do
+   contains
+      !> The columns ja .. jb of row `row` (0-based over both surfaces) among heights
+      !> t0 .. t1.
+      pure subroutine row_columns(row, t0, t1, ja, jb)
+         integer(i8), intent(in) :: row, t0, t1
+         integer, intent(out) :: ja, jb
+         ja = int(max(t0, row*np) - row*np) + 1
+         jb = int(min(t1, row*np + np - 1) - row*np) + 1
+      end subroutine row_columns
+      !> Heights t0 .. t0 + n - 1 (0-based, file order) in columns c0 + 1 .. c0 + nc.
+      pure integer(i8) function in_columns(t0, n, c0, nc) result(hits)
+         integer(i8), intent(in) :: t0, n
+         integer, intent(in) :: c0, nc
+         integer(i8) :: row
+         integer :: ja, jb
+         hits = 0
+         if (n <= 0 .or. nc <= 0) return
+         do row = t0/np, (t0 + n - 1)/np
+            call row_columns(row, t0, t0 + n - 1, ja, jb)
+            hits = hits + max(0, min(jb, c0 + nc) - max(ja, c0 + 1) + 1)
+         end do
+      end function in_columns
+   end subroutine to_column_owners
 
    !> This rank's columns of the composite gaps from its columns of the two surfaces
    !> (femcod_scene's initial gaps, as scatter_problem forms them on rank 0): the upper
