@@ -1,8 +1,10 @@
 !> A text deck read in slabs: its header as read_deck reads it (femcod_deck's
 !> read_deck_header), then its 2 NP^2 heights in file order, as many at a time as the
 !> caller asks for, through a buffer of CHUNK_BYTES: the file is never held whole, so a
-!> deck larger than the 2 GiB that read_file takes (8192^2 and up) is read too. femcod-mpi
-!> streams a text deck this way on rank 0 and scatters each slab (mpi/src/femcod_mpi_input).
+!> deck larger than the 2 GiB that read_file takes (8192^2 and up) is read too. A stream
+!> may also cover one range of the file's bytes (open_deck_range, with count_deck_range
+!> and separator_at_or_after to cut and count the ranges): femcod-mpi's ranks each read
+!> their own range this way (mpi/src/femcod_mpi_input).
 !>
 !> Every message is read_deck's: the file, the line, what was expected and what was
 !> found (a value that is not a finite number, or beyond 1e12 nm, with its row and
