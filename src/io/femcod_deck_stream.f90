@@ -181,15 +181,9 @@ contains
       integer(i8), intent(in) :: first_byte, last_byte, before
       type(deck_stream), intent(out) :: stream
       type(status_type), intent(inout) :: status
-      integer :: ios
       stream%path = path
-      open(newunit=stream%unit, file=path, access="stream", form="unformatted", action="read", status="old", &
-         iostat=ios)
-      if (ios /= 0) then
-         call set_error(status, STATUS_IO, path//": cannot open it ("//os_error_text()//")")
-         stream%unit = -1
-         return
-      end if
+      call open_bytes(path, stream%unit, status)
+      if (status%code /= 0) return
       stream%np = np
       stream%size = last_byte
       stream%next = first_byte
@@ -211,6 +205,19 @@ contains
          int_str(code)//") at byte "//int_str(at)
    end function binary_byte
 
+   !> `path` opened for reading its bytes (unit -1 and STATUS_IO if it cannot be).
+   subroutine open_bytes(path, unit, status)
+      character(len=*), intent(in) :: path
+      integer, intent(out) :: unit
+      type(status_type), intent(inout) :: status
+      integer :: ios
+      open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
+      if (ios /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot open it ("//os_error_text()//")")
+         unit = -1
+      end if
+   end subroutine open_bytes
+
    !> The tokens (heights or not) and the line ends in bytes first_byte .. last_byte of
    !> `path` (a range as open_deck_range takes it), read a chunk at a time; `binary`:
    !> the first binary control byte's place in the file (0: none), the line ends before
@@ -227,11 +234,8 @@ contains
       line_ends = 0
       binary = 0
       if (last_byte < first_byte) return
-      open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
-      if (ios /= 0) then
-         call set_error(status, STATUS_IO, path//": cannot open it ("//os_error_text()//")")
-         return
-      end if
+      call open_bytes(path, unit, status)
+      if (status%code /= 0) return
       at = first_byte
       do while (at <= last_byte)
          n = int(min(int(CHUNK_BYTES, i8), last_byte - at + 1))
@@ -276,11 +280,8 @@ contains
       integer :: unit, ios, n, k
       at = size + 1
       if (from > size) return
-      open(newunit=unit, file=path, access="stream", form="unformatted", action="read", status="old", iostat=ios)
-      if (ios /= 0) then
-         call set_error(status, STATUS_IO, path//": cannot open it ("//os_error_text()//")")
-         return
-      end if
+      call open_bytes(path, unit, status)
+      if (status%code /= 0) return
       at = from
       do while (at <= size)
          n = int(min(int(len(window), i8), size - at + 1))
