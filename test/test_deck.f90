@@ -1024,7 +1024,9 @@ contains
    !> femcod-mpi's ranks each read one range of a text deck's bytes (cut at a separator
    !> at or after an even share), counting its heights and lines first so that each range
    !> knows its first height's number and line: read range after range in 1 to 7 pieces,
-   !> the heights are read_deck's; a bad height anywhere gets the whole file's message
+   !> the heights are read_deck's; the counts, read in chunks of 1, 7 and 4096 bytes
+   !> (tokens and lines cut anywhere), are the whole file's; a bad height anywhere gets
+   !> the whole file's message
    !> (the expected words are test_stream's bad cases'); every range's file is closed
    !> after it (NEWUNIT numbers are negative: a check for a unit >= 0 never closed one).
    subroutine test_ranges(error)
@@ -1039,6 +1041,8 @@ contains
       integer :: d, p, k, at
       do d = 1, size(decks)
          call read_deck(trim(decks(d)), whole, status)
+         call check(error, counts_in_chunks(trim(decks(d))), trim(decks(d))//": the counts depend on the chunks")
+         if (allocated(error)) return
          do p = 1, size(pieces)
             call read_ranges(trim(decks(d)), pieces(p), got, status)
             call check(error, status%code, 0, trim(decks(d))//": "//status%message)
@@ -1130,6 +1134,27 @@ contains
             line = line + lines(r)
          end do
       end subroutine read_ranges
+      !> Whether the heights' counts (tokens, line ends) of `file` are the same read in
+      !> chunks of 1, 7 and 4096 bytes as in one, and the tokens 2 NP^2.
+      logical function counts_in_chunks(file) result(same)
+         character(len=*), intent(in) :: file
+         integer, parameter :: chunks(3) = [1, 7, 4096]
+         type(contact_problem) :: header
+         type(deck_stream) :: stream
+         type(status_type) :: st
+         integer(i8) :: first_byte, last, one(2), other(2), binary(3)
+         integer :: c
+         call open_deck_stream(file, stream, header, st)
+         first_byte = stream%next
+         last = stream%size
+         call close_deck_stream(stream)
+         call count_deck_range(file, first_byte, last, one(1), one(2), binary, st)
+         same = st%code == 0 .and. one(1) == 2*int(header%np, i8)**2
+         do c = 1, size(chunks)
+            call count_deck_range(file, first_byte, last, other(1), other(2), binary, st, at_a_time=chunks(c))
+            same = same .and. st%code == 0 .and. all(other == one)
+         end do
+      end function counts_in_chunks
       subroutine set_bad(st, message)
          type(status_type), intent(inout) :: st
          character(len=*), intent(in) :: message

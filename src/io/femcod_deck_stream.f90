@@ -205,6 +205,12 @@ contains
          int_str(code)//") at byte "//int_str(at)
    end function binary_byte
 
+   !> Whether a byte separates heights (a blank, a control character or a comma).
+   elemental logical function separates(byte)
+      character(len=1), intent(in) :: byte
+      separates = iachar(byte) < 33 .or. byte == ","
+   end function separates
+
    !> `path` opened for reading its bytes (unit -1 and STATUS_IO if it cannot be).
    subroutine open_bytes(path, unit, status)
       character(len=*), intent(in) :: path
@@ -221,24 +227,30 @@ contains
    !> The tokens (heights or not) and the line ends in bytes first_byte .. last_byte of
    !> `path` (a range as open_deck_range takes it), read a chunk at a time; `binary`:
    !> the first binary control byte's place in the file (0: none), the line ends before
-   !> it in the range, and its code.
-   subroutine count_deck_range(path, first_byte, last_byte, tokens, line_ends, binary, status)
+   !> it in the range, and its code. `at_a_time`: read that many bytes at a time
+   !> (CHUNK_BYTES by default; the tests take a few, to cut tokens and lines).
+   subroutine count_deck_range(path, first_byte, last_byte, tokens, line_ends, binary, status, at_a_time)
       character(len=*), intent(in) :: path
       integer(i8), intent(in) :: first_byte, last_byte
       integer(i8), intent(out) :: tokens, line_ends, binary(3)
       type(status_type), intent(inout) :: status
+      integer, intent(in), optional :: at_a_time
       character(len=:), allocatable :: text
       integer(i8) :: at
-      integer :: unit, ios, n, cut, count, ends, bad
+      integer :: unit, ios, n, count, ends, bad, chunk
+      logical :: inside
       tokens = 0
       line_ends = 0
       binary = 0
+      inside = .false.
+      chunk = CHUNK_BYTES
+      if (present(at_a_time)) chunk = max(1, at_a_time)
       if (last_byte < first_byte) return
       call open_bytes(path, unit, status)
       if (status%code /= 0) return
       at = first_byte
       do while (at <= last_byte)
-         n = int(min(int(CHUNK_BYTES, i8), last_byte - at + 1))
+         n = int(min(int(chunk, i8), last_byte - at + 1))
          if (allocated(text)) deallocate(text)
          allocate(character(len=n) :: text)
          read(unit, pos=at, iostat=ios) text
@@ -246,25 +258,18 @@ contains
             call set_error(status, STATUS_IO, path//": cannot read it past byte "//int_str(at))
             exit
          end if
-         ! Cut after the chunk's last separator (the rest is read with the next chunk),
-         ! unless it is the range's end or holds none.
-         cut = n
-         if (at + n <= last_byte) then
-            do while (cut > 0)
-               if (iachar(text(cut:cut)) < 33 .or. text(cut:cut) == ",") exit
-               cut = cut - 1
-            end do
-            if (cut == 0) cut = n
-         end if
          if (binary(1) == 0) then
-            bad = first_control(text(1:cut))
+            bad = first_control(text)
             if (bad > 0) binary = [at + bad - 1, line_ends + count_line_ends(text(1:bad - 1)), &
                int(iachar(text(bad:bad)), i8)]
          end if
-         call scan_all(text(1:cut), 0, 0, count, ends)
+         call scan_all(text, 0, 0, count, ends)
+         ! A token cut by the chunk's end was counted with the chunk before.
+         if (inside .and. .not. separates(text(1:1))) count = count - 1
+         inside = .not. separates(text(n:n))
          tokens = tokens + count
          line_ends = line_ends + ends
-         at = at + cut
+         at = at + n
       end do
       close(unit)
    end subroutine count_deck_range
@@ -291,7 +296,7 @@ contains
             exit
          end if
          do k = 1, n
-            if (iachar(window(k:k)) < 33 .or. window(k:k) == ",") then
+            if (separates(window(k:k))) then
                at = at + k - 1
                close(unit)
                return
