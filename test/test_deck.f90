@@ -5,7 +5,7 @@ module test_deck
    use femcod_status, only: status_type, set_error
    use femcod_deck, only: read_deck, write_deck
    use femcod_deck_stream, only: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream, open_deck_range, &
-      count_deck_range, separator_at_or_after, binary_byte
+      count_deck_range, separator_at_or_after, binary_byte, balanced_cuts
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type, format_real, format_reals, int_str, parse_real
    use femcod_cli, only: run_femcod
@@ -66,7 +66,8 @@ contains
          new_unittest("bad deck through femcod run: exit 3, no result file", test_run_bad_deck), &
          new_unittest("a UTF-8 byte order mark is not part of the label", test_bom), &
          new_unittest("streamed in slabs: the same heights and messages, cut anywhere", test_stream), &
-         new_unittest("read by ranges of bytes (femcod-mpi's ranks): the same heights and messages", test_ranges) &
+         new_unittest("read by ranges of bytes (femcod-mpi's ranks): the same heights and messages", test_ranges), &
+         new_unittest("blocks of work cut into parts of about equal weight", test_balanced_cuts) &
          ]
    end subroutine collect_deck
 
@@ -1020,6 +1021,41 @@ contains
          call close_deck_stream(stream)
       end subroutine stream_all
    end subroutine test_stream
+
+   !> balanced_cuts, by hand: four equal blocks in two parts are 2 + 2; a heavy first
+   !> block (3, 1, 1, 1: middles 1.5, 3.5, 4.5, 5.5 of 6, halves at 3) stands alone; no
+   !> weight at all goes to the first part; one block in three parts goes to the part its
+   !> middle falls in (the second). And on 200 random weights in 1 to 9 parts: the cuts
+   !> rise, end at the last block, and no part is heavier than its share plus one block.
+   subroutine test_balanced_cuts(error)
+      type(error_type), allocatable, intent(out) :: error
+      real(dp) :: w(200), load
+      integer :: parts, r
+      integer, allocatable :: cuts(:)
+      call check(error, all(balanced_cuts([1.0_dp, 1.0_dp, 1.0_dp, 1.0_dp], 2) == [0, 2, 4]), "1, 1, 1, 1 in 2")
+      if (allocated(error)) return
+      call check(error, all(balanced_cuts([3.0_dp, 1.0_dp, 1.0_dp, 1.0_dp], 2) == [0, 1, 4]), "3, 1, 1, 1 in 2")
+      if (allocated(error)) return
+      call check(error, all(balanced_cuts([0.0_dp, 0.0_dp], 3) == [0, 2, 2, 2]), "no weight in 3")
+      if (allocated(error)) return
+      call check(error, all(balanced_cuts([1.0_dp], 3) == [0, 0, 1, 1]), "one block in 3")
+      if (allocated(error)) return
+      call random_number(w)
+      do parts = 1, 9
+         allocate(cuts(0:parts))
+         cuts(:) = balanced_cuts(w, parts)
+         call check(error, cuts(0) == 0 .and. cuts(parts) == size(w) .and. all(cuts(1:) >= cuts(:parts - 1)), &
+            to_string(parts)//" parts: the cuts do not rise to the last block")
+         if (allocated(error)) return
+         do r = 1, parts
+            load = sum(w(cuts(r - 1) + 1:cuts(r)))
+            call check(error, load <= sum(w)/parts + maxval(w), to_string(parts)//" parts: part "//to_string(r)// &
+               " carries "//to_string(load)//" of "//to_string(sum(w)))
+            if (allocated(error)) return
+         end do
+         deallocate(cuts)
+      end do
+   end subroutine test_balanced_cuts
 
    !> femcod-mpi's ranks each read one range of a text deck's bytes (cut at a separator
    !> at or after an even share), counting its heights and lines first so that each range

@@ -20,7 +20,7 @@ module femcod_deck_stream
    implicit none
    private
    public :: deck_stream, open_deck_stream, read_deck_heights, close_deck_stream, read_text_deck_header, CHUNK_BYTES
-   public :: open_deck_range, count_deck_range, separator_at_or_after, too_few_heights, binary_byte
+   public :: open_deck_range, count_deck_range, separator_at_or_after, too_few_heights, binary_byte, balanced_cuts
 
    !> Bytes read from the file at a time (the buffer holds one chunk and the part of a
    !> token cut at its end).
@@ -204,6 +204,28 @@ contains
       message = path//":"//int_str(line)//": expected a text deck, found a binary control character (code "// &
          int_str(code)//") at byte "//int_str(at)
    end function binary_byte
+
+   !> Consecutive blocks of work `weights` (in file order) cut into `parts` runs of about
+   !> equal weight: part r (1-based) takes blocks cuts(r - 1) + 1 .. cuts(r), each block
+   !> going to the part in whose share the middle of its weight falls (cuts(0) = 0,
+   !> cuts(parts) = the blocks; a part may take none).
+   pure function balanced_cuts(weights, parts) result(cuts)
+      real(dp), intent(in) :: weights(:)
+      integer, intent(in) :: parts
+      integer :: cuts(0:parts)
+      real(dp) :: total, before
+      integer :: k, r
+      total = sum(weights)
+      cuts = 0
+      before = 0
+      do k = 1, size(weights)
+         r = 1
+         if (total > 0) r = min(parts, 1 + int((before + weights(k)/2)*parts/total))
+         cuts(r:) = k
+         before = before + weights(k)
+      end do
+      cuts(parts) = size(weights)
+   end function balanced_cuts
 
    !> Whether a byte separates heights (a blank, a control character or a comma).
    elemental logical function separates(byte)
