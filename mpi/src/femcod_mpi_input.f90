@@ -88,12 +88,13 @@ contains
 
    !> The text deck `path` on the ranks of `comm`, as read_deck_columns gives an HDF5
    !> deck, read by every rank: rank 0 reads the header (in `problem`, on rank 0 only);
-   !> the heights' bytes are cut in as many ranges as ranks, each at a separator, and each
-   !> rank counts the heights and lines of its range, then reads them (femcod_deck_stream,
-   !> with the file's line and height numbers), and an all-to-all takes each height to the
-   !> rank of its column. Every message is read_deck's (file, line, what was expected),
-   !> the first in the file if several ranks find one. `constants` and `block` on every
-   !> rank. Collective.
+   !> each rank counts the heights and line ends of blocks of the bytes (each block from a
+   !> separator), every rank learns every block, the ranges are cut between blocks for
+   !> about equal work, and each rank reads its range (femcod_deck_stream, with the file's
+   !> line and height numbers); an all-to-all takes each height to the rank of its column.
+   !> Every message is read_deck's (file, line, what was expected), the first in the file
+   !> if several ranks find one, a binary byte anywhere first. `constants` and `block` on
+   !> every rank. Collective.
    subroutine read_text_deck_columns(path, comm, how, problem, local, constants, block, status)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
