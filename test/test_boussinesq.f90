@@ -7,8 +7,8 @@ module test_boussinesq
       offset_table
    use femcod_spring, only: spring_stiffness
    use femcod_skyline, only: colht, diagonal_addresses, assemble_element
-   use femcod_trfact, only: trfact, TRFACT_FACTOR, TRFACT_SOLVE
-   use femcod_lapack, only: dgesv
+   use femcod_trfact, only: trfact, trfact_condition, TRFACT_FACTOR, TRFACT_SOLVE
+   use femcod_lapack, only: dgesv, dlacn2
    use femcod_random, only: random_stream, seed_stream, uniform
    use femcod_workspace, only: workspace_type, workspace_layout, allocate_workspace, skyline_words, IPIADR, IPCONT, MPWORK
    use femcod_legacy, only: legacy_unit_solution, legacy_materials
@@ -32,6 +32,7 @@ contains
          new_unittest("SPRING stiffness eq. 4.9", test_spring), &
          new_unittest("COLHT heights by hand and femcod's skyline size", test_colht), &
          new_unittest("TRFACT against a dense LAPACK solve", test_trfact), &
+         new_unittest("TRFACT's condition estimate against the exact one and LAPACK's dlacn2", test_condition), &
          new_unittest("legacy unit solution: one and two contacts by hand", test_unit_solution) &
          ]
    end subroutine collect_boussinesq
@@ -182,6 +183,85 @@ contains
       call dgesv(n, 1, dense, n, ipiv, b, n, info)
       call check(error, maxval(abs(x - b)) < 1.0e-13_dp*maxval(abs(b)), "skyline solve equals dense LU")
    end subroutine test_trfact
+
+   !> trfact_condition on random symmetric skyline matrices (n = 2 to 40, diagonally
+   !> dominant by a factor 4 down to 1.0001, so from well to ill conditioned): never above the exact ||K||_1 ||K^-1||_1 (the
+   !> inverse by a dense LAPACK solve of the identity) and within a factor 3 of it (Higham
+   !> 1988: the estimator is usually exact on such matrices), and equal to within 1e-12 to
+   !> the same estimator through LAPACK's own dlacn2 (femcod's until it was written in
+   !> plain loops; only the order of its sums differs).
+   subroutine test_condition(error)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: trial, n, i, j, info, kase, isave(3), checked
+      integer, allocatable :: height(:), iadr(:), ipiv(:), isgn(:)
+      real(dp), allocatable :: a(:), factored(:), dense(:, :), inverse(:, :), v(:), x(:)
+      real(dp) :: u, exact, lapack, est, diagonal, norm, diagonals(4)
+      type(random_stream) :: stream
+      type(status_type) :: status
+      call seed_stream(stream, 11)
+      checked = 0
+      do trial = 1, 40
+         n = 2 + mod(trial*7, 39)
+         diagonals = [4.0_dp, 1.5_dp, 1.01_dp, 1.0001_dp]
+         diagonal = diagonals(1 + mod(trial, 4))
+         allocate(height(n), iadr(n), ipiv(n), isgn(n), dense(n, n), inverse(n, n), v(n), x(n))
+         do j = 1, n
+            call uniform(stream, u)
+            height(j) = min(j - 1, int(u*8))
+         end do
+         call diagonal_addresses(height, iadr)
+         allocate(a(iadr(n)))
+         dense = 0
+         do j = 1, n
+            do i = j - height(j), j - 1
+               call uniform(stream, u)
+               dense(i, j) = u - 0.5_dp
+               dense(j, i) = dense(i, j)
+            end do
+         end do
+         ! Diagonally dominant by a factor `diagonal` (symmetric: positive definite).
+         do j = 1, n
+            dense(j, j) = diagonal*sum(abs(dense(:, j))) + 1.0e-3_dp
+         end do
+         do j = 1, n
+            do i = j - height(j), j
+               a(iadr(j) - (j - i)) = dense(i, j)
+            end do
+         end do
+         factored = a
+         call trfact(factored, iadr, x, TRFACT_FACTOR, status)
+         if (status%code /= 0) then
+            deallocate(height, iadr, ipiv, isgn, dense, inverse, v, x, a)
+            cycle
+         end if
+         est = trfact_condition(factored, a, iadr)
+         inverse = 0
+         do i = 1, n
+            inverse(i, i) = 1
+         end do
+         norm = maxval(sum(abs(dense), dim=1))
+         call dgesv(n, n, dense, n, ipiv, inverse, n, info)
+         exact = norm*maxval(sum(abs(inverse), dim=1))
+         ! The same estimator through dlacn2 (reverse communication, solves by TRFACT).
+         kase = 0
+         lapack = 0
+         do
+            call dlacn2(n, v, x, isgn, lapack, kase, isave)
+            if (kase == 0) exit
+            call trfact(factored, iadr, x, TRFACT_SOLVE, status)
+         end do
+         lapack = norm*lapack
+         call check(error, info == 0 .and. est <= exact*(1 + 1.0e-10_dp) .and. est >= exact/3, "n = "// &
+            to_string(n)//": estimate "//to_string(est)//" against the exact "//to_string(exact))
+         if (allocated(error)) return
+         call check(error, abs(est - lapack) <= 1.0e-12_dp*est, "n = "//to_string(n)//": estimate "// &
+            to_string(est)//" against dlacn2's "//to_string(lapack))
+         if (allocated(error)) return
+         deallocate(height, iadr, ipiv, isgn, dense, inverse, v, x, a)
+         checked = checked + 1
+      end do
+      call check(error, checked == 40, "only "//to_string(checked)//" of 40 matrices were factored")
+   end subroutine test_condition
 
    subroutine test_unit_solution(error)
       type(error_type), allocatable, intent(out) :: error

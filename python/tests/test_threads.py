@@ -80,3 +80,23 @@ def test_a_spin_count_of_the_users_keeps_the_default(tmp_path):
     with one_busy_process():
         record = openmp_record(tmp_path, OMP_NUM_THREADS=str(max(2, machine_cpus())), GOMP_SPINCOUNT="1000")
     assert record["wait_policy"] == "default"
+
+
+def test_the_legacy_condition_estimate_does_not_follow_openblas_threads(tmp_path):
+    """The legacy solver's condition estimate (/run/trfact_condition; doc/results.md) is
+    the same to the last bit whatever OpenBLAS's thread count. Through LAPACK's dlacn2
+    it was not: on input/sphere_d05.deck at 1167.54 nN it read 166600739.38782102 with
+    OPENBLAS_NUM_THREADS=1 and 166600739.387821 with 2 (the estimator now sums in
+    femcod's own loops, legacy/femcod_trfact)."""
+    import h5py
+    values = []
+    for threads in ("1", "2"):
+        env = dict(os.environ, OPENBLAS_NUM_THREADS=threads)
+        prefix = tmp_path / f"blas{threads}"
+        p = subprocess.run([femcod_program(), "run", os.path.join(REPO, "input", "sphere_d05.deck"), "--solver",
+                            "legacy", "--loads", "1167.5434222245665", "-o", str(prefix), "-q", "--figures", "none"],
+                           env=env, capture_output=True, text=True)
+        assert p.returncode == 0, p.stderr
+        with h5py.File(f"{prefix}.h5", "r") as f:
+            values.append(float(f["run/trfact_condition"][()]))
+    assert values[0] == values[1] and values[0] > 1, values

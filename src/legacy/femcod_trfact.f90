@@ -7,7 +7,6 @@
 module femcod_trfact
    use femcod_kinds, only: dp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL
-   use femcod_lapack, only: dlacn2
    implicit none
    private
    public :: trfact, trfact_condition, TRFACT_FACTOR, TRFACT_SOLVE
@@ -92,20 +91,25 @@ contains
 
    !> Estimate of the 1-norm condition number ||K||_1 ||K^-1||_1 of the symmetric
    !> skyline matrix: ||K||_1 from `original` (K before TRFACT_FACTOR), ||K^-1||_1 by
-   !> LAPACK's estimator dlacn2 driving solves with the factor in `factored` (a few
-   !> solves, each as cheap as one TRFACT_SOLVE). The relative error of a solve is then
-   !> about eps times the estimate.
+   !> Hager's and Higham's estimator (LAPACK's dlacn2, Higham, ACM TOMS 14, 1988, 381-396,
+   !> Algorithm 4.1) driving solves with the factor in `factored`: at most 5 steps and the
+   !> alternative vector, each a solve as cheap as one TRFACT_SOLVE; K symmetric, so that
+   !> K^-T = K^-1. Written here, in plain loops, rather than through dlacn2, whose sums are
+   !> OpenBLAS's (dasum, idamax): through them the estimate followed OpenBLAS's thread
+   !> count in its last digits (input/sphere_d05.deck's /run/trfact_condition differed
+   !> under OPENBLAS_NUM_THREADS=1 and 2). The relative error of a solve is about eps
+   !> times the estimate.
    function trfact_condition(factored, original, iadr) result(kappa)
       real(dp), intent(in) :: factored(:), original(:)
       integer, intent(in) :: iadr(:)
       real(dp) :: kappa
-      real(dp), allocatable :: colsum(:), v(:), x(:), work(:)
-      integer, allocatable :: isgn(:)
-      real(dp) :: est
-      integer :: n, j, i, top_j, kase, isave(3)
+      integer, parameter :: MAX_STEPS = 5
+      real(dp), allocatable :: colsum(:), x(:), xi(:), work(:)
+      real(dp) :: est, previous
+      integer :: n, j, i, top_j, jlast, step
       type(status_type) :: ignore
       n = size(iadr)
-      allocate(colsum(n), v(n), x(n), isgn(n))
+      allocate(colsum(n), x(n), xi(n))
       colsum = 0
       do j = 1, n
          top_j = 1
@@ -115,15 +119,55 @@ contains
             if (i < j) colsum(i) = colsum(i) + abs(original(iadr(j) - (j - i)))
          end do
       end do
-      est = 0
-      kase = 0
       work = factored
-      do
-         call dlacn2(n, v, x, isgn, est, kase, isave)
-         if (kase == 0) exit
-         ! K is symmetric: K^-T x = K^-1 x.
-         call trfact(work, iadr, x, TRFACT_SOLVE, ignore)
-      end do
+      ! ||K^-1 x||_1 of x = (1/n, ..., 1/n), then steps from the unit vector of the largest
+      ! |K^-1 sign(K^-1 x)| while the estimate grows and the signs change.
+      x = 1.0_dp/n
+      call solve(x)
+      est = sum(abs(x))
+      if (n > 1) then
+         xi = signs(x)
+         x = xi
+         call solve(x)
+         j = largest(x)
+         do step = 2, MAX_STEPS
+            x = 0
+            x(j) = 1
+            call solve(x)
+            previous = est
+            est = sum(abs(x))
+            ! A repeated sign vector (converged) or no growth (cycling): as dlacn2, the
+            ! last estimate stands.
+            if (all(signs(x) == xi) .or. est <= previous) exit
+            xi = signs(x)
+            x = xi
+            call solve(x)
+            jlast = j
+            j = largest(x)
+            if (x(jlast) == abs(x(j))) exit
+         end do
+         ! The alternative vector, against cancellation: 2 ||K^-1 b||_1/(3n) of
+         ! b(i) = (-1)^(i+1) (1 + (i-1)/(n-1)).
+         x = [(merge(1.0_dp, -1.0_dp, mod(i, 2) == 1)*(1 + real(i - 1, dp)/(n - 1)), i = 1, n)]
+         call solve(x)
+         est = max(est, 2*(sum(abs(x))/real(3*n, dp)))
+      end if
       kappa = maxval(colsum)*est
+   contains
+      subroutine solve(b)
+         real(dp), intent(inout) :: b(:)
+         call trfact(work, iadr, b, TRFACT_SOLVE, ignore)
+      end subroutine solve
+      !> +1 where v(i) >= 0 (-0 too), -1 elsewhere.
+      pure function signs(v)
+         real(dp), intent(in) :: v(:)
+         real(dp) :: signs(size(v))
+         signs = merge(1.0_dp, -1.0_dp, v >= 0)
+      end function signs
+      !> The first index of the largest |v(i)| (BLAS's idamax).
+      pure integer function largest(v)
+         real(dp), intent(in) :: v(:)
+         largest = maxloc(abs(v), dim=1)
+      end function largest
    end function trfact_condition
 end module femcod_trfact
