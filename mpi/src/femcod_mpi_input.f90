@@ -109,12 +109,12 @@ contains
       real(dp), allocatable :: lower(:, :), upper(:, :), values(:)
       !> file: the heights' first byte, the file's size, the line at that byte, the last
       !> line of the header, 1 if the file ends with a line end. bytes: this rank's range.
-      !> mine, before, total: the heights and line ends of this range, of the ranges
-      !> before it, of all. taken: the heights read here, and the first one's number.
+      !> mine: the heights of this range; before, total: the heights and line ends of the
+      !> ranges before it, of all. taken: the heights read here, and the first one's number.
       !> every: each block's first byte, heights, line ends and first binary byte (place,
       !> line ends before it, code), all ranks' in file order.
       integer, parameter :: BLOCKS = 16
-      integer(i8) :: file(5), bytes(2), mine(2), before(2), total(2), taken(2)
+      integer(i8) :: file(5), bytes(2), mine, before(2), total(2), taken(2)
       integer(i8), allocatable :: every(:, :), starts(:)
       integer, allocatable :: cuts(:)
       integer :: k
@@ -155,7 +155,7 @@ contains
       allocate(cuts(0:ranks))
       cuts(:) = balanced_cuts(real(every(2, :), dp) + real(starts(2:) - starts(:size(starts) - 1), dp)/6, ranks)
       bytes = [starts(cuts(rank) + 1), starts(cuts(rank + 1) + 1) - 1]
-      mine = [sum(every(2, cuts(rank) + 1:cuts(rank + 1))), sum(every(3, cuts(rank) + 1:cuts(rank + 1)))]
+      mine = sum(every(2, cuts(rank) + 1:cuts(rank + 1)))
       before = [sum(every(2, :cuts(rank))), sum(every(3, :cuts(rank)))]
       total = [sum(every(2, :)), sum(every(3, :))]
       ! A binary byte anywhere first (the file is no text deck), as read_deck.
@@ -167,7 +167,7 @@ contains
       end if
       ! This range's heights up to the 2 NP^2th; the range that holds the one after it
       ! (if any) reports it as read_deck does.
-      taken = [max(0_i8, min(mine(1), 2*int(np, i8)**2 - before(1))), before(1)]
+      taken = [max(0_i8, min(mine, 2*int(np, i8)**2 - before(1))), before(1)]
       allocate(values(taken(1)))
       if (taken(1) > 0 .or. before(1) == 2*int(np, i8)**2) then
          call open_deck_range(path, np, bytes(1), bytes(2), int(file(3) + before(2)), before(1), stream, status)
