@@ -1061,10 +1061,10 @@ contains
    !> at or after an even share), counting its heights and lines first so that each range
    !> knows its first height's number and line: read range after range in 1 to 7 pieces,
    !> the heights are read_deck's; the counts, read in chunks of 1, 7 and 4096 bytes
-   !> (tokens and lines cut anywhere), are the whole file's; a bad height anywhere gets
-   !> the whole file's message
-   !> (the expected words are test_stream's bad cases'); every range's file is closed
-   !> after it (NEWUNIT numbers are negative: a check for a unit >= 0 never closed one).
+   !> (tokens and lines cut anywhere), are the whole file's; a fault in the heights gets
+   !> read_deck's own message for the whole file, word for word; every range's file is
+   !> closed after it (NEWUNIT numbers are negative: a check for a unit >= 0 never closed
+   !> one).
    subroutine test_ranges(error)
       type(error_type), allocatable, intent(out) :: error
       integer, parameter :: pieces(5) = [1, 2, 3, 5, 7]
