@@ -20,9 +20,12 @@
 !>   uses them: the search directions always, the forces' own displacements while the
 !>   residual is above `single_until`; every switch and the final answer from a fresh
 !>   double convolution.
-!> - Every force the projection changes brings a fresh convolution (the serial solver adds
-!>   up to `direct_corrections` of them from the Love table, which would be NP^2 values on
-!>   every rank): more convolutions, the same answer (to the tolerance).
+!> - Up to `direct_corrections` forces the projection changes are corrected directly from
+!>   the float32 Love table, as the serial solver does, when every rank is on one node:
+!>   the table (NP^2 values, 4 bytes each) is then held once in memory the node's ranks
+!>   share (an MPI-3 shared window), each rank writing its own columns of it. On more
+!>   nodes, and beyond that many changes (where the serial solver splits the kernel), a
+!>   fresh convolution: more convolutions, the same answer (to the tolerance).
 !>
 !> The grid is an elastic operator (model/femcod_elastic_operator) whose reductions are
 !> MPI all-reduces: femcod_cg's one constrained iteration, its plastic rounds and its
@@ -34,6 +37,8 @@
 !> No I/O and no stop: errors come back in a status, identical on every rank.
 module femcod_mpi_cg
    use mpi_f08
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
+   use, intrinsic :: iso_fortran_env, only: int64
    use femcod_mpi_slab_transform, only: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, &
       slab_backward, slab_forward_single, slab_backward_single, EXTEND_EVEN
    use femcod_kinds, only: dp, sp
@@ -84,6 +89,12 @@ module femcod_mpi_cg
       real(sp), allocatable :: kernel32(:, :)
       !> The gap-variable iteration's transform grid (gap_grid_setup; femcod_mpi_gap_transform).
       type(distributed_gap_transform) :: gaps
+      !> The float32 Love table I(p, q), offsets p, q = 0 .. np-1 (the serial operator's
+      !> table), in the shared window `table_window` when every rank is on one node
+      !> (table_window_setup); not associated: no direct corrections. A pointer because
+      !> the window's memory is MPI's, not an allocatable's.
+      real(sp), pointer, contiguous :: table(:, :) => null()
+      type(MPI_Win) :: table_window = MPI_WIN_NULL
    contains
       procedure :: displace => distributed_displace
       procedure :: apply_spectrum => distributed_apply_spectrum
@@ -94,6 +105,8 @@ module femcod_mpi_cg
       procedure :: any_over_grid => any_over_ranks
       procedure :: exchange_halo => exchange_halo
       procedure :: start_forces => coarse_start
+      procedure :: correction_limits => ranks_correction_limits
+      procedure :: add_direct => ranks_add_direct
    end type distributed_grid
 
    !> One requested state on the ranks: its values (model/femcod_contact_result: the
@@ -213,10 +226,102 @@ contains
       call slab_setup(grid%slab, comm, np, grid%j0, grid%nj, grid%count(0), grid%periodic, how%measure_plans, &
          how%single_until > 0, status)
       if (status%code /= 0) return
+      call table_window_setup(grid, how)
       call kernel_spectrum(grid, how)
       if (grid%slab%has_single) grid%kernel32 = real(grid%kernel, sp)
       call preconditioner(grid, how)
+      if (associated(grid%table)) then
+         if (grid%periodic) call periodic_table_columns(grid)
+         ! Every rank's columns written before any rank reads the table.
+         call MPI_Win_fence(0, grid%table_window)
+      end if
    end subroutine grid_setup
+
+   !> The shared window of the Love table (distributed_grid%table), allocated by rank 0
+   !> and mapped by every rank, when how%direct_corrections > 0 and every rank of the
+   !> grid's communicator is on one node (one shared-memory domain). Collective.
+   subroutine table_window_setup(grid, how)
+      type(distributed_grid), intent(inout) :: grid
+      type(cg_settings), intent(in) :: how
+      type(MPI_Comm) :: node
+      type(c_ptr) :: base
+      integer(MPI_ADDRESS_KIND) :: bytes
+      integer :: node_ranks, unit
+      real(sp), pointer, contiguous :: flat(:)
+      if (how%direct_corrections <= 0) return
+      call MPI_Comm_split_type(grid%comm, MPI_COMM_TYPE_SHARED, grid%rank, MPI_INFO_NULL, node)
+      call MPI_Comm_size(node, node_ranks)
+      if (node_ranks == grid%ranks) then
+         unit = storage_size(1.0_sp)/8
+         bytes = 0
+         if (grid%rank == 0) bytes = int(unit, MPI_ADDRESS_KIND)*int(grid%np, MPI_ADDRESS_KIND)**2
+         call MPI_Win_allocate_shared(bytes, unit, MPI_INFO_NULL, node, base, grid%table_window)
+         call MPI_Win_shared_query(grid%table_window, 0, bytes, unit, base)
+         call c_f_pointer(base, flat, [int(grid%np, int64)**2])
+         grid%table(0:grid%np - 1, 0:grid%np - 1) => flat
+         call MPI_Win_fence(0, grid%table_window)
+      end if
+      call MPI_Comm_free(node)
+   end subroutine table_window_setup
+
+   !> This rank's columns of the periodic cell's Love table: the kernel's spectrum (over
+   !> m^2) transformed back. Collective.
+   subroutine periodic_table_columns(grid)
+      type(distributed_grid), intent(inout) :: grid
+      real(dp), allocatable :: columns(:, :)
+      allocate(columns(grid%np, grid%nj))
+      if (grid%slab%freqs > 0) grid%slab%rows(:, 1:grid%slab%freqs) = cmplx(grid%kernel, 0, dp)
+      call slab_backward(grid%slab, columns)
+      grid%table(:, grid%j0:grid%j0 + grid%nj - 1) = real(columns, sp)
+   end subroutine periodic_table_columns
+
+   !> Up to how%direct_corrections changes from the table where the ranks share it; no
+   !> kernel split (femcod_split_correction works on a whole grid).
+   subroutine ranks_correction_limits(op, how, limit, split_limit)
+      class(distributed_grid), intent(in) :: op
+      type(cg_settings), intent(in) :: how
+      integer, intent(out) :: limit, split_limit
+      limit = 0
+      split_limit = 0
+      if (associated(op%table)) limit = max(how%direct_corrections, 0)
+   end subroutine ranks_correction_limits
+
+   !> w += c I * (every rank's changed forces), on this rank's columns: the changes of all
+   !> ranks gathered in rank order (each rank's sorted by column, then row: the serial
+   !> solver's order) and summed from the shared table. Collective.
+   subroutine ranks_add_direct(op, w, changed, delta, n)
+      class(distributed_grid), intent(in) :: op
+      real(dp), intent(inout) :: w(:, :)
+      integer, intent(in) :: changed(:, :)
+      real(dp), intent(in) :: delta(:)
+      integer, intent(in) :: n
+      integer, allocatable :: counts(:), displs(:), mine(:, :), every(:, :)
+      real(dp), allocatable :: deltas(:)
+      integer :: total, q, jj, ii, iq, jq, r
+      allocate(counts(0:op%ranks - 1), displs(0:op%ranks - 1))
+      call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, op%comm)
+      displs(0) = 0
+      do r = 1, op%ranks - 1
+         displs(r) = displs(r - 1) + counts(r - 1)
+      end do
+      total = sum(counts)
+      ! Global columns (1-based) for the others.
+      allocate(mine(2, max(n, 1)), every(2, max(total, 1)), deltas(max(total, 1)))
+      mine(1, 1:n) = changed(1, 1:n)
+      mine(2, 1:n) = changed(2, 1:n) + op%j0
+      call MPI_Allgatherv(mine, 2*n, MPI_INTEGER, every, 2*counts, 2*displs, MPI_INTEGER, op%comm)
+      call MPI_Allgatherv(delta, n, MPI_DOUBLE_PRECISION, deltas, counts, displs, MPI_DOUBLE_PRECISION, op%comm)
+      !$omp parallel do private(ii, q, iq, jq)
+      do jj = 1, op%nj
+         do q = 1, total
+            iq = every(1, q)
+            jq = every(2, q)
+            do ii = 1, op%np
+               w(ii, jj) = w(ii, jj) + op%c*deltas(q)*real(op%table(abs(ii - iq), abs(op%j0 + jj - jq)), dp)
+            end do
+         end do
+      end do
+   end subroutine ranks_add_direct
 
    !> The kernel's spectrum on this rank's frequencies kx, over all ky (m values), divided
    !> by m^2 (FFTW's transforms are not normalised). Free surface: the Love table's even
@@ -251,6 +356,7 @@ contains
          if (how%kernel_radius > 0) where ([(real(p, dp)**2, p = 0, np - 1)] + real(q, dp)**2 > how%kernel_radius**2) &
             line = 0
          grid%slab%column_real(1:np, jj) = line
+         if (associated(grid%table)) grid%table(:, q) = real(line, sp)
          grid%slab%column_real(np + 1, jj) = 0
          do i = np + 2, grid%slab%m
             grid%slab%column_real(i, jj) = line(grid%slab%m - i + 1)
@@ -399,6 +505,8 @@ contains
    !> Frees the plans, the transform memory and the column type; the grid is empty after.
    subroutine grid_free(grid)
       type(distributed_grid), intent(inout) :: grid
+      if (grid%table_window /= MPI_WIN_NULL) call MPI_Win_free(grid%table_window)
+      grid%table => null()
       call slab_free(grid%slab)
       call gap_transform_free(grid%gaps)
       grid = distributed_grid(comm=MPI_COMM_NULL)

@@ -35,6 +35,8 @@ contains
          new_unittest("column split and coarse width follow their definitions", test_split), &
          new_unittest("convolution = direct sum of Love's influence coefficients", test_convolution), &
          new_unittest("float32 convolution within float32's round-off of the double one", test_single), &
+         new_unittest("direct corrections: the convolution of the changed forces, free and periodic", &
+            test_direct_corrections), &
          new_unittest("too few columns for the ranks: refused on every rank", test_too_few_columns), &
          new_unittest("Hertz at 1000 nN on the 0.5 nm sphere deck", test_hertz), &
          new_unittest("--generate self-affine: mkdeck's surface on 1, 2 and 4 ranks, to round-off", test_generate), &
@@ -175,6 +177,78 @@ contains
       call check(error, worst(1) > 1.0e-9_dp*worst(2) .and. worst(1) <= 1.0e-5_dp*worst(2), &
          "float32 - double: "//to_string(worst(1)/worst(2))//" of max |u|")
    end subroutine test_single
+
+   !> The direct corrections on ranks (the shared float32 table, every rank's changes
+   !> gathered): seven changed forces spread over the columns of a 64 x 64 grid, added to
+   !> zero displacements, against the distributed convolution of the same forces (itself
+   !> checked against Love's direct sum, test_convolution), within 1e-6 of max |u| (the
+   !> table's float32 rounding, 6e-8 a term); and the shared table itself against the
+   !> closed forms (femcod_love's coefficients, femcod_love_periodic's table) to float32's
+   !> rounding. Free surface and periodic cell.
+   subroutine test_direct_corrections(error)
+      use femcod_love_periodic, only: periodic_offset_table
+      use femcod_kinds, only: sp
+      type(error_type), allocatable, intent(out) :: error
+      integer, parameter :: np = 64
+      integer, parameter :: pixels(2, 7) = reshape([3, 1, 10, 5, 64, 20, 1, 33, 40, 40, 22, 63, 5, 64], [2, 7])
+      real(dp), parameter :: deltas(7) = [1.5_dp, -0.25_dp, 2.0_dp, 0.75_dp, -1.0_dp, 0.5_dp, 3.0_dp]
+      type(distributed_grid) :: grid
+      type(cg_settings) :: how
+      type(status_type) :: status
+      real(dp), allocatable :: forces(:, :), direct(:, :), convolved(:, :), exact(:, :)
+      integer, allocatable :: first(:), count(:), changed(:, :)
+      real(dp), allocatable :: delta(:)
+      integer :: ranks, rank, q, p, limit, split_limit, case
+      real(dp) :: worst(4)
+      logical :: periodic
+      call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+      call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+      call column_split(np, ranks, 1, first, count)
+      do case = 1, 2
+         periodic = case == 2
+         call grid_setup(grid, MPI_COMM_WORLD, np, 1, spread(spread(0.0_dp, 1, np), 2, count(rank)), 1.0_dp, &
+            1.0_dp, 0.0_dp, how, status, periodic)
+         call check(error, status%code, 0)
+         if (allocated(error)) return
+         call grid%correction_limits(how, limit, split_limit)
+         allocate(forces(np, count(rank)), direct(np, count(rank)), convolved(np, count(rank)))
+         forces = 0
+         direct = 0
+         changed = reshape([integer ::], [2, 0])
+         delta = [real(dp) ::]
+         ! This rank's changes, by column then row, in its own columns (1-based).
+         do q = 1, size(deltas)
+            if (pixels(2, q) > first(rank) .and. pixels(2, q) <= first(rank) + count(rank)) then
+               changed = reshape([changed, pixels(1, q), pixels(2, q) - first(rank)], [2, size(changed, 2) + 1])
+               delta = [delta, deltas(q)]
+               forces(pixels(1, q), pixels(2, q) - first(rank)) = deltas(q)
+            end if
+         end do
+         if (limit > 0) call grid%add_direct(direct, changed, delta, size(delta))
+         call distributed_convolve(grid, forces, convolved, 1.0_dp)
+         if (periodic) then
+            exact = periodic_offset_table(np)
+         else
+            allocate(exact(0:np - 1, 0:np - 1))
+            do p = 0, np - 1
+               exact(:, p) = love_influence([(q, q = 0, np - 1)], p)
+            end do
+         end if
+         worst = [maxval(abs(direct - convolved)), maxval(abs(convolved)), 0.0_dp, maxval(abs(exact))]
+         if (limit > 0) worst(3) = maxval(abs(real(grid%table, dp) - exact))
+         call MPI_Allreduce(MPI_IN_PLACE, worst, 4, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+         call grid_free(grid)
+         deallocate(forces, direct, convolved, exact)
+         call check(error, limit, how%direct_corrections, "direct corrections on one node")
+         if (allocated(error)) return
+         call check(error, worst(1) <= 1.0e-6_dp*worst(2), merge("periodic", "free    ", periodic)// &
+            ": direct - convolved "//to_string(worst(1)/worst(2))//" of max |u|")
+         if (allocated(error)) return
+         call check(error, worst(3) <= real(epsilon(1.0_sp), dp)*worst(4), "shared table off the closed form by "// &
+            to_string(worst(3)/worst(4))//" of its largest value")
+         if (allocated(error)) return
+      end do
+   end subroutine test_direct_corrections
 
    !> Each rank needs two columns (the preconditioner's halo): NP = 2 P - 1 is refused,
    !> with the usage code, on every rank.
