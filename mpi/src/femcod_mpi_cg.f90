@@ -44,6 +44,7 @@ module femcod_mpi_cg
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
+   use femcod_convolution, only: inverse_tap_sums
    use femcod_mpi_patches, only: count_patches_on_ranks
    use femcod_love_periodic, only: periodic_love_spectrum_rows
    use femcod_spring, only: spring_stiffness
@@ -406,31 +407,22 @@ contains
    end subroutine preconditioner
 
    !> The preconditioner's taps (femcod_convolution's inverse_kernel_taps): the centre of
-   !> the inverse of the padded convolution, taps(a, b) = sum over all frequencies of
-   !> cos(2 pi a kx/m) cos(2 pi b ky/m) / kernel / m^4, each rank over its own kx (weight 2
-   !> for the half spectrum's inner ones), summed by MPI_Allreduce; on the periodic cell
-   !> without the zero frequency (femcod_convolution's pseudo-inverse).
+   !> the inverse of the padded convolution, femcod_convolution's inverse_tap_sums over
+   !> this rank's frequencies kx (weight 2 for the half spectrum's inner ones) and all ky,
+   !> summed over the ranks by MPI_Allreduce, over m^4; on the periodic cell without the
+   !> zero frequency (femcod_convolution's pseudo-inverse).
    subroutine inverse_taps(grid)
       type(distributed_grid), intent(inout) :: grid
-      real(dp), parameter :: two_pi = 8*atan(1.0_dp)
-      real(dp) :: cy(0:2), cx(0:2), w, partial(0:2, 0:2)
-      integer :: l, ky, kx, a, b
-      partial = 0
-      do l = 1, grid%slab%freqs
-         kx = grid%slab%freq_start + l - 1
-         w = merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%slab%m)
-         cx = [(w*cos(two_pi*real(a*kx, dp)/real(grid%slab%m, dp)), a = 0, 2)]
-         do ky = 0, grid%slab%m - 1
-            ! The periodic kernel's zero frequency has no inverse: the pseudo-inverse's 0.
-            if (grid%periodic .and. kx == 0 .and. ky == 0) cycle
-            cy = [(cos(two_pi*real(b*ky, dp)/real(grid%slab%m, dp)), b = 0, 2)]
-            do b = 0, 2
-               partial(:, b) = partial(:, b) + cx*cy(b)/grid%kernel(ky + 1, l)
-            end do
-         end do
-      end do
-      call MPI_Allreduce(MPI_IN_PLACE, partial, 9, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
-      grid%taps = partial/real(grid%slab%m, dp)**4
+      real(dp) :: partial(0:2, 0:2)
+      integer :: kx(grid%slab%freqs), k
+      associate(slab => grid%slab)
+         kx = [(slab%freq_start + k, k = 0, slab%freqs - 1)]
+         partial = inverse_tap_sums(grid%kernel, slab%m, [(k, k = 0, slab%m - 1)], [(1.0_dp, k = 1, slab%m)], kx, &
+            merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == slab%m), 1, &
+            merge([1, 1], [0, 0], grid%periodic .and. slab%freq_start == 0))
+         call MPI_Allreduce(MPI_IN_PLACE, partial, 9, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
+         grid%taps = partial/real(slab%m, dp)**4
+      end associate
    end subroutine inverse_taps
 
    !> The grid of `problem` (read on rank 0 only; the others' is not looked at) spread over

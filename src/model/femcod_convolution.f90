@@ -51,7 +51,7 @@ module femcod_convolution
    implicit none
    private
    public :: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, convolution_free, &
-      inverse_kernel_taps
+      inverse_kernel_taps, inverse_tap_sums
    public :: gap_transform, gap_transform_setup, gap_transform_apply, gap_transform_free, SPECTRUM_COMPLIANCE, &
       SPECTRUM_STIFFNESS
    public :: inverse_half_spectrum, inverse_complex_transform, forward_complex_transform, line_transform, line_transform_setup, &
@@ -453,44 +453,71 @@ contains
    !> frequency). `ok` is false when another coefficient of the kernel spectrum is not
    !> positive, so that it has no inverse.
    !> The inverse's spectrum is real and even in both frequencies, so each tap is a
-   !> cosine sum over the quarter k1, k2 = 0..M/2 (weight 2 off the lines 0 and M/2).
+   !> cosine sum over the quarter k1, k2 = 0..M/2 (weight 2 off the lines 0 and M/2):
+   !> inverse_tap_sums over M^4.
    subroutine inverse_kernel_taps(conv, taps, ok)
       type(love_convolution), intent(in) :: conv
       real(dp), intent(out) :: taps(0:2, 0:2)
       logical, intent(out) :: ok
-      real(dp), parameter :: two_pi = 8*atan(1.0_dp)
-      real(dp), allocatable :: inner(:, :), weight(:), cosines(:, :), inverse(:, :)
-      integer :: kh, k, a
+      real(dp), allocatable :: weight(:)
+      integer :: kh, k
       taps = 0
       ok = conv%np >= 3
       if (.not. ok) return
-      kh = conv%m/2
-      inverse = conv%kernel
-      if (conv%periodic) inverse(0, 1) = 1
-      ok = minval(inverse) > 0
+      if (conv%periodic) then
+         ok = minval(conv%kernel(1:, :)) > 0 .and. minval(conv%kernel(0, 2:)) > 0
+      else
+         ok = minval(conv%kernel) > 0
+      end if
       if (.not. ok) return
-      inverse = 1/inverse
-      if (conv%periodic) inverse(0, 1) = 0
-      allocate(weight(0:kh), cosines(0:kh, 0:2), inner(0:2, conv%mh))
+      kh = conv%m/2
+      allocate(weight(0:kh))
       weight = 2
       weight(0) = 1
       if (mod(conv%m, 2) == 0) weight(kh) = 1
-      do a = 0, 2
-         do k = 0, kh
-            cosines(k, a) = weight(k)*cos(two_pi*real(a*k, dp)/real(conv%m, dp))
-         end do
-      end do
-      ! inner(b, k1) = sum over k2 of w cos(2 pi b k2 / M) / kernel(k2, k1)
-      !$omp parallel do num_threads(conv%threads) private(a)
-      do k = 1, conv%mh
-         do a = 0, 2
-            inner(a, k) = sum(cosines(:, a)*inverse(:, k))
-         end do
-      end do
-      do a = 0, 2
-         taps(a, :) = matmul(inner, cosines(:, a))/real(conv%m, dp)**4
-      end do
+      taps = inverse_tap_sums(conv%kernel, conv%m, [(k, k = 0, kh)], weight, [(k, k = 0, kh)], weight, &
+         conv%threads, merge([1, 1], [0, 0], conv%periodic))/real(conv%m, dp)**4
    end subroutine inverse_kernel_taps
+
+   !> The sums behind the preconditioner's taps (inverse_kernel_taps; femcod-mpi's ranks
+   !> each over their own frequencies): sums(a, b), a, b = 0..2, the sum over the kernel's
+   !> columns k of cos_a(k) times the sum over its rows l of cos_b(l) / kernel(l, k), with
+   !> cos_a(k) = column_weight(k) cos(2 pi a column_freq(k) / m) and cos_b(l) likewise for
+   !> the rows. `zero_at` (row, column; 1-based; 0, 0: none): the zero frequency, left out
+   !> (the periodic kernel's, which has no inverse). The rows summed in order for each
+   !> column, then the columns in order: the same bits on any number of threads. Not
+   !> divided by m^4.
+   function inverse_tap_sums(kernel, m, row_freq, row_weight, column_freq, column_weight, threads, zero_at) &
+      result(sums)
+      real(dp), intent(in) :: kernel(:, :), row_weight(:), column_weight(:)
+      integer, intent(in) :: m, row_freq(:), column_freq(:), threads, zero_at(2)
+      real(dp) :: sums(0:2, 0:2)
+      real(dp), parameter :: two_pi = 8*atan(1.0_dp)
+      real(dp), allocatable :: inner(:, :), row_cos(:, :), column_cos(:, :)
+      integer :: k, l, a
+      real(dp) :: r
+      allocate(inner(0:2, size(kernel, 2)), row_cos(size(row_freq), 0:2), column_cos(size(column_freq), 0:2))
+      do a = 0, 2
+         row_cos(:, a) = row_weight*cos(two_pi*real(a*row_freq, dp)/real(m, dp))
+         column_cos(:, a) = column_weight*cos(two_pi*real(a*column_freq, dp)/real(m, dp))
+      end do
+      ! inner(b, k) = sum over l of row_cos(l, b) / kernel(l, k)
+      !$omp parallel do num_threads(threads) private(l, r)
+      do k = 1, size(kernel, 2)
+         inner(:, k) = 0
+         do l = 1, size(kernel, 1)
+            r = 1/kernel(l, k)
+            if (l == zero_at(1) .and. k == zero_at(2)) r = 0
+            inner(:, k) = inner(:, k) + row_cos(l, :)*r
+         end do
+      end do
+      sums = 0
+      do a = 0, 2
+         do k = 1, size(kernel, 2)
+            sums(a, :) = sums(a, :) + inner(:, k)*column_cos(k, a)
+         end do
+      end do
+   end function inverse_tap_sums
 
    subroutine convolution_free(conv)
       type(love_convolution), intent(inout) :: conv
