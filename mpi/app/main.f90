@@ -423,13 +423,15 @@ contains
    !> Each rank's storage: what it holds now and its share of the distributed solver's
    !> arrays (distributed_storage_bytes over the ranks: the grid is split in column slabs;
    !> with the gap variables their transform grid too). The ranks that
-   !> share a node (MPI_COMM_TYPE_SHARED) share its memory, so their sum is compared with
-   !> it; the largest node's sum is reported.
+   !> share a node (MPI_COMM_TYPE_SHARED) share its memory, so their sum, with the Love
+   !> table they share when every rank is on one node, is compared with it; the largest
+   !> node's sum is reported.
    subroutine check_node_memory(n, nstates, st)
       integer, intent(in) :: n, nstates
       type(status_type), intent(inout) :: st
       type(MPI_Comm) :: node
-      integer(i8) :: on_node, worst, may
+      integer(i8) :: on_node, worst, may, table
+      integer :: node_ranks
       estimated_rank_bytes = distributed_storage_bytes(n, nstates, settings%solve%boundary == BOUNDARY_PERIODIC, &
          settings%solve%plastic)
       ! The gap variables: their transform grid besides the fixed-load solver's grid.
@@ -439,7 +441,15 @@ contains
       if (settings%solve%tangential) estimated_rank_bytes = estimated_rank_bytes + tangential_storage_bytes(n)
       estimated_rank_bytes = resident_bytes() + (estimated_rank_bytes + ranks - 1)/ranks
       call MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
+      call MPI_Comm_size(node, node_ranks)
+      ! The direct corrections' float32 Love table when every rank is on one node: in each
+      ! rank's resident memory (each reads all of it), on the node once (femcod_mpi_cg's
+      ! table_window_setup).
+      table = 0
+      if (node_ranks == ranks .and. settings%solve%cg%direct_corrections > 0) table = 4*int(n, i8)**2
+      estimated_rank_bytes = estimated_rank_bytes + table
       call MPI_Allreduce(estimated_rank_bytes, on_node, 1, MPI_INTEGER8, MPI_SUM, node)
+      on_node = on_node - (node_ranks - 1)*table
       call MPI_Comm_free(node)
       may = physical_memory()
       worst = 0
