@@ -15,4 +15,9 @@ for ranks in 1 2 4; do
   OMP_NUM_THREADS=1 fpm test --profile release --flag "$FEMCOD_MPI_FLAGS" \
     --runner "mpirun $FEMCOD_MPIRUN_FLAGS -np $ranks" | tail -8
 done
+# On one node the ranks transpose through shared memory; FFTW-MPI's transposes (what
+# ranks on several nodes use) are kept by FEMCOD_MPI_TRANSPOSES=fftw-mpi.
+echo "== distributed suite on 2 ranks, FFTW-MPI's transposes"
+FEMCOD_MPI_TRANSPOSES=fftw-mpi OMP_NUM_THREADS=1 fpm test --profile release --flag "$FEMCOD_MPI_FLAGS" \
+  --runner "mpirun $FEMCOD_MPIRUN_FLAGS -x FEMCOD_MPI_TRANSPOSES -np 2" | tail -8
 bash ./test_command.sh

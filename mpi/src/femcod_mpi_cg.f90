@@ -4,8 +4,9 @@
 !>
 !> - The Love-kernel convolution on the zero-padded (2 NP)^2 grid, pruned as the serial
 !>   one is (femcod_convolution): real-to-complex transforms of length 2 NP down this
-!>   rank's columns (only NP of the 2 NP are not zero), FFTW-MPI's distributed transpose of
-!>   the (NP + 1) x NP half spectrum, complex transforms of length 2 NP along the rows of
+!>   rank's columns (only NP of the 2 NP are not zero), the distributed transpose of the
+!>   (NP + 1) x NP half spectrum (FFTW-MPI's, or through the node's shared memory when
+!>   every rank is on one node), complex transforms of length 2 NP along the rows of
 !>   this rank's frequencies, the kernel, and back the same way. Only the non-zero half is
 !>   transformed and moved: the full FFTW-MPI r2c of the padded grid transforms and
 !>   transposes twice as much, and hands the physical columns to half of the ranks. The
@@ -173,7 +174,7 @@ contains
    end subroutine column_split
 
    !> The distributed grid from this rank's initial gaps (g0 of the columns `first`..)
-   !> and the global constants; makes the FFTW plans (the transposes FFTW-MPI's) and the
+   !> and the global constants; makes the FFTW plans (femcod_mpi_slab_transform) and the
    !> kernel's spectrum.
    !> Collective over `comm`.
    subroutine grid_setup(grid, comm, np, block, g0, pixel, c, s, how, status, periodic)

@@ -2,9 +2,13 @@
 !> across the ranks (femcod_mpi_cg's Love convolution and femcod_mpi_shear's Cerruti
 !> operator both apply theirs through it): real-to-complex transforms of length M down
 !> this rank's columns (M = 2 NP zero-padded on the free surface, NP on the periodic cell;
-!> only NP of the M are not zero), FFTW-MPI's distributed transpose of the (M/2 + 1) x NP
-!> half spectrum, and complex transforms of length M along the rows of this rank's
+!> only NP of the M are not zero), the distributed transpose of the (M/2 + 1) x NP half
+!> spectrum, and complex transforms of length M along the rows of this rank's
 !> frequencies; and back the same way. Only the non-zero half is transformed and moved.
+!> The transpose is FFTW-MPI's, or, when every rank is on one node, a copy through memory
+!> the node's ranks share: each rank's columns live in one MPI-3 shared window, and each
+!> rank reads (and writes back) its frequencies of every rank's columns after a barrier.
+!> A transpose moves values and computes nothing, so both give the same bits.
 !> The spectrum (M, freqs) lies in `rows` between slab_forward and slab_backward, where
 !> the operator multiplies it. float32 views of the same memory with their own plans.
 !>
@@ -20,7 +24,10 @@
 module femcod_mpi_slab_transform
    use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_float, c_float_complex, &
       c_intptr_t, c_int, c_f_pointer, c_associated, c_size_t
-   use mpi_f08, only: MPI_Comm, MPI_COMM_NULL
+   use mpi_f08, only: MPI_Comm, MPI_COMM_NULL, MPI_Win, MPI_WIN_NULL, MPI_INFO_NULL, MPI_ADDRESS_KIND, &
+      MPI_COMM_TYPE_SHARED, MPI_MODE_NOCHECK, MPI_Comm_split_type, MPI_Comm_size, MPI_Comm_rank, MPI_Comm_free, &
+      MPI_Win_allocate_shared, MPI_Win_shared_query, MPI_Win_lock_all, MPI_Win_unlock_all, MPI_Win_sync, &
+      MPI_Win_free, MPI_Barrier, operator(/=)
    use femcod_fftw_mpi, only: fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, fftw_mpi_execute_r2r, &
       fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft_r2c, fftw_execute_dft_c2r, &
       fftw_execute_dft, fftw_alloc_complex, fftw_free, fftw_destroy_plan, FFTW_ESTIMATE, FFTW_MEASURE, FFTW_FORWARD, &
@@ -41,6 +48,10 @@ module femcod_mpi_slab_transform
 
    !> How the transposed rows of NP become rows of M (module header).
    integer, parameter :: PAD_ZEROS = 0, EXTEND_EVEN = 1, EXTEND_ODD = -1
+   !> Bytes to which the shared window's parts are aligned (FFTW's SIMD wants 16 to 64).
+   integer, parameter :: ALIGNMENT = 64
+   !> The environment variable that keeps FFTW-MPI's transposes on one node (`fftw-mpi`).
+   character(len=*), parameter :: TRANSPOSES_VARIABLE = "FEMCOD_MPI_TRANSPOSES"
 
    type :: slab_transform
       type(MPI_Comm) :: comm = MPI_COMM_NULL
@@ -68,11 +79,24 @@ module femcod_mpi_slab_transform
       !> Wall seconds so far in the transforms (the 1-D transforms, the multiplications
       !> between them) and in FFTW-MPI's transposes.
       real(dp) :: transform_seconds = 0, communication_seconds = 0
+      !> The transpose through shared memory (module header): the window of every rank's
+      !> columns and each rank's columns in it, (0:ranks-1); not on_node: FFTW-MPI's.
+      logical :: on_node = .false.
+      type(MPI_Win) :: window = MPI_WIN_NULL
+      type(rank_columns), allocatable :: peer(:)
       !> Columns the ranks hold in another order than the grid's (femcod_mpi_gap_transform's
       !> pixel and padding columns): natural(P), the position along a row (1-based) of the
       !> P-th value of a transposed row; not allocated: the grid's own order.
       integer, allocatable :: natural(:)
    end type slab_transform
+
+   !> One rank's columns in the shared window: their first column (0-based) in the grid, and
+   !> the half spectra (mh, count) in double and, over the same memory, in float32.
+   type :: rank_columns
+      integer :: first = 0
+      complex(c_double_complex), pointer, contiguous :: z(:, :) => null()
+      complex(c_float_complex), pointer, contiguous :: c(:, :) => null()
+   end type rank_columns
 
    !> The complex 2-D backward DFT of an NP x NP field in column slabs: this rank's columns
    !> of the input and of the output (np, nj; FFTW's memory), and the plan between them.
@@ -116,7 +140,9 @@ contains
       end if
       t%freqs = int(local_freqs)
       t%freq_start = int(freq_start)
-      t%column_memory = fftw_alloc_complex(int(max(alloc/2, int(t%mh, c_intptr_t)*nj, 1_c_intptr_t), c_size_t))
+      call node_window_setup(t)
+      if (.not. t%on_node) &
+         t%column_memory = fftw_alloc_complex(int(max(alloc/2, int(t%mh, c_intptr_t)*nj, 1_c_intptr_t), c_size_t))
       t%row_memory = fftw_alloc_complex(int(max(alloc/2, int(t%m, c_intptr_t)*t%freqs, 1_c_intptr_t), c_size_t))
       flags = FFTW_ESTIMATE
       if (measure) flags = FFTW_MEASURE
@@ -154,12 +180,14 @@ contains
          t%rows_backward = fftw_plan_many_dft(1_c_int, [m], freqs, t%rows, [m], 1_c_int, m, t%rows, [m], &
             1_c_int, m, FFTW_BACKWARD, flags)
       end if
-      t%to_rows = fftw_mpi_plan_many_transpose(int(t%np, c_intptr_t), int(t%mh, c_intptr_t), 2_c_intptr_t, &
-         int(t%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, t%column_flat, t%row_flat, t%comm%MPI_VAL, flags)
-      t%to_columns = fftw_mpi_plan_many_transpose(int(t%mh, c_intptr_t), int(t%np, c_intptr_t), 2_c_intptr_t, &
-         FFTW_MPI_DEFAULT_BLOCK, int(t%block_columns, c_intptr_t), t%row_flat, t%column_flat, t%comm%MPI_VAL, flags)
-      if (.not. (c_associated(t%columns_forward) .and. c_associated(t%columns_backward) .and. &
-         c_associated(t%to_rows) .and. c_associated(t%to_columns) .and. (t%freqs == 0 .or. &
+      if (.not. t%on_node) then
+         t%to_rows = fftw_mpi_plan_many_transpose(int(t%np, c_intptr_t), int(t%mh, c_intptr_t), 2_c_intptr_t, &
+            int(t%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, t%column_flat, t%row_flat, t%comm%MPI_VAL, flags)
+         t%to_columns = fftw_mpi_plan_many_transpose(int(t%mh, c_intptr_t), int(t%np, c_intptr_t), 2_c_intptr_t, &
+            FFTW_MPI_DEFAULT_BLOCK, int(t%block_columns, c_intptr_t), t%row_flat, t%column_flat, t%comm%MPI_VAL, flags)
+      end if
+      if (.not. (c_associated(t%columns_forward) .and. c_associated(t%columns_backward) .and. (t%on_node .or. &
+         (c_associated(t%to_rows) .and. c_associated(t%to_columns))) .and. (t%freqs == 0 .or. &
          (c_associated(t%rows_forward) .and. c_associated(t%rows_backward))))) &
          call set_error(status, STATUS_NUMERICAL, "FFTW made no plan for the "//int_str(t%m)//" x "// &
          int_str(t%m)//" grid")
@@ -191,14 +219,16 @@ contains
          t%rows_backward32 = fftwf_plan_many_dft(1_c_int, [m], freqs, t%rows32, [m], 1_c_int, m, t%rows32, &
             [m], 1_c_int, m, FFTW_BACKWARD, flags)
       end if
-      t%to_rows32 = fftwf_mpi_plan_many_transpose(int(t%np, c_intptr_t), int(t%mh, c_intptr_t), &
-         2_c_intptr_t, int(t%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, t%column32_flat, &
-         t%row32_flat, t%comm%MPI_VAL, flags)
-      t%to_columns32 = fftwf_mpi_plan_many_transpose(int(t%mh, c_intptr_t), int(t%np, c_intptr_t), &
-         2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(t%block_columns, c_intptr_t), t%row32_flat, &
-         t%column32_flat, t%comm%MPI_VAL, flags)
-      if (.not. (c_associated(t%columns_forward32) .and. c_associated(t%columns_backward32) .and. &
-         c_associated(t%to_rows32) .and. c_associated(t%to_columns32) .and. (t%freqs == 0 .or. &
+      if (.not. t%on_node) then
+         t%to_rows32 = fftwf_mpi_plan_many_transpose(int(t%np, c_intptr_t), int(t%mh, c_intptr_t), &
+            2_c_intptr_t, int(t%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, t%column32_flat, &
+            t%row32_flat, t%comm%MPI_VAL, flags)
+         t%to_columns32 = fftwf_mpi_plan_many_transpose(int(t%mh, c_intptr_t), int(t%np, c_intptr_t), &
+            2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, int(t%block_columns, c_intptr_t), t%row32_flat, &
+            t%column32_flat, t%comm%MPI_VAL, flags)
+      end if
+      if (.not. (c_associated(t%columns_forward32) .and. c_associated(t%columns_backward32) .and. (t%on_node .or. &
+         (c_associated(t%to_rows32) .and. c_associated(t%to_columns32))) .and. (t%freqs == 0 .or. &
          (c_associated(t%rows_forward32) .and. c_associated(t%rows_backward32))))) &
          call set_error(status, STATUS_NUMERICAL, "FFTW made no float32 plan for the "//int_str(t%m)//" x "// &
          int_str(t%m)//" grid")
@@ -217,7 +247,12 @@ contains
       do k = 1, size(plans)
          if (c_associated(plans(k))) call fftwf_destroy_plan(plans(k))
       end do
-      if (c_associated(t%column_memory)) call fftw_free(t%column_memory)
+      if (t%window /= MPI_WIN_NULL) then
+         call MPI_Win_unlock_all(t%window)
+         call MPI_Win_free(t%window)
+      else if (c_associated(t%column_memory)) then
+         call fftw_free(t%column_memory)
+      end if
       if (c_associated(t%row_memory)) call fftw_free(t%row_memory)
       t = slab_transform()
    end subroutine slab_free
@@ -250,7 +285,11 @@ contains
       call wall_clock(t0)
       call fftw_execute_dft_r2c(t%columns_forward, t%column_real, t%columns)
       call wall_clock(t1)
-      call fftw_mpi_execute_r2r(t%to_rows, t%column_flat, t%row_flat)
+      if (t%on_node) then
+         call node_to_rows(t, double=.true.)
+      else
+         call fftw_mpi_execute_r2r(t%to_rows, t%column_flat, t%row_flat)
+      end if
       call wall_clock(t2)
       call expand_rows(t, rows)
       if (allocated(t%natural)) call reorder_rows(t, .true.)
@@ -272,7 +311,11 @@ contains
       if (allocated(t%natural)) call reorder_rows(t, .false.)
       call compress_rows(t)
       call wall_clock(t1)
-      call fftw_mpi_execute_r2r(t%to_columns, t%row_flat, t%column_flat)
+      if (t%on_node) then
+         call node_to_columns(t, double=.true.)
+      else
+         call fftw_mpi_execute_r2r(t%to_columns, t%row_flat, t%column_flat)
+      end if
       call wall_clock(t2)
       call fftw_execute_dft_c2r(t%columns_backward, t%columns, t%column_real)
       !$omp parallel do
@@ -300,7 +343,11 @@ contains
       end do
       call fftwf_execute_dft_r2c(t%columns_forward32, t%column32_real, t%columns32)
       call wall_clock(t1)
-      call fftwf_mpi_execute_r2r(t%to_rows32, t%column32_flat, t%row32_flat)
+      if (t%on_node) then
+         call node_to_rows(t, double=.false.)
+      else
+         call fftwf_mpi_execute_r2r(t%to_rows32, t%column32_flat, t%row32_flat)
+      end if
       call wall_clock(t2)
       ! As expand_rows (zero padding), in float32.
       do k = t%freqs, 1, -1
@@ -333,7 +380,11 @@ contains
          end do
       end do
       call wall_clock(t1)
-      call fftwf_mpi_execute_r2r(t%to_columns32, t%row32_flat, t%column32_flat)
+      if (t%on_node) then
+         call node_to_columns(t, double=.false.)
+      else
+         call fftwf_mpi_execute_r2r(t%to_columns32, t%row32_flat, t%column32_flat)
+      end if
       call wall_clock(t2)
       call fftwf_execute_dft_c2r(t%columns_backward32, t%columns32, t%column32_real)
       if (present(out32)) then
@@ -351,6 +402,132 @@ contains
       t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
       t%communication_seconds = t%communication_seconds + (t2 - t1)
    end subroutine slab_backward_single
+
+   !> The shared window of every rank's columns (module header) when every rank of t%comm
+   !> is on one node and FEMCOD_MPI_TRANSPOSES is not `fftw-mpi` (which keeps FFTW-MPI's
+   !> transposes, as on several nodes: the tests run both): this rank's part, its mh x nj
+   !> half spectra, is its column memory, and every rank's part is mapped (t%peer).
+   !> Collective.
+   subroutine node_window_setup(t)
+      type(slab_transform), intent(inout) :: t
+      type(MPI_Comm) :: node
+      type(c_ptr) :: base
+      integer(MPI_ADDRESS_KIND) :: bytes
+      integer :: ranks, node_ranks, rank, r, unit, count, length
+      character(len=16) :: choice
+      call get_environment_variable(TRANSPOSES_VARIABLE, choice, length)
+      if (length > 0 .and. choice == "fftw-mpi") return
+      call MPI_Comm_size(t%comm, ranks)
+      call MPI_Comm_rank(t%comm, rank)
+      call MPI_Comm_split_type(t%comm, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
+      call MPI_Comm_size(node, node_ranks)
+      call MPI_Comm_free(node)
+      t%on_node = node_ranks == ranks
+      if (.not. t%on_node) return
+      ! One byte units, and ALIGNMENT more: each part is used from its first aligned byte,
+      ! as FFTW's own allocations are (a window's part may start at any 8 bytes, and FFTW
+      ! plans other, slower, codelets for unaligned memory).
+      unit = 1
+      bytes = int(storage_size((1.0_c_double, 0.0_c_double))/8, MPI_ADDRESS_KIND)* &
+         max(int(t%mh, MPI_ADDRESS_KIND)*int(t%nj, MPI_ADDRESS_KIND), 1_MPI_ADDRESS_KIND) + ALIGNMENT
+      call MPI_Win_allocate_shared(bytes, unit, MPI_INFO_NULL, t%comm, base, t%window)
+      call MPI_Win_lock_all(MPI_MODE_NOCHECK, t%window)
+      t%column_memory = aligned(base)
+      allocate(t%peer(0:ranks - 1))
+      do r = 0, ranks - 1
+         t%peer(r)%first = min(r*t%block_columns, t%np)
+         count = max(0, min(t%block_columns, t%np - r*t%block_columns))
+         call MPI_Win_shared_query(t%window, r, bytes, unit, base)
+         call c_f_pointer(aligned(base), t%peer(r)%z, [t%mh, count])
+         call c_f_pointer(aligned(base), t%peer(r)%c, [t%mh, count])
+      end do
+   contains
+      !> The first address at or after `address` that is a multiple of ALIGNMENT (the
+      !> ranks map the window at page boundaries, so every rank finds the same byte).
+      type(c_ptr) function aligned(address)
+         type(c_ptr), intent(in) :: address
+         integer(c_intptr_t) :: a
+         a = transfer(address, a)
+         a = a + modulo(-a, int(ALIGNMENT, c_intptr_t))
+         aligned = transfer(a, aligned)
+      end function aligned
+   end subroutine node_window_setup
+
+   !> The shared-memory transpose to rows (slab_forward's): after every rank's columns are
+   !> complete (a barrier), this rank's frequencies of every column into the packed rows
+   !> (np values a frequency), in blocks of columns that stay in cache; then a barrier
+   !> again, before any rank writes its columns anew (two forward transforms in a row, as
+   !> the shear operator's). `double`: the double or the float32 view. Collective.
+   subroutine node_to_rows(t, double)
+      type(slab_transform), intent(inout) :: t
+      logical, intent(in) :: double
+      integer, parameter :: COLUMNS_AT_A_TIME = 256
+      integer :: r, jb, l, j, f0, np
+      call node_barrier(t)
+      f0 = t%freq_start
+      np = t%np
+      do r = 0, size(t%peer) - 1
+         associate(p => t%peer(r))
+            do jb = 1, size(p%z, 2), COLUMNS_AT_A_TIME
+               !$omp parallel do private(j)
+               do l = 1, t%freqs
+                  if (double) then
+                     do j = jb, min(jb + COLUMNS_AT_A_TIME - 1, size(p%z, 2))
+                        t%row_values((l - 1)*np + p%first + j) = p%z(f0 + l, j)
+                     end do
+                  else
+                     do j = jb, min(jb + COLUMNS_AT_A_TIME - 1, size(p%c, 2))
+                        t%row32_values((l - 1)*np + p%first + j) = p%c(f0 + l, j)
+                     end do
+                  end if
+               end do
+            end do
+         end associate
+      end do
+      call node_barrier(t)
+   end subroutine node_to_rows
+
+   !> The shared-memory transpose back (slab_backward's): once no rank is still at work on
+   !> its columns (a barrier), this rank's frequencies of the packed rows into every rank's
+   !> columns, then a barrier, after which every rank's own columns are complete.
+   !> Collective.
+   subroutine node_to_columns(t, double)
+      type(slab_transform), intent(inout) :: t
+      logical, intent(in) :: double
+      integer, parameter :: COLUMNS_AT_A_TIME = 256
+      integer :: r, jb, l, j, f0, np
+      call node_barrier(t)
+      f0 = t%freq_start
+      np = t%np
+      do r = 0, size(t%peer) - 1
+         associate(p => t%peer(r))
+            do jb = 1, size(p%z, 2), COLUMNS_AT_A_TIME
+               !$omp parallel do private(j)
+               do l = 1, t%freqs
+                  if (double) then
+                     do j = jb, min(jb + COLUMNS_AT_A_TIME - 1, size(p%z, 2))
+                        p%z(f0 + l, j) = t%row_values((l - 1)*np + p%first + j)
+                     end do
+                  else
+                     do j = jb, min(jb + COLUMNS_AT_A_TIME - 1, size(p%c, 2))
+                        p%c(f0 + l, j) = t%row32_values((l - 1)*np + p%first + j)
+                     end do
+                  end if
+               end do
+            end do
+         end associate
+      end do
+      call node_barrier(t)
+   end subroutine node_to_columns
+
+   !> Every rank's stores to the window seen by every rank (MPI's unified memory model:
+   !> sync, barrier, sync).
+   subroutine node_barrier(t)
+      type(slab_transform), intent(inout) :: t
+      call MPI_Win_sync(t%window)
+      call MPI_Barrier(t%comm)
+      call MPI_Win_sync(t%window)
+   end subroutine node_barrier
 
    !> The transposed rows (np values per frequency, packed) spread in place to rows of m:
    !> zero-padded, or evenly (x(m - q) = x(q)) or oddly (x(m - q) = -x(q)) extended, with
