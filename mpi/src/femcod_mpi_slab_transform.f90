@@ -286,7 +286,7 @@ contains
       call fftw_execute_dft_r2c(t%columns_forward, t%column_real, t%columns)
       call wall_clock(t1)
       if (t%on_node) then
-         call node_to_rows(t, double=.true.)
+         call node_transpose(t, double=.true., to_rows=.true.)
       else
          call fftw_mpi_execute_r2r(t%to_rows, t%column_flat, t%row_flat)
       end if
@@ -312,7 +312,7 @@ contains
       call compress_rows(t)
       call wall_clock(t1)
       if (t%on_node) then
-         call node_to_columns(t, double=.true.)
+         call node_transpose(t, double=.true., to_rows=.false.)
       else
          call fftw_mpi_execute_r2r(t%to_columns, t%row_flat, t%column_flat)
       end if
@@ -344,7 +344,7 @@ contains
       call fftwf_execute_dft_r2c(t%columns_forward32, t%column32_real, t%columns32)
       call wall_clock(t1)
       if (t%on_node) then
-         call node_to_rows(t, double=.false.)
+         call node_transpose(t, double=.false., to_rows=.true.)
       else
          call fftwf_mpi_execute_r2r(t%to_rows32, t%column32_flat, t%row32_flat)
       end if
@@ -381,7 +381,7 @@ contains
       end do
       call wall_clock(t1)
       if (t%on_node) then
-         call node_to_columns(t, double=.false.)
+         call node_transpose(t, double=.false., to_rows=.false.)
       else
          call fftwf_mpi_execute_r2r(t%to_columns32, t%row32_flat, t%column32_flat)
       end if
@@ -453,72 +453,42 @@ contains
       end function aligned
    end subroutine node_window_setup
 
-   !> The shared-memory transpose to rows (slab_forward's): after every rank's columns are
-   !> complete (a barrier), this rank's frequencies of every column into the packed rows
-   !> (np values a frequency), in blocks of columns that stay in cache; then a barrier
-   !> again, before any rank writes its columns anew (two forward transforms in a row, as
-   !> the shear operator's). `double`: the double or the float32 view. Collective.
-   subroutine node_to_rows(t, double)
+   !> The transpose through the node's shared memory, between barriers (every rank's
+   !> stores seen before any rank reads, and no rank writes anew, two forward transforms
+   !> in a row as the shear operator's, before every rank has read): `to_rows`
+   !> (slab_forward's), this rank's frequencies of every rank's columns into the packed
+   !> rows (np values a frequency); else (slab_backward's) the packed rows back into
+   !> every rank's columns. In blocks of columns that stay in cache; `double`: the double
+   !> or the float32 views. Collective.
+   subroutine node_transpose(t, double, to_rows)
       type(slab_transform), intent(inout) :: t
-      logical, intent(in) :: double
+      logical, intent(in) :: double, to_rows
       integer, parameter :: COLUMNS_AT_A_TIME = 256
-      integer :: r, jb, l, j, f0, np
+      integer :: r, jb, je, l, f0, np
       call node_barrier(t)
       f0 = t%freq_start
       np = t%np
       do r = 0, size(t%peer) - 1
          associate(p => t%peer(r))
             do jb = 1, size(p%z, 2), COLUMNS_AT_A_TIME
-               !$omp parallel do private(j)
+               je = min(jb + COLUMNS_AT_A_TIME - 1, size(p%z, 2))
+               !$omp parallel do
                do l = 1, t%freqs
-                  if (double) then
-                     do j = jb, min(jb + COLUMNS_AT_A_TIME - 1, size(p%z, 2))
-                        t%row_values((l - 1)*np + p%first + j) = p%z(f0 + l, j)
-                     end do
+                  if (double .and. to_rows) then
+                     t%row_values((l - 1)*np + p%first + jb:(l - 1)*np + p%first + je) = p%z(f0 + l, jb:je)
+                  else if (double) then
+                     p%z(f0 + l, jb:je) = t%row_values((l - 1)*np + p%first + jb:(l - 1)*np + p%first + je)
+                  else if (to_rows) then
+                     t%row32_values((l - 1)*np + p%first + jb:(l - 1)*np + p%first + je) = p%c(f0 + l, jb:je)
                   else
-                     do j = jb, min(jb + COLUMNS_AT_A_TIME - 1, size(p%c, 2))
-                        t%row32_values((l - 1)*np + p%first + j) = p%c(f0 + l, j)
-                     end do
+                     p%c(f0 + l, jb:je) = t%row32_values((l - 1)*np + p%first + jb:(l - 1)*np + p%first + je)
                   end if
                end do
             end do
          end associate
       end do
       call node_barrier(t)
-   end subroutine node_to_rows
-
-   !> The shared-memory transpose back (slab_backward's): once no rank is still at work on
-   !> its columns (a barrier), this rank's frequencies of the packed rows into every rank's
-   !> columns, then a barrier, after which every rank's own columns are complete.
-   !> Collective.
-   subroutine node_to_columns(t, double)
-      type(slab_transform), intent(inout) :: t
-      logical, intent(in) :: double
-      integer, parameter :: COLUMNS_AT_A_TIME = 256
-      integer :: r, jb, l, j, f0, np
-      call node_barrier(t)
-      f0 = t%freq_start
-      np = t%np
-      do r = 0, size(t%peer) - 1
-         associate(p => t%peer(r))
-            do jb = 1, size(p%z, 2), COLUMNS_AT_A_TIME
-               !$omp parallel do private(j)
-               do l = 1, t%freqs
-                  if (double) then
-                     do j = jb, min(jb + COLUMNS_AT_A_TIME - 1, size(p%z, 2))
-                        p%z(f0 + l, j) = t%row_values((l - 1)*np + p%first + j)
-                     end do
-                  else
-                     do j = jb, min(jb + COLUMNS_AT_A_TIME - 1, size(p%c, 2))
-                        p%c(f0 + l, j) = t%row32_values((l - 1)*np + p%first + j)
-                     end do
-                  end if
-               end do
-            end do
-         end associate
-      end do
-      call node_barrier(t)
-   end subroutine node_to_columns
+   end subroutine node_transpose
 
    !> Every rank's stores to the window seen by every rank (MPI's unified memory model:
    !> sync, barrier, sync).
