@@ -189,8 +189,9 @@ contains
          "the input path (the surface made on the ranks) included (the method is printed).", ""
       call print_lines(option_help(bench_mpi_table(), ""))
       write(output_unit, '(a)') "Columns: NP, run, ranks x threads, whole command s, solve s, transforms % and", &
-         "communication % of the solve (rank 0: the 1-D FFTs; FFTW-MPI's transposes, the sums and halos,", &
-         "waiting included), iterations (+ coarse, fresh convolutions), peak MB of the largest rank,", &
+         "communication % of the solve (rank 0: the 1-D FFTs; the transposes, FFTW-MPI's or on one node", &
+         "through shared memory, the sums and halos, waiting included), iterations (+ coarse, fresh", &
+         "convolutions), peak MB of the largest rank,", &
          "contact %, approach's difference from the serial run's (relative)."
    end subroutine print_mpi_help
 

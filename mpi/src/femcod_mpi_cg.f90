@@ -41,7 +41,7 @@ module femcod_mpi_cg
    use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
    use, intrinsic :: iso_fortran_env, only: int64
    use femcod_mpi_slab_transform, only: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, &
-      slab_backward, slab_forward_single, slab_backward_single, EXTEND_EVEN
+      slab_backward, slab_forward_single, slab_backward_single, EXTEND_EVEN, on_one_node
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
@@ -245,25 +245,20 @@ contains
    subroutine table_window_setup(grid, how)
       type(distributed_grid), intent(inout) :: grid
       type(cg_settings), intent(in) :: how
-      type(MPI_Comm) :: node
       type(c_ptr) :: base
       integer(MPI_ADDRESS_KIND) :: bytes
-      integer :: node_ranks, unit
+      integer :: unit
       real(sp), pointer, contiguous :: flat(:)
       if (how%direct_corrections <= 0) return
-      call MPI_Comm_split_type(grid%comm, MPI_COMM_TYPE_SHARED, grid%rank, MPI_INFO_NULL, node)
-      call MPI_Comm_size(node, node_ranks)
-      if (node_ranks == grid%ranks) then
-         unit = storage_size(1.0_sp)/8
-         bytes = 0
-         if (grid%rank == 0) bytes = int(unit, MPI_ADDRESS_KIND)*int(grid%np, MPI_ADDRESS_KIND)**2
-         call MPI_Win_allocate_shared(bytes, unit, MPI_INFO_NULL, node, base, grid%table_window)
-         call MPI_Win_shared_query(grid%table_window, 0, bytes, unit, base)
-         call c_f_pointer(base, flat, [int(grid%np, int64)**2])
-         grid%table(0:grid%np - 1, 0:grid%np - 1) => flat
-         call MPI_Win_fence(0, grid%table_window)
-      end if
-      call MPI_Comm_free(node)
+      if (.not. on_one_node(grid%comm)) return
+      unit = storage_size(1.0_sp)/8
+      bytes = 0
+      if (grid%rank == 0) bytes = int(unit, MPI_ADDRESS_KIND)*int(grid%np, MPI_ADDRESS_KIND)**2
+      call MPI_Win_allocate_shared(bytes, unit, MPI_INFO_NULL, grid%comm, base, grid%table_window)
+      call MPI_Win_shared_query(grid%table_window, 0, bytes, unit, base)
+      call c_f_pointer(base, flat, [int(grid%np, int64)**2])
+      grid%table(0:grid%np - 1, 0:grid%np - 1) => flat
+      call MPI_Win_fence(0, grid%table_window)
    end subroutine table_window_setup
 
    !> This rank's columns of the periodic cell's Love table: the kernel's spectrum (over

@@ -7,7 +7,7 @@
 !> columns: its nj pixel columns j0 + 1 .. j0 + nj, and on the free surface besides the
 !> nj padding columns NP + j0 + 1 .. NP + j0 + nj. Its field is (M, 2 nj) (free) or
 !> (NP, nj) (periodic), pixel columns first, so that its pixels are the field's first
-!> NP rows of its first nj columns, as the elastic operator says. FFTW-MPI's transpose
+!> NP rows of its first nj columns, as the elastic operator says. The slab transpose
 !> moves contiguous blocks of columns; in this order rank r's columns are the block
 !> 2 r b .. 2 r b + 2 nj - 1 (b the solver's columns per rank), so the transposes move
 !> the columns in that permuted order, and each rank puts its rows back in the natural

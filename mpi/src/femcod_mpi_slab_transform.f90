@@ -44,7 +44,7 @@ module femcod_mpi_slab_transform
    public :: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, slab_backward, &
       slab_forward_single, slab_backward_single, slab_permute
    public :: PAD_ZEROS, EXTEND_EVEN, EXTEND_ODD
-   public :: slab_dft, slab_dft_setup, slab_dft_backward, slab_dft_free
+   public :: slab_dft, slab_dft_setup, slab_dft_backward, slab_dft_free, on_one_node
 
    !> How the transposed rows of NP become rows of M (module header).
    integer, parameter :: PAD_ZEROS = 0, EXTEND_EVEN = 1, EXTEND_ODD = -1
@@ -410,20 +410,15 @@ contains
    !> Collective.
    subroutine node_window_setup(t)
       type(slab_transform), intent(inout) :: t
-      type(MPI_Comm) :: node
       type(c_ptr) :: base
       integer(MPI_ADDRESS_KIND) :: bytes
-      integer :: ranks, node_ranks, rank, r, unit, count, length
+      integer :: ranks, r, unit, count, length
       character(len=16) :: choice
       call get_environment_variable(TRANSPOSES_VARIABLE, choice, length)
       if (length > 0 .and. choice == "fftw-mpi") return
-      call MPI_Comm_size(t%comm, ranks)
-      call MPI_Comm_rank(t%comm, rank)
-      call MPI_Comm_split_type(t%comm, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
-      call MPI_Comm_size(node, node_ranks)
-      call MPI_Comm_free(node)
-      t%on_node = node_ranks == ranks
+      t%on_node = on_one_node(t%comm)
       if (.not. t%on_node) return
+      call MPI_Comm_size(t%comm, ranks)
       ! One byte units, and ALIGNMENT more: each part is used from its first aligned byte,
       ! as FFTW's own allocations are (a window's part may start at any 8 bytes, and FFTW
       ! plans other, slower, codelets for unaligned memory).
@@ -452,6 +447,20 @@ contains
          aligned = transfer(a, aligned)
       end function aligned
    end subroutine node_window_setup
+
+   !> True on every rank when all the ranks of `comm` share one node's memory
+   !> (MPI_COMM_TYPE_SHARED). Collective.
+   logical function on_one_node(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(MPI_Comm) :: node
+      integer :: ranks, rank, node_ranks
+      call MPI_Comm_size(comm, ranks)
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, node)
+      call MPI_Comm_size(node, node_ranks)
+      call MPI_Comm_free(node)
+      on_one_node = node_ranks == ranks
+   end function on_one_node
 
    !> The transpose through the node's shared memory, between barriers (every rank's
    !> stores seen before any rank reads, and no rank writes anew, two forward transforms
