@@ -40,8 +40,8 @@ module femcod_mpi_cg
    use mpi_f08
    use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
    use, intrinsic :: iso_fortran_env, only: int64
-   use femcod_mpi_slab_transform, only: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, &
-      slab_backward, slab_forward_single, slab_backward_single, EXTEND_EVEN, on_one_node
+   use femcod_mpi_slab_transform, only: slab_transform, slab_setup, slab_free, slab_forward, &
+      slab_backward, slab_convolve, slab_convolve_single, EXTEND_EVEN, on_one_node
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
@@ -509,23 +509,13 @@ contains
       real(dp), intent(in) :: factor
       !> In float32 (the grid made with float32 transforms): the same steps, half the bytes.
       logical, intent(in), optional :: single
-      integer :: k
-      real(dp) :: t0, t1
       if (present(single)) then
          if (single .and. grid%slab%has_single) then
             call convolve_single(grid, f, factor, out)
             return
          end if
       end if
-      call slab_forward_field(grid%slab, f)
-      call wall_clock(t0)
-      !$omp parallel do
-      do k = 1, grid%slab%freqs
-         grid%slab%rows(:, k) = grid%slab%rows(:, k)*(factor*grid%kernel(:, k))
-      end do
-      call wall_clock(t1)
-      grid%slab%transform_seconds = grid%slab%transform_seconds + (t1 - t0)
-      call slab_backward(grid%slab, out)
+      call slab_convolve(grid%slab, f, grid%kernel, factor, out)
    end subroutine distributed_convolve
 
    !> distributed_convolve in float32.
@@ -535,17 +525,7 @@ contains
       real(dp), intent(in) :: factor
       real(dp), intent(out), optional :: out(:, :)
       real(sp), intent(out), optional :: out32(:, :)
-      integer :: k
-      real(dp) :: t0, t1
-      call slab_forward_single(grid%slab, f)
-      call wall_clock(t0)
-      !$omp parallel do
-      do k = 1, grid%slab%freqs
-         grid%slab%rows32(:, k) = grid%slab%rows32(:, k)*(real(factor, sp)*grid%kernel32(:, k))
-      end do
-      call wall_clock(t1)
-      grid%slab%transform_seconds = grid%slab%transform_seconds + (t1 - t0)
-      call slab_backward_single(grid%slab, out, out32)
+      call slab_convolve_single(grid%slab, f, grid%kernel32, factor, out, out32)
    end subroutine convolve_single
 
    !> Every target of `targets` (loads in nN, or with `by_approach` approaches in nm;

@@ -12,6 +12,14 @@
 !> The spectrum (M, freqs) lies in `rows` between slab_forward and slab_backward, where
 !> the operator multiplies it. float32 views of the same memory with their own plans.
 !>
+!> A convolution with a real kernel spectrum (slab_convolve, slab_convolve_single) does
+!> its row step in one pass, as the serial convolution's second pass does
+!> (femcod_convolution): each block of ROW_BLOCK rows is zero-padded to M in a buffer of
+!> its thread that stays in cache, transformed, multiplied, transformed back, and its
+!> first NP values kept; the rows are never spread to M in place. On one node the block
+!> is read straight from every rank's columns in the shared window and written back
+!> there: that copy is the transpose, and the packed rows are not used.
+!>
 !> The transposed rows are extended to M in place: zero-padded (a field), or evenly or
 !> oddly (a kernel table placed at the offsets -(NP-1) .. NP-1, each rank from its own
 !> columns).
@@ -24,6 +32,7 @@
 module femcod_mpi_slab_transform
    use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_double, c_double_complex, c_float, c_float_complex, &
       c_intptr_t, c_int, c_f_pointer, c_associated, c_size_t
+   !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
    use mpi_f08, only: MPI_Comm, MPI_COMM_NULL, MPI_Win, MPI_WIN_NULL, MPI_INFO_NULL, MPI_ADDRESS_KIND, &
       MPI_COMM_TYPE_SHARED, MPI_MODE_NOCHECK, MPI_Comm_split_type, MPI_Comm_size, MPI_Comm_rank, MPI_Comm_free, &
       MPI_Win_allocate_shared, MPI_Win_shared_query, MPI_Win_lock_all, MPI_Win_unlock_all, MPI_Win_sync, &
@@ -42,7 +51,7 @@ module femcod_mpi_slab_transform
    implicit none
    private
    public :: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, slab_backward, &
-      slab_forward_single, slab_backward_single, slab_permute
+      slab_convolve, slab_convolve_single, slab_permute
    public :: PAD_ZEROS, EXTEND_EVEN, EXTEND_ODD
    public :: slab_dft, slab_dft_setup, slab_dft_backward, slab_dft_free, on_one_node
 
@@ -50,6 +59,9 @@ module femcod_mpi_slab_transform
    integer, parameter :: PAD_ZEROS = 0, EXTEND_EVEN = 1, EXTEND_ODD = -1
    !> Bytes to which the shared window's parts are aligned (FFTW's SIMD wants 16 to 64).
    integer, parameter :: ALIGNMENT = 64
+   !> Rows per block of the one-pass row step: 8 rows of M = 8192 are 1 MB of double
+   !> complex (femcod_convolution's lines_per_block).
+   integer, parameter :: ROW_BLOCK = 8
    !> The environment variable that keeps FFTW-MPI's transposes on one node (`fftw-mpi`).
    character(len=*), parameter :: TRANSPOSES_VARIABLE = "FEMCOD_MPI_TRANSPOSES"
 
@@ -76,6 +88,11 @@ module femcod_mpi_slab_transform
          row32_values(:) => null()
       type(c_ptr) :: columns_forward32 = c_null_ptr, columns_backward32 = c_null_ptr, rows_forward32 = c_null_ptr, &
          rows_backward32 = c_null_ptr, to_rows32 = c_null_ptr, to_columns32 = c_null_ptr
+      !> The one-pass row step (module header): each thread's buffer of ROW_BLOCK rows of m
+      !> (0:threads-1), and plans for one block in place, double and float32.
+      type(c_ptr), allocatable :: line_memory(:)
+      type(c_ptr) :: block_forward = c_null_ptr, block_backward = c_null_ptr, block_forward32 = c_null_ptr, &
+         block_backward32 = c_null_ptr
       !> Wall seconds so far in the transforms (the 1-D transforms, the multiplications
       !> between them) and in FFTW-MPI's transposes.
       real(dp) :: transform_seconds = 0, communication_seconds = 0
@@ -160,6 +177,8 @@ contains
       integer(c_int), intent(in) :: flags
       type(status_type), intent(inout) :: status
       integer(c_int) :: m, mh, nj, freqs
+      complex(c_double_complex), pointer :: lines(:, :)
+      integer :: threads, k
       m = int(t%m, c_int)
       mh = int(t%mh, c_int)
       nj = int(t%nj, c_int)
@@ -180,6 +199,17 @@ contains
          t%rows_backward = fftw_plan_many_dft(1_c_int, [m], freqs, t%rows, [m], 1_c_int, m, t%rows, [m], &
             1_c_int, m, FFTW_BACKWARD, flags)
       end if
+      threads = 1
+      !$ threads = omp_get_max_threads()
+      allocate(t%line_memory(0:threads - 1))
+      do k = 0, threads - 1
+         t%line_memory(k) = fftw_alloc_complex(int(t%m, c_size_t)*ROW_BLOCK)
+      end do
+      call c_f_pointer(t%line_memory(0), lines, [t%m, ROW_BLOCK])
+      t%block_forward = fftw_plan_many_dft(1_c_int, [m], int(ROW_BLOCK, c_int), lines, [m], 1_c_int, m, lines, [m], &
+         1_c_int, m, FFTW_FORWARD, flags)
+      t%block_backward = fftw_plan_many_dft(1_c_int, [m], int(ROW_BLOCK, c_int), lines, [m], 1_c_int, m, lines, &
+         [m], 1_c_int, m, FFTW_BACKWARD, flags)
       if (.not. t%on_node) then
          t%to_rows = fftw_mpi_plan_many_transpose(int(t%np, c_intptr_t), int(t%mh, c_intptr_t), 2_c_intptr_t, &
             int(t%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, t%column_flat, t%row_flat, t%comm%MPI_VAL, flags)
@@ -187,7 +217,8 @@ contains
             FFTW_MPI_DEFAULT_BLOCK, int(t%block_columns, c_intptr_t), t%row_flat, t%column_flat, t%comm%MPI_VAL, flags)
       end if
       if (.not. (c_associated(t%columns_forward) .and. c_associated(t%columns_backward) .and. (t%on_node .or. &
-         (c_associated(t%to_rows) .and. c_associated(t%to_columns))) .and. (t%freqs == 0 .or. &
+         (c_associated(t%to_rows) .and. c_associated(t%to_columns))) .and. c_associated(t%block_forward) .and. &
+         c_associated(t%block_backward) .and. (t%freqs == 0 .or. &
          (c_associated(t%rows_forward) .and. c_associated(t%rows_backward))))) &
          call set_error(status, STATUS_NUMERICAL, "FFTW made no plan for the "//int_str(t%m)//" x "// &
          int_str(t%m)//" grid")
@@ -199,6 +230,7 @@ contains
       integer(c_int), intent(in) :: flags
       type(status_type), intent(inout) :: status
       integer(c_int) :: m, mh, nj, freqs
+      complex(c_float_complex), pointer :: lines32(:, :)
       m = int(t%m, c_int)
       mh = int(t%mh, c_int)
       nj = int(t%nj, c_int)
@@ -219,6 +251,11 @@ contains
          t%rows_backward32 = fftwf_plan_many_dft(1_c_int, [m], freqs, t%rows32, [m], 1_c_int, m, t%rows32, &
             [m], 1_c_int, m, FFTW_BACKWARD, flags)
       end if
+      call c_f_pointer(t%line_memory(0), lines32, [t%m, ROW_BLOCK])
+      t%block_forward32 = fftwf_plan_many_dft(1_c_int, [m], int(ROW_BLOCK, c_int), lines32, [m], 1_c_int, m, &
+         lines32, [m], 1_c_int, m, FFTW_FORWARD, flags)
+      t%block_backward32 = fftwf_plan_many_dft(1_c_int, [m], int(ROW_BLOCK, c_int), lines32, [m], 1_c_int, m, &
+         lines32, [m], 1_c_int, m, FFTW_BACKWARD, flags)
       if (.not. t%on_node) then
          t%to_rows32 = fftwf_mpi_plan_many_transpose(int(t%np, c_intptr_t), int(t%mh, c_intptr_t), &
             2_c_intptr_t, int(t%block_columns, c_intptr_t), FFTW_MPI_DEFAULT_BLOCK, t%column32_flat, &
@@ -228,7 +265,8 @@ contains
             t%column32_flat, t%comm%MPI_VAL, flags)
       end if
       if (.not. (c_associated(t%columns_forward32) .and. c_associated(t%columns_backward32) .and. (t%on_node .or. &
-         (c_associated(t%to_rows32) .and. c_associated(t%to_columns32))) .and. (t%freqs == 0 .or. &
+         (c_associated(t%to_rows32) .and. c_associated(t%to_columns32))) .and. c_associated(t%block_forward32) .and. &
+         c_associated(t%block_backward32) .and. (t%freqs == 0 .or. &
          (c_associated(t%rows_forward32) .and. c_associated(t%rows_backward32))))) &
          call set_error(status, STATUS_NUMERICAL, "FFTW made no float32 plan for the "//int_str(t%m)//" x "// &
          int_str(t%m)//" grid")
@@ -237,16 +275,22 @@ contains
    subroutine slab_free(t)
       type(slab_transform), intent(inout) :: t
       integer :: k
-      type(c_ptr) :: plans(6)
-      plans = [t%columns_forward, t%columns_backward, t%rows_forward, t%rows_backward, t%to_rows, t%to_columns]
+      type(c_ptr) :: plans(8)
+      plans = [t%columns_forward, t%columns_backward, t%rows_forward, t%rows_backward, t%to_rows, t%to_columns, &
+         t%block_forward, t%block_backward]
       do k = 1, size(plans)
          if (c_associated(plans(k))) call fftw_destroy_plan(plans(k))
       end do
       plans = [t%columns_forward32, t%columns_backward32, t%rows_forward32, t%rows_backward32, t%to_rows32, &
-         t%to_columns32]
+         t%to_columns32, t%block_forward32, t%block_backward32]
       do k = 1, size(plans)
          if (c_associated(plans(k))) call fftwf_destroy_plan(plans(k))
       end do
+      if (allocated(t%line_memory)) then
+         do k = 0, size(t%line_memory) - 1
+            if (c_associated(t%line_memory(k))) call fftw_free(t%line_memory(k))
+         end do
+      end if
       if (t%window /= MPI_WIN_NULL) then
          call MPI_Win_unlock_all(t%window)
          call MPI_Win_free(t%window)
@@ -262,16 +306,7 @@ contains
    subroutine slab_forward_field(t, f)
       type(slab_transform), intent(inout) :: t
       real(dp), intent(in) :: f(:, :)
-      integer :: j
-      real(dp) :: t0, t1
-      call wall_clock(t0)
-      !$omp parallel do
-      do j = 1, t%nj
-         t%column_real(1:t%np, j) = f(:, j)
-         t%column_real(t%np + 1:, j) = 0
-      end do
-      call wall_clock(t1)
-      t%transform_seconds = t%transform_seconds + (t1 - t0)
+      call fill_columns(t, f, .true.)
       call slab_forward(t, PAD_ZEROS)
    end subroutine slab_forward_field
 
@@ -281,22 +316,15 @@ contains
    subroutine slab_forward(t, rows)
       type(slab_transform), intent(inout) :: t
       integer, intent(in) :: rows
-      real(dp) :: t0, t1, t2, t3
+      real(dp) :: t0, t1
+      call column_transforms(t, .true., forward=.true.)
+      call transpose_slab(t, .true., to_rows=.true., packed=.true.)
       call wall_clock(t0)
-      call fftw_execute_dft_r2c(t%columns_forward, t%column_real, t%columns)
-      call wall_clock(t1)
-      if (t%on_node) then
-         call node_transpose(t, double=.true., to_rows=.true.)
-      else
-         call fftw_mpi_execute_r2r(t%to_rows, t%column_flat, t%row_flat)
-      end if
-      call wall_clock(t2)
       call expand_rows(t, rows)
       if (allocated(t%natural)) call reorder_rows(t, .true.)
       if (t%freqs > 0) call fftw_execute_dft(t%rows_forward, t%rows, t%rows)
-      call wall_clock(t3)
-      t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
-      t%communication_seconds = t%communication_seconds + (t2 - t1)
+      call wall_clock(t1)
+      t%transform_seconds = t%transform_seconds + (t1 - t0)
    end subroutine slab_forward
 
    !> The spectrum in t%rows transformed back: out (np, nj), this rank's columns, not
@@ -304,104 +332,244 @@ contains
    subroutine slab_backward(t, out)
       type(slab_transform), intent(inout) :: t
       real(dp), intent(out) :: out(:, :)
-      integer :: j
-      real(dp) :: t0, t1, t2, t3
+      real(dp) :: t0, t1
       call wall_clock(t0)
       if (t%freqs > 0) call fftw_execute_dft(t%rows_backward, t%rows, t%rows)
       if (allocated(t%natural)) call reorder_rows(t, .false.)
       call compress_rows(t)
       call wall_clock(t1)
-      if (t%on_node) then
-         call node_transpose(t, double=.true., to_rows=.false.)
-      else
-         call fftw_mpi_execute_r2r(t%to_columns, t%row_flat, t%column_flat)
-      end if
-      call wall_clock(t2)
-      call fftw_execute_dft_c2r(t%columns_backward, t%columns, t%column_real)
-      !$omp parallel do
-      do j = 1, t%nj
-         out(:, j) = t%column_real(1:t%np, j)
-      end do
-      call wall_clock(t3)
-      t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
-      t%communication_seconds = t%communication_seconds + (t2 - t1)
+      t%transform_seconds = t%transform_seconds + (t1 - t0)
+      call transpose_slab(t, .true., to_rows=.false., packed=.true.)
+      call column_transforms(t, .true., forward=.false.)
+      call crop_columns(t, .true., out)
    end subroutine slab_backward
 
-   !> slab_forward_field in float32: the spectrum in t%rows32. Collective.
-   subroutine slab_forward_single(t, f)
+   !> out = factor K * f on this rank's columns (np, nj), K the real spectrum `kernel`
+   !> (m, freqs; over m^2 for FFTW's unnormalised transforms) on this rank's frequencies:
+   !> slab_forward_field, the multiplication and slab_backward with the row step in one
+   !> pass (module header). Not for a slab in another order (slab_permute). Collective.
+   subroutine slab_convolve(t, f, kernel, factor, out)
+      type(slab_transform), intent(inout) :: t
+      real(dp), intent(in) :: f(:, :), kernel(:, :), factor
+      real(dp), intent(out) :: out(:, :)
+      call fill_columns(t, f, .true.)
+      call column_transforms(t, .true., forward=.true.)
+      call transpose_slab(t, .true., to_rows=.true., packed=.not. t%on_node)
+      call rows_convolve(t, factor, kernel=kernel)
+      call transpose_slab(t, .true., to_rows=.false., packed=.not. t%on_node)
+      call column_transforms(t, .true., forward=.false.)
+      call crop_columns(t, .true., out)
+   end subroutine slab_convolve
+
+   !> slab_convolve in float32 (the float32 plans, `kernel32`), into out (double) or out32.
+   !> Collective.
+   subroutine slab_convolve_single(t, f, kernel32, factor, out, out32)
+      type(slab_transform), intent(inout) :: t
+      real(dp), intent(in) :: f(:, :), factor
+      real(sp), intent(in) :: kernel32(:, :)
+      real(dp), intent(out), optional :: out(:, :)
+      real(sp), intent(out), optional :: out32(:, :)
+      call fill_columns(t, f, .false.)
+      call column_transforms(t, .false., forward=.true.)
+      call transpose_slab(t, .false., to_rows=.true., packed=.not. t%on_node)
+      call rows_convolve(t, factor, kernel32=kernel32)
+      call transpose_slab(t, .false., to_rows=.false., packed=.not. t%on_node)
+      call column_transforms(t, .false., forward=.false.)
+      call crop_columns(t, .false., out, out32)
+   end subroutine slab_convolve_single
+
+   !> f (np, nj) into this rank's columns, zero-padded to m: in double or (`double` false)
+   !> rounded to float32. Timed.
+   subroutine fill_columns(t, f, double)
       type(slab_transform), intent(inout) :: t
       real(dp), intent(in) :: f(:, :)
-      integer :: j, k, i, np, m
-      real(dp) :: t0, t1, t2, t3
-      np = t%np
-      m = t%m
+      logical, intent(in) :: double
+      integer :: j
+      real(dp) :: t0, t1
       call wall_clock(t0)
       !$omp parallel do
       do j = 1, t%nj
-         t%column32_real(1:np, j) = real(f(:, j), sp)
-         t%column32_real(np + 1:, j) = 0
+         if (double) then
+            t%column_real(1:t%np, j) = f(:, j)
+            t%column_real(t%np + 1:, j) = 0
+         else
+            t%column32_real(1:t%np, j) = real(f(:, j), sp)
+            t%column32_real(t%np + 1:, j) = 0
+         end if
       end do
-      call fftwf_execute_dft_r2c(t%columns_forward32, t%column32_real, t%columns32)
       call wall_clock(t1)
-      if (t%on_node) then
-         call node_transpose(t, double=.false., to_rows=.true.)
-      else
-         call fftwf_mpi_execute_r2r(t%to_rows32, t%column32_flat, t%row32_flat)
-      end if
-      call wall_clock(t2)
-      ! As expand_rows (zero padding), in float32.
-      do k = t%freqs, 1, -1
-         do i = np, 1, -1
-            t%row32_values((k - 1)*m + i) = t%row32_values((k - 1)*np + i)
-         end do
-         t%row32_values((k - 1)*m + np + 1:k*m) = 0
-      end do
-      if (t%freqs > 0) call fftwf_execute_dft(t%rows_forward32, t%rows32, t%rows32)
-      call wall_clock(t3)
-      t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
-      t%communication_seconds = t%communication_seconds + (t2 - t1)
-   end subroutine slab_forward_single
+      t%transform_seconds = t%transform_seconds + (t1 - t0)
+   end subroutine fill_columns
 
-   !> slab_backward in float32: into out (double) or out32. Collective.
-   subroutine slab_backward_single(t, out, out32)
+   !> This rank's columns, cropped to np, into out (double) or out32, from the double or
+   !> (`double` false) the float32 view.
+   subroutine crop_columns(t, double, out, out32)
       type(slab_transform), intent(inout) :: t
+      logical, intent(in) :: double
       real(dp), intent(out), optional :: out(:, :)
       real(sp), intent(out), optional :: out32(:, :)
-      integer :: j, k, i, np, m
-      real(dp) :: t0, t1, t2, t3
-      np = t%np
-      m = t%m
+      integer :: j
+      real(dp) :: t0, t1
       call wall_clock(t0)
-      if (t%freqs > 0) call fftwf_execute_dft(t%rows_backward32, t%rows32, t%rows32)
-      ! As compress_rows, in float32.
-      do k = 1, t%freqs
-         do i = 1, np
-            t%row32_values((k - 1)*np + i) = t%row32_values((k - 1)*m + i)
-         end do
+      !$omp parallel do
+      do j = 1, t%nj
+         if (present(out32)) then
+            out32(:, j) = t%column32_real(1:t%np, j)
+         else if (double) then
+            out(:, j) = t%column_real(1:t%np, j)
+         else
+            out(:, j) = real(t%column32_real(1:t%np, j), dp)
+         end if
       end do
       call wall_clock(t1)
-      if (t%on_node) then
-         call node_transpose(t, double=.false., to_rows=.false.)
+      t%transform_seconds = t%transform_seconds + (t1 - t0)
+   end subroutine crop_columns
+
+   !> The r2c (`forward`) or c2r transforms down this rank's columns as they stand in the
+   !> column memory, in double or (`double` false) float32. Timed.
+   subroutine column_transforms(t, double, forward)
+      type(slab_transform), intent(inout) :: t
+      logical, intent(in) :: double, forward
+      real(dp) :: t0, t1
+      call wall_clock(t0)
+      if (double .and. forward) then
+         call fftw_execute_dft_r2c(t%columns_forward, t%column_real, t%columns)
+      else if (double) then
+         call fftw_execute_dft_c2r(t%columns_backward, t%columns, t%column_real)
+      else if (forward) then
+         call fftwf_execute_dft_r2c(t%columns_forward32, t%column32_real, t%columns32)
+      else
+         call fftwf_execute_dft_c2r(t%columns_backward32, t%columns32, t%column32_real)
+      end if
+      call wall_clock(t1)
+      t%transform_seconds = t%transform_seconds + (t1 - t0)
+   end subroutine column_transforms
+
+   !> The transpose between this rank's columns and its frequencies' packed rows (np
+   !> values each; `to_rows`: towards them), FFTW-MPI's or through the node's memory; with
+   !> `packed` false on one node only the barrier after which every rank's writes to the
+   !> columns are seen (the one-pass row step reads and writes them there). Timed as
+   !> communication. Collective.
+   subroutine transpose_slab(t, double, to_rows, packed)
+      type(slab_transform), intent(inout) :: t
+      logical, intent(in) :: double, to_rows, packed
+      real(dp) :: t0, t1
+      call wall_clock(t0)
+      if (t%on_node .and. .not. packed) then
+         call node_barrier(t)
+      else if (t%on_node) then
+         call node_transpose(t, double, to_rows)
+      else if (double .and. to_rows) then
+         call fftw_mpi_execute_r2r(t%to_rows, t%column_flat, t%row_flat)
+      else if (double) then
+         call fftw_mpi_execute_r2r(t%to_columns, t%row_flat, t%column_flat)
+      else if (to_rows) then
+         call fftwf_mpi_execute_r2r(t%to_rows32, t%column32_flat, t%row32_flat)
       else
          call fftwf_mpi_execute_r2r(t%to_columns32, t%row32_flat, t%column32_flat)
       end if
-      call wall_clock(t2)
-      call fftwf_execute_dft_c2r(t%columns_backward32, t%columns32, t%column32_real)
-      if (present(out32)) then
-         !$omp parallel do
-         do j = 1, t%nj
-            out32(:, j) = t%column32_real(1:np, j)
+      call wall_clock(t1)
+      t%communication_seconds = t%communication_seconds + (t1 - t0)
+   end subroutine transpose_slab
+
+   !> The row step of a convolution in one pass (module header): in blocks of ROW_BLOCK of
+   !> this rank's frequencies, the rows zero-padded to m in the thread's buffer, transformed
+   !> forward, multiplied by factor kernel(:, k) (or, in float32, by factor kernel32(:, k)),
+   !> transformed back, and their first np values stored back. The rows are read from and
+   !> written to the packed rows of the transpose, or, on one node, every rank's columns in
+   !> the shared window, as the serial convolution reads its spectrum: the transpose is
+   !> this copy. Timed.
+   subroutine rows_convolve(t, factor, kernel, kernel32)
+      type(slab_transform), intent(inout) :: t
+      real(dp), intent(in) :: factor
+      real(dp), intent(in), optional :: kernel(:, :)
+      real(sp), intent(in), optional :: kernel32(:, :)
+      complex(c_double_complex), pointer :: lines(:, :)
+      complex(c_float_complex), pointer :: lines32(:, :)
+      integer :: thread, kb, k0, nb, l
+      real(dp) :: t0, t1
+      call wall_clock(t0)
+      !$omp parallel num_threads(size(t%line_memory)) private(thread, lines, lines32, kb, k0, nb, l)
+      thread = 0
+      !$ thread = omp_get_thread_num()
+      call c_f_pointer(t%line_memory(thread), lines, [t%m, ROW_BLOCK])
+      call c_f_pointer(t%line_memory(thread), lines32, [t%m, ROW_BLOCK])
+      !$omp do schedule(static)
+      do kb = 1, (t%freqs + ROW_BLOCK - 1)/ROW_BLOCK
+         k0 = (kb - 1)*ROW_BLOCK
+         nb = min(ROW_BLOCK, t%freqs - k0)
+         call move_rows(t, k0, nb, present(kernel), lines, lines32, to_lines=.true.)
+         if (present(kernel)) then
+            call fftw_execute_dft(t%block_forward, lines, lines)
+            do l = 1, nb
+               lines(:, l) = lines(:, l)*(factor*kernel(:, k0 + l))
+            end do
+            call fftw_execute_dft(t%block_backward, lines, lines)
+         else
+            call fftwf_execute_dft(t%block_forward32, lines32, lines32)
+            do l = 1, nb
+               lines32(:, l) = lines32(:, l)*(real(factor, sp)*kernel32(:, k0 + l))
+            end do
+            call fftwf_execute_dft(t%block_backward32, lines32, lines32)
+         end if
+         call move_rows(t, k0, nb, present(kernel), lines, lines32, to_lines=.false.)
+      end do
+      !$omp end do
+      !$omp end parallel
+      call wall_clock(t1)
+      t%transform_seconds = t%transform_seconds + (t1 - t0)
+   end subroutine rows_convolve
+
+   !> Rows k0 + 1 .. k0 + nb of this rank's frequencies into the block `lines` (double) or
+   !> `lines32`, zero-padded to m (the block's unused rows zero), from the packed rows or
+   !> on one node every rank's columns; or (`to_lines` false) their first np values back.
+   subroutine move_rows(t, k0, nb, double, lines, lines32, to_lines)
+      type(slab_transform), intent(inout) :: t
+      integer, intent(in) :: k0, nb
+      logical, intent(in) :: double, to_lines
+      complex(c_double_complex), intent(inout) :: lines(:, :)
+      complex(c_float_complex), intent(inout) :: lines32(:, :)
+      integer :: l, r, j, np, f0
+      np = t%np
+      f0 = t%freq_start + k0
+      if (t%on_node) then
+         do r = 0, size(t%peer) - 1
+            associate(p => t%peer(r))
+               do j = 1, size(p%z, 2)
+                  if (double .and. to_lines) then
+                     lines(p%first + j, 1:nb) = p%z(f0 + 1:f0 + nb, j)
+                  else if (double) then
+                     p%z(f0 + 1:f0 + nb, j) = lines(p%first + j, 1:nb)
+                  else if (to_lines) then
+                     lines32(p%first + j, 1:nb) = p%c(f0 + 1:f0 + nb, j)
+                  else
+                     p%c(f0 + 1:f0 + nb, j) = lines32(p%first + j, 1:nb)
+                  end if
+               end do
+            end associate
          end do
       else
-         !$omp parallel do
-         do j = 1, t%nj
-            out(:, j) = real(t%column32_real(1:np, j), dp)
+         do l = 1, nb
+            if (double .and. to_lines) then
+               lines(1:np, l) = t%row_values((k0 + l - 1)*np + 1:(k0 + l)*np)
+            else if (double) then
+               t%row_values((k0 + l - 1)*np + 1:(k0 + l)*np) = lines(1:np, l)
+            else if (to_lines) then
+               lines32(1:np, l) = t%row32_values((k0 + l - 1)*np + 1:(k0 + l)*np)
+            else
+               t%row32_values((k0 + l - 1)*np + 1:(k0 + l)*np) = lines32(1:np, l)
+            end if
          end do
       end if
-      call wall_clock(t3)
-      t%transform_seconds = t%transform_seconds + (t1 - t0) + (t3 - t2)
-      t%communication_seconds = t%communication_seconds + (t2 - t1)
-   end subroutine slab_backward_single
+      if (.not. to_lines) return
+      if (double) then
+         lines(np + 1:, 1:nb) = 0
+         lines(:, nb + 1:) = 0
+      else
+         lines32(np + 1:, 1:nb) = 0
+         lines32(:, nb + 1:) = 0
+      end if
+   end subroutine move_rows
 
    !> The shared window of every rank's columns (module header) when every rank of t%comm
    !> is on one node and FEMCOD_MPI_TRANSPOSES is not `fftw-mpi` (which keeps FFTW-MPI's
