@@ -56,6 +56,7 @@ program femcod_mpi
       SOLVER_CG, BOUNDARY_PERIODIC
    use femcod_tangential, only: tangential_request_of, tangential_storage_bytes
    use femcod_mpi_shear, only: tangential_on_ranks
+   use femcod_mpi_slab_transform, only: shared_transposes
    use femcod_contact_result, only: stop_reason_text, STOP_LOADS
    use femcod_state_record, only: loads_csv_header, loads_csv_row, state_json, run_info_of
    use femcod_results_json, only: run_header_json
@@ -433,7 +434,7 @@ contains
       integer(i8) :: on_node, worst, may, table
       integer :: node_ranks
       estimated_rank_bytes = distributed_storage_bytes(n, nstates, settings%solve%boundary == BOUNDARY_PERIODIC, &
-         settings%solve%plastic)
+         settings%solve%plastic, shared_transposes(MPI_COMM_WORLD))
       ! The gap variables: their transform grid besides the fixed-load solver's grid.
       if (by_gap_variables(settings%solve)) estimated_rank_bytes = estimated_rank_bytes + &
          gap_solver_storage_bytes(n, nstates, settings%solve%boundary == BOUNDARY_PERIODIC, settings%solve%plastic)

@@ -41,7 +41,7 @@ module femcod_mpi_cg
    use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
    use, intrinsic :: iso_fortran_env, only: int64
    use femcod_mpi_slab_transform, only: slab_transform, slab_setup, slab_free, slab_forward, &
-      slab_backward, slab_convolve, slab_convolve_single, EXTEND_EVEN, on_one_node
+      slab_backward, slab_convolve, slab_convolve_single, slab_release_rows, EXTEND_EVEN, on_one_node
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
@@ -85,7 +85,8 @@ module femcod_mpi_cg
       !> wall seconds; the solver's other communication (sums, halos) is counted with the
       !> transposes'.
       type(slab_transform) :: slab
-      !> The kernel's spectrum over m^2 (real: the table is even), (m, freqs).
+      !> The kernel's spectrum over m^2 (real: the table is even), for ky = 0 .. m/2 only
+      !> (even in ky: ky and m - ky the same), (m/2 + 1, freqs).
       real(dp), allocatable :: kernel(:, :)
       !> The kernel rounded to float32 (cg_settings%single_until > 0: float32 transforms).
       real(sp), allocatable :: kernel32(:, :)
@@ -237,6 +238,8 @@ contains
          ! Every rank's columns written before any rank reads the table.
          call MPI_Win_fence(0, grid%table_window)
       end if
+      ! The convolutions need no row memory on one node.
+      call slab_release_rows(grid%slab)
    end subroutine grid_setup
 
    !> The shared window of the Love table (distributed_grid%table), allocated by rank 0
@@ -267,7 +270,7 @@ contains
       type(distributed_grid), intent(inout) :: grid
       real(dp), allocatable :: columns(:, :)
       allocate(columns(grid%np, grid%nj))
-      if (grid%slab%freqs > 0) grid%slab%rows(:, 1:grid%slab%freqs) = cmplx(grid%kernel, 0, dp)
+      if (grid%slab%freqs > 0) grid%slab%rows(:, 1:grid%slab%freqs) = cmplx(whole_kernel(grid), 0, dp)
       call slab_backward(grid%slab, columns)
       grid%table(:, grid%j0:grid%j0 + grid%nj - 1) = real(columns, sp)
    end subroutine periodic_table_columns
@@ -333,13 +336,13 @@ contains
       integer :: jj, q, i, p, np, l, ky
       np = grid%np
       grid%self = love_influence(0, 0)
-      allocate(grid%kernel(grid%slab%m, grid%slab%freqs))
+      allocate(grid%kernel(grid%slab%m/2 + 1, grid%slab%freqs))
       if (grid%periodic) then
          ! (An expression's bounds start at 1: quarter(l, k2 + 1) is S(freq_start + l - 1, k2).)
          quarter = periodic_love_spectrum_rows(np, grid%slab%freq_start, grid%slab%freqs)
          do l = 1, grid%slab%freqs
-            do ky = 0, np - 1
-               grid%kernel(ky + 1, l) = quarter(l, min(ky, np - ky) + 1)/real(np, dp)**2
+            do ky = 0, np/2
+               grid%kernel(ky + 1, l) = quarter(l, ky + 1)/real(np, dp)**2
             end do
          end do
          ! I(0, 0) of the periodic table: the mean of the spectrum over all frequencies.
@@ -360,7 +363,8 @@ contains
          end do
       end do
       call slab_forward(grid%slab, EXTEND_EVEN)
-      if (grid%slab%freqs > 0) grid%kernel = real(grid%slab%rows(:, 1:grid%slab%freqs), dp)/real(grid%slab%m, dp)**2
+      if (grid%slab%freqs > 0) grid%kernel = real(grid%slab%rows(1:grid%slab%m/2 + 1, 1:grid%slab%freqs), dp)/ &
+         real(grid%slab%m, dp)**2
    end subroutine kernel_spectrum
 
    !> I(0, 0) of the periodic table from the spectrum: the sum over all m^2 frequencies of
@@ -371,10 +375,31 @@ contains
       total = 0
       do l = 1, grid%slab%freqs
          kx = grid%slab%freq_start + l - 1
-         total = total + merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%slab%m)*sum(grid%kernel(:, l))
+         total = total + merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == grid%slab%m)*sum(mirror_weights(grid%slab%m)* &
+            grid%kernel(:, l))
       end do
       call MPI_Allreduce(MPI_IN_PLACE, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
    end function sum_of_spectrum
+
+   !> How often each stored ky = 0 .. m/2 of the kernel (distributed_grid%kernel) occurs
+   !> among all m: once at 0 and at m/2 (m even), twice (ky and m - ky) otherwise.
+   pure function mirror_weights(m) result(w)
+      integer, intent(in) :: m
+      real(dp) :: w(m/2 + 1)
+      w = 2
+      w(1) = 1
+      if (mod(m, 2) == 0) w(m/2 + 1) = 1
+   end function mirror_weights
+
+   !> The kernel's spectrum on all m values of ky, (m, freqs), from the stored half.
+   pure function whole_kernel(grid) result(whole)
+      type(distributed_grid), intent(in) :: grid
+      real(dp) :: whole(grid%slab%m, size(grid%kernel, 2))
+      integer :: kh
+      kh = grid%slab%m/2
+      whole(1:kh + 1, :) = grid%kernel
+      whole(kh + 2:, :) = grid%kernel(grid%slab%m - kh:2:-1, :)
+   end function whole_kernel
 
    !> The preconditioner (how%precondition, NP >= 3) when the kernel's spectrum is
    !> positive (at every frequency but zero, for the periodic cell).
@@ -396,7 +421,7 @@ contains
       !> The periodic kernel's zero frequency, where it has no inverse (none for the free
       !> surface).
       function zero_frequency() result(mask)
-         logical :: mask(grid%slab%m, grid%slab%freqs)
+         logical :: mask(grid%slab%m/2 + 1, grid%slab%freqs)
          mask = .false.
          if (grid%periodic .and. grid%slab%freq_start == 0) mask(1, 1) = .true.
       end function zero_frequency
@@ -413,7 +438,7 @@ contains
       integer :: kx(grid%slab%freqs), k
       associate(slab => grid%slab)
          kx = [(slab%freq_start + k, k = 0, slab%freqs - 1)]
-         partial = inverse_tap_sums(grid%kernel, slab%m, [(k, k = 0, slab%m - 1)], [(1.0_dp, k = 1, slab%m)], kx, &
+         partial = inverse_tap_sums(grid%kernel, slab%m, [(k, k = 0, slab%m/2)], mirror_weights(slab%m), kx, &
             merge(1.0_dp, 2.0_dp, kx == 0 .or. 2*kx == slab%m), 1, &
             merge([1, 1], [0, 0], grid%periodic .and. slab%freq_start == 0))
          call MPI_Allreduce(MPI_IN_PLACE, partial, 9, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
@@ -779,7 +804,7 @@ contains
       type(status_type), intent(inout) :: status
       if (grid%tm > 0) return
       call gap_transform_setup(grid%gaps, grid%comm, grid%np, grid%first, grid%count, grid%slab%block_columns, &
-         grid%periodic, grid%kernel, grid%slab%freq_start, grid%c, grid%s, status)
+         grid%periodic, whole_kernel(grid), grid%slab%freq_start, grid%c, grid%s, status)
       if (status%code /= 0) return
       grid%tm = grid%gaps%m
       grid%tmj = grid%gaps%columns

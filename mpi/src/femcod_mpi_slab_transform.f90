@@ -51,9 +51,9 @@ module femcod_mpi_slab_transform
    implicit none
    private
    public :: slab_transform, slab_setup, slab_free, slab_forward, slab_forward_field, slab_backward, &
-      slab_convolve, slab_convolve_single, slab_permute
+      slab_convolve, slab_convolve_single, slab_permute, slab_release_rows
    public :: PAD_ZEROS, EXTEND_EVEN, EXTEND_ODD
-   public :: slab_dft, slab_dft_setup, slab_dft_backward, slab_dft_free, on_one_node
+   public :: slab_dft, slab_dft_setup, slab_dft_backward, slab_dft_free, on_one_node, shared_transposes
 
    !> How the transposed rows of NP become rows of M (module header).
    integer, parameter :: PAD_ZEROS = 0, EXTEND_EVEN = 1, EXTEND_ODD = -1
@@ -77,6 +77,8 @@ module femcod_mpi_slab_transform
       !> (mh, nj); along the rows: the complex view (m, freqs), its first np*freqs values
       !> the transpose's (np, freqs).
       type(c_ptr) :: column_memory = c_null_ptr, row_memory = c_null_ptr
+      !> Complex values of the row memory (FFTW-MPI's transpose may want more than m freqs).
+      integer(c_size_t) :: row_values_count = 0
       real(c_double), pointer :: column_real(:, :) => null(), column_flat(:) => null(), row_flat(:) => null()
       complex(c_double_complex), pointer :: columns(:, :) => null(), rows(:, :) => null(), row_values(:) => null()
       type(c_ptr) :: columns_forward = c_null_ptr, columns_backward = c_null_ptr, rows_forward = c_null_ptr, &
@@ -160,7 +162,8 @@ contains
       call node_window_setup(t)
       if (.not. t%on_node) &
          t%column_memory = fftw_alloc_complex(int(max(alloc/2, int(t%mh, c_intptr_t)*nj, 1_c_intptr_t), c_size_t))
-      t%row_memory = fftw_alloc_complex(int(max(alloc/2, int(t%m, c_intptr_t)*t%freqs, 1_c_intptr_t), c_size_t))
+      t%row_values_count = int(max(alloc/2, int(t%m, c_intptr_t)*t%freqs, 1_c_intptr_t), c_size_t)
+      call allocate_rows(t)
       flags = FFTW_ESTIMATE
       if (measure) flags = FFTW_MEASURE
       call make_plans(t, flags, status)
@@ -186,9 +189,6 @@ contains
       call c_f_pointer(t%column_memory, t%column_real, [2*t%mh, t%nj])
       call c_f_pointer(t%column_memory, t%column_flat, [2*t%mh*t%nj])
       call c_f_pointer(t%column_memory, t%columns, [t%mh, t%nj])
-      call c_f_pointer(t%row_memory, t%rows, [t%m, max(t%freqs, 1)])
-      call c_f_pointer(t%row_memory, t%row_values, [t%m*max(t%freqs, 1)])
-      call c_f_pointer(t%row_memory, t%row_flat, [2*t%m*max(t%freqs, 1)])
       t%columns_forward = fftw_plan_many_dft_r2c(1_c_int, [m], nj, t%column_real, [2*mh], 1_c_int, 2*mh, &
          t%columns, [mh], 1_c_int, mh, flags)
       t%columns_backward = fftw_plan_many_dft_c2r(1_c_int, [m], nj, t%columns, [mh], 1_c_int, mh, &
@@ -238,9 +238,6 @@ contains
       call c_f_pointer(t%column_memory, t%column32_real, [2*t%mh, t%nj])
       call c_f_pointer(t%column_memory, t%column32_flat, [2*t%mh*t%nj])
       call c_f_pointer(t%column_memory, t%columns32, [t%mh, t%nj])
-      call c_f_pointer(t%row_memory, t%rows32, [t%m, max(t%freqs, 1)])
-      call c_f_pointer(t%row_memory, t%row32_values, [t%m*max(t%freqs, 1)])
-      call c_f_pointer(t%row_memory, t%row32_flat, [2*t%m*max(t%freqs, 1)])
       t%columns_forward32 = fftwf_plan_many_dft_r2c(1_c_int, [m], nj, t%column32_real, [2*mh], 1_c_int, &
          2*mh, t%columns32, [mh], 1_c_int, mh, flags)
       t%columns_backward32 = fftwf_plan_many_dft_c2r(1_c_int, [m], nj, t%columns32, [mh], 1_c_int, mh, &
@@ -271,6 +268,31 @@ contains
          call set_error(status, STATUS_NUMERICAL, "FFTW made no float32 plan for the "//int_str(t%m)//" x "// &
          int_str(t%m)//" grid")
    end subroutine make_single_plans
+
+   !> The row memory (t%row_values_count complex values, FFTW's alignment, so that the
+   !> plans made on the first apply to any) and its double and float32 views.
+   subroutine allocate_rows(t)
+      type(slab_transform), intent(inout) :: t
+      t%row_memory = fftw_alloc_complex(t%row_values_count)
+      call c_f_pointer(t%row_memory, t%rows, [t%m, max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%row_values, [t%m*max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%row_flat, [2*t%m*max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%rows32, [t%m, max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%row32_values, [t%m*max(t%freqs, 1)])
+      call c_f_pointer(t%row_memory, t%row32_flat, [2*t%m*max(t%freqs, 1)])
+   end subroutine allocate_rows
+
+   !> The row memory freed when every rank is on one node, where slab_convolve reads its
+   !> rows from the shared columns (an m x freqs complex array: 32 bytes a pixel of the
+   !> free surface's grid over the ranks, 8 on the periodic cell); slab_forward allocates
+   !> it again when called. Kept on several nodes: the transposes need it.
+   subroutine slab_release_rows(t)
+      type(slab_transform), intent(inout) :: t
+      if (.not. (t%on_node .and. c_associated(t%row_memory))) return
+      call fftw_free(t%row_memory)
+      t%row_memory = c_null_ptr
+      nullify(t%rows, t%row_values, t%row_flat, t%rows32, t%row32_values, t%row32_flat)
+   end subroutine slab_release_rows
 
    subroutine slab_free(t)
       type(slab_transform), intent(inout) :: t
@@ -317,6 +339,7 @@ contains
       type(slab_transform), intent(inout) :: t
       integer, intent(in) :: rows
       real(dp) :: t0, t1
+      if (.not. c_associated(t%row_memory)) call allocate_rows(t)
       call column_transforms(t, .true., forward=.true.)
       call transpose_slab(t, .true., to_rows=.true., packed=.true.)
       call wall_clock(t0)
@@ -345,7 +368,8 @@ contains
    end subroutine slab_backward
 
    !> out = factor K * f on this rank's columns (np, nj), K the real spectrum `kernel`
-   !> (m, freqs; over m^2 for FFTW's unnormalised transforms) on this rank's frequencies:
+   !> (m/2 + 1, freqs: ky = 0 .. m/2, the kernel even in ky; over m^2 for FFTW's
+   !> unnormalised transforms) on this rank's frequencies:
    !> slab_forward_field, the multiplication and slab_backward with the row step in one
    !> pass (module header). Not for a slab in another order (slab_permute). Collective.
    subroutine slab_convolve(t, f, kernel, factor, out)
@@ -474,7 +498,7 @@ contains
 
    !> The row step of a convolution in one pass (module header): in blocks of ROW_BLOCK of
    !> this rank's frequencies, the rows zero-padded to m in the thread's buffer, transformed
-   !> forward, multiplied by factor kernel(:, k) (or, in float32, by factor kernel32(:, k)),
+   !> forward, multiplied by factor kernel(|ky|, k) (or, in float32, factor kernel32),
    !> transformed back, and their first np values stored back. The rows are read from and
    !> written to the packed rows of the transpose, or, on one node, every rank's columns in
    !> the shared window, as the serial convolution reads its spectrum: the transpose is
@@ -486,9 +510,10 @@ contains
       real(sp), intent(in), optional :: kernel32(:, :)
       complex(c_double_complex), pointer :: lines(:, :)
       complex(c_float_complex), pointer :: lines32(:, :)
-      integer :: thread, kb, k0, nb, l
+      integer :: thread, kb, k0, nb, l, kh
       real(dp) :: t0, t1
       call wall_clock(t0)
+      kh = t%m/2
       !$omp parallel num_threads(size(t%line_memory)) private(thread, lines, lines32, kb, k0, nb, l)
       thread = 0
       !$ thread = omp_get_thread_num()
@@ -502,13 +527,15 @@ contains
          if (present(kernel)) then
             call fftw_execute_dft(t%block_forward, lines, lines)
             do l = 1, nb
-               lines(:, l) = lines(:, l)*(factor*kernel(:, k0 + l))
+               lines(1:kh + 1, l) = lines(1:kh + 1, l)*(factor*kernel(:, k0 + l))
+               lines(kh + 2:, l) = lines(kh + 2:, l)*(factor*kernel(t%m - kh:2:-1, k0 + l))
             end do
             call fftw_execute_dft(t%block_backward, lines, lines)
          else
             call fftwf_execute_dft(t%block_forward32, lines32, lines32)
             do l = 1, nb
-               lines32(:, l) = lines32(:, l)*(real(factor, sp)*kernel32(:, k0 + l))
+               lines32(1:kh + 1, l) = lines32(1:kh + 1, l)*(real(factor, sp)*kernel32(:, k0 + l))
+               lines32(kh + 2:, l) = lines32(kh + 2:, l)*(real(factor, sp)*kernel32(t%m - kh:2:-1, k0 + l))
             end do
             call fftwf_execute_dft(t%block_backward32, lines32, lines32)
          end if
@@ -580,11 +607,8 @@ contains
       type(slab_transform), intent(inout) :: t
       type(c_ptr) :: base
       integer(MPI_ADDRESS_KIND) :: bytes
-      integer :: ranks, r, unit, count, length
-      character(len=16) :: choice
-      call get_environment_variable(TRANSPOSES_VARIABLE, choice, length)
-      if (length > 0 .and. choice == "fftw-mpi") return
-      t%on_node = on_one_node(t%comm)
+      integer :: ranks, r, unit, count
+      t%on_node = shared_transposes(t%comm)
       if (.not. t%on_node) return
       call MPI_Comm_size(t%comm, ranks)
       ! One byte units, and ALIGNMENT more: each part is used from its first aligned byte,
@@ -615,6 +639,18 @@ contains
          aligned = transfer(a, aligned)
       end function aligned
    end subroutine node_window_setup
+
+   !> True on every rank when the slab transforms of `comm` go through the node's shared
+   !> memory: every rank on one node, and FEMCOD_MPI_TRANSPOSES not `fftw-mpi`.
+   !> Collective.
+   logical function shared_transposes(comm)
+      type(MPI_Comm), intent(in) :: comm
+      character(len=16) :: choice
+      integer :: length
+      call get_environment_variable(TRANSPOSES_VARIABLE, choice, length)
+      shared_transposes = .not. (length > 0 .and. choice == "fftw-mpi")
+      if (shared_transposes) shared_transposes = on_one_node(comm)
+   end function shared_transposes
 
    !> True on every rank when all the ranks of `comm` share one node's memory
    !> (MPI_COMM_TYPE_SHARED). Collective.
