@@ -52,6 +52,7 @@ module femcod_mpi_cg
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: cg_settings
    use femcod_elastic_operator, only: elastic_operator, spread_load, cg_constraint
+   use femcod_constrained_cg, only: constrained_cg, cg_residuals
    use femcod_cg, only: coarse_start_forces, materials_of, approach_error_bound, cg_session, cg_answer, session_start, &
       solve_target, ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
@@ -730,10 +731,13 @@ contains
    end subroutine record_state
 
    !> The coarse start (the elastic operator's start_forces): the gaps averaged over f x f
-   !> blocks (f = grid%block; in femcod_cg's order for f = 2), gathered on rank 0, solved
-   !> there by femcod_cg's nested start to how%coarse_tol, and each coarse force split
-   !> equally over its f^2 pixels. With f = 1, spread_load.
-   subroutine coarse_start(op, target, how, p, coarse_iterations, status, observer)
+   !> blocks (f = grid%block; in femcod_cg's order for f = 2), the coarse grid solved to
+   !> how%coarse_tol from its own start, and each coarse force split equally over its f^2
+   !> pixels. The coarse grid is solved on the ranks (ranks_coarse_solve) when it is at
+   !> least 2 how%coarsest a side, as large as the serial nested start's grids that have a
+   !> start of their own; smaller ones on rank 0 (rank0_coarse_solve). With f = 1,
+   !> spread_load.
+   recursive subroutine coarse_start(op, target, how, p, coarse_iterations, status, observer)
       class(distributed_grid), intent(inout) :: op
       type(cg_constraint), intent(in) :: target
       type(cg_settings), intent(in) :: how
@@ -741,10 +745,8 @@ contains
       integer, intent(inout) :: coarse_iterations
       type(status_type), intent(inout) :: status
       class(solver_observer), intent(inout) :: observer
-      real(dp), allocatable :: local(:, :), whole(:, :), forces(:, :)
-      integer, allocatable :: counts(:), displs(:)
-      integer :: n, nl, i, j, di, dj, code, f, iterations
-      character(len=512) :: message
+      real(dp), allocatable :: local(:, :)
+      integer :: n, nl, i, j, di, dj, f, iterations
       f = op%block
       if (f <= 1) then
          call spread_load(op, target, p)
@@ -752,7 +754,7 @@ contains
       end if
       n = op%np/f
       nl = op%nj/f
-      allocate(local(n, nl), counts(0:op%ranks - 1), displs(0:op%ranks - 1))
+      allocate(local(n, nl))
       !$omp parallel do private(i, di, dj)
       do j = 1, nl
          do i = 1, n
@@ -765,16 +767,117 @@ contains
             local(i, j) = local(i, j)/f**2
          end do
       end do
+      iterations = 0
+      if (on_the_ranks(op, n, how)) then
+         call ranks_coarse_solve(op, local, n, target, how, iterations, status, observer)
+      else
+         call rank0_coarse_solve(op, local, n, target, how, iterations, status, observer)
+      end if
+      if (status%code /= 0) return
+      coarse_iterations = coarse_iterations + iterations
+      !$omp parallel do private(i)
+      do j = 1, nl
+         do i = 1, n
+            p(f*(i - 1) + 1:f*i, f*(j - 1) + 1:f*j) = local(i, j)/f**2
+         end do
+      end do
+   end subroutine coarse_start
+
+   !> Whether the n x n coarse grid of `op` is solved on the ranks: at least 2 how%coarsest
+   !> a side, the full kernel (a truncated one is scaled to each grid's pixel by the
+   !> serial start), and the coarse grid's own column split (coarse_factor's block) the
+   !> fine one's divided by f, so that each rank keeps the columns it averaged.
+   logical function on_the_ranks(op, n, how)
+      class(distributed_grid), intent(in) :: op
+      integer, intent(in) :: n
+      type(cg_settings), intent(in) :: how
+      integer, allocatable :: first(:), count(:)
+      on_the_ranks = .false.
+      if (n < 2*how%coarsest .or. how%kernel_radius > 0) return
+      call column_split(n, op%ranks, coarse_factor(n, op%ranks, how), first, count)
+      on_the_ranks = all(count == op%count/op%block) .and. all(first == op%first/op%block)
+   end function on_the_ranks
+
+   !> The coarse grid's forces solved on the ranks, as femcod_cg's nested start solves each
+   !> grid on one process: the n x n grid of the averaged gaps `forces` (in: this rank's
+   !> columns of them; out: its coarse forces) set up as a distributed grid at f times the
+   !> pixel, its own coarse start (coarse_start, a level down), and the constrained
+   !> iteration to how%coarse_tol. Collective.
+   recursive subroutine ranks_coarse_solve(op, forces, n, target, how, iterations, status, observer)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(inout) :: forces(:, :)
+      integer, intent(in) :: n
+      type(cg_constraint), intent(in) :: target
+      type(cg_settings), intent(in) :: how
+      integer, intent(out) :: iterations
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      type(distributed_grid) :: coarse
+      type(contact_problem) :: materials
+      type(cg_constraint) :: moved
+      type(cg_residuals) :: rep
+      real(dp) :: constants(4), lowest, approach
+      iterations = 0
+      ! The compliance and the springs at the coarse pixel, from rank 0's materials.
+      constants = 0
+      if (op%rank == 0) then
+         materials = op%materials
+         materials%pixel = op%block*op%pixel
+         constants = problem_constants(materials)
+      end if
+      call MPI_Bcast(constants, 4, MPI_DOUBLE_PRECISION, 0, op%comm)
+      call grid_setup(coarse, op%comm, n, coarse_factor(n, op%ranks, how), forces, op%block*op%pixel, &
+         constants(3), constants(4), how, status, op%periodic)
+      if (status%code /= 0) then
+         call grid_free(coarse)
+         return
+      end if
+      if (op%rank == 0) coarse%materials = op%materials
+      ! femcod_cg's coarse_target: an approach moved by the coarse grid's lowest gap.
+      moved = target
+      if (target%by_approach) then
+         lowest = minval(forces)
+         call MPI_Allreduce(MPI_IN_PLACE, lowest, 1, MPI_DOUBLE_PRECISION, MPI_MIN, op%comm)
+         moved%value = target%value + lowest
+      end if
+      call coarse_start(coarse, target, how, forces, rep%coarse_iterations, status, observer)
+      if (status%code == 0) call constrained_cg(coarse, moved, how%coarse_tol, 10000, how, forces, approach, rep, &
+         status, observer)
+      op%slab%transform_seconds = op%slab%transform_seconds + coarse%slab%transform_seconds
+      op%slab%communication_seconds = op%slab%communication_seconds + coarse%slab%communication_seconds
+      call grid_free(coarse)
+      iterations = rep%iterations + rep%coarse_iterations
+   end subroutine ranks_coarse_solve
+
+   !> The coarse grid's forces solved on rank 0 alone: the averaged gaps `forces` (each
+   !> rank's columns) gathered there, solved by femcod_cg's nested start to
+   !> how%coarse_tol, and each rank's coarse forces sent back into `forces`. The outcome
+   !> and the iterations on every rank. Collective.
+   subroutine rank0_coarse_solve(op, forces, n, target, how, iterations, status, observer)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(inout) :: forces(:, :)
+      integer, intent(in) :: n
+      type(cg_constraint), intent(in) :: target
+      type(cg_settings), intent(in) :: how
+      integer, intent(out) :: iterations
+      type(status_type), intent(inout) :: status
+      class(solver_observer), intent(inout) :: observer
+      real(dp), allocatable :: whole(:, :), solved(:, :)
+      integer, allocatable :: counts(:), displs(:)
+      integer :: code, f
+      character(len=512) :: message
+      f = op%block
       counts = n*(op%count/f)
       displs = n*(op%first/f)
       if (op%rank == 0) then
-         allocate(whole(n, n), forces(n, n))
+         allocate(whole(n, n), solved(n, n))
       else
-         allocate(whole(1, 1), forces(1, 1))
+         allocate(whole(1, 1), solved(1, 1))
       end if
-      call MPI_Gatherv(local, n*nl, MPI_DOUBLE_PRECISION, whole, counts, displs, MPI_DOUBLE_PRECISION, 0, op%comm)
+      call MPI_Gatherv(forces, size(forces), MPI_DOUBLE_PRECISION, whole, counts, displs, MPI_DOUBLE_PRECISION, 0, &
+         op%comm)
       iterations = 0
-      if (op%rank == 0) call coarse_start_forces(whole, op%materials, f*op%pixel, target, how, op%periodic, forces, &
+      if (op%rank == 0) call coarse_start_forces(whole, op%materials, f*op%pixel, target, how, op%periodic, solved, &
          iterations, status, observer)
       ! The coarse solve's outcome, the same on every rank.
       code = status%code
@@ -787,15 +890,9 @@ contains
          if (status%code == 0) call set_error(status, code, trim(message))
          return
       end if
-      coarse_iterations = coarse_iterations + iterations
-      call MPI_Scatterv(forces, counts, displs, MPI_DOUBLE_PRECISION, local, n*nl, MPI_DOUBLE_PRECISION, 0, op%comm)
-      !$omp parallel do private(i)
-      do j = 1, nl
-         do i = 1, n
-            p(f*(i - 1) + 1:f*i, f*(j - 1) + 1:f*j) = local(i, j)/f**2
-         end do
-      end do
-   end subroutine coarse_start
+      call MPI_Scatterv(solved, counts, displs, MPI_DOUBLE_PRECISION, forces, size(forces), MPI_DOUBLE_PRECISION, 0, &
+         op%comm)
+   end subroutine rank0_coarse_solve
 
    !> The transform grid of the gap variables (femcod_mpi_gap_transform) from the grid's
    !> kernel spectrum, once. Collective.

@@ -41,6 +41,7 @@ contains
          new_unittest("Hertz at 1000 nN on the 0.5 nm sphere deck", test_hertz), &
          new_unittest("--generate self-affine: mkdeck's surface on 1, 2 and 4 ranks, to round-off", test_generate), &
          new_unittest("the serial cg solver's answer on 1, 2 and 4 ranks, rough surface", test_against_serial), &
+         new_unittest("the coarse start solved on the ranks: the serial answer at 256^2", test_coarse_on_ranks), &
          new_unittest("--plastic: the serial answer and plastic set on 1, 2 and 4 ranks", test_plastic_against_serial), &
          new_unittest("--approach: the serial loads on 1, 2 and 4 ranks", test_approach_against_serial), &
          new_unittest("--kernel-radius: the serial answer on 1, 2 and 4 ranks", test_truncated_against_serial), &
@@ -373,6 +374,21 @@ contains
       call against_serial(error, options)
    end subroutine test_against_serial
 
+   !> The same at 256^2, where the coarse start's 128^2 grid is solved on the ranks
+   !> (femcod_mpi_cg's ranks_coarse_solve, from its own 64^2 start on rank 0): loads on the
+   !> free surface, approaches on the periodic cell.
+   subroutine test_coarse_on_ranks(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_options) :: options
+      options%loads = [3.0e3_dp, 2.0e4_dp]
+      call against_serial(error, options, 256)
+      if (allocated(error)) return
+      options = contact_options()
+      options%boundary = BOUNDARY_PERIODIC
+      options%approaches = [0.04_dp, 0.1_dp]
+      call against_serial(error, options, 256)
+   end subroutine test_coarse_on_ranks
+
    !> The same with the plastic cap at H = 10 GPa (below the elastic peak pressures of
    !> these loads, so that pixels cap): the plastic set as serial's too, pixel count and
    !> plastic volume (to 1e-9).
@@ -514,10 +530,12 @@ contains
    !> contacts: the pixels with a force (the gaps at 0 in the gap variables, where a
    !> contact may pull); loads relative to the serial one's (the largest |load| of the
    !> path in the gap variables, where a load may pass through 0).
-   subroutine against_serial(error, options)
+   subroutine against_serial(error, options, side)
       type(error_type), allocatable, intent(out) :: error
       type(contact_options), intent(inout) :: options
-      integer, parameter :: np = 128
+      !> The grid's side (default 128).
+      integer, intent(in), optional :: side
+      integer :: np
       type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(contact_result) :: res
@@ -532,6 +550,8 @@ contains
       real(dp) :: range, bad(7), load_scale
       real(dp), allocatable :: targets(:)
       logical :: by_approach, by_gaps
+      np = 128
+      if (present(side)) np = side
       call MPI_Comm_size(MPI_COMM_WORLD, ranks)
       call MPI_Comm_rank(MPI_COMM_WORLD, rank)
       spec%kind = "self-affine"
