@@ -53,6 +53,7 @@ module femcod_mpi_cg
    use femcod_solver_options, only: cg_settings
    use femcod_elastic_operator, only: elastic_operator, spread_load, cg_constraint
    use femcod_constrained_cg, only: constrained_cg, cg_residuals
+   use femcod_split_correction, only: split_correction, split_setup, split_apply, split_free
    use femcod_cg, only: coarse_start_forces, materials_of, approach_error_bound, cg_session, cg_answer, session_start, &
       solve_target, ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
@@ -99,6 +100,10 @@ module femcod_mpi_cg
       !> the window's memory is MPI's, not an allocatable's.
       real(sp), pointer, contiguous :: table(:, :) => null()
       type(MPI_Win) :: table_window = MPI_WIN_NULL
+      !> The kernel split (femcod_split_correction) for more changes than the table takes:
+      !> every rank holds its tables and the node mesh, and applies all ranks' changes to
+      !> its own columns.
+      type(split_correction) :: split
    contains
       procedure :: displace => distributed_displace
       procedure :: apply_spectrum => distributed_apply_spectrum
@@ -111,6 +116,7 @@ module femcod_mpi_cg
       procedure :: start_forces => coarse_start
       procedure :: correction_limits => ranks_correction_limits
       procedure :: add_direct => ranks_add_direct
+      procedure :: split_correct => ranks_split_correct
    end type distributed_grid
 
    !> One requested state on the ranks: its values (model/femcod_contact_result: the
@@ -276,8 +282,10 @@ contains
       grid%table(:, grid%j0:grid%j0 + grid%nj - 1) = real(columns, sp)
    end subroutine periodic_table_columns
 
-   !> Up to how%direct_corrections changes from the table where the ranks share it; no
-   !> kernel split (femcod_split_correction works on a whole grid).
+   !> Up to how%direct_corrections changes from the table where the ranks share it; the
+   !> kernel split up to the serial operator's budget (elastic_operator's
+   !> grid_correction_limits), for the full kernel of the free surface, on any number of
+   !> nodes (it needs no table).
    subroutine ranks_correction_limits(op, how, limit, split_limit)
       class(distributed_grid), intent(in) :: op
       type(cg_settings), intent(in) :: how
@@ -285,6 +293,10 @@ contains
       limit = 0
       split_limit = 0
       if (associated(op%table)) limit = max(how%direct_corrections, 0)
+      if (how%split_radius >= how%split_cell .and. how%split_cell >= 1 .and. .not. op%periodic .and. &
+         .not. how%kernel_radius > 0) &
+         split_limit = int(min(how%split_budget*real(op%np, dp)**2/real(2*how%split_cell + 1, dp)**2, &
+         real(op%np, dp)**2, real(huge(1)/2, dp)))
    end subroutine ranks_correction_limits
 
    !> w += c I * (every rank's changed forces), on this rank's columns: the changes of all
@@ -296,22 +308,10 @@ contains
       integer, intent(in) :: changed(:, :)
       real(dp), intent(in) :: delta(:)
       integer, intent(in) :: n
-      integer, allocatable :: counts(:), displs(:), mine(:, :), every(:, :)
+      integer, allocatable :: every(:, :)
       real(dp), allocatable :: deltas(:)
-      integer :: total, q, jj, ii, iq, jq, r
-      allocate(counts(0:op%ranks - 1), displs(0:op%ranks - 1))
-      call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, op%comm)
-      displs(0) = 0
-      do r = 1, op%ranks - 1
-         displs(r) = displs(r - 1) + counts(r - 1)
-      end do
-      total = sum(counts)
-      ! Global columns (1-based) for the others.
-      allocate(mine(2, max(n, 1)), every(2, max(total, 1)), deltas(max(total, 1)))
-      mine(1, 1:n) = changed(1, 1:n)
-      mine(2, 1:n) = changed(2, 1:n) + op%j0
-      call MPI_Allgatherv(mine, 2*n, MPI_INTEGER, every, 2*counts, 2*displs, MPI_INTEGER, op%comm)
-      call MPI_Allgatherv(delta, n, MPI_DOUBLE_PRECISION, deltas, counts, displs, MPI_DOUBLE_PRECISION, op%comm)
+      integer :: total, q, jj, ii, iq, jq
+      call gather_changes(op, changed, delta, n, every, deltas, total)
       !$omp parallel do private(ii, q, iq, jq)
       do jj = 1, op%nj
          do q = 1, total
@@ -323,6 +323,64 @@ contains
          end do
       end do
    end subroutine ranks_add_direct
+
+   !> Every rank's changes (this rank's: `changed` in its own columns, `delta`, n of them)
+   !> on every rank, in rank order (each rank's sorted by column, then row: the serial
+   !> solver's order), in the grid's columns (1-based): every(2, total), deltas(total).
+   !> Collective.
+   subroutine gather_changes(op, changed, delta, n, every, deltas, total)
+      class(distributed_grid), intent(in) :: op
+      integer, intent(in) :: changed(:, :)
+      real(dp), intent(in) :: delta(:)
+      integer, intent(in) :: n
+      integer, allocatable, intent(out) :: every(:, :)
+      real(dp), allocatable, intent(out) :: deltas(:)
+      integer, intent(out) :: total
+      integer, allocatable :: counts(:), displs(:), mine(:, :)
+      integer :: r
+      allocate(counts(0:op%ranks - 1), displs(0:op%ranks - 1))
+      call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, op%comm)
+      displs(0) = 0
+      do r = 1, op%ranks - 1
+         displs(r) = displs(r - 1) + counts(r - 1)
+      end do
+      total = sum(counts)
+      allocate(mine(2, max(n, 1)), every(2, max(total, 1)), deltas(max(total, 1)))
+      mine(1, 1:n) = changed(1, 1:n)
+      mine(2, 1:n) = changed(2, 1:n) + op%j0
+      call MPI_Allgatherv(mine, 2*n, MPI_INTEGER, every, 2*counts, 2*displs, MPI_INTEGER, op%comm)
+      call MPI_Allgatherv(delta, n, MPI_DOUBLE_PRECISION, deltas, counts, displs, MPI_DOUBLE_PRECISION, op%comm)
+   end subroutine gather_changes
+
+   !> The kernel split on the ranks, as elastic_operator's grid_split_correct on one
+   !> process: every rank's changes gathered on every rank, the window and the error bound
+   !> from all of them (the same decision on every rank), and split_apply on this rank's
+   !> columns (every rank convolves the same node loads: the mesh is 1/k^2 of the grid).
+   !> Collective.
+   subroutine ranks_split_correct(op, w, changed, delta, n, how, allowance, split_error, applied)
+      class(distributed_grid), intent(inout) :: op
+      real(dp), intent(inout) :: w(:, :)
+      integer, intent(in) :: changed(:, :)
+      real(dp), intent(in) :: delta(:)
+      integer, intent(in) :: n
+      type(cg_settings), intent(in) :: how
+      real(dp), intent(in) :: allowance
+      real(dp), intent(inout) :: split_error
+      logical, intent(out) :: applied
+      integer, allocatable :: every(:, :)
+      real(dp), allocatable :: deltas(:)
+      real(dp) :: bound
+      integer :: reach, total
+      call gather_changes(op, changed, delta, n, every, deltas, total)
+      if (op%split%np /= op%np) call split_setup(op%split, op%np, how%split_cell, how%split_radius)
+      reach = min(how%split_radius, int((sqrt(how%split_budget*real(op%np, dp)**2/max(total, 1)) - 1)/2))
+      reach = max(reach, how%split_cell)
+      bound = split_error + op%c*op%split%far_error(reach)*sum(abs(deltas(1:total)))
+      applied = bound <= allowance
+      if (.not. applied) return
+      split_error = bound
+      call split_apply(op%split, w, op%c, every, deltas, total, reach, op%j0)
+   end subroutine ranks_split_correct
 
    !> The kernel's spectrum on this rank's frequencies kx, over all ky (m values), divided
    !> by m^2 (FFTW's transforms are not normalised). Free surface: the Love table's even
@@ -523,6 +581,7 @@ contains
       grid%table => null()
       call slab_free(grid%slab)
       call gap_transform_free(grid%gaps)
+      call split_free(grid%split)
       grid = distributed_grid(comm=MPI_COMM_NULL)
    end subroutine grid_free
 

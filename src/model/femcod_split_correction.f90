@@ -169,21 +169,26 @@ contains
    !> (changed(1, q), changed(2, q)), q = 1 .. n, with c the compliance (nm/nN). The changes
    !> come sorted by column, then row (every pixel's sum is then taken in one order, the
    !> answer the same for any number of threads). Beyond the window each change's error
-   !> is at most |c delta(q)| far_error(radius).
-   subroutine split_apply(split, w, c, changed, delta, n, radius)
+   !> is at most |c delta(q)| far_error(radius). With `first_column` (0-based), w holds
+   !> only the grid's columns first_column + 1 .. first_column + size(w, 2) (a rank's
+   !> slab; the changes are given in the grid's columns, all of them).
+   subroutine split_apply(split, w, c, changed, delta, n, radius, first_column)
       type(split_correction), intent(inout) :: split
       real(dp), intent(inout) :: w(:, :)
       real(dp), intent(in) :: c
       integer, intent(in) :: changed(:, :)
       real(dp), intent(in) :: delta(:)
       integer, intent(in) :: n, radius
+      integer, intent(in), optional :: first_column
       integer, allocatable :: first(:)
       real(dp), allocatable :: col(:)
-      integer :: k, np, q, i, j, a0, b0, sx, sy, ii, iq, jq, rad
+      integer :: k, np, q, i, j, jj, j0, a0, b0, sx, sy, ii, iq, jq, rad
       real(dp) :: fx, fy, d
       k = split%k
       np = split%np
       rad = min(radius, split%radius)
+      j0 = 0
+      if (present(first_column)) j0 = first_column
       ! Far: the changes assigned to the nodes, the nodes convolved.
       split%load = 0
       do q = 1, n
@@ -213,14 +218,15 @@ contains
       !$omp parallel private(col, j, i, a0, b0, fx, fy, q, iq, jq, sx, sy, d, ii)
       allocate(col(split%nn))
       !$omp do schedule(static)
-      do j = 1, np
+      do jj = 1, size(w, 2)
+         j = j0 + jj
          b0 = (j - 1)/k
          fy = real(j - 1 - k*b0, dp)/k
          col = (1 - fy)*split%field(:, b0 + 1) + fy*split%field(:, b0 + 2)
          do a0 = 0, (np - 1)/k
             do i = a0*k + 1, min(a0*k + k, np)
                fx = real(i - 1 - a0*k, dp)/k
-               w(i, j) = w(i, j) + ((1 - fx)*col(a0 + 1) + fx*col(a0 + 2))
+               w(i, jj) = w(i, jj) + ((1 - fx)*col(a0 + 1) + fx*col(a0 + 2))
             end do
          end do
          do q = first(max(j - rad, 1)), first(min(j + rad, np) + 1) - 1
@@ -230,7 +236,7 @@ contains
             sy = mod(jq - 1, k)
             d = c*delta(q)
             do ii = max(iq - rad, 1), min(iq + rad, np)
-               w(ii, j) = w(ii, j) + d*real(split%near(ii - iq, j - jq, sx, sy), dp)
+               w(ii, jj) = w(ii, jj) + d*real(split%near(ii - iq, j - jq, sx, sy), dp)
             end do
          end do
       end do
