@@ -45,15 +45,16 @@ module femcod_mpi_cg
    use femcod_kinds, only: dp, sp
    use femcod_status, only: status_type, set_error, STATUS_NUMERICAL, STATUS_INTERRUPTED, STATUS_USAGE
    use femcod_love, only: love_influence, surface_compliance
-   use femcod_convolution, only: inverse_tap_sums
+   use femcod_convolution, only: inverse_tap_sums, mirror_weights
    use femcod_mpi_patches, only: count_patches_on_ranks
    use femcod_love_periodic, only: periodic_love_spectrum_rows
    use femcod_spring, only: spring_stiffness
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: cg_settings
-   use femcod_elastic_operator, only: elastic_operator, spread_load, cg_constraint
+   use femcod_elastic_operator, only: elastic_operator, spread_load, cg_constraint, kernel_split_limit, &
+      split_within_allowance
    use femcod_constrained_cg, only: constrained_cg, cg_residuals
-   use femcod_split_correction, only: split_correction, split_setup, split_apply, split_free
+   use femcod_split_correction, only: split_correction, split_free
    use femcod_cg, only: coarse_start_forces, materials_of, approach_error_bound, cg_session, cg_answer, session_start, &
       solve_target, ascending_order, refuse_beyond_full_contact, unconverged_message
    use femcod_interface_law, only: interface_law
@@ -293,10 +294,7 @@ contains
       limit = 0
       split_limit = 0
       if (associated(op%table)) limit = max(how%direct_corrections, 0)
-      if (how%split_radius >= how%split_cell .and. how%split_cell >= 1 .and. .not. op%periodic .and. &
-         .not. how%kernel_radius > 0) &
-         split_limit = int(min(how%split_budget*real(op%np, dp)**2/real(2*how%split_cell + 1, dp)**2, &
-         real(op%np, dp)**2, real(huge(1)/2, dp)))
+      if (.not. (op%periodic .or. how%kernel_radius > 0)) split_limit = kernel_split_limit(op%np, how)
    end subroutine ranks_correction_limits
 
    !> w += c I * (every rank's changed forces), on this rank's columns: the changes of all
@@ -369,17 +367,10 @@ contains
       logical, intent(out) :: applied
       integer, allocatable :: every(:, :)
       real(dp), allocatable :: deltas(:)
-      real(dp) :: bound
-      integer :: reach, total
+      integer :: total
       call gather_changes(op, changed, delta, n, every, deltas, total)
-      if (op%split%np /= op%np) call split_setup(op%split, op%np, how%split_cell, how%split_radius)
-      reach = min(how%split_radius, int((sqrt(how%split_budget*real(op%np, dp)**2/max(total, 1)) - 1)/2))
-      reach = max(reach, how%split_cell)
-      bound = split_error + op%c*op%split%far_error(reach)*sum(abs(deltas(1:total)))
-      applied = bound <= allowance
-      if (.not. applied) return
-      split_error = bound
-      call split_apply(op%split, w, op%c, every, deltas, total, reach, op%j0)
+      call split_within_allowance(op%split, op%np, op%c, w, every, deltas, total, how, allowance, split_error, &
+         applied, op%j0)
    end subroutine ranks_split_correct
 
    !> The kernel's spectrum on this rank's frequencies kx, over all ky (m values), divided
@@ -439,16 +430,6 @@ contains
       end do
       call MPI_Allreduce(MPI_IN_PLACE, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, grid%comm)
    end function sum_of_spectrum
-
-   !> How often each stored ky = 0 .. m/2 of the kernel (distributed_grid%kernel) occurs
-   !> among all m: once at 0 and at m/2 (m even), twice (ky and m - ky) otherwise.
-   pure function mirror_weights(m) result(w)
-      integer, intent(in) :: m
-      real(dp) :: w(m/2 + 1)
-      w = 2
-      w(1) = 1
-      if (mod(m, 2) == 0) w(m/2 + 1) = 1
-   end function mirror_weights
 
    !> The kernel's spectrum on all m values of ky, (m, freqs), from the stored half.
    pure function whole_kernel(grid) result(whole)

@@ -51,7 +51,7 @@ module femcod_convolution
    implicit none
    private
    public :: love_convolution, convolution_setup, convolution_apply, convolution_apply_single, convolution_free, &
-      inverse_kernel_taps, inverse_tap_sums
+      inverse_kernel_taps, inverse_tap_sums, mirror_weights
    public :: gap_transform, gap_transform_setup, gap_transform_apply, gap_transform_free, SPECTRUM_COMPLIANCE, &
       SPECTRUM_STIFFNESS
    public :: inverse_half_spectrum, inverse_complex_transform, forward_complex_transform, line_transform, line_transform_setup, &
@@ -459,7 +459,6 @@ contains
       type(love_convolution), intent(in) :: conv
       real(dp), intent(out) :: taps(0:2, 0:2)
       logical, intent(out) :: ok
-      real(dp), allocatable :: weight(:)
       integer :: kh, k
       taps = 0
       ok = conv%np >= 3
@@ -471,13 +470,19 @@ contains
       end if
       if (.not. ok) return
       kh = conv%m/2
-      allocate(weight(0:kh))
-      weight = 2
-      weight(0) = 1
-      if (mod(conv%m, 2) == 0) weight(kh) = 1
-      taps = inverse_tap_sums(conv%kernel, conv%m, [(k, k = 0, kh)], weight, [(k, k = 0, kh)], weight, &
-         conv%threads, merge([1, 1], [0, 0], conv%periodic))/real(conv%m, dp)**4
+      taps = inverse_tap_sums(conv%kernel, conv%m, [(k, k = 0, kh)], mirror_weights(conv%m), [(k, k = 0, kh)], &
+         mirror_weights(conv%m), conv%threads, merge([1, 1], [0, 0], conv%periodic))/real(conv%m, dp)**4
    end subroutine inverse_kernel_taps
+
+   !> How often each frequency k = 0 .. m/2 of a spectrum even in k occurs among all m:
+   !> once at 0 and at m/2 (m even), twice (k and m - k) otherwise.
+   pure function mirror_weights(m) result(w)
+      integer, intent(in) :: m
+      real(dp) :: w(m/2 + 1)
+      w = 2
+      w(1) = 1
+      if (mod(m, 2) == 0) w(m/2 + 1) = 1
+   end function mirror_weights
 
    !> The sums behind the preconditioner's taps (inverse_kernel_taps; femcod-mpi's ranks
    !> each over their own frequencies): sums(a, b), a, b = 0..2, the sum over the kernel's

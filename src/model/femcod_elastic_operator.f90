@@ -34,7 +34,7 @@ module femcod_elastic_operator
    implicit none
    private
    public :: elastic_operator, grid_operator, grid_operator_setup, grid_operator_free, truncate_table, spread_load
-   public :: cg_constraint
+   public :: cg_constraint, kernel_split_limit, split_within_allowance
    public :: SPECTRUM_COMPLIANCE, SPECTRUM_STIFFNESS, TABLE_NONE, TABLE_SINGLE, TABLE_DOUBLE
 
    !> Which Love table a grid operator keeps besides its convolution (grid_operator_setup's
@@ -351,11 +351,19 @@ contains
       ! The corrections read the float32 table: an operator without it convolves afresh.
       if (.not. allocated(op%table)) return
       limit = max(how%direct_corrections, 0)
-      if (how%split_radius >= how%split_cell .and. how%split_cell >= 1 .and. .not. op%periodic .and. &
-         .not. op%truncated) &
-         split_limit = int(min(how%split_budget*real(op%np, dp)**2/real(2*how%split_cell + 1, dp)**2, &
-         real(op%np, dp)**2, real(huge(1)/2, dp)))
+      if (.not. (op%periodic .or. op%truncated)) split_limit = kernel_split_limit(op%np, how)
    end subroutine grid_correction_limits
+
+   !> How many changed forces the kernel split takes on an NP x NP grid: the budget with
+   !> the smallest window (one lattice cell); 0 when how's split is off.
+   pure integer function kernel_split_limit(np, how) result(limit)
+      integer, intent(in) :: np
+      type(cg_settings), intent(in) :: how
+      limit = 0
+      if (how%split_radius >= how%split_cell .and. how%split_cell >= 1) &
+         limit = int(min(how%split_budget*real(np, dp)**2/real(2*how%split_cell + 1, dp)**2, &
+         real(np, dp)**2, real(huge(1)/2, dp)))
+   end function kernel_split_limit
 
    !> w += c I * (the changed forces' corrections), summed directly from the table (the
    !> changes sorted by column, then row: the sums in one order).
@@ -391,15 +399,36 @@ contains
       real(dp), intent(in) :: allowance
       real(dp), intent(inout) :: split_error
       logical, intent(out) :: applied
+      call split_within_allowance(op%split, op%np, op%c, w, changed, delta, n, how, allowance, split_error, applied)
+   end subroutine grid_split_correct
+
+   !> The kernel split of the n changes (changed: the grid's rows and columns, delta: nN)
+   !> on an NP x NP grid of compliance c (nm/nN), with the widest window the budget allows,
+   !> applied to w when the error bound since the last fresh convolution (split_error, nm)
+   !> stays within `allowance` (nm); `applied` false when it would not. w holds the
+   !> grid's columns first_column + 1 .. (split_apply; default all of them).
+   subroutine split_within_allowance(split, np, c, w, changed, delta, n, how, allowance, split_error, applied, &
+      first_column)
+      type(split_correction), intent(inout) :: split
+      integer, intent(in) :: np, n
+      real(dp), intent(in) :: c
+      real(dp), intent(inout) :: w(:, :)
+      integer, intent(in) :: changed(:, :)
+      real(dp), intent(in) :: delta(:)
+      type(cg_settings), intent(in) :: how
+      real(dp), intent(in) :: allowance
+      real(dp), intent(inout) :: split_error
+      logical, intent(out) :: applied
+      integer, intent(in), optional :: first_column
       real(dp) :: bound
       integer :: reach
-      if (op%split%np /= op%np) call split_setup(op%split, op%np, how%split_cell, how%split_radius)
-      reach = min(how%split_radius, int((sqrt(how%split_budget*real(op%np, dp)**2/n) - 1)/2))
+      if (split%np /= np) call split_setup(split, np, how%split_cell, how%split_radius)
+      reach = min(how%split_radius, int((sqrt(how%split_budget*real(np, dp)**2/max(n, 1)) - 1)/2))
       reach = max(reach, how%split_cell)
-      bound = split_error + op%c*op%split%far_error(reach)*sum(abs(delta(1:n)))
+      bound = split_error + c*split%far_error(reach)*sum(abs(delta(1:n)))
       applied = bound <= allowance
       if (.not. applied) return
       split_error = bound
-      call split_apply(op%split, w, op%c, changed, delta, n, reach)
-   end subroutine grid_split_correct
+      call split_apply(split, w, c, changed, delta, n, reach, first_column)
+   end subroutine split_within_allowance
 end module femcod_elastic_operator
