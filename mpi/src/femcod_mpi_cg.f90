@@ -5,18 +5,22 @@
 !> - The Love-kernel convolution on the zero-padded (2 NP)^2 grid, pruned as the serial
 !>   one is (femcod_convolution): real-to-complex transforms of length 2 NP down this
 !>   rank's columns (only NP of the 2 NP are not zero), the distributed transpose of the
-!>   (NP + 1) x NP half spectrum (FFTW-MPI's, or through the node's shared memory when
-!>   every rank is on one node), complex transforms of length 2 NP along the rows of
-!>   this rank's frequencies, the kernel, and back the same way. Only the non-zero half is
-!>   transformed and moved: the full FFTW-MPI r2c of the padded grid transforms and
-!>   transposes twice as much, and hands the physical columns to half of the ranks. The
-!>   kernel's spectrum is made the same way from the even extension of the Love table,
-!>   each rank from its own columns. FFTW's threads within a rank.
+!>   (NP + 1) x NP half spectrum (FFTW-MPI's; when every rank is on one node the row step
+!>   reads its rows straight from every rank's columns in the node's shared memory),
+!>   complex transforms of length 2 NP along the rows of this rank's frequencies in
+!>   blocks, the kernel, and back the same way (femcod_mpi_slab_transform's
+!>   slab_convolve). Only the non-zero half is transformed and moved: the full FFTW-MPI
+!>   r2c of the padded grid transforms and transposes twice as much, and hands the
+!>   physical columns to half of the ranks. The kernel's spectrum is made the same way
+!>   from the even extension of the Love table, each rank from its own columns, and kept
+!>   for half of the row frequencies (it is even). FFTW's threads within a rank.
 !> - Sums and maxima by MPI_Allreduce; the preconditioner's 13-point stencil reads two
 !>   columns of each neighbour (MPI_Sendrecv).
-!> - The first load starts from a coarse solution on rank 0 (femcod_cg's own nested start
-!>   at NP/f, f the smallest power of two with f^2 >= ranks, so that it needs no more memory
-!>   than a rank's share): with up to 4 ranks the same start as the serial solver's.
+!> - The first load starts from a coarse solution at NP/f, f the smallest power of two
+!>   with f^2 >= ranks (with up to 4 ranks the serial solver's first level): a coarse grid
+!>   of at least 2 coarsest pixels a side is a distributed grid of its own, solved on the
+!>   ranks from its own coarse start; a smaller one is solved on rank 0 by femcod_cg's
+!>   nested start.
 !> - float32 transforms (FFTW's fftwf, the transposes fftwf_mpi) where the serial solver
 !>   uses them: the search directions always, the forces' own displacements while the
 !>   residual is above `single_until`; every switch and the final answer from a fresh
@@ -24,9 +28,10 @@
 !> - Up to `direct_corrections` forces the projection changes are corrected directly from
 !>   the float32 Love table, as the serial solver does, when every rank is on one node:
 !>   the table (NP^2 values, 4 bytes each) is then held once in memory the node's ranks
-!>   share (an MPI-3 shared window), each rank writing its own columns of it. On more
-!>   nodes, and beyond that many changes (where the serial solver splits the kernel), a
-!>   fresh convolution: more convolutions, the same answer (to the tolerance).
+!>   share (an MPI-3 shared window), each rank writing its own columns of it. More
+!>   changes (and, on more nodes, any) go to the kernel split on the free surface, as in
+!>   the serial solver: every rank gathers all the changes and corrects its own columns.
+!>   Otherwise a fresh convolution: more convolutions, the same answer (to the tolerance).
 !>
 !> The grid is an elastic operator (model/femcod_elastic_operator) whose reductions are
 !> MPI all-reduces: femcod_cg's one constrained iteration, its plastic rounds and its
