@@ -49,7 +49,6 @@ program femcod_mpi
    use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, &
       agree
    use femcod_svg, only: svg_pressure_map, svg_map, BLOCK_SMALLEST
-   use femcod_maps, only: state_maps
    use femcod_gap_cg, only: gap_solver_storage_bytes
    use femcod_interface_law, only: make_interface_law
    use femcod_solver_options, only: by_gap_variables, run_shear_model, &
@@ -62,6 +61,11 @@ program femcod_mpi
    use femcod_results_json, only: run_header_json
    use femcod_run_summary, only: state_summary_lines
    implicit none
+
+   !> One load's two map figures, gathered on rank 0 (gather_block_maxima).
+   type :: map_figures
+      real(dp), allocatable :: pressure(:, :), gap(:, :)
+   end type map_figures
 
    type(string_type), allocatable :: args(:)
    type(run_settings) :: settings
@@ -77,7 +81,8 @@ program femcod_mpi
    real(dp), allocatable :: local(:, :), estimated_mb(:)
    type(string_type), allocatable :: outputs(:), inputs(:)
    integer(i8) :: estimated_rank_bytes
-   type(state_maps), allocatable :: figures(:)
+   !> Each load's figures: block maxima of the pressure (GPa), block minima of the gap (nm).
+   type(map_figures), allocatable :: figures(:)
    integer :: provided, rank, ranks, np, block, code, k, figure
    logical :: locked, slab_input, hdf5_input, dataset_input, generating
    character(len=:), allocatable :: fftw_message

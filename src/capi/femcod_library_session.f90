@@ -18,7 +18,7 @@ module femcod_library_session
    use femcod_solver_options, only: contact_options, BOUNDARY_PERIODIC, OPTION_NAMES, IN_HISTORY
    use femcod_observer, only: solver_observer
    use femcod_solver, only: solve_contact, run_warnings
-   use femcod_maps, only: load_maps, state_maps, tangential_step_maps
+   use femcod_maps, only: load_maps, state_maps, tangential_step_maps, state_pressure_map
    use femcod_options, only: parsed_options, parse_options
    use femcod_run_options, only: run_table, run_settings, parse_run_arguments
    implicit none
@@ -254,7 +254,7 @@ contains
       end if
       select case (name)
       case ("pressure")
-         map = session%maps(k)%pressure
+         map = state_pressure_map(session%problem%np, session%problem%pixel, session%res%states(k))
       case ("gap")
          map = session%maps(k)%gap
       case ("plastic_displacement")

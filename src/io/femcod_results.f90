@@ -16,7 +16,7 @@ module femcod_results
    use femcod_strings, only: string_type, int_str, sig_str
    use femcod_files, only: atomic_rename, remove_file, temporary_name, write_bytes, base_name
    use femcod_contact_result, only: contact_result
-   use femcod_maps, only: state_maps, tangential_step_maps
+   use femcod_maps, only: state_maps, tangential_step_maps, state_pressure_map
    use femcod_svg, only: svg_plot, svg_pressure_map, svg_map, svg_stick_slip_map, BLOCK_SMALLEST, BLOCK_LARGEST
    use femcod_result_schema, only: run_info, FIGURES_AUTO_LIMIT, HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, &
       FRICTION_COLUMNS, TANGENTIAL_COLUMNS, PATCH_COLUMNS, result_name, area_fit, load_group
@@ -152,7 +152,8 @@ contains
          at = " at "//sig_str(res%states(k)%load, 6)//" nN (approach "//sig_str(res%states(k)%approach, 4)//" nm, "// &
             int_str(res%states(k)%contacts)//" contacts)"
          call add(".pressure_"//int_str(k)//".svg")
-         call write_text(temps(size(temps))%s, svg_pressure_map("contact pressure"//at, maps(k)%pressure, side), status)
+         call write_text(temps(size(temps))%s, svg_pressure_map("contact pressure"//at, &
+            state_pressure_map(deck%np, deck%pixel, res%states(k)), side), status)
          call add(".gap_"//int_str(k)//".svg")
          call write_text(temps(size(temps))%s, svg_map("gap"//at, maps(k)%gap, side, "nm", "gap", BLOCK_SMALLEST, &
             .false.), status)

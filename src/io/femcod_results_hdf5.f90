@@ -10,7 +10,7 @@ module femcod_results_hdf5
       legacy_diagnostics, event_checks, legacy_checks, cg_work
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
       h5_read_string_attribute, h5_flat_view
-   use femcod_maps, only: state_maps, tangential_step_maps
+   use femcod_maps, only: state_maps, tangential_step_maps, state_pressure_map
    use femcod_patches, only: contact_patches, perimeter_area_fit
    use femcod_shear_model, only: friction_coefficient
    use femcod_state_record, only: state_attributes
@@ -85,8 +85,7 @@ contains
             call state_attributes(file, g, k, s%state_values, deck%pixel, deck%np, info, cg_work(res, k), local)
             if (info%tangential) call write_tangential(file, g, deck, s, local)
             call write_patches(file, g, maps(k)%patches, local)
-            call h5_write(file, g//"/pressure", maps(k)%pressure, "GPa", local, &
-               compress=mostly_zero(maps(k)%pressure))
+            call write_pressure(file, g, deck, s, local)
             call h5_write(file, g//"/gap", maps(k)%gap, "nm", local, compress=mostly_zero(maps(k)%gap))
             if (allocated(s%plastic)) call h5_write(file, g//"/plastic_displacement", s%plastic, "nm", local, &
                compress=mostly_zero(s%plastic))
@@ -193,6 +192,19 @@ contains
          end do
       end do
    end subroutine write_mesh
+
+   !> A state's pressure map (GPa) in its load group, formed from its contact list here
+   !> and freed after: a run's maps are not all held at once.
+   subroutine write_pressure(file, g, deck, s, status)
+      type(h5_file), intent(in) :: file
+      character(len=*), intent(in) :: g
+      type(contact_problem), intent(in) :: deck
+      type(load_state), intent(in) :: s
+      type(status_type), intent(inout) :: status
+      real(dp), allocatable :: pressure(:, :)
+      pressure = state_pressure_map(deck%np, deck%pixel, s)
+      call h5_write(file, g//"/pressure", pressure, "GPa", status, compress=mostly_zero(pressure))
+   end subroutine write_pressure
 
    !> A state's tangential step in its load group (its attributes: state_attributes): the
    !> traction maps tau_x, tau_y (GPa) and the stick and slip maps (1 where the contact

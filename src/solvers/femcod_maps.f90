@@ -11,16 +11,17 @@ module femcod_maps
    private
    public :: load_maps, state_maps, tangential_step_maps, state_pressure_map
 
-   !> The maps of one load state, and its contact patches (model/femcod_patches).
+   !> The gap map of one load state, and its contact patches (model/femcod_patches). Its
+   !> pressure map is formed where it is written (state_pressure_map), from the state's
+   !> contact list: 8 bytes a pixel a state less held.
    type :: state_maps
-      real(dp), allocatable :: pressure(:, :), gap(:, :)
+      real(dp), allocatable :: gap(:, :)
       type(contact_patches) :: patches
    end type state_maps
 
 contains
 
    !> For every reached state: its contact patches (kept in the state's values too);
-   !> pressure(i, j) (GPa) = contact force / pixel area;
    !> gap(i, j) (nm) = separation of the deformed surfaces, g0 - approach + c (I * F),
    !> from the elastic operator's zero-padded FFT convolution (cyclic on a periodic cell),
    !> and 0 at the contacts (where the penalty springs' compression s F is the only
@@ -48,7 +49,6 @@ contains
       handed = allocated_gap(states)
       do s = 1, size(states)
          if (.not. states(s)%reached) cycle
-         maps(s)%pressure = state_pressure_map(np, problem%pixel, states(s))
          call find_patches(np, states(s)%i, states(s)%j, cyclic, maps(s)%patches)
          states(s)%patches_4 = maps(s)%patches%count4
          states(s)%patches_8 = maps(s)%patches%count8
