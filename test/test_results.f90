@@ -2,7 +2,7 @@
 !> heights straight from files, checkpoint and restart under SIGKILL.
 module test_results
    use femcod_kinds, only: dp
-   use femcod_status, only: status_type, STATUS_BAD_INPUT
+   use femcod_status, only: status_type, STATUS_BAD_INPUT, STATUS_NUMERICAL
    use femcod_deck, only: read_deck, write_deck
    use femcod_problem, only: contact_problem
    use femcod_strings, only: string_type
@@ -38,6 +38,8 @@ contains
             test_memory_estimate), &
          new_unittest("existing results are kept without --force", test_force), &
          new_unittest("a result that cannot be put in place leaves no partial set", test_partial), &
+         new_unittest("cg's gap maps written while it solves: each its own state's; a failed run leaves none", &
+            test_streamed_gaps), &
          new_unittest("--lower/--upper: ASCII and HDF5 heights equal the deck", test_height_files), &
          new_unittest("checkpoint: killed with SIGKILL and restarted, the same results (elastic, plastic)", &
             test_sigkill), &
@@ -740,6 +742,56 @@ contains
          file_exists(prefix//".pressure_1.svg") .or. file_exists(prefix//".h5.part")), "no partial result set")
       call execute_command_line("rmdir "//prefix//".h5")
    end subroutine test_partial
+
+   !> femcod run's cg writes each state's gap map into PREFIX.h5's temporary as soon as the
+   !> state is solved (cli/femcod_run_observer). The loads given out of order (the solver
+   !> takes them in ascending order): each /loads/<k>/gap is its own state's, by the
+   !> contact condition (the gap is 0 exactly where the state's pressure is positive,
+   !> and positive elsewhere), and the three states' contact sets differ, so a map under
+   !> another state's name fails. A run that fails after solving (cg stopped after one
+   !> iteration, exit 4) leaves neither PREFIX.h5 nor its temporary.
+   subroutine test_streamed_gaps(error)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: prefix
+      character(len=*), parameter :: GROUPS(3) = ["/loads/001", "/loads/002", "/loads/003"]
+      type(h5_file) :: file
+      type(status_type) :: st
+      real(dp), allocatable :: gap(:, :), pressure(:, :)
+      integer :: code, k, contacts(3)
+      prefix = scratch_path("streamed")
+      call execute_command_line("rm -f '"//prefix//"'.*")
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--solver"), string_type("cg"), string_type("--loads"), &
+         string_type("1000,100,300"), string_type("--quiet")], code)
+      call check(error, code, 0, "femcod run")
+      if (allocated(error)) return
+      call h5_open(prefix//".h5", file, st, STATUS_BAD_INPUT)
+      do k = 1, 3
+         call h5_read(file, GROUPS(k)//"/gap", gap, st, STATUS_BAD_INPUT)
+         call h5_read(file, GROUPS(k)//"/pressure", pressure, st, STATUS_BAD_INPUT)
+         if (st%code /= 0) exit
+         contacts(k) = count(pressure > 0)
+         call check(error, all((gap == 0) .eqv. (pressure > 0)) .and. all(gap >= 0), GROUPS(k)// &
+            ": the gap is 0 exactly at the state's contacts ("//to_string(count((gap == 0) .neqv. (pressure > 0)))// &
+            " pixels disagree)")
+         if (allocated(error)) exit
+      end do
+      call h5_close(file, st)
+      if (allocated(error)) return
+      call check(error, st%code, 0, st%message)
+      if (allocated(error)) return
+      call check(error, contacts(2) < contacts(3) .and. contacts(3) < contacts(1), "contacts grow with the load: "// &
+         to_string(contacts(1))//", "//to_string(contacts(2))//", "//to_string(contacts(3)))
+      if (allocated(error)) return
+      call execute_command_line("rm -f '"//prefix//"'.*")
+      call run_femcod([string_type("run"), string_type("input/sphere_d1.deck"), string_type("-o"), &
+         string_type(prefix), string_type("--solver"), string_type("cg"), string_type("--loads"), &
+         string_type("1000,100,300"), string_type("--max-iterations"), string_type("1"), string_type("--quiet")], code)
+      call check(error, code, STATUS_NUMERICAL, "cg stopped after one iteration: exit 4")
+      if (allocated(error)) return
+      call check(error, .not. (file_exists(prefix//".h5") .or. file_exists(prefix//".h5.part")), &
+         "no PREFIX.h5 and no PREFIX.h5.part")
+   end subroutine test_streamed_gaps
 
    !> The sphere deck's upper surface written as an ASCII matrix and as an HDF5 dataset,
    !> run with --upper FILE and the deck's pixel, materials (the thesis' rigid factor

@@ -14,7 +14,7 @@ module femcod_run
    use femcod_status, only: status_type, set_error, STATUS_USAGE, STATUS_IO, STATUS_INTERRUPTED
    use femcod_strings, only: string_type, int_str, format_real, append_string, count_text, json_string
    use femcod_files, only: remove_file, path_exists, path_is_directory, canonical_path, acquire_lock, release_lock, &
-      make_directories, write_file
+      make_directories, write_file, temporary_name
    use femcod_process, only: catch_stop_signals, stop_signal, signal_name, host_name, &
       openmp_threads, wait_policy_text, local_time_iso
    use femcod_sha256, only: sha256_hex, file_digest, file_sha256_start, file_sha256_finish
@@ -180,6 +180,9 @@ contains
          if (notice /= "" .and. .not. settings%quiet) write(error_unit, '(a)') "femcod: "//notice
          if (st%code == 0) then
             call run_locked(deck_path, prefix, settings, problem, inputs, files, pending, read_seconds, st)
+            ! The solved states' gap maps streamed into PREFIX.h5's temporary go with a
+            ! run that ends without its results.
+            if (st%code /= 0) call remove_file(temporary_name(prefix//".h5"))
             call release_lock(prefix//".lock")
          end if
       end if
@@ -437,7 +440,11 @@ contains
          info%read_seconds = read_seconds
          info%digest_seconds = digest_seconds
          call wall_clock(t0)
-         call load_maps(problem, res%states, maps, options%boundary == BOUNDARY_PERIODIC)
+         if (allocated(observer%gap_in_file)) then
+            call load_maps(problem, res%states, maps, options%boundary == BOUNDARY_PERIODIC, observer%gap_in_file)
+         else
+            call load_maps(problem, res%states, maps, options%boundary == BOUNDARY_PERIODIC)
+         end if
          call wall_clock(t1)
          info%maps_seconds = t1 - t0
          warnings = run_warnings(options, res)

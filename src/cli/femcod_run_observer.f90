@@ -12,6 +12,9 @@ module femcod_run_observer
    use femcod_observer, only: solver_observer
    use femcod_state_visitor, only: visitable
    use femcod_checkpoint, only: write_checkpoint
+   use femcod_contact_result, only: load_state
+   use femcod_files, only: temporary_name
+   use femcod_results_hdf5, only: stream_gap_map
    implicit none
    private
    public :: run_observer
@@ -34,10 +37,17 @@ module femcod_run_observer
       !> whether one was stored.
       character(len=:), allocatable :: checkpoint_path
       logical :: warned = .false., stored = .false.
+      !> The temporary of PREFIX.h5 the solved states' gap maps go to (stream_gap_map),
+      !> which states' maps are there, and whether writing one failed (the maps then stay
+      !> in memory, and the writer at the end reports the disk's error).
+      character(len=:), allocatable :: stream_path
+      logical, allocatable :: gap_in_file(:)
+      logical :: stream_failed = .false.
    contains
       procedure :: configure => configure_observer
       procedure :: progress => report_progress
       procedure :: checkpoint => store_checkpoint
+      procedure :: state_solved => stream_state
       procedure :: stop_requested => signal_arrived
    end type run_observer
 
@@ -62,6 +72,7 @@ contains
          self%states = requested_states(options)
       end if
       self%checkpoint_path = prefix//".ckpt.h5"
+      self%stream_path = temporary_name(prefix//".h5")
    end subroutine configure_observer
 
    !> A progress line on standard error at most every 5 s, with an estimate of the time
@@ -110,6 +121,24 @@ contains
          self%warned = .true.
       end if
    end subroutine store_checkpoint
+
+   !> State k of n is solved: its gap map (8 bytes a pixel) goes to the result file
+   !> being built and leaves memory, so that a run of many states holds one map.
+   subroutine stream_state(self, k, n, state)
+      class(run_observer), intent(inout) :: self
+      integer, intent(in) :: k, n
+      type(load_state), intent(inout) :: state
+      type(status_type) :: st
+      if (.not. allocated(state%gap) .or. self%stream_failed .or. .not. allocated(self%stream_path)) return
+      if (.not. allocated(self%gap_in_file)) allocate(self%gap_in_file(n), source=.false.)
+      call stream_gap_map(self%stream_path, .not. any(self%gap_in_file), k, n, state%gap, st)
+      if (st%code /= 0) then
+         self%stream_failed = .true.
+         return
+      end if
+      self%gap_in_file(k) = .true.
+      deallocate(state%gap)
+   end subroutine stream_state
 
    !> A stop signal (SIGTERM, SIGINT, SIGUSR1) has arrived.
    logical function signal_arrived(self)

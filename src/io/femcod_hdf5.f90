@@ -14,7 +14,8 @@ module femcod_hdf5
       h5dwrite_f, h5dread_f, h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
       h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, h5oopen_f, h5oclose_f, h5tcopy_f, h5tset_size_f, &
       h5tclose_f, h5lexists_f, h5aexists_f, h5dget_type_f, h5tget_class_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
-      H5S_SCALAR_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_INTEGER_F, H5T_FLOAT_F, H5T_STRING_F, &
+      H5F_ACC_RDWR_F, H5S_SCALAR_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_INTEGER_F, H5T_FLOAT_F, &
+      H5T_STRING_F, &
       H5T_COMPOUND_F, H5T_ENUM_F, H5T_C_S1, h5tset_cset_f, H5T_CSET_UTF8_F, h5tis_variable_str_f, h5aget_type_f, &
       h5pcreate_f, h5pclose_f, h5pset_chunk_f, h5pset_deflate_f, h5pset_shuffle_f, h5pset_virtual_f, &
       h5sselect_all_f, H5P_DATASET_CREATE_F, H5P_DEFAULT_F, h5sselect_hyperslab_f, H5S_SELECT_SET_F, &
@@ -29,7 +30,7 @@ module femcod_hdf5
    use femcod_files, only: clear_write_error, write_error_cause
    implicit none
    private
-   public :: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, h5_read, h5_exists
+   public :: h5_file, h5_create, h5_open, h5_reopen, h5_close, h5_group, h5_write, h5_attribute, h5_read, h5_exists
    public :: h5_read_string_attribute, h5_rank_and_dims, h5_flat_view
 
    !> An open HDF5 file and the name it was opened under (for messages).
@@ -165,6 +166,24 @@ contains
          file%id = -1
       end if
    end subroutine h5_open
+
+   !> Open, for reading and writing, a file this run created itself (a temporary it is
+   !> still building): no test read first, as h5_open makes of the files a user gives.
+   subroutine h5_reopen(path, file, status)
+      character(len=*), intent(in) :: path
+      type(h5_file), intent(out) :: file
+      type(status_type), intent(inout) :: status
+      integer :: error
+      if (status%code /= 0) return
+      call initialise()
+      file%path = path
+      call clear_write_error()
+      call h5fopen_f(path, H5F_ACC_RDWR_F, file%id, error)
+      if (error /= 0) then
+         call set_error(status, STATUS_IO, path//": cannot open the HDF5 file again"//write_error_cause())
+         file%id = -1
+      end if
+   end subroutine h5_reopen
 
    !> The test read of h5_open, in the child: every string attribute femcod reads (the
    !> deck's, the checkpoint's and a result set's), through h5_read_string_attribute's own

@@ -21,7 +21,7 @@ module femcod_results
    use femcod_result_schema, only: run_info, FIGURES_AUTO_LIMIT, HISTORY_HEADER, LOADS_HEADER, CONTACTS_HEADER, &
       FRICTION_COLUMNS, TANGENTIAL_COLUMNS, PATCH_COLUMNS, result_name, area_fit, load_group
    use femcod_results_csv, only: history_csv, contacts_csv, loads_csv
-   use femcod_results_hdf5, only: write_hdf5, xdmf_text, stored_fingerprint
+   use femcod_results_hdf5, only: write_hdf5, xdmf_text, stored_fingerprint, read_streamed_gap_map
    use femcod_results_json, only: summary_json
    implicit none
    private
@@ -146,7 +146,7 @@ contains
       subroutine write_map_figures(k)
          integer, intent(in) :: k
          character(len=:), allocatable :: at
-         real(dp), allocatable :: step(:, :, :)
+         real(dp), allocatable :: step(:, :, :), gap(:, :)
          real(dp) :: side
          side = deck%np*deck%pixel
          at = " at "//sig_str(res%states(k)%load, 6)//" nN (approach "//sig_str(res%states(k)%approach, 4)//" nm, "// &
@@ -155,8 +155,12 @@ contains
          call write_text(temps(size(temps))%s, svg_pressure_map("contact pressure"//at, &
             state_pressure_map(deck%np, deck%pixel, res%states(k)), side), status)
          call add(".gap_"//int_str(k)//".svg")
-         call write_text(temps(size(temps))%s, svg_map("gap"//at, maps(k)%gap, side, "nm", "gap", BLOCK_SMALLEST, &
-            .false.), status)
+         if (maps(k)%gap_in_file) then
+            call read_streamed_gap_map(temporary_name(prefix//".h5"), k, size(res%states), gap, status)
+            if (status%code == 0) call write_gap_figure(gap, at, side)
+         else
+            call write_gap_figure(maps(k)%gap, at, side)
+         end if
          if (allocated(res%states(k)%plastic)) then
             call add(".plastic_"//int_str(k)//".svg")
             call write_text(temps(size(temps))%s, svg_map("plastic displacement"//at, res%states(k)%plastic, side, &
@@ -169,6 +173,13 @@ contains
                step(:, :, 4), side), status)
          end if
       end subroutine write_map_figures
+
+      subroutine write_gap_figure(gap, at, side)
+         real(dp), intent(in) :: gap(:, :), side
+         character(len=*), intent(in) :: at
+         call write_text(temps(size(temps))%s, svg_map("gap"//at, gap, side, "nm", "gap", BLOCK_SMALLEST, .false.), &
+            status)
+      end subroutine write_gap_figure
    end subroutine write_results
 
    !> Rename every temporary into place, in order; if anything failed before or a

@@ -8,8 +8,8 @@ module femcod_results_hdf5
    use femcod_strings, only: string_type, int_str, xml_escape
    use femcod_contact_result, only: contact_result, load_state, stop_reason_text, event_path_diagnostics, &
       legacy_diagnostics, event_checks, legacy_checks, cg_work
-   use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_close, h5_group, h5_write, h5_attribute, &
-      h5_read_string_attribute, h5_flat_view
+   use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_reopen, h5_close, h5_group, h5_write, h5_attribute, &
+      h5_read_string_attribute, h5_flat_view, h5_exists, h5_read
    use femcod_maps, only: state_maps, tangential_step_maps, state_pressure_map
    use femcod_patches, only: contact_patches, perimeter_area_fit
    use femcod_shear_model, only: friction_coefficient
@@ -18,7 +18,7 @@ module femcod_results_hdf5
       load_group, run_boundary, has_adhesion
    implicit none
    private
-   public :: write_hdf5, xdmf_text, stored_fingerprint
+   public :: write_hdf5, xdmf_text, stored_fingerprint, stream_gap_map, read_streamed_gap_map
 
 contains
 
@@ -39,7 +39,12 @@ contains
       n = res%nsteps
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      call h5_create(tmp, file, local)
+      ! The gap maps streamed while the run solved (stream_gap_map) are in the file already.
+      if (any(maps%gap_in_file)) then
+         call h5_reopen(tmp, file, local)
+      else
+         call h5_create(tmp, file, local)
+      end if
       file%path = result_name(tmp)
       call h5_group(file, "/deck", local)
       call h5_attribute(file, "/deck", "label", deck%label, local)
@@ -76,17 +81,18 @@ contains
       call h5_write(file, "/contacts/step", res%contact_step, "1", local)
       call h5_write(file, "/contacts/force", res%contact_force, "nN", local)
       call h5_write(file, "/contacts/pressure", res%contact_force/area_pixel, "GPa", local)
-      call h5_group(file, "/loads", local)
+      if (.not. h5_exists(file, "/loads")) call h5_group(file, "/loads", local)
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          g = load_group(k, size(res%states))
          associate(s => res%states(k))
-            call h5_group(file, g, local)
+            if (.not. maps(k)%gap_in_file) call h5_group(file, g, local)
             call state_attributes(file, g, k, s%state_values, deck%pixel, deck%np, info, cg_work(res, k), local)
             if (info%tangential) call write_tangential(file, g, deck, s, local)
             call write_patches(file, g, maps(k)%patches, local)
             call write_pressure(file, g, deck, s, local)
-            call h5_write(file, g//"/gap", maps(k)%gap, "nm", local, compress=mostly_zero(maps(k)%gap))
+            if (.not. maps(k)%gap_in_file) call h5_write(file, g//"/gap", maps(k)%gap, "nm", local, &
+               compress=mostly_zero(maps(k)%gap))
             if (allocated(s%plastic)) call h5_write(file, g//"/plastic_displacement", s%plastic, "nm", local, &
                compress=mostly_zero(s%plastic))
          end associate
@@ -192,6 +198,42 @@ contains
          end do
       end do
    end subroutine write_mesh
+
+   !> State k of n's gap map (nm), written as soon as the state is solved into the
+   !> temporary `tmp` of PREFIX.h5 that write_hdf5 completes at the end (created by the
+   !> first state, `create`): a run holds one state's gap map, not all of them.
+   subroutine stream_gap_map(tmp, create, k, n, gap, status)
+      character(len=*), intent(in) :: tmp
+      logical, intent(in) :: create
+      integer, intent(in) :: k, n
+      real(dp), intent(in) :: gap(:, :)
+      type(status_type), intent(inout) :: status
+      type(h5_file) :: file
+      character(len=:), allocatable :: g
+      if (create) then
+         call h5_create(tmp, file, status)
+         call h5_group(file, "/loads", status)
+      else
+         call h5_reopen(tmp, file, status)
+      end if
+      file%path = result_name(tmp)
+      g = load_group(k, n)
+      call h5_group(file, g, status)
+      call h5_write(file, g//"/gap", gap, "nm", status, compress=mostly_zero(gap))
+      call h5_close(file, status)
+   end subroutine stream_gap_map
+
+   !> State k of n's gap map back from `tmp` (stream_gap_map), for its figure.
+   subroutine read_streamed_gap_map(tmp, k, n, gap, status)
+      character(len=*), intent(in) :: tmp
+      integer, intent(in) :: k, n
+      real(dp), allocatable, intent(out) :: gap(:, :)
+      type(status_type), intent(inout) :: status
+      type(h5_file) :: file
+      call h5_reopen(tmp, file, status)
+      call h5_read(file, load_group(k, n)//"/gap", gap, status, STATUS_IO)
+      call h5_close(file, status)
+   end subroutine read_streamed_gap_map
 
    !> A state's pressure map (GPa) in its load group, formed from its contact list here
    !> and freed after: a run's maps are not all held at once.

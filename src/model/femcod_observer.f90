@@ -7,6 +7,7 @@ module femcod_observer
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: contact_options
    use femcod_state_visitor, only: visitable
+   use femcod_contact_result, only: load_state
    implicit none
    private
    public :: solver_observer
@@ -18,6 +19,9 @@ module femcod_observer
       procedure :: progress => ignore_progress
       !> Every options%checkpoint_interval seconds, with the solver's complete state.
       procedure :: checkpoint => ignore_checkpoint
+      !> After each state of the cg solver is recorded: an observer may take the state's
+      !> NP x NP maps out of memory (femcod run writes them to the result file it builds).
+      procedure :: state_solved => keep_state
       !> Asked between steps (iterations of the cg solver): should the solver stop now?
       !> The incremental solver then hands over a checkpoint first; every solver returns
       !> STATUS_INTERRUPTED.
@@ -41,6 +45,14 @@ contains
       type(contact_options), intent(in) :: options
       class(visitable), intent(inout) :: state
    end subroutine ignore_checkpoint
+
+   !> State k of n (the target's place in the options, not the order of solving), with
+   !> its gap map when the solver has one. The base keeps everything.
+   subroutine keep_state(self, k, n, state)
+      class(solver_observer), intent(inout) :: self
+      integer, intent(in) :: k, n
+      type(load_state), intent(inout) :: state
+   end subroutine keep_state
 
    logical function never_stop(self)
       class(solver_observer), intent(inout) :: self

@@ -270,6 +270,7 @@ contains
             t1 - t0)
          if (kk > 1 .and. by_gaps) call mark_jump(res%states(order(kk - 1))%contacts, res%states(k))
          call observer%progress(kk, res%states(k)%contacts, res%states(k)%load, t1 - tstart)
+         call observer%state_solved(k, m, res%states(k))
          if ((by_gaps .and. kk == m) .or. (.not. by_gaps .and. targets(k) == maxval(targets))) &
             call report_state(res, res%states(k), kk)
       end do

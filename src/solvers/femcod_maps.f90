@@ -16,6 +16,9 @@ module femcod_maps
    !> contact list: 8 bytes a pixel a state less held.
    type :: state_maps
       real(dp), allocatable :: gap(:, :)
+      !> The gap map is not here but in the result file being written (PREFIX.h5's
+      !> temporary: femcod run's observer wrote it when the state was solved).
+      logical :: gap_in_file = .false.
       type(contact_patches) :: patches
    end type state_maps
 
@@ -28,13 +31,16 @@ contains
    !> remaining separation). The operator is made once for all states, and only when a
    !> state lacks the gap map its solver already had (the cg solver's, from the same
    !> formula and its own last double-precision convolution).
-   subroutine load_maps(problem, states, maps, periodic)
+   subroutine load_maps(problem, states, maps, periodic, in_file)
       type(contact_problem), intent(in) :: problem
       !> A gap map a state holds (the cg solver's) is moved into `maps`, not copied.
       type(load_state), intent(inout) :: states(:)
       type(state_maps), allocatable, intent(out) :: maps(:)
       !> The grid is one cell of a periodic surface (default: free).
       logical, intent(in), optional :: periodic
+      !> The states whose gap maps are in the result file already (state_maps'
+      !> gap_in_file): not made again.
+      logical, intent(in), optional :: in_file(:)
       logical :: cyclic
       type(grid_operator) :: op
       type(cg_settings) :: plain
@@ -47,12 +53,16 @@ contains
       cyclic = .false.
       if (present(periodic)) cyclic = periodic
       handed = allocated_gap(states)
+      if (present(in_file)) then
+         maps%gap_in_file = in_file .and. states%reached
+         handed = handed .or. maps%gap_in_file
+      end if
       do s = 1, size(states)
          if (.not. states(s)%reached) cycle
          call find_patches(np, states(s)%i, states(s)%j, cyclic, maps(s)%patches)
          states(s)%patches_4 = maps(s)%patches%count4
          states(s)%patches_8 = maps(s)%patches%count8
-         if (handed(s)) call move_alloc(states(s)%gap, maps(s)%gap)
+         if (allocated(states(s)%gap)) call move_alloc(states(s)%gap, maps(s)%gap)
       end do
       if (all(handed .or. .not. states%reached)) return
       allocate(force(np, np), disp(np, np))
