@@ -162,7 +162,7 @@ contains
    subroutine run_row(name, s, deck, load, reference, source, row)
       character(len=*), intent(in) :: name, source
       integer, intent(in) :: s
-      type(contact_problem), intent(in) :: deck
+      type(contact_problem), intent(inout) :: deck
       real(dp), intent(in) :: load, reference
       type(degenerate_row), intent(out) :: row
       real(dp) :: approach
@@ -176,7 +176,7 @@ contains
    !> cg; the row's solver, bound, and its refusal (code, message) where there is one
    !> (code -1: the state was not reached, a warning of the run).
    real(dp) function solved_approach(deck, s, load, row) result(approach)
-      type(contact_problem), intent(in) :: deck
+      type(contact_problem), intent(inout) :: deck
       integer, intent(in) :: s
       real(dp), intent(in) :: load
       type(degenerate_row), intent(inout) :: row

@@ -41,7 +41,7 @@ contains
 
    !> Run one solver on a deck at the given loads.
    subroutine solve(deck, solver, loads, res, status, max_contacts)
-      type(contact_problem), intent(in) :: deck
+      type(contact_problem), intent(inout) :: deck
       character(len=*), intent(in) :: solver
       real(dp), intent(in) :: loads(:)
       type(contact_result), intent(out) :: res
@@ -144,7 +144,7 @@ contains
    !> the square: max |F - T(F)| / max F. `sets` counts states whose contact set is
    !> not symmetric.
    subroutine symmetry_defect(deck, solver, defect, sets, nstates, status)
-      type(contact_problem), intent(in) :: deck
+      type(contact_problem), intent(inout) :: deck
       character(len=*), intent(in) :: solver
       real(dp), intent(out) :: defect
       integer, intent(out) :: sets, nstates

@@ -58,12 +58,14 @@ contains
       type(contact_options) :: options
       type(contact_result) :: res
       real(dp), parameter :: young = 1, work = 0.01_dp
+      type(contact_problem) :: scene
       options%solver = SOLVER_CG
       options%adhesion = LAW_DUGDALE
       options%work = work
       options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
       options%approaches = [1.0_dp, approaches]
-      call solve_contact(paraboloid_problem(np, pixel, radius, young), options, res, status)
+      scene = paraboloid_problem(np, pixel, radius, young)
+      call solve_contact(scene, options, res, status)
       pmin = minval(res%states%load)/(pi*work*radius)
       iterations = cg_iterations_in_all(res)
    end subroutine sphere_pull_off
@@ -138,12 +140,14 @@ contains
       real(dp), parameter :: lambda = 1, radius = 1000, work = 0.01_dp, young = 1
       real(dp) :: pbar, abar, dbar, asc, dsc, a
       integer :: k
+      type(contact_problem) :: scene
       options%solver = SOLVER_CG
       options%adhesion = LAW_DUGDALE
       options%work = work
       options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
       options%approaches = [0.5_dp, 1.0_dp, 1.5_dp]
-      call solve_contact(paraboloid_problem(128, 1.0_dp, radius, young), options, res, status)
+      scene = paraboloid_problem(128, 1.0_dp, radius, young)
+      call solve_contact(scene, options, res, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       ! The scales of Johnson's notation, K = 4 E*/3.
@@ -264,16 +268,18 @@ contains
       type(status_type) :: status
       real(dp), parameter :: radius = 100, work = 0.01_dp, young = 1, lambda = 0.5_dp
       integer :: k
+      type(contact_problem) :: scene
       options%solver = SOLVER_CG
       options%adhesion = LAW_DUGDALE
       options%work = work
       options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
       options%approaches = [1.0_dp, (-0.05_dp*k, k = 1, 10)]
-      call solve_contact(paraboloid_problem(64, 1.0_dp, radius, young), options, free, status)
+      scene = paraboloid_problem(64, 1.0_dp, radius, young)
+      call solve_contact(scene, options, free, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       options%boundary = BOUNDARY_PERIODIC
-      call solve_contact(paraboloid_problem(64, 1.0_dp, radius, young), options, periodic, status)
+      call solve_contact(scene, options, periodic, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       call check(error, minval(periodic%states%load), minval(free%states%load), rel=.true., thr=0.01_dp, &
@@ -381,17 +387,19 @@ contains
       type(status_type) :: status
       real(dp), parameter :: radius = 1000, work = 0.01_dp, young = 1, lambda = 1
       integer :: k
+      type(contact_problem) :: scene
       options%solver = SOLVER_CG
       options%adhesion = LAW_DUGDALE
       options%work = work
       options%range = work/lambda*(9*radius/(2*pi*work*young**2))**(1.0_dp/3)
       options%approaches = [1.0_dp, (-0.1_dp*k, k = 0, 12)]
-      call solve_contact(paraboloid_problem(64, 2.0_dp, radius, young), options, elastic, status)
+      scene = paraboloid_problem(64, 2.0_dp, radius, young)
+      call solve_contact(scene, options, elastic, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       options%plastic = .true.
       options%hardness = 0.015_dp
-      call solve_contact(paraboloid_problem(64, 2.0_dp, radius, young), options, capped, status)
+      call solve_contact(scene, options, capped, status)
       call check(error, status%code, 0, status%message)
       if (allocated(error)) return
       call check(error, capped%states(1)%n_plastic > 0, "no pixel reached the hardness at 1 nm")

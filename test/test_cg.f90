@@ -341,7 +341,7 @@ contains
    !> The event path's exact states at loads in the middle of its steps (every n/4-th
    !> step from n/8 on, n steps to MAXCONT): options%loads set to them, inc their states.
    subroutine midstep_states(deck, options, inc, error)
-      type(contact_problem), intent(in) :: deck
+      type(contact_problem), intent(inout) :: deck
       type(contact_options), intent(inout) :: options
       type(contact_result), intent(out) :: inc
       type(error_type), allocatable, intent(out) :: error

@@ -148,6 +148,7 @@ contains
       real(dp), parameter :: radius = 1000, a = 24, estar = 200/(1 - 0.25_dp**2)
       real(dp) :: load, p0, k, pc, s, exact(2), errors(2, 3), pixel
       integer :: level, m
+      type(contact_problem) :: scene
       load = 4*estar*a**3/(3*radius)
       p0 = 3*load/(2*pi*a**2)
       ! Not capped: tau0 = 0.2 GPa, alpha = 0.1.
@@ -168,7 +169,8 @@ contains
                options%hardness = 1.5_dp*p0
             end if
             options%cg%tol = 1.0e-9_dp
-            call solve_contact(paraboloid(pixel, radius, 3*a), options, res, status)
+            scene = paraboloid(pixel, radius, 3*a)
+            call solve_contact(scene, options, res, status)
             call check(error, status%code, 0, status%message)
             if (allocated(error)) return
             call check(error, res%states(1)%n_plastic, 0, "no pixel plastic at H = 1.5 p0")

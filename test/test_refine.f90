@@ -189,9 +189,11 @@ contains
       type(status_type) :: st
       integer :: k, last
       real(dp) :: coarse_error, refined_error
+      type(contact_problem) :: scene
       call self_affine_surface(FINE, PIXEL, 0.7_dp, 3.0_dp, 1, z)
       LOADS = loads_for(z, PIXEL)
-      call solve_contact(problem_of(z, PIXEL), options_at(LOADS), res, st)
+      scene = problem_of(z, PIXEL)
+      call solve_contact(scene, options_at(LOADS), res, st)
       call check(error, st%code == 0, st%message)
       if (allocated(error)) return
       do k = 1, size(LOADS)

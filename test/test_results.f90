@@ -38,7 +38,8 @@ contains
             test_memory_estimate), &
          new_unittest("existing results are kept without --force", test_force), &
          new_unittest("a result that cannot be put in place leaves no partial set", test_partial), &
-         new_unittest("cg's gap maps written while it solves: each its own state's; a failed run leaves none", &
+         new_unittest("cg's heights and gap maps written while it solves: the deck's, each state's own; "// &
+            "a failed run leaves none", &
             test_streamed_gaps), &
          new_unittest("--lower/--upper: ASCII and HDF5 heights equal the deck", test_height_files), &
          new_unittest("checkpoint: killed with SIGKILL and restarted, the same results (elastic, plastic)", &
@@ -748,15 +749,18 @@ contains
    !> takes them in ascending order): each /loads/<k>/gap is its own state's, by the
    !> contact condition (the gap is 0 exactly where the state's pressure is positive,
    !> and positive elsewhere), and the three states' contact sets differ, so a map under
-   !> another state's name fails. A run that fails after solving (cg stopped after one
-   !> iteration, exit 4) leaves neither PREFIX.h5 nor its temporary.
+   !> another state's name fails. The heights, written there before the solve (which
+   !> then frees them), are the deck's to the bit (read_deck). A run that fails after
+   !> solving (cg stopped after one iteration, exit 4) leaves neither PREFIX.h5 nor its
+   !> temporary.
    subroutine test_streamed_gaps(error)
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: prefix
       character(len=*), parameter :: GROUPS(3) = ["/loads/001", "/loads/002", "/loads/003"]
       type(h5_file) :: file
       type(status_type) :: st
-      real(dp), allocatable :: gap(:, :), pressure(:, :)
+      real(dp), allocatable :: gap(:, :), pressure(:, :), lower(:, :), upper(:, :)
+      type(contact_problem) :: deck
       integer :: code, k, contacts(3)
       prefix = scratch_path("streamed")
       call execute_command_line("rm -f '"//prefix//"'.*")
@@ -776,9 +780,15 @@ contains
             " pixels disagree)")
          if (allocated(error)) exit
       end do
+      call h5_read(file, "/surfaces/lower", lower, st, STATUS_BAD_INPUT)
+      call h5_read(file, "/surfaces/upper", upper, st, STATUS_BAD_INPUT)
       call h5_close(file, st)
       if (allocated(error)) return
       call check(error, st%code, 0, st%message)
+      if (allocated(error)) return
+      call read_deck("input/sphere_d1.deck", deck, st)
+      call check(error, st%code == 0 .and. all(lower == deck%lower) .and. all(upper == deck%upper), &
+         "/surfaces: the deck's heights")
       if (allocated(error)) return
       call check(error, contacts(2) < contacts(3) .and. contacts(3) < contacts(1), "contacts grow with the load: "// &
          to_string(contacts(1))//", "//to_string(contacts(2))//", "//to_string(contacts(3)))

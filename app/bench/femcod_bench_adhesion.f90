@@ -243,7 +243,7 @@ contains
    !> Part 3: femcod and tamaas on the periodic sphere at the same mean gaps.
    subroutine side_by_side(python, fine, code)
       character(len=*), intent(in) :: python
-      type(contact_problem), intent(in) :: fine
+      type(contact_problem), intent(inout) :: fine
       integer, intent(inout) :: code
       type(status_type) :: status
       type(contact_problem) :: deck

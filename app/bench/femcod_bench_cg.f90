@@ -194,7 +194,7 @@ contains
    !> column its load's relative difference from the load asked and its wall time over the
    !> load solve's.
    subroutine approach_row(deck, options, np, fraction, loaded)
-      type(contact_problem), intent(in) :: deck
+      type(contact_problem), intent(inout) :: deck
       type(contact_options), intent(in) :: options
       integer, intent(in) :: np
       real(dp), intent(in) :: fraction

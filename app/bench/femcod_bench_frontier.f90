@@ -282,7 +282,7 @@ contains
    !> One solve, timed (s); a failure stays in tab%status.
    subroutine timed_solve(tab, problem, opts, out, seconds)
       type(frontier_table), intent(inout) :: tab
-      type(contact_problem), intent(in) :: problem
+      type(contact_problem), intent(inout) :: problem
       type(contact_options), intent(in) :: opts
       type(contact_result), intent(out) :: out
       real(dp), intent(out) :: seconds

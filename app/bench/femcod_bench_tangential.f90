@@ -105,6 +105,7 @@ contains
       type(status_type) :: status
       real(dp) :: load, shift, stick_radius, pixel, t0, t1, got, previous, c
       integer :: level, levels, np
+      type(contact_problem) :: scene
       load = 4*young*a**3/(3*radius)
       shift = 3*mu*load*2/(16*a*young/2)*(1 - (1 - ratio)**(2.0_dp/3))
       stick_radius = a*(1 - ratio)**(1.0_dp/3)
@@ -120,7 +121,8 @@ contains
          pixel = a/2.0_dp**(level + 2)
          np = 2*nint(1.5_dp*a/pixel) + 1
          call wall_clock(t0)
-         call solve_contact(paraboloid_problem(np, pixel, radius, young), options, res, status)
+         scene = paraboloid_problem(np, pixel, radius, young)
+         call solve_contact(scene, options, res, status)
          call wall_clock(t1)
          if (failed(status, code)) return
          got = res%states(1)%tangential_shift(1)

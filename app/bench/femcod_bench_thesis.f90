@@ -182,7 +182,7 @@ contains
    !> One solver through the dispatcher; a failure is reported and the table goes on.
    subroutine solve_with(solver, problem, opts, res)
       character(len=*), intent(in) :: solver
-      type(contact_problem), intent(in) :: problem
+      type(contact_problem), intent(inout) :: problem
       type(contact_options), intent(inout) :: opts
       type(contact_result), intent(out) :: res
       type(status_type) :: status

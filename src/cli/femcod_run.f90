@@ -34,6 +34,7 @@ module femcod_run
    use femcod_output_guard, only: guard_outputs, OUTPUT_WISDOM, OUTPUT_RESULT
    use femcod_results, only: write_results, run_info, result_files, stored_fingerprint, pressure_figure_wanted, &
       MAP_FIGURES, figure_name
+   use femcod_results_hdf5, only: start_result_file
    use femcod_about, only: FEMCOD_VERSION
    use femcod_help, only: help_requested
    use femcod_run_options, only: run_table, run_settings, parse_run_arguments, run_help, deck_label
@@ -340,7 +341,7 @@ contains
    subroutine run_locked(deck_path, prefix, settings, problem, inputs, files, pending, read_seconds, st)
       character(len=*), intent(in) :: deck_path, prefix
       type(run_settings), intent(in) :: settings
-      type(contact_problem), intent(in) :: problem
+      type(contact_problem), intent(inout) :: problem
       type(string_type), intent(in) :: inputs(:), files(:)
       !> The input files' digests, started while they were read (file_sha256_start).
       type(file_digest), intent(inout) :: pending(:)
@@ -354,7 +355,7 @@ contains
       type(run_info) :: info
       character(len=:), allocatable :: fingerprint, started
       type(string_type), allocatable :: digests(:), warnings(:)
-      logical :: resuming, ok, have_checkpoint, complete, interrupted
+      logical :: resuming, ok, have_checkpoint, complete, interrupted, file_started
       type(status_type) :: stopped
       type(contact_options) :: solve_options
       integer(i8) :: held
@@ -396,6 +397,18 @@ contains
          ! The solvers check their storage against what this run may still take; the
          ! summary's estimate is what the run holds now plus that storage.
          solve_options = options
+         ! What the summary says of the scene and the surface's slope, while the heights
+         ! are here: a cg solve frees them once its grid holds the initial gaps, after they
+         ! went into PREFIX.h5's temporary (16 bytes a pixel less through the solve).
+         info = run_info_for(problem, options)
+         info%scene = model_notes(problem, options)
+         file_started = options%solver == SOLVER_CG
+         if (file_started) then
+            call start_result_file(observer%stream_path, problem, st)
+            if (st%code /= 0) return
+            observer%stream_started = .true.
+            solve_options%release_heights = .true.
+         end if
          held = resident_bytes()
          solve_options%memory_available = available_memory()
          if (resuming) then
@@ -403,6 +416,8 @@ contains
          else
             call solve_contact(problem, solve_options, res, st, observer)
          end if
+         ! The heights the solve freed (two NP x NP maps of doubles) are not held during it.
+         if (solve_options%release_heights) held = held - 16*int(problem%np, i8)**2
          if (res%estimated_peak_bytes > 0) res%estimated_peak_bytes = res%estimated_peak_bytes + held
          interrupted = st%code == STATUS_INTERRUPTED
          if (interrupted) then
@@ -420,7 +435,6 @@ contains
          if (st%code == 0 .and. options%solver == SOLVER_CG .and. len(settings%wisdom) > 0) &
             call save_wisdom(settings%wisdom, st)
          if (st%code /= 0) return
-         info = run_info_for(problem, options)
          info%version = FEMCOD_VERSION
          info%beta = second_dundurs_constant(problem%young(1:2), problem%poisson(1:2))
          info%options = settings%command_line
@@ -431,7 +445,6 @@ contains
          info%wait_policy = wait_policy_text()
          info%started = started
          info%finished = local_time_iso()
-         info%scene = model_notes(problem, options)
          info%inputs = inputs
          info%fingerprint = fingerprint
          ! A partial run is not the run asked for: --restart runs it again.
@@ -449,7 +462,7 @@ contains
          info%maps_seconds = t1 - t0
          warnings = run_warnings(options, res)
          info%warnings = warnings
-         call write_results(prefix, problem, res, maps, info, st)
+         call write_results(prefix, problem, res, maps, info, st, file_started)
          if (st%code /= 0) return
          ! The set is replaced as a whole: what an earlier run left beside it goes, and the
          ! checkpoint has served its purpose.

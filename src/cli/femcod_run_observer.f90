@@ -42,7 +42,8 @@ module femcod_run_observer
       !> in memory, and the writer at the end reports the disk's error).
       character(len=:), allocatable :: stream_path
       logical, allocatable :: gap_in_file(:)
-      logical :: stream_failed = .false.
+      !> Whether that file exists (run_locked's start_result_file, or the first map).
+      logical :: stream_started = .false., stream_failed = .false.
    contains
       procedure :: configure => configure_observer
       procedure :: progress => report_progress
@@ -131,11 +132,12 @@ contains
       type(status_type) :: st
       if (.not. allocated(state%gap) .or. self%stream_failed .or. .not. allocated(self%stream_path)) return
       if (.not. allocated(self%gap_in_file)) allocate(self%gap_in_file(n), source=.false.)
-      call stream_gap_map(self%stream_path, .not. any(self%gap_in_file), k, n, state%gap, st)
+      call stream_gap_map(self%stream_path, .not. self%stream_started, k, n, state%gap, st)
       if (st%code /= 0) then
          self%stream_failed = .true.
          return
       end if
+      self%stream_started = .true.
       self%gap_in_file(k) = .true.
       deallocate(state%gap)
    end subroutine stream_state

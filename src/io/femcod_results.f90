@@ -89,7 +89,7 @@ contains
    !> Write every result file for `prefix`; on failure none is left behind and
    !> existing files of that name are untouched. Each file is renamed into place when
    !> all are written, PREFIX.h5 last, so its presence marks a complete set.
-   subroutine write_results(prefix, deck, res, maps, info, status)
+   subroutine write_results(prefix, deck, res, maps, info, status, started)
       character(len=*), intent(in) :: prefix
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
@@ -97,6 +97,9 @@ contains
       type(state_maps), intent(in) :: maps(:)
       type(run_info), intent(in) :: info
       type(status_type), intent(inout) :: status
+      !> PREFIX.h5's temporary was started before the solve, with the heights
+      !> (femcod_results_hdf5's start_result_file); `deck` may have none.
+      logical, intent(in), optional :: started
       type(string_type), allocatable :: names(:), temps(:)
       character(len=:), allocatable :: figures
       real(dp) :: t0, t1, t2, hdf5_seconds
@@ -108,7 +111,7 @@ contains
       ! PREFIX.h5 is written first and renamed last (when it exists, the whole set is
       ! complete); the summary is written last, so that it holds the writing's times.
       call wall_clock(t0)
-      call write_hdf5(temporary_name(prefix//".h5"), deck, res, info, maps, status)
+      call write_hdf5(temporary_name(prefix//".h5"), deck, res, info, maps, status, started)
       call wall_clock(t1)
       hdf5_seconds = t1 - t0
       call add(".history.csv")

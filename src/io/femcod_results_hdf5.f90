@@ -18,18 +18,22 @@ module femcod_results_hdf5
       load_group, run_boundary, has_adhesion
    implicit none
    private
-   public :: write_hdf5, xdmf_text, stored_fingerprint, stream_gap_map, read_streamed_gap_map
+   public :: write_hdf5, xdmf_text, stored_fingerprint, start_result_file, stream_gap_map, read_streamed_gap_map
 
 contains
 
    !> The HDF5 file (schema in doc/results.md).
-   subroutine write_hdf5(tmp, deck, res, info, maps, status)
+   subroutine write_hdf5(tmp, deck, res, info, maps, status, started)
       character(len=*), intent(in) :: tmp
+      !> Its height maps only where `tmp` was not started.
       type(contact_problem), intent(in) :: deck
       type(contact_result), intent(in) :: res
       type(run_info), intent(in) :: info
       type(state_maps), intent(in) :: maps(:)
       type(status_type), intent(inout) :: status
+      !> `tmp` was started before the solve (start_result_file: /surfaces is in it).
+      logical, intent(in), optional :: started
+      logical :: surfaces_in_file
       type(h5_file) :: file
       type(status_type) :: local
       character(len=:), allocatable :: g, scene
@@ -39,8 +43,11 @@ contains
       n = res%nsteps
       area_pixel = deck%pixel**2
       region = deck%np**2*area_pixel
-      ! The gap maps streamed while the run solved (stream_gap_map) are in the file already.
-      if (any(maps%gap_in_file)) then
+      surfaces_in_file = .false.
+      if (present(started)) surfaces_in_file = started
+      ! The heights (start_result_file) and the gap maps streamed while the run solved
+      ! (stream_gap_map) are in the file already.
+      if (surfaces_in_file .or. any(maps%gap_in_file)) then
          call h5_reopen(tmp, file, local)
       else
          call h5_create(tmp, file, local)
@@ -57,9 +64,7 @@ contains
       call h5_attribute(file, "/deck", "poisson_lower", deck%poisson(1), local)
       call h5_attribute(file, "/deck", "poisson_upper", deck%poisson(2), local)
       call h5_attribute(file, "/deck", "poisson_contact", deck%poisson(3), local)
-      call h5_group(file, "/surfaces", local)
-      call h5_write(file, "/surfaces/lower", deck%lower, "nm", local, compress=mostly_zero(deck%lower))
-      call h5_write(file, "/surfaces/upper", deck%upper, "nm", local, compress=mostly_zero(deck%upper))
+      if (.not. surfaces_in_file) call write_surfaces(file, deck, local)
       call h5_group(file, "/history", local)
       call h5_write(file, "/history/step", [(k, k = 1, n)], "1", local)
       call h5_write(file, "/history/contacts", res%step_contacts(1:n), "1", local)
@@ -198,6 +203,31 @@ contains
          end do
       end do
    end subroutine write_mesh
+
+   !> Start PREFIX.h5's temporary `tmp` before the solve with the problem's two height
+   !> maps (/surfaces) and the /loads group: the solve may then free the heights
+   !> (contact_options%release_heights), and write_hdf5 (`started`) completes the file.
+   subroutine start_result_file(tmp, deck, status)
+      character(len=*), intent(in) :: tmp
+      type(contact_problem), intent(in) :: deck
+      type(status_type), intent(inout) :: status
+      type(h5_file) :: file
+      call h5_create(tmp, file, status)
+      file%path = result_name(tmp)
+      call write_surfaces(file, deck, status)
+      call h5_group(file, "/loads", status)
+      call h5_close(file, status)
+   end subroutine start_result_file
+
+   !> /surfaces: the lower and upper heights (nm), deflated where mostly zero (a flat).
+   subroutine write_surfaces(file, deck, status)
+      type(h5_file), intent(in) :: file
+      type(contact_problem), intent(in) :: deck
+      type(status_type), intent(inout) :: status
+      call h5_group(file, "/surfaces", status)
+      call h5_write(file, "/surfaces/lower", deck%lower, "nm", status, compress=mostly_zero(deck%lower))
+      call h5_write(file, "/surfaces/upper", deck%upper, "nm", status, compress=mostly_zero(deck%upper))
+   end subroutine write_surfaces
 
    !> State k of n's gap map (nm), written as soon as the state is solved into the
    !> temporary `tmp` of PREFIX.h5 that write_hdf5 completes at the end (created by the

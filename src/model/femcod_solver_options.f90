@@ -169,6 +169,11 @@ module femcod_solver_options
       !> what the run holds when it begins, measured by the caller (core/femcod_memory's
       !> available_memory); 0: unknown, not checked. Not part of the answer.
       integer(i8) :: memory_available = 0
+      !> cg: free the problem's two height maps (16 bytes a pixel) once the grid holds the
+      !> initial gaps, the only form the solve needs. Set by femcod run, which has written
+      !> the heights where its results need them before the solve; the problem comes back
+      !> without them. Not part of the answer.
+      logical :: release_heights = .false.
    end type contact_options
 
 contains

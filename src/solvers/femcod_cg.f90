@@ -202,7 +202,9 @@ contains
    !> Approaches with an adhesive law or the plastic cap are solved in the gap variables,
    !> along the path in the order given (by_gap_variables).
    subroutine solve_cg(problem, options, res, status, observer)
-      type(contact_problem), intent(in) :: problem
+      !> Its height maps freed once the grid holds the initial gaps when
+      !> options%release_heights.
+      type(contact_problem), intent(inout) :: problem
       type(contact_options), intent(in) :: options
       type(contact_result), intent(out) :: res
       type(status_type), intent(inout) :: status
@@ -328,12 +330,15 @@ contains
    !> The grid operator for the run, after its memory estimate: the convolution, or the
    !> transform grid of the gap variables (`by_gaps`).
    subroutine make_fine_grid(problem, options, by_gaps, fine, estimated, status)
-      type(contact_problem), intent(in) :: problem
+      !> Its height maps freed once the initial gaps are formed when
+      !> options%release_heights: nothing after reads them.
+      type(contact_problem), intent(inout) :: problem
       type(contact_options), intent(in) :: options
       logical, intent(in) :: by_gaps
       type(nested_grid_operator), intent(inout) :: fine
       integer(i8), intent(out) :: estimated
       type(status_type), intent(inout) :: status
+      real(dp), allocatable :: g0(:, :)
       integer :: m
       m = requested_states(options)
       if (by_gaps) then
@@ -345,8 +350,10 @@ contains
          call refuse_beyond_memory("cg: NP = "//int_str(problem%np), estimated, options%memory_available, status)
       end if
       if (status%code /= 0) return
-      call grid_operator_setup(fine%grid_operator, initial_gap_map(problem%lower, problem%upper), problem, &
-         problem%pixel, options%cg, options%boundary == BOUNDARY_PERIODIC, gap_variables=by_gaps)
+      g0 = initial_gap_map(problem%lower, problem%upper)
+      if (options%release_heights) deallocate(problem%lower, problem%upper)
+      call grid_operator_setup(fine%grid_operator, g0, problem, problem%pixel, options%cg, &
+         options%boundary == BOUNDARY_PERIODIC, gap_variables=by_gaps)
       fine%materials = materials_of(problem)
    end subroutine make_fine_grid
 

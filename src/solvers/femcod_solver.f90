@@ -42,7 +42,8 @@ contains
    !> Solve `problem` with the solver options%solver names. `resume` (incremental solver
    !> only) continues a run from a stored state.
    subroutine solve_contact(problem, options, res, status, observer, resume)
-      type(contact_problem), intent(in) :: problem
+      !> Without its height maps on return when options%release_heights (cg only).
+      type(contact_problem), intent(inout) :: problem
       type(contact_options), intent(in) :: options
       type(contact_result), intent(out) :: res
       type(status_type), intent(inout) :: status
