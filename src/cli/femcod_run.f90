@@ -408,6 +408,7 @@ contains
             if (st%code /= 0) return
             observer%stream_started = .true.
             solve_options%release_heights = .true.
+            solve_options%states_streamed = .true.
          end if
          held = resident_bytes()
          solve_options%memory_available = available_memory()

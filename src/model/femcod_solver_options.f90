@@ -174,6 +174,10 @@ module femcod_solver_options
       !> the heights where its results need them before the solve; the problem comes back
       !> without them. Not part of the answer.
       logical :: release_heights = .false.
+      !> The observer takes each state's NP x NP maps out of memory as it is solved
+      !> (femcod run's writes them to its result file): the storage estimate counts none
+      !> kept. Not part of the answer.
+      logical :: states_streamed = .false.
    end type contact_options
 
 contains

@@ -141,21 +141,27 @@ module femcod_cg
 contains
 
 
-   !> The cg solver's storage at its largest (bytes), from the arrays it allocates per
-   !> pixel of the NP x NP grid: the forces, the grid's gaps and Love table (8 bytes each);
-   !> the kernel's spectrum, complex on (M/2 + 1) x NP with M = 2 NP free or NP periodic
-   !> (16 or 8 bytes a pixel), and its half-plane of real coefficients (8 or 2); the
-   !> iteration's w, t, the stencil's padded copy, the residual and the last gradient (8
-   !> each), its contact flags (4) and list (8); each requested state's gap map (8). With
-   !> the plastic cap: the deck's gaps, the capped flags, the capped rounds' force, field
-   !> and gap maps (8 + 4 + 24), and each state's plastic map (8). The nested coarse grids
-   !> (a third of this) come and go before the fine grid's iteration.
-   pure function cg_storage_bytes(np, nstates, periodic, plastic) result(bytes)
+   !> The cg solver's storage at its largest (bytes), from the arrays it holds per pixel
+   !> of the NP x NP grid through the iteration: the forces, the initial gaps, the force
+   !> displacements and the search direction (8 bytes each); the kernel's spectrum,
+   !> complex on (M/2 + 1) x NP with M = 2 NP free or NP periodic (16 or 8 bytes a pixel),
+   !> and its real coefficients for one quarter of the frequencies (8 or 2); the direct
+   !> corrections' float32 Love table, the stencil's padded float32 gaps and the
+   !> direction's float32 displacements (4 each); the contact marks (1); the contact
+   !> list, the kernel split's changes and mesh (4 at most); each state's gap map kept
+   !> in memory (8; none when `streamed`: an observer takes them out as they are
+   !> solved). With the plastic cap: the deck's gaps, the capped flags, the capped
+   !> rounds' force, field and gap maps (8 + 4 + 24), and each state's plastic map (8).
+   !> The nested coarse grids (a third of this) come and go before the fine grid's
+   !> iteration. Against femcod run's peak resident memory (one load, the heights freed,
+   !> doc/performance.md): 4096^2 free 73 against 72.7 bytes a pixel measured for the
+   !> whole process, periodic 59 against 60.5.
+   pure function cg_storage_bytes(np, nstates, periodic, plastic, streamed) result(bytes)
       integer, intent(in) :: np, nstates
-      logical, intent(in) :: periodic, plastic
+      logical, intent(in) :: periodic, plastic, streamed
       integer(i8) :: bytes, n2, per_pixel
       n2 = int(np, i8)**2
-      per_pixel = 3*8 + merge(8, 16, periodic) + merge(2, 8, periodic) + 5*8 + 4 + 8 + 8*nstates
+      per_pixel = 4*8 + merge(8, 16, periodic) + merge(2, 8, periodic) + 3*4 + 1 + 4 + merge(0, 8*nstates, streamed)
       if (plastic) per_pixel = per_pixel + 8 + 4 + 24 + 8*nstates
       bytes = n2*per_pixel
    end function cg_storage_bytes
@@ -346,7 +352,8 @@ contains
          call refuse_beyond_memory("cg --approach (gap variables): NP = "//int_str(problem%np), estimated, &
             options%memory_available, status)
       else
-         estimated = cg_storage_bytes(problem%np, m, options%boundary == BOUNDARY_PERIODIC, options%plastic)
+         estimated = cg_storage_bytes(problem%np, m, options%boundary == BOUNDARY_PERIODIC, options%plastic, &
+            options%states_streamed)
          call refuse_beyond_memory("cg: NP = "//int_str(problem%np), estimated, options%memory_available, status)
       end if
       if (status%code /= 0) return
