@@ -181,8 +181,8 @@ contains
          if (notice /= "" .and. .not. settings%quiet) write(error_unit, '(a)') "femcod: "//notice
          if (st%code == 0) then
             call run_locked(deck_path, prefix, settings, problem, inputs, files, pending, read_seconds, st)
-            ! The solved states' gap maps streamed into PREFIX.h5's temporary go with a
-            ! run that ends without its results.
+            ! PREFIX.h5's temporary, begun before a cg solve (the heights, the solved
+            ! states' gap maps), goes with a run that ends without its results.
             if (st%code /= 0) call remove_file(temporary_name(prefix//".h5"))
             call release_lock(prefix//".lock")
          end if

@@ -38,12 +38,12 @@ module femcod_run_observer
       character(len=:), allocatable :: checkpoint_path
       logical :: warned = .false., stored = .false.
       !> The temporary of PREFIX.h5 the solved states' gap maps go to (stream_gap_map),
+      !> whether the run has begun it (start_result_file; no map goes out before),
       !> which states' maps are there, and whether writing one failed (the maps then stay
       !> in memory, and the writer at the end reports the disk's error).
       character(len=:), allocatable :: stream_path
-      logical, allocatable :: gap_in_file(:)
-      !> Whether that file exists (run_locked's start_result_file, or the first map).
       logical :: stream_started = .false., stream_failed = .false.
+      logical, allocatable :: gap_in_file(:)
    contains
       procedure :: configure => configure_observer
       procedure :: progress => report_progress
@@ -130,14 +130,13 @@ contains
       integer, intent(in) :: k, n
       type(load_state), intent(inout) :: state
       type(status_type) :: st
-      if (.not. allocated(state%gap) .or. self%stream_failed .or. .not. allocated(self%stream_path)) return
+      if (.not. allocated(state%gap) .or. .not. self%stream_started .or. self%stream_failed) return
       if (.not. allocated(self%gap_in_file)) allocate(self%gap_in_file(n), source=.false.)
-      call stream_gap_map(self%stream_path, .not. self%stream_started, k, n, state%gap, st)
+      call stream_gap_map(self%stream_path, k, n, state%gap, st)
       if (st%code /= 0) then
          self%stream_failed = .true.
          return
       end if
-      self%stream_started = .true.
       self%gap_in_file(k) = .true.
       deallocate(state%gap)
    end subroutine stream_state

@@ -118,19 +118,7 @@ contains
       character(len=*), intent(in) :: path
       type(h5_file), intent(out) :: file
       type(status_type), intent(inout) :: status
-      integer :: error
-      character(len=:), allocatable :: cause
-      if (status%code /= 0) return
-      call initialise()
-      file%path = path
-      call clear_write_error()
-      call h5fcreate_f(path, H5F_ACC_TRUNC_F, file%id, error)
-      if (error /= 0) then
-         cause = write_error_cause()
-         if (len(cause) == 0) cause = " (directory missing or not writable)"
-         call set_error(status, STATUS_IO, path//": cannot create the HDF5 file"//cause)
-         file%id = -1
-      end if
+      call open_writable(path, .true., file, status)
    end subroutine h5_create
 
    !> Open an existing file read-only. `code` is the status code of a failure
@@ -173,17 +161,34 @@ contains
       character(len=*), intent(in) :: path
       type(h5_file), intent(out) :: file
       type(status_type), intent(inout) :: status
+      call open_writable(path, .false., file, status)
+   end subroutine h5_reopen
+
+   !> h5_create (`create`) and h5_reopen: the file for writing, or the disk's reason why not.
+   subroutine open_writable(path, create, file, status)
+      character(len=*), intent(in) :: path
+      logical, intent(in) :: create
+      type(h5_file), intent(out) :: file
+      type(status_type), intent(inout) :: status
       integer :: error
+      character(len=:), allocatable :: cause
       if (status%code /= 0) return
       call initialise()
       file%path = path
       call clear_write_error()
-      call h5fopen_f(path, H5F_ACC_RDWR_F, file%id, error)
+      if (create) then
+         call h5fcreate_f(path, H5F_ACC_TRUNC_F, file%id, error)
+      else
+         call h5fopen_f(path, H5F_ACC_RDWR_F, file%id, error)
+      end if
       if (error /= 0) then
-         call set_error(status, STATUS_IO, path//": cannot open the HDF5 file again"//write_error_cause())
+         cause = write_error_cause()
+         if (len(cause) == 0 .and. create) cause = " (directory missing or not writable)"
+         call set_error(status, STATUS_IO, path//": cannot "//trim(merge("create", "open  ", create))// &
+            " the HDF5 file"//cause)
          file%id = -1
       end if
-   end subroutine h5_reopen
+   end subroutine open_writable
 
    !> The test read of h5_open, in the child: every string attribute femcod reads (the
    !> deck's, the checkpoint's and a result set's), through h5_read_string_attribute's own

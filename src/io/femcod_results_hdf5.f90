@@ -9,7 +9,7 @@ module femcod_results_hdf5
    use femcod_contact_result, only: contact_result, load_state, stop_reason_text, event_path_diagnostics, &
       legacy_diagnostics, event_checks, legacy_checks, cg_work
    use femcod_hdf5, only: h5_file, h5_create, h5_open, h5_reopen, h5_close, h5_group, h5_write, h5_attribute, &
-      h5_read_string_attribute, h5_flat_view, h5_exists, h5_read
+      h5_read_string_attribute, h5_flat_view, h5_read
    use femcod_maps, only: state_maps, tangential_step_maps, state_pressure_map
    use femcod_patches, only: contact_patches, perimeter_area_fit
    use femcod_shear_model, only: friction_coefficient
@@ -45,9 +45,9 @@ contains
       region = deck%np**2*area_pixel
       surfaces_in_file = .false.
       if (present(started)) surfaces_in_file = started
-      ! The heights (start_result_file) and the gap maps streamed while the run solved
-      ! (stream_gap_map) are in the file already.
-      if (surfaces_in_file .or. any(maps%gap_in_file)) then
+      ! The heights and the /loads group (start_result_file), and the gap maps streamed
+      ! while the run solved (stream_gap_map), are in the file already.
+      if (surfaces_in_file) then
          call h5_reopen(tmp, file, local)
       else
          call h5_create(tmp, file, local)
@@ -86,7 +86,7 @@ contains
       call h5_write(file, "/contacts/step", res%contact_step, "1", local)
       call h5_write(file, "/contacts/force", res%contact_force, "nN", local)
       call h5_write(file, "/contacts/pressure", res%contact_force/area_pixel, "GPa", local)
-      if (.not. h5_exists(file, "/loads")) call h5_group(file, "/loads", local)
+      if (.not. surfaces_in_file) call h5_group(file, "/loads", local)
       do k = 1, size(res%states)
          if (.not. res%states(k)%reached) cycle
          g = load_group(k, size(res%states))
@@ -230,22 +230,16 @@ contains
    end subroutine write_surfaces
 
    !> State k of n's gap map (nm), written as soon as the state is solved into the
-   !> temporary `tmp` of PREFIX.h5 that write_hdf5 completes at the end (created by the
-   !> first state, `create`): a run holds one state's gap map, not all of them.
-   subroutine stream_gap_map(tmp, create, k, n, gap, status)
+   !> temporary `tmp` of PREFIX.h5 (start_result_file began it; write_hdf5 completes it):
+   !> a run holds one state's gap map, not all of them.
+   subroutine stream_gap_map(tmp, k, n, gap, status)
       character(len=*), intent(in) :: tmp
-      logical, intent(in) :: create
       integer, intent(in) :: k, n
       real(dp), intent(in) :: gap(:, :)
       type(status_type), intent(inout) :: status
       type(h5_file) :: file
       character(len=:), allocatable :: g
-      if (create) then
-         call h5_create(tmp, file, status)
-         call h5_group(file, "/loads", status)
-      else
-         call h5_reopen(tmp, file, status)
-      end if
+      call h5_reopen(tmp, file, status)
       file%path = result_name(tmp)
       g = load_group(k, n)
       call h5_group(file, g, status)
