@@ -117,6 +117,10 @@ fi
 expect 2 "--kernel-radius on the periodic cell refused" mpirun_2 "$femcod_mpi" "$deck" --loads 10 \
   --boundary periodic --kernel-radius 4 -o "$work/bad"
 expect 2 "two decks refused" mpirun_2 "$femcod_mpi" "$deck" ../input/sphere_d2.deck --loads 10
+# A solve that fails after the result file was begun (each state's maps go there as it is
+# solved): exit 4, and its temporary (PREFIX.h5.part) is gone.
+expect 4 "an unconverged solve leaves no temporary result file" mpirun_2 "$femcod_mpi" "$deck" --loads 50,1000 \
+  --max-iterations 2 -o "$work/bad"
 expect 2 "--generate of a kind the ranks do not make refused" mpirun_2 "$femcod_mpi" --generate sphere --np 32 \
   --pixel 1 --radius 10 --loads 10 -o "$work/bad"
 expect 2 "--generate next to a deck refused" mpirun_2 "$femcod_mpi" "$deck" --generate self-affine --np 32 \

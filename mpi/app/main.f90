@@ -46,9 +46,8 @@ program femcod_mpi
       distributed_rms_slope
    use femcod_love, only: composite_modulus
    use femcod_cg, only: distributed_storage_bytes
-   use femcod_mpi_results, only: distributed_run_info, write_distributed_results, gather_block_maxima, figure_block, &
+   use femcod_mpi_results, only: distributed_run_info, begin_distributed_results, write_distributed_results, figure_block, &
       agree
-   use femcod_svg, only: svg_pressure_map, svg_map, BLOCK_SMALLEST
    use femcod_gap_cg, only: gap_solver_storage_bytes
    use femcod_interface_law, only: make_interface_law
    use femcod_solver_options, only: by_gap_variables, run_shear_model, &
@@ -62,11 +61,6 @@ program femcod_mpi
    use femcod_run_summary, only: state_summary_lines
    implicit none
 
-   !> One load's two map figures, gathered on rank 0 (gather_block_maxima).
-   type :: map_figures
-      real(dp), allocatable :: pressure(:, :), gap(:, :)
-   end type map_figures
-
    type(string_type), allocatable :: args(:)
    type(run_settings) :: settings
    type(status_type) :: status
@@ -76,14 +70,12 @@ program femcod_mpi
    type(distributed_run_info) :: info
    type(signal_observer) :: observer
    type(string_type), allocatable :: warnings(:)
-   character(len=:), allocatable :: prefix, notice, started, blocks_note
+   character(len=:), allocatable :: prefix, notice, started
    real(dp) :: t_start, t_read, t_solve, t_write, peak, read_peak, constants(4), slope
    real(dp), allocatable :: local(:, :), estimated_mb(:)
    type(string_type), allocatable :: outputs(:), inputs(:)
    integer(i8) :: estimated_rank_bytes
-   !> Each load's figures: block maxima of the pressure (GPa), block minima of the gap (nm).
-   type(map_figures), allocatable :: figures(:)
-   integer :: provided, rank, ranks, np, block, code, k, figure
+   integer :: provided, rank, ranks, np, block, code, k
    logical :: locked, slab_input, hdf5_input, dataset_input, generating
    character(len=:), allocatable :: fftw_message
    type(scene_spec) :: generated
@@ -205,7 +197,8 @@ program femcod_mpi
    if (allocated(problem%upper)) deallocate(problem%upper)
    ! What each rank is about to allocate, summed over the ranks of a node, against that
    ! node's memory: refused on every rank (exit 4) before the grids are made.
-   call check_node_memory(np, size(targets()), status)
+   ! Each state's columns leave memory once written (femcod_mpi_observer): one state's at a time.
+   call check_node_memory(np, 1, status)
    if (status%code /= 0) call finish(status%code, status%message)
    call grid_setup(grid, MPI_COMM_WORLD, np, block, local, constants(2), constants(3), constants(4), &
       settings%solve%cg, status, settings%solve%boundary == BOUNDARY_PERIODIC)
@@ -214,6 +207,12 @@ program femcod_mpi
    slope = 0
    if (status%code == 0) slope = distributed_rms_slope(grid)
    call wall_clock(t_read)
+   ! PREFIX.h5's temporary, begun before the solve: each state's maps go there as soon as
+   ! it is solved, with its figures' blocks to rank 0 (femcod_mpi_observer).
+   observer%path = prefix//".h5.part"
+   observer%figure = figure_block(np)
+   observer%tangential = settings%solve%tangential
+   call begin_distributed_results(observer%path, grid, size(targets()), status)
    if (status%code == 0) call solve_loads(grid, problem, targets(), settings%solve%cg, states, status, observer, &
       settings%solve%hardness, settings%solve%plastic, by_approach(), make_interface_law(settings%solve%adhesion, &
       settings%solve%work, settings%solve%range, grid%pixel, settings%solve%plastic, settings%solve%hardness), &
@@ -221,6 +220,8 @@ program femcod_mpi
    if (status%code == 0 .and. settings%solve%tangential) call tangential_on_ranks(grid, problem, &
       tangential_request_of(settings%solve), states, status, observer)
    call wall_clock(t_solve)
+   ! A state's maps that could not be written stopped the solve: that is the error.
+   if (observer%written%code /= 0) status = observer%written
    if (status%code /= 0) then
       if (status%code == STATUS_INTERRUPTED) call finish(128 + stop_signal(), signal_name(stop_signal())//": "// &
          status%message)
@@ -254,32 +255,15 @@ program femcod_mpi
    if (.not. allocated(info%label)) info%label = ""
    info%wall_seconds = t_solve - t_start
    call write_distributed_results(prefix//".h5.part", grid, states, info, status)
-   ! The figures: each load's pressure and gap maps as the serial writer draws them (largest
-   ! pressure of each block, at most 1024 blocks per side; the gap's smallest), gathered
-   ! block by block.
-   figure = figure_block(np)
-   allocate(figures(size(states)))
-   do k = 1, size(states)
-      call gather_block_maxima(grid, states(k)%force/grid%pixel**2, figure, figures(k)%pressure)
-      ! The gap map by each block's smallest gap (no contact disappears): -(largest of -gap).
-      call gather_block_maxima(grid, -states(k)%gap, figure, figures(k)%gap)
-      figures(k)%gap = -figures(k)%gap
-   end do
    if (rank == 0) then
       if (status%code == 0) call atomic_rename(prefix//".h5.part", prefix//".h5", status)
       if (status%code /= 0) call remove_file(prefix//".h5.part")
       if (status%code == 0) call write_file(prefix//".loads.csv", loads_csv(), status)
-      blocks_note = ""
-      if (figure > 1) blocks_note = ", "//int_str(figure)//" x "//int_str(figure)//" blocks"
+      ! Each load's two figures, drawn as it was solved (femcod_mpi_observer).
       do k = 1, size(states)
-         if (status%code == 0) call write_file(prefix//".pressure_"//int_str(k)//".svg", svg_pressure_map( &
-            "contact pressure at "//sig_str(states(k)%load, 6)//" nN (approach "//sig_str(states(k)%approach, 4)// &
-            " nm, "//int_str(states(k)%contacts)//" contacts"//blocks_note//")", figures(k)%pressure, &
-            np*grid%pixel), status)
-         if (status%code == 0) call write_file(prefix//".gap_"//int_str(k)//".svg", svg_map("gap at "// &
-            sig_str(states(k)%load, 6)//" nN (approach "//sig_str(states(k)%approach, 4)//" nm, "// &
-            int_str(states(k)%contacts)//" contacts"//blocks_note//")", figures(k)%gap, np*grid%pixel, "nm", "gap", &
-            BLOCK_SMALLEST, .false.), status)
+         if (status%code == 0) call write_file(prefix//".pressure_"//int_str(k)//".svg", observer%pressure_svg(k)%s, &
+            status)
+         if (status%code == 0) call write_file(prefix//".gap_"//int_str(k)//".svg", observer%gap_svg(k)%s, status)
       end do
       call wall_clock(t_write)
       if (status%code == 0) call write_file(prefix//".summary.json", summary_json(), status)
@@ -500,6 +484,8 @@ contains
    subroutine finish(code, message)
       integer, intent(in) :: code
       character(len=*), intent(in) :: message
+      ! A run that ends without results leaves no temporary result file.
+      if (rank == 0 .and. code /= 0 .and. allocated(observer%path)) call remove_file(observer%path)
       if (rank == 0 .and. locked) call release_lock(prefix//".lock")
       if (rank == 0 .and. code /= 0 .and. message /= "") write(error_unit, '(a)') "femcod-mpi: "//message
       call stop_distributed_fftw()

@@ -73,8 +73,8 @@ module femcod_mpi_cg
    use femcod_clock, only: wall_clock
    implicit none
    private
-   public :: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, coarse_factor, &
-      gap_grid_setup
+   public :: distributed_grid, distributed_state, distributed_observer, grid_setup, grid_free, solve_loads, &
+      column_split, coarse_factor, gap_grid_setup
    public :: distribute_problem, scatter_problem, distributed_convolve, problem_constants, distributed_rms_slope
 
    !> One rank's part of the problem and of the distributed convolution: an elastic
@@ -141,11 +141,32 @@ module femcod_mpi_cg
       !> This rank's columns: contact forces (nN) and gaps (nm, 0 at the contacts).
       real(dp), allocatable :: force(:, :), gap(:, :)
       !> With --tangential or --slip (femcod_mpi_shear): this rank's contact pixels (rows,
-      !> columns 1 .. nj, in column order), the order of the values' tractions.
+      !> columns 1 .. nj, in column order), the order of the values' tractions, and their
+      !> normal forces (nN): the tangential step's input once `force` has left memory.
       integer, allocatable :: tangential_i(:), tangential_j(:)
+      real(dp), allocatable :: contact_force(:)
    end type distributed_state
 
+   !> What solve_loads tells as it goes: the serial observer's hooks, and each state's
+   !> columns as soon as the state is recorded. The base keeps them; femcod-mpi's
+   !> observer (femcod_mpi_observer) writes them into the result file and frees them, so
+   !> that a run of many states holds the columns of one.
+   type, extends(solver_observer) :: distributed_observer
+   contains
+      procedure :: columns_solved => keep_columns
+   end type distributed_observer
+
 contains
+
+   !> State k of n (its place in the targets given, not the order of solving) is recorded
+   !> on every rank, with this rank's columns. Collective: every rank is told of the same
+   !> state at the same time. The base keeps everything.
+   subroutine keep_columns(self, k, n, grid, state)
+      class(distributed_observer), intent(inout) :: self
+      integer, intent(in) :: k, n
+      type(distributed_grid), intent(inout) :: grid
+      type(distributed_state), intent(inout) :: state
+   end subroutine keep_columns
 
    !> What every rank needs of the deck besides its columns of the gaps: [NP, pixel (nm),
    !> the composite compliance c, the springs' s (nm/nN)].
@@ -614,7 +635,7 @@ contains
       type(cg_settings), intent(in) :: how
       type(distributed_state), allocatable, intent(out) :: states(:)
       type(status_type), intent(inout) :: status
-      class(solver_observer), intent(inout) :: observer
+      class(distributed_observer), intent(inout) :: observer
       !> GPa: the pressure n_above_hardness counts beyond (default: none counted), and the
       !> cap with `plastic`.
       real(dp), intent(in), optional :: hardness
@@ -688,6 +709,7 @@ contains
                return
             end if
          end associate
+         call observer%columns_solved(k, m, grid, states(k))
       end do
    end subroutine solve_loads
 

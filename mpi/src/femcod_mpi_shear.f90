@@ -28,7 +28,7 @@ module femcod_mpi_shear
    use femcod_mpi_cg, only: distributed_grid, distributed_state
    implicit none
    private
-   public :: distributed_shear, distributed_shear_setup, distributed_shear_free, tangential_on_ranks
+   public :: distributed_shear, distributed_shear_setup, distributed_shear_free, tangential_on_ranks, take_contact_list
 
    !> One rank's part of the tangential operator (the parent type: the grid side, this
    !> rank's columns, the periodic cell, the largest eigenvalue of the whole spectrum).
@@ -207,8 +207,9 @@ contains
    end function norm_over_ranks
 
    !> femcod run's tangential step (--tangential or --slip) at each state with contacts,
-   !> on the ranks: this rank's contact pixels (force > 0, in column order) and their
-   !> answer into the state. `problem` is read on rank 0 only. Collective.
+   !> on the ranks: this rank's contact pixels (take_contact_list, unless the state has
+   !> them already) and their answer into the state. `problem` is read on rank 0 only.
+   !> Collective.
    subroutine tangential_on_ranks(grid, problem, request, states, status, observer)
       type(distributed_grid), intent(inout) :: grid
       type(contact_problem), intent(in) :: problem
@@ -219,7 +220,7 @@ contains
       type(distributed_shear) :: op
       type(tangential_answer) :: answer
       real(dp) :: sticking(1)
-      integer :: k, i, j, n
+      integer :: k
       if (status%code /= 0) return
       if (.not. any(states%contacts > 0)) return
       call distributed_shear_setup(op, grid, problem, status)
@@ -227,20 +228,9 @@ contains
          if (status%code /= 0) exit
          associate(s => states(k))
             if (s%contacts == 0) cycle
-            n = count(s%force > 0)
-            allocate(s%tangential_i(n), s%tangential_j(n))
-            n = 0
-            do j = 1, grid%nj
-               do i = 1, grid%np
-                  if (s%force(i, j) > 0) then
-                     n = n + 1
-                     s%tangential_i(n) = i
-                     s%tangential_j(n) = j
-                  end if
-               end do
-            end do
-            call solve_tangential_on(op, s%tangential_i, s%tangential_j, &
-               [(s%force(s%tangential_i(i), s%tangential_j(i)), i = 1, n)], request, answer, status, observer)
+            if (.not. allocated(s%tangential_i)) call take_contact_list(s)
+            call solve_tangential_on(op, s%tangential_i, s%tangential_j, s%contact_force, request, answer, status, &
+               observer)
             if (status%code /= 0) then
                status%message = "state "//int_str(k)//" (load "//sig_str(s%load, 6)//" nN): "//status%message
                exit
@@ -253,4 +243,25 @@ contains
       end do
       call distributed_shear_free(op)
    end subroutine tangential_on_ranks
+
+   !> This rank's contact pixels of `state` (force > 0; rows, columns 1 .. nj in column
+   !> order) and their forces (nN), from its force columns: all the tangential step needs
+   !> of the state, so that the columns may leave memory before it runs.
+   subroutine take_contact_list(state)
+      type(distributed_state), intent(inout) :: state
+      integer :: i, j, n
+      n = count(state%force > 0)
+      allocate(state%tangential_i(n), state%tangential_j(n), state%contact_force(n))
+      n = 0
+      do j = 1, size(state%force, 2)
+         do i = 1, size(state%force, 1)
+            if (state%force(i, j) > 0) then
+               n = n + 1
+               state%tangential_i(n) = i
+               state%tangential_j(n) = j
+               state%contact_force(n) = state%force(i, j)
+            end if
+         end do
+      end do
+   end subroutine take_contact_list
 end module femcod_mpi_shear

@@ -15,14 +15,18 @@ module test_distributed
       SOLVER_CG, BOUNDARY_PERIODIC, LAW_HARD_WALL, LAW_DUGDALE, LAW_EXPONENTIAL
    use femcod_contact_result, only: contact_result
    use femcod_solver, only: solve_contact
-   use femcod_observer, only: solver_observer
    use femcod_interface_law, only: make_interface_law
    use femcod_mpi_generate, only: generate_columns
    use femcod_scene, only: initial_gap_map
-   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_setup, grid_free, solve_loads, column_split, &
-      coarse_factor, distribute_problem, distributed_convolve
+   use femcod_mpi_cg, only: distributed_grid, distributed_state, distributed_observer, grid_setup, grid_free, &
+      solve_loads, column_split, coarse_factor, distribute_problem, distributed_convolve
    use femcod_tangential, only: tangential_request_of
    use femcod_mpi_shear, only: tangential_on_ranks
+   use femcod_mpi_observer, only: signal_observer
+   use femcod_mpi_results, only: begin_distributed_results, values_per_block
+   use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close
+   use femcod_results, only: load_group
+   use femcod_files, only: remove_file
    implicit none
    private
    public :: collect_distributed
@@ -58,6 +62,8 @@ contains
          test_periodic_approach_against_serial), &
          new_unittest("--shear-strength --shear-slope --plastic: the serial friction on 1, 2 and 4 ranks", &
          test_friction_against_serial), &
+         new_unittest("femcod-mpi's observer: each state's columns into the file as solved, then freed", &
+            test_streamed_columns), &
          new_unittest("--tangential (partial slip): the serial tractions and stick map on 1, 2 and 4 ranks", &
          test_tangential_against_serial), &
          new_unittest("--boundary periodic --slip: the serial tractions and stick map on 1, 2 and 4 ranks", &
@@ -400,7 +406,7 @@ contains
       type(distributed_grid) :: grid
       type(distributed_state), allocatable :: states(:)
       type(cg_settings) :: how
-      type(solver_observer) :: observer
+      type(distributed_observer) :: observer
       integer :: rank, block
       real(dp) :: estar
       call MPI_Comm_rank(MPI_COMM_WORLD, rank)
@@ -517,6 +523,109 @@ contains
       call against_serial(error, options)
    end subroutine test_tangential_against_serial
 
+   !> femcod-mpi's observer (femcod_mpi_observer) writes each state's columns into the
+   !> result file as soon as the state is solved, then frees them. Loads given out of order
+   !> (20000, 3000, 8000 nN; the plastic cap; a tangential step after the states) on all
+   !> ranks, once with the base observer that keeps the columns and once streamed, the
+   !> maps written in blocks of 100 values (several a map): each /loads/<k>'s pressure,
+   !> gap and plastic displacement equal to the kept columns of state k, bit for bit (the
+   !> same solve; a map under another state's name, or a block in the wrong place,
+   !> differs), the streamed states' columns gone, and the tangential step, which ran on
+   !> the contact lists the observer kept, with the kept columns' answer.
+   subroutine test_streamed_columns(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_spec) :: spec
+      type(contact_problem) :: deck
+      type(contact_options) :: options
+      type(status_type) :: status
+      type(distributed_grid) :: grid
+      type(distributed_state), allocatable :: kept(:), streamed(:)
+      type(distributed_observer) :: keeper
+      type(signal_observer) :: streamer
+      type(h5_file) :: file
+      real(dp), allocatable :: map(:, :)
+      real(dp) :: bad(3)
+      character(len=:), allocatable :: path, g
+      integer :: block, k, rank, ranks, stage
+      call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+      call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+      spec%kind = "self-affine"
+      spec%label = "test"
+      spec%np = 64
+      spec%pixel = 2
+      spec%seed = 3
+      call build_problem(spec, deck, status)
+      options%solver = SOLVER_CG
+      options%loads = [2.0e4_dp, 3.0e3_dp, 8.0e3_dp]
+      options%plastic = .true.
+      options%hardness = 10
+      options%tangential = .true.
+      options%friction = 0.5_dp
+      options%tangential_load = 900
+      options%cg%tol = 1.0e-12_dp
+      path = "test_streamed_"//to_string(ranks)//".h5.part"
+      do stage = 1, 2
+         call distribute_problem(deck, MPI_COMM_WORLD, options%cg, grid, block, status, .false.)
+         if (stage == 1) then
+            call solve_and_shear(kept, keeper)
+         else
+            streamer%path = path
+            streamer%tangential = .true.
+            values_per_block = 100
+            call begin_distributed_results(path, grid, size(options%loads), status)
+            call solve_and_shear(streamed, streamer)
+            values_per_block = 2**20
+         end if
+         if (stage == 1 .or. status%code /= 0) call grid_free(grid)
+      end do
+      if (status%code /= 0) call check(error, status%code, 0, "the solves and the writes: "//status%message)
+      if (allocated(error)) then
+         if (rank == 0) call remove_file(path)
+         return
+      end if
+      bad = 0
+      do k = 1, size(options%loads)
+         g = load_group(k, size(options%loads))
+         if (allocated(streamed(k)%force) .or. allocated(streamed(k)%gap) .or. allocated(streamed(k)%plastic)) &
+            bad(1) = bad(1) + 1
+         call h5_open(path, file, status, 3)
+         call h5_read(file, g//"/pressure", map, status, 3)
+         if (status%code == 0) bad(2) = bad(2) + count(map(:, grid%j0 + 1:grid%j0 + grid%nj) /= &
+            kept(k)%force/grid%pixel**2)
+         call h5_read(file, g//"/gap", map, status, 3)
+         if (status%code == 0) bad(2) = bad(2) + count(map(:, grid%j0 + 1:grid%j0 + grid%nj) /= kept(k)%gap)
+         call h5_read(file, g//"/plastic_displacement", map, status, 3)
+         if (status%code == 0) bad(2) = bad(2) + count(map(:, grid%j0 + 1:grid%j0 + grid%nj) /= kept(k)%plastic)
+         call h5_close(file, status)
+         if (status%code /= 0) bad(2) = bad(2) + 1
+         if (kept(k)%stick_contacts /= streamed(k)%stick_contacts .or. size(kept(k)%shear_x) /= &
+            size(streamed(k)%shear_x)) then
+            bad(3) = bad(3) + 1
+         else if (any(kept(k)%shear_x /= streamed(k)%shear_x) .or. any(kept(k)%shear_y /= streamed(k)%shear_y)) then
+            bad(3) = bad(3) + 1
+         end if
+      end do
+      call grid_free(grid)
+      call MPI_Allreduce(MPI_IN_PLACE, bad, 3, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_COMM_WORLD)
+      call MPI_Barrier(MPI_COMM_WORLD)
+      if (rank == 0) call remove_file(path)
+      call check(error, nint(bad(1)), 0, "states whose columns stayed in memory")
+      if (allocated(error)) return
+      call check(error, nint(bad(2)), 0, "map values in the file unlike the kept columns (or unreadable maps)")
+      if (allocated(error)) return
+      call check(error, nint(bad(3)), 0, "states whose tangential answer differs from the kept columns'")
+   contains
+      subroutine solve_and_shear(states, observer)
+         type(distributed_state), allocatable, intent(out) :: states(:)
+         class(distributed_observer), intent(inout) :: observer
+         if (status%code == 0) call solve_loads(grid, deck, options%loads, options%cg, states, status, observer, &
+            options%hardness, options%plastic, .false., make_interface_law(options%adhesion, options%work, &
+            options%range, deck%pixel, options%plastic, options%hardness), run_shear_model(options))
+         if (status%code == 0) call tangential_on_ranks(grid, deck, tangential_request_of(options), states, status, &
+            observer)
+      end subroutine solve_and_shear
+   end subroutine test_streamed_columns
+
    !> The same on the periodic cell under a rigid shift (slip control, 0.05 nm: partial
    !> slip at both loads), the Cerruti spectra in closed form on each rank's frequencies.
    subroutine test_periodic_slip_against_serial(error)
@@ -597,7 +706,7 @@ contains
       type(status_type) :: status, serial_status
       type(distributed_grid) :: grid
       type(distributed_state), allocatable :: states(:)
-      type(solver_observer) :: observer
+      type(distributed_observer) :: observer
       type(MPI_Comm) :: group
       real(dp), allocatable :: forces(:, :)
       integer, allocatable :: firsts(:), counts(:)

@@ -174,10 +174,11 @@ contains
    !> convolution reads its rows from the shared columns); the kernel's real spectrum for
    !> half of one axis' frequencies (it is even) and its float32 copy (2 + 1, or 8 + 4
    !> free); the iteration's w and t (16), the stencil's float32 copy and the float32
-   !> residual (8), the contact flags (1); the forces (8); per requested state the gap map
-   !> and a copy of the forces (16). With the plastic cap, as femcod_cg's: the deck's
-   !> gaps, the capped flags, the capped rounds' force, field and gap maps (36) and per
-   !> state the plastic map (8). Measured on one node (4096^2 text deck, 2 ranks, 1 state;
+   !> residual (8), the contact flags (1); the forces (8); per state held at once
+   !> (`nstates`: femcod-mpi writes each state's columns as soon as it is solved and frees
+   !> them, 1) the gap map and a copy of the forces (16). With the plastic cap, as
+   !> femcod_cg's: the deck's gaps, the capped flags, the capped rounds' force, field and
+   !> gap maps (36) and per state held the plastic map (8). Measured on one node (4096^2 text deck, 2 ranks, 1 state;
    !> femcod-mpi's estimate adds what each rank holds and the shared Love table): free
    !> 864 and 852 MB estimated against 892 and 845 MB peak resident memory, periodic 728
    !> and 716 against 605 and 574.
