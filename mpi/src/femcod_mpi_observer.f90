@@ -29,6 +29,9 @@ module femcod_mpi_observer
       integer :: figure = 1
       !> Keep each state's contact list for the tangential step that follows the states.
       logical :: tangential = .false.
+      !> Values of a rank's columns one collective write of a map takes (0: the writer's
+      !> default; a test sets a few to write a small grid in several blocks).
+      integer :: block_values = 0
       !> Each state's two figures (SVG text), by the state's place in the targets (rank 0).
       type(string_type), allocatable :: pressure_svg(:), gap_svg(:)
       !> The first failure to write a state's columns, the same on every rank: the solver
@@ -62,7 +65,11 @@ contains
       character(len=:), allocatable :: title
       if (.not. allocated(self%path) .or. self%written%code /= 0) return
       if (.not. allocated(self%pressure_svg)) allocate(self%pressure_svg(n), self%gap_svg(n))
-      call write_state_columns(self%path, grid, k, n, state, self%written)
+      if (self%block_values > 0) then
+         call write_state_columns(self%path, grid, k, n, state, self%written, self%block_values)
+      else
+         call write_state_columns(self%path, grid, k, n, state, self%written)
+      end if
       if (self%written%code /= 0) return
       title = " at "//sig_str(state%load, 6)//" nN (approach "//sig_str(state%approach, 4)//" nm, "// &
          int_str(state%contacts)//" contacts"

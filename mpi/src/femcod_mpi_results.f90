@@ -23,12 +23,10 @@ module femcod_mpi_results
    private
    public :: distributed_run_info, begin_distributed_results, write_state_columns, write_distributed_results, &
       gather_block_maxima, figure_block, agree
-   public :: values_per_block
 
-   !> How many values of a rank's columns one collective write of a map takes (the
-   !> transposed block write_columns holds: 8 MB). A setting, so that a test can write a
-   !> small grid in several blocks.
-   integer :: values_per_block = 2**20
+   !> How many values of a rank's columns one collective write of a map takes by default
+   !> (the transposed block write_columns holds: 8 MB).
+   integer, parameter :: VALUES_PER_BLOCK = 2**20
 
    !> What /run records of a distributed run: the run's record (io/femcod_result_schema:
    !> version, command, times, which columns the states have), and the ranks'.
@@ -73,22 +71,25 @@ contains
    !> State k of n's /pressure (GPa) and /gap (nm), and with --plastic its plastic
    !> displacement (nm): every rank its columns, collectively, into `path` (made by
    !> begin_distributed_results). `status` the same on every rank afterwards.
-   subroutine write_state_columns(path, grid, k, n, state, status)
+   subroutine write_state_columns(path, grid, k, n, state, status, block_values)
       character(len=*), intent(in) :: path
       type(distributed_grid), intent(in) :: grid
       integer, intent(in) :: k, n
       type(distributed_state), intent(in) :: state
       type(status_type), intent(inout) :: status
+      !> Values of this rank's columns a collective write takes (default VALUES_PER_BLOCK;
+      !> a test writes a small grid in several blocks).
+      integer, intent(in), optional :: block_values
       type(collective_file) :: out
       character(len=:), allocatable :: g
       if (status%code /= 0) return
       call open_collective(path, grid, out, status)
       if (status%code /= 0) return
       g = load_group(k, n)
-      call write_columns(out, grid, g//"/pressure", state%force, "GPa", status, grid%pixel**2)
-      call write_columns(out, grid, g//"/gap", state%gap, "nm", status)
+      call write_columns(out, grid, g//"/pressure", state%force, "GPa", status, grid%pixel**2, block_values)
+      call write_columns(out, grid, g//"/gap", state%gap, "nm", status, block_values=block_values)
       if (allocated(state%plastic)) call write_columns(out, grid, g//"/plastic_displacement", state%plastic, "nm", &
-         status)
+         status, block_values=block_values)
       call close_collective(out, status)
       call agree_on_write(grid, path, status)
    end subroutine write_state_columns
@@ -220,7 +221,7 @@ contains
    !> One NP x NP dataset `name` with `units`: this rank's columns `local` (over
    !> `divisor` when given) as its hyperslab, stored transposed (as the serial writer stores maps), a block of
    !> rows at a time so that no transposed copy of the whole slab is made. Collective.
-   subroutine write_columns(out, grid, name, local, units, status, divisor)
+   subroutine write_columns(out, grid, name, local, units, status, divisor, block_values)
       type(collective_file), intent(inout) :: out
       type(distributed_grid), intent(in) :: grid
       character(len=*), intent(in) :: name, units
@@ -228,12 +229,16 @@ contains
       type(status_type), intent(inout) :: status
       !> Divides the values (forces in nN over the pixel's area: pressures).
       real(dp), intent(in), optional :: divisor
+      !> Values a collective write takes (default VALUES_PER_BLOCK).
+      integer, intent(in), optional :: block_values
       integer(hid_t) :: fspace, mspace, dset
       integer(hsize_t) :: dims(2), block(2), offset(2)
       real(dp), allocatable :: stored(:, :)
       integer :: e(4), error, rows, i0, ni
       if (status%code /= 0) return
-      rows = max(1, min(grid%np, values_per_block/max(1, grid%nj)))
+      rows = VALUES_PER_BLOCK
+      if (present(block_values)) rows = block_values
+      rows = max(1, min(grid%np, rows/max(1, grid%nj)))
       dims = [integer(hsize_t) :: grid%np, grid%np]
       call h5screate_simple_f(2, dims, fspace, e(1))
       call h5dcreate_f(out%file%id, name, H5T_NATIVE_DOUBLE, fspace, dset, e(2))

@@ -23,7 +23,7 @@ module test_distributed
    use femcod_tangential, only: tangential_request_of
    use femcod_mpi_shear, only: tangential_on_ranks
    use femcod_mpi_observer, only: signal_observer
-   use femcod_mpi_results, only: begin_distributed_results, values_per_block
+   use femcod_mpi_results, only: begin_distributed_results
    use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close
    use femcod_results, only: load_group
    use femcod_files, only: remove_file
@@ -571,10 +571,9 @@ contains
          else
             streamer%path = path
             streamer%tangential = .true.
-            values_per_block = 100
+            streamer%block_values = 100
             call begin_distributed_results(path, grid, size(options%loads), status)
             call solve_and_shear(streamed, streamer)
-            values_per_block = 2**20
          end if
          if (stage == 1 .or. status%code /= 0) call grid_free(grid)
       end do
