@@ -57,7 +57,7 @@ module femcod_mpi_cg
    use femcod_problem, only: contact_problem
    use femcod_solver_options, only: cg_settings
    use femcod_elastic_operator, only: elastic_operator, spread_load, cg_constraint, kernel_split_limit, &
-      split_within_allowance
+      split_within_allowance, copy_and_displace_single
    use femcod_constrained_cg, only: constrained_cg, cg_residuals
    use femcod_split_correction, only: split_correction, split_free
    use femcod_cg, only: coarse_start_forces, materials_of, approach_error_bound, cg_session, cg_answer, session_start, &
@@ -114,6 +114,7 @@ module femcod_mpi_cg
       procedure :: displace => distributed_displace
       procedure :: apply_spectrum => distributed_apply_spectrum
       procedure :: displace_single => distributed_displace_single
+      procedure :: displace_single_in_place => distributed_displace_single_in_place
       procedure :: sum_over_grid => sum_over_ranks
       procedure :: max_over_grid => max_over_ranks
       procedure :: min_over_grid => min_over_ranks
@@ -1014,6 +1015,18 @@ contains
          call distributed_convolve(op, f, out, op%c)
       end if
    end subroutine distributed_displace_single
+
+   !> f32 replaced by c (I * f32) in float32 transforms, with no copy of f32 (when the grid
+   !> has them; else as the elastic operator's base, from a copy).
+   subroutine distributed_displace_single_in_place(op, f32)
+      class(distributed_grid), intent(inout) :: op
+      real(sp), intent(inout) :: f32(:, :)
+      if (op%slab%has_single) then
+         call slab_convolve_single(op%slab, kernel32=op%kernel32, factor=op%c, in_place32=f32)
+      else
+         call copy_and_displace_single(op, f32)
+      end if
+   end subroutine distributed_displace_single_in_place
 
    !> values(:) summed over the ranks, in place; the time it takes is communication.
    subroutine sum_over_ranks(op, values)

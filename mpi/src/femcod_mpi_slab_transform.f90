@@ -385,35 +385,50 @@ contains
       call crop_columns(t, .true., out)
    end subroutine slab_convolve
 
-   !> slab_convolve in float32 (the float32 plans, `kernel32`), into out (double) or out32.
-   !> Collective.
-   subroutine slab_convolve_single(t, f, kernel32, factor, out, out32)
+   !> slab_convolve in float32 (the float32 plans, `kernel32`), into out (double) or out32;
+   !> or a float32 field replaced by its float32 result (`in_place32`, instead of f and
+   !> out). Collective.
+   subroutine slab_convolve_single(t, f, kernel32, factor, out, out32, in_place32)
       type(slab_transform), intent(inout) :: t
-      real(dp), intent(in) :: f(:, :), factor
+      real(dp), intent(in), optional :: f(:, :)
+      real(dp), intent(in) :: factor
       real(sp), intent(in) :: kernel32(:, :)
       real(dp), intent(out), optional :: out(:, :)
       real(sp), intent(out), optional :: out32(:, :)
-      call fill_columns(t, f, .false.)
+      real(sp), intent(inout), optional :: in_place32(:, :)
+      if (present(in_place32)) then
+         call fill_columns(t, double=.false., f32=in_place32)
+      else
+         call fill_columns(t, f, .false.)
+      end if
       call column_transforms(t, .false., forward=.true.)
       call transpose_slab(t, .false., to_rows=.true., packed=.not. t%on_node)
       call rows_convolve(t, factor, kernel32=kernel32)
       call transpose_slab(t, .false., to_rows=.false., packed=.not. t%on_node)
       call column_transforms(t, .false., forward=.false.)
-      call crop_columns(t, .false., out, out32)
+      if (present(in_place32)) then
+         call crop_columns(t, .false., out32=in_place32)
+      else
+         call crop_columns(t, .false., out, out32)
+      end if
    end subroutine slab_convolve_single
 
    !> f (np, nj) into this rank's columns, zero-padded to m: in double or (`double` false)
-   !> rounded to float32. Timed.
-   subroutine fill_columns(t, f, double)
+   !> rounded to float32; or f32, in float32 as it is. Timed.
+   subroutine fill_columns(t, f, double, f32)
       type(slab_transform), intent(inout) :: t
-      real(dp), intent(in) :: f(:, :)
+      real(dp), intent(in), optional :: f(:, :)
       logical, intent(in) :: double
+      real(sp), intent(in), optional :: f32(:, :)
       integer :: j
       real(dp) :: t0, t1
       call wall_clock(t0)
       !$omp parallel do
       do j = 1, t%nj
-         if (double) then
+         if (present(f32)) then
+            t%column32_real(1:t%np, j) = f32(:, j)
+            t%column32_real(t%np + 1:, j) = 0
+         else if (double) then
             t%column_real(1:t%np, j) = f(:, j)
             t%column_real(t%np + 1:, j) = 0
          else

@@ -298,13 +298,16 @@ contains
       end associate
    end subroutine make_plans_single
 
-   !> result(i, j) = factor * sum_{k,l} I(i-k, j-l) field(k, l) over the NP x NP grid.
-   subroutine convolution_apply(conv, field, result, factor)
+   !> result(i, j) = factor * sum_{k,l} I(i-k, j-l) field(k, l) over the NP x NP grid;
+   !> with `in_place` instead of field and result, the field replaced by its result (the
+   !> first pass reads all of it before the last writes).
+   subroutine convolution_apply(conv, field, result, factor, in_place)
       type(love_convolution), intent(inout) :: conv
-      real(dp), intent(in) :: field(:, :)
-      real(dp), intent(out) :: result(:, :)
+      real(dp), intent(in), optional :: field(:, :)
+      real(dp), intent(out), optional :: result(:, :)
       !> Multiplies the result (default 1): a compliance, folded into the last pass.
       real(dp), intent(in), optional :: factor
+      real(dp), intent(inout), optional :: in_place(:, :)
       real(c_double), pointer :: lines(:, :)
       complex(c_double_complex), pointer :: half(:, :)
       real(dp) :: f
@@ -326,7 +329,11 @@ contains
       do jb = 1, (np + b - 1)/b
          j0 = (jb - 1)*b
          nb = min(b, np - j0)
-         lines(1:np, 1:nb) = field(:, j0 + 1:j0 + nb)
+         if (present(in_place)) then
+            lines(1:np, 1:nb) = in_place(:, j0 + 1:j0 + nb)
+         else
+            lines(1:np, 1:nb) = field(:, j0 + 1:j0 + nb)
+         end if
          lines(np + 1:, 1:nb) = 0
          lines(:, nb + 1:) = 0
          call fftw_execute_dft_r2c(conv%double%columns_forward, lines, half)
@@ -364,21 +371,28 @@ contains
          half(:, 1:nb) = conv%spectrum(:, j0 + 1:j0 + nb)
          half(:, nb + 1:) = 0
          call fftw_execute_dft_c2r(conv%double%columns_backward, half, lines)
-         result(:, j0 + 1:j0 + nb) = f*lines(1:np, 1:nb)
+         if (present(in_place)) then
+            in_place(:, j0 + 1:j0 + nb) = f*lines(1:np, 1:nb)
+         else
+            result(:, j0 + 1:j0 + nb) = f*lines(1:np, 1:nb)
+         end if
       end do
       !$omp end do
       !$omp end parallel
    end subroutine convolution_apply
 
    !> As convolution_apply, with float32 transforms (needs setup with single = .true.).
-   !> The result in double (`result`) or, rounded once more, in float32 (`result32`).
-   subroutine convolution_apply_single(conv, field, result, factor, result32)
+   !> The result in double (`result`) or, rounded once more, in float32 (`result32`); or
+   !> a float32 field replaced by its float32 result (`in_place32`, instead of field and
+   !> result).
+   subroutine convolution_apply_single(conv, field, result, factor, result32, in_place32)
       type(love_convolution), intent(inout) :: conv
-      real(dp), intent(in) :: field(:, :)
+      real(dp), intent(in), optional :: field(:, :)
       real(dp), intent(out), optional :: result(:, :)
       !> Multiplies the result (default 1): a compliance, folded into the last pass.
       real(dp), intent(in), optional :: factor
       real(sp), intent(out), optional :: result32(:, :)
+      real(sp), intent(inout), optional :: in_place32(:, :)
       real(c_float), pointer :: lines(:, :)
       complex(c_float_complex), pointer :: half(:, :)
       real(dp) :: f
@@ -399,7 +413,11 @@ contains
       do jb = 1, (np + b - 1)/b
          j0 = (jb - 1)*b
          nb = min(b, np - j0)
-         lines(1:np, 1:nb) = real(field(:, j0 + 1:j0 + nb), sp)
+         if (present(in_place32)) then
+            lines(1:np, 1:nb) = in_place32(:, j0 + 1:j0 + nb)
+         else
+            lines(1:np, 1:nb) = real(field(:, j0 + 1:j0 + nb), sp)
+         end if
          lines(np + 1:, 1:nb) = 0
          lines(:, nb + 1:) = 0
          call fftwf_execute_dft_r2c(conv%single%columns_forward, lines, half)
@@ -437,6 +455,8 @@ contains
          call fftwf_execute_dft_c2r(conv%single%columns_backward, half, lines)
          if (present(result32)) then
             result32(:, j0 + 1:j0 + nb) = real(f*real(lines(1:np, 1:nb), dp), sp)
+         else if (present(in_place32)) then
+            in_place32(:, j0 + 1:j0 + nb) = real(f*real(lines(1:np, 1:nb), dp), sp)
          else
             result(:, j0 + 1:j0 + nb) = f*real(lines(1:np, 1:nb), dp)
          end if

@@ -34,7 +34,7 @@ module femcod_elastic_operator
    implicit none
    private
    public :: elastic_operator, grid_operator, grid_operator_setup, grid_operator_free, truncate_table, spread_load
-   public :: cg_constraint, kernel_split_limit, split_within_allowance
+   public :: cg_constraint, kernel_split_limit, split_within_allowance, copy_and_displace_single
    public :: SPECTRUM_COMPLIANCE, SPECTRUM_STIFFNESS, TABLE_NONE, TABLE_SINGLE, TABLE_DOUBLE
 
    !> Which Love table a grid operator keeps besides its convolution (grid_operator_setup's
@@ -77,6 +77,12 @@ module femcod_elastic_operator
       procedure(displace_interface), deferred :: displace
       !> The same in float32 transforms, into out (double) or out32.
       procedure(displace_single_interface), deferred :: displace_single
+      !> f (nN) replaced by c (I * f) (nm), in double, and the same for a float32 f by
+      !> float32 transforms: the search direction's displacements formed in the storage
+      !> its forces were scattered into. The base copies f first; an operator whose
+      !> transforms read all of f before they write overrides them with no copy.
+      procedure :: displace_in_place => copy_and_displace
+      procedure :: displace_single_in_place => copy_and_displace_single
       !> values(:), this part's sums or maxima or minima, become the whole grid's.
       procedure :: sum_over_grid => local_reduction
       procedure :: max_over_grid => local_reduction
@@ -132,6 +138,8 @@ module femcod_elastic_operator
    contains
       procedure :: displace => grid_displace
       procedure :: displace_single => grid_displace_single
+      procedure :: displace_in_place => grid_displace_in_place
+      procedure :: displace_single_in_place => grid_displace_single_in_place
       procedure :: correction_limits => grid_correction_limits
       procedure :: add_direct => grid_add_direct
       procedure :: split_correct => grid_split_correct
@@ -139,6 +147,25 @@ module femcod_elastic_operator
    end type grid_operator
 
 contains
+
+   !> f replaced by c (I * f) through displace, from a copy of f.
+   subroutine copy_and_displace(op, f)
+      class(elastic_operator), intent(inout) :: op
+      real(dp), intent(inout) :: f(:, :)
+      real(dp), allocatable :: copy(:, :)
+      copy = f
+      call op%displace(copy, f)
+   end subroutine copy_and_displace
+
+   !> The float32 f replaced by c (I * f) through displace_single, from a copy of f in
+   !> double (the transforms round it back to the same float32 values).
+   subroutine copy_and_displace_single(op, f32)
+      class(elastic_operator), intent(inout) :: op
+      real(sp), intent(inout) :: f32(:, :)
+      real(dp), allocatable :: copy(:, :)
+      copy = real(f32, dp)
+      call op%displace_single(copy, out32=f32)
+   end subroutine copy_and_displace_single
 
    subroutine local_reduction(op, values)
       class(elastic_operator), intent(inout) :: op
@@ -330,6 +357,18 @@ contains
          call convolution_apply_single(op%conv, f, out, op%c)
       end if
    end subroutine grid_displace_single
+
+   subroutine grid_displace_in_place(op, f)
+      class(grid_operator), intent(inout) :: op
+      real(dp), intent(inout) :: f(:, :)
+      call convolution_apply(op%conv, factor=op%c, in_place=f)
+   end subroutine grid_displace_in_place
+
+   subroutine grid_displace_single_in_place(op, f32)
+      class(grid_operator), intent(inout) :: op
+      real(sp), intent(inout) :: f32(:, :)
+      call convolution_apply_single(op%conv, factor=op%c, in_place32=f32)
+   end subroutine grid_displace_single_in_place
 
    subroutine grid_apply_spectrum(op, which, in, out)
       class(grid_operator), intent(inout) :: op

@@ -142,26 +142,26 @@ contains
 
 
    !> The cg solver's storage at its largest (bytes), from the arrays it holds per pixel
-   !> of the NP x NP grid through the iteration: the forces, the initial gaps, the force
-   !> displacements and the search direction (8 bytes each); the kernel's spectrum,
-   !> complex on (M/2 + 1) x NP with M = 2 NP free or NP periodic (16 or 8 bytes a pixel),
-   !> and its real coefficients for one quarter of the frequencies (8 or 2); the direct
-   !> corrections' float32 Love table, the stencil's padded float32 gaps and the
-   !> direction's float32 displacements (4 each); the contact marks (1); the contact
-   !> list, the kernel split's changes and mesh (4 at most); each state's gap map kept
-   !> in memory (8; none when `streamed`: an observer takes them out as they are
-   !> solved). With the plastic cap: the deck's gaps, the capped flags, the capped
-   !> rounds' force, field and gap maps (8 + 4 + 24), and each state's plastic map (8).
-   !> The nested coarse grids (a third of this) come and go before the fine grid's
-   !> iteration. Against femcod run's peak resident memory (one load, the heights freed,
-   !> doc/performance.md): 4096^2 free 73 against 72.7 bytes a pixel measured for the
-   !> whole process, periodic 59 against 60.5.
+   !> of the NP x NP grid through the iteration: the forces, the initial gaps and the
+   !> force displacements (8 bytes each); the kernel's spectrum, complex on (M/2 + 1) x NP
+   !> with M = 2 NP free or NP periodic (16 or 8 bytes a pixel), and its real
+   !> coefficients for one quarter of the frequencies (8 or 2); the direct corrections'
+   !> float32 Love table, the stencil's padded float32 gaps and the direction's float32
+   !> displacements (4 each); the contact marks (1); the contact list with the search
+   !> direction on it, the kernel split's changes and mesh (4 at most up to a quarter of
+   !> the pixels in contact); each state's gap map kept in memory (8; none when
+   !> `streamed`: an observer takes them out as they are solved). With the plastic cap:
+   !> the deck's gaps, the capped flags, the capped rounds' force, field and gap maps (8 +
+   !> 4 + 24), and each state's plastic map (8). The nested coarse grids (a third of this)
+   !> come and go before the fine grid's iteration. Against femcod run's peak resident
+   !> memory (one load, the heights freed, doc/performance.md): 4096^2 free 65 against
+   !> 64.7 bytes a pixel measured for the whole process, periodic 51 against 52.0.
    pure function cg_storage_bytes(np, nstates, periodic, plastic, streamed) result(bytes)
       integer, intent(in) :: np, nstates
       logical, intent(in) :: periodic, plastic, streamed
       integer(i8) :: bytes, n2, per_pixel
       n2 = int(np, i8)**2
-      per_pixel = 4*8 + merge(8, 16, periodic) + merge(2, 8, periodic) + 3*4 + 1 + 4 + merge(0, 8*nstates, streamed)
+      per_pixel = 3*8 + merge(8, 16, periodic) + merge(2, 8, periodic) + 3*4 + 1 + 4 + merge(0, 8*nstates, streamed)
       if (plastic) per_pixel = per_pixel + 8 + 4 + 24 + 8*nstates
       bytes = n2*per_pixel
    end function cg_storage_bytes

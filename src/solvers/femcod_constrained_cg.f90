@@ -48,14 +48,17 @@ module femcod_constrained_cg
    !> used, and gm keeps them in float32 on the contacts (zero elsewhere, two pixels of
    !> padding for the stencil) for the direction and its step, which the gaps recomputed
    !> in double each iteration correct; nor of the preconditioned gaps z (stencil_at,
-   !> formed twice). r, the displacements of the direction, is float32 (r32) when the
-   !> transform making it is. At NP = 4096 each NP x NP array is 134 MB in double.
+   !> formed twice). The direction t is zero off the contacts, so it is kept on the
+   !> contacts only, and scattered for its convolution into r, which the convolution
+   !> then overwrites with t's displacements; r is float32 (r32) when the transform
+   !> making it is. At NP = 4096 each NP x NP array is 134 MB in double.
    type :: cg_iteration
       !> Rows and this process's columns; c and s (nm/nN).
       integer :: np = 0, nj = 0
       real(dp) :: c = 0, s = 0
-      !> Displacements of the stored forces w, the direction t, its displacements r (nm).
-      real(dp), allocatable :: w(:, :), t(:, :), r(:, :)
+      !> Displacements of the stored forces w and of the direction r (nm); the direction
+      !> t (nN) at the contacts, in the order of `contact`.
+      real(dp), allocatable :: w(:, :), r(:, :), t(:)
       real(sp), allocatable :: gm(:, :), r32(:, :)
       !> The contact pixels (p > 0) as (i, j), column by column, and on the grid as 1 in
       !> `touching` (one byte a pixel, for the pass over all pixels).
@@ -200,8 +203,9 @@ contains
    end subroutine constrained_cg
 
    !> The state for a solve from the forces p under `target`: the arrays, the start's
-   !> contacts (the direction is zero off the contacts throughout) and the load balance
-   !> (1 at an approach, which fixes gbar instead).
+   !> contacts (the direction, zero at first, is kept on the contacts only: it is zero
+   !> off them throughout) and the load balance (1 at an approach, which fixes gbar
+   !> instead).
    subroutine iteration_start(st, grid, how, p, target)
       type(cg_iteration), intent(inout) :: st
       class(elastic_operator), intent(inout) :: grid
@@ -220,7 +224,7 @@ contains
       st%capacity = max(st%limit, st%split_limit)
       st%threads = 1
       !$ st%threads = omp_get_max_threads()
-      allocate(st%w(np, nj), st%t(np, nj), st%gm(-1:np + 2, -1:nj + 2), st%changed(2, st%capacity), &
+      allocate(st%w(np, nj), st%gm(-1:np + 2, -1:nj + 2), st%changed(2, st%capacity), &
          st%delta(st%capacity), st%touching(np, nj), st%entering(0:st%threads - 1))
       if (how%single_until > 0) then
          allocate(st%r32(np, nj))
@@ -238,7 +242,6 @@ contains
       do j = 1, nj
          do i = 1, np
             st%touching(i, j) = merge(1_int8, 0_int8, p(i, j) > 0)
-            st%t(i, j) = 0
          end do
       end do
       call list_contacts(st)
@@ -407,22 +410,24 @@ contains
             i = st%contact(1, q)
             j = st%contact(2, q)
             if (grid%preconditioned) then
-               st%t(i, j) = stencil_at(st, grid%taps, i, j) - zbar + beta*st%t(i, j)
+               st%t(q) = stencil_at(st, grid%taps, i, j) - zbar + beta*st%t(q)
             else
-               st%t(i, j) = real(st%gm(i, j), dp) + beta*st%t(i, j)
+               st%t(q) = real(st%gm(i, j), dp) + beta*st%t(q)
             end if
-            part(1, b) = part(1, b) + real(st%gm(i, j), dp)*st%t(i, j)
+            part(1, b) = part(1, b) + real(st%gm(i, j), dp)*st%t(q)
          end do
       end do
       num = sum(part(1, :))
       ! r = c (I * t): the displacements of the search direction, always in float32
       ! when float32 is on: its round-off (1e-7 of r) scales with the step, and the
       ! steps shrink with the residual, so it never limits the accuracy; the forces'
-      ! own displacements (fresh) switch to double below `single_until`.
+      ! own displacements (fresh) switch to double below `single_until`. t is scattered
+      ! into r's storage (as the transform rounds it) and replaced there.
+      call scatter_direction(st)
       if (allocated(st%r32)) then
-         call grid%displace_single(st%t, out32=st%r32)
+         call grid%displace_single_in_place(st%r32)
       else
-         call grid%displace(st%t, st%r)
+         call grid%displace_in_place(st%r)
       end if
       st%fresh_double = .false.
       s = st%s
@@ -432,9 +437,9 @@ contains
          do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, st%nc)
             i = st%contact(1, q)
             j = st%contact(2, q)
-            part(1, b) = part(1, b) + (r_at(st, i, j) + s*st%t(i, j))*st%t(i, j)
-            part(2, b) = part(2, b) + r_at(st, i, j) + s*st%t(i, j)
-            part(3, b) = part(3, b) + st%t(i, j)
+            part(1, b) = part(1, b) + (r_at(st, i, j) + s*st%t(q))*st%t(q)
+            part(2, b) = part(2, b) + r_at(st, i, j) + s*st%t(q)
+            part(3, b) = part(3, b) + st%t(q)
          end do
       end do
       rt = sum(part(1, :))
@@ -508,14 +513,14 @@ contains
          do q = (b - 1)*SUM_BLOCK + 1, min(b*SUM_BLOCK, st%nc)
             i = st%contact(1, q)
             j = st%contact(2, q)
-            lin = alpha*p(i, j) - tau*st%t(i, j)
+            lin = alpha*p(i, j) - tau*st%t(q)
             pn = max(lin, 0.0_dp)
             p(i, j) = pn
             part(1, b) = part(1, b) + pn
             if (.not. pn > 0) then
-               ! Leaves the contacts: no force, no direction, no contact gap.
+               ! Leaves the contacts: no force, no contact gap (and no direction: the
+               ! list after the step drops it).
                st%touching(i, j) = 0
-               st%t(i, j) = 0
                st%gm(i, j) = 0
             end if
             if (pn /= lin) call record_change(st, nchanged, i, j, pn - lin)
@@ -563,7 +568,7 @@ contains
    end subroutine correct_displacements
 
    !> The answer: the forces with the load balance applied, the residuals reached, and
-   !> the gap map (formed in t's storage and handed over: no further NP x NP array at
+   !> the gap map (formed in w's storage and handed over: no further NP x NP array at
    !> the peak).
    subroutine iteration_finish(st, grid, p, target, rep, final_gap)
       type(cg_iteration), intent(inout) :: st
@@ -598,13 +603,13 @@ contains
       do j = 1, st%nj
          do i = 1, st%np
             if (st%touching(i, j) /= 0) then
-               st%t(i, j) = 0
+               st%w(i, j) = 0
             else
-               st%t(i, j) = grid%g0(i, j) + alpha*st%w(i, j) - gbar
+               st%w(i, j) = grid%g0(i, j) + alpha*st%w(i, j) - gbar
             end if
          end do
       end do
-      call move_alloc(st%t, final_gap)
+      call move_alloc(st%w, final_gap)
    end subroutine iteration_finish
 
    !> out = c (I * f) with fresh transforms (float32 while `single`), counted.
@@ -668,36 +673,80 @@ contains
       st%kept_old = .false.
    end subroutine join_overlapping
 
-   !> `contact` from `touching`: every contact pixel, column by column.
+   !> `contact` from `touching`: every contact pixel, column by column; the direction
+   !> carried over to the pixels that were in the list before (zero at the others).
    subroutine list_contacts(st)
       type(cg_iteration), intent(inout) :: st
-      integer :: ii, jj, n
-      if (allocated(st%contact)) deallocate(st%contact)
+      integer, allocatable :: old(:, :)
+      real(dp), allocatable :: t_old(:)
+      integer :: ii, jj, n, a
+      if (allocated(st%contact)) call move_alloc(st%contact, old)
+      if (allocated(st%t)) call move_alloc(st%t, t_old)
       allocate(st%contact(2, count(st%touching /= 0)))
+      allocate(st%t(size(st%contact, 2)))
+      st%t = 0
       n = 0
+      a = 1
       do jj = 1, st%nj
          do ii = 1, st%np
             if (st%touching(ii, jj) /= 0) then
                n = n + 1
                st%contact(1, n) = ii
                st%contact(2, n) = jj
+               if (.not. allocated(t_old)) cycle
+               ! The old list is in the same (column, row) order: walk it alongside.
+               do while (a <= size(old, 2))
+                  if (old(2, a) > jj .or. (old(2, a) == jj .and. old(1, a) >= ii)) exit
+                  a = a + 1
+               end do
+               if (a <= size(old, 2)) then
+                  if (old(1, a) == ii .and. old(2, a) == jj) st%t(n) = t_old(a)
+               end if
             end if
          end do
       end do
    end subroutine list_contacts
 
+   !> t scattered into r32 (rounded to float32, as the float32 transform would round it)
+   !> or r, zero off the contacts: the direction's field for its convolution in place.
+   subroutine scatter_direction(st)
+      type(cg_iteration), intent(inout) :: st
+      integer :: q, j
+      if (allocated(st%r32)) then
+         !$omp parallel do
+         do j = 1, st%nj
+            st%r32(:, j) = 0
+         end do
+         !$omp parallel do
+         do q = 1, size(st%contact, 2)
+            st%r32(st%contact(1, q), st%contact(2, q)) = real(st%t(q), sp)
+         end do
+      else
+         !$omp parallel do
+         do j = 1, st%nj
+            st%r(:, j) = 0
+         end do
+         !$omp parallel do
+         do q = 1, size(st%contact, 2)
+            st%r(st%contact(1, q), st%contact(2, q)) = st%t(q)
+         end do
+      end if
+   end subroutine scatter_direction
+
    !> `contact` after a step: the pixels of the list that kept a force merged with those
    !> that entered (each thread's in column order, the threads' columns in order), so the
-   !> list stays in column order and every sum over it in one order.
+   !> list stays in column order and every sum over it in one order; the direction
+   !> follows (zero at the pixels that entered).
    subroutine list_contacts_after_step(st)
       type(cg_iteration), intent(inout) :: st
       integer, allocatable :: new(:, :), came(:, :)
+      real(dp), allocatable :: new_t(:)
       integer :: n, k, a, b, kept, th
       kept = 0
       do k = 1, size(st%contact, 2)
          if (st%touching(st%contact(1, k), st%contact(2, k)) /= 0) kept = kept + 1
       end do
-      allocate(came(2, sum(st%entering%n)), new(2, kept + sum(st%entering%n)))
+      allocate(came(2, sum(st%entering%n)), new(2, kept + sum(st%entering%n)), new_t(kept + sum(st%entering%n)))
       n = 0
       do th = 0, st%threads - 1
          if (st%entering(th)%n == 0) cycle
@@ -718,20 +767,25 @@ contains
             n = n + 1
             if (b > size(came, 2)) then
                new(:, n) = contact(:, a)
+               new_t(n) = st%t(a)
                a = a + 1
             else if (a > size(contact, 2)) then
                new(:, n) = came(:, b)
+               new_t(n) = 0
                b = b + 1
             else if (contact(2, a) < came(2, b) .or. (contact(2, a) == came(2, b) .and. contact(1, a) < came(1, b))) then
                new(:, n) = contact(:, a)
+               new_t(n) = st%t(a)
                a = a + 1
             else
                new(:, n) = came(:, b)
+               new_t(n) = 0
                b = b + 1
             end if
          end do
       end associate
       call move_alloc(new, st%contact)
+      call move_alloc(new_t, st%t)
    end subroutine list_contacts_after_step
 
    !> Count a change of the force at pixel (i, j) by the projection, d (nN), and keep it
