@@ -139,7 +139,8 @@ module femcod_mpi_cg
       real(dp), allocatable :: plastic(:, :)
       !> Of `seconds`: in the transforms and in communication (distributed_grid).
       real(dp) :: transform_seconds = 0, communication_seconds = 0
-      !> This rank's columns: contact forces (nN) and gaps (nm, 0 at the contacts).
+      !> This rank's columns: contact forces (nN; kept by the observer's choice) and gaps
+      !> (nm, 0 at the contacts).
       real(dp), allocatable :: force(:, :), gap(:, :)
       !> With --tangential or --slip (femcod_mpi_shear): this rank's contact pixels (rows,
       !> columns 1 .. nj, in column order), the order of the values' tractions, and their
@@ -149,9 +150,10 @@ module femcod_mpi_cg
    end type distributed_state
 
    !> What solve_loads tells as it goes: the serial observer's hooks, and each state's
-   !> columns as soon as the state is recorded. The base keeps them; femcod-mpi's
-   !> observer (femcod_mpi_observer) writes them into the result file and frees them, so
-   !> that a run of many states holds the columns of one.
+   !> columns as soon as the state is recorded, with the solver's forces. The base keeps
+   !> them (a copy of the forces in the state); femcod-mpi's observer
+   !> (femcod_mpi_observer) writes them into the result file and frees them, so that a
+   !> run of many states holds the columns of one, and no copy of the forces is made.
    type, extends(solver_observer) :: distributed_observer
    contains
       procedure :: columns_solved => keep_columns
@@ -160,13 +162,17 @@ module femcod_mpi_cg
 contains
 
    !> State k of n (its place in the targets given, not the order of solving) is recorded
-   !> on every rank, with this rank's columns. Collective: every rank is told of the same
-   !> state at the same time. The base keeps everything.
-   subroutine keep_columns(self, k, n, grid, state)
+   !> on every rank, with this rank's columns of its gaps (in the state) and of its
+   !> contact forces (nN, the solver's own, valid until the next state). Collective:
+   !> every rank is told of the same state at the same time. The base keeps everything,
+   !> the forces copied into the state.
+   subroutine keep_columns(self, k, n, grid, state, forces)
       class(distributed_observer), intent(inout) :: self
       integer, intent(in) :: k, n
       type(distributed_grid), intent(inout) :: grid
       type(distributed_state), intent(inout) :: state
+      real(dp), intent(in) :: forces(:, :)
+      state%force = forces
    end subroutine keep_columns
 
    !> What every rank needs of the deck besides its columns of the gaps: [NP, pixel (nm),
@@ -710,7 +716,7 @@ contains
                return
             end if
          end associate
-         call observer%columns_solved(k, m, grid, states(k))
+         call observer%columns_solved(k, m, grid, states(k), session%p)
       end do
    end subroutine solve_loads
 
@@ -759,7 +765,6 @@ contains
       st%attractive = answer%attractive
       st%attractive_load = answer%attractive_load
       st%mean_gap = answer%mean_gap
-      st%force = session%p
       if (allocated(answer%gap)) then
          call move_alloc(answer%gap, st%gap)
       else

@@ -5,7 +5,8 @@
 !> - Each state, as soon as it is solved: its columns go into the result file being built
 !>   (femcod_mpi_results' write_state_columns), its two map figures are drawn on rank 0
 !>   (their text kept until the result set is written), with --tangential its contact
-!>   list is kept, and its columns leave memory. A run of many states thus holds the
+!>   list is kept, and its columns leave memory (the forces are read from the solver's
+!>   own columns: no copy). A run of many states thus holds the
 !>   columns of one (16 bytes a pixel a state before, and on rank 0 16 MB a state of
 !>   figure blocks).
 module femcod_mpi_observer
@@ -56,25 +57,26 @@ contains
    !> area (the same numbers as the largest pressure: division by a positive number keeps
    !> the order), the gap figure the blocks' largest negated gap, negated back: no copy of
    !> the columns is made.
-   subroutine write_and_free(self, k, n, grid, state)
+   subroutine write_and_free(self, k, n, grid, state, forces)
       class(signal_observer), intent(inout) :: self
       integer, intent(in) :: k, n
       type(distributed_grid), intent(inout) :: grid
       type(distributed_state), intent(inout) :: state
+      real(dp), intent(in) :: forces(:, :)
       real(dp), allocatable :: blocks(:, :)
       character(len=:), allocatable :: title
       if (.not. allocated(self%path) .or. self%written%code /= 0) return
       if (.not. allocated(self%pressure_svg)) allocate(self%pressure_svg(n), self%gap_svg(n))
       if (self%block_values > 0) then
-         call write_state_columns(self%path, grid, k, n, state, self%written, self%block_values)
+         call write_state_columns(self%path, grid, k, n, state, forces, self%written, self%block_values)
       else
-         call write_state_columns(self%path, grid, k, n, state, self%written)
+         call write_state_columns(self%path, grid, k, n, state, forces, self%written)
       end if
       if (self%written%code /= 0) return
       title = " at "//sig_str(state%load, 6)//" nN (approach "//sig_str(state%approach, 4)//" nm, "// &
          int_str(state%contacts)//" contacts"
       if (self%figure > 1) title = title//", "//int_str(self%figure)//" x "//int_str(self%figure)//" blocks"
-      call gather_block_maxima(grid, state%force, self%figure, blocks)
+      call gather_block_maxima(grid, forces, self%figure, blocks)
       if (grid%rank == 0) then
          blocks = blocks/grid%pixel**2
          self%pressure_svg(k)%s = svg_pressure_map("contact pressure"//title//")", blocks, grid%np*grid%pixel)
@@ -86,8 +88,8 @@ contains
          blocks = -blocks
          self%gap_svg(k)%s = svg_map("gap"//title//")", blocks, grid%np*grid%pixel, "nm", "gap", BLOCK_SMALLEST, .false.)
       end if
-      if (self%tangential) call take_contact_list(state)
-      deallocate(state%force, state%gap)
+      if (self%tangential) call take_contact_list(forces, state%tangential_i, state%tangential_j, state%contact_force)
+      deallocate(state%gap)
       if (allocated(state%plastic)) deallocate(state%plastic)
    end subroutine write_and_free
 end module femcod_mpi_observer

@@ -228,7 +228,8 @@ contains
          if (status%code /= 0) exit
          associate(s => states(k))
             if (s%contacts == 0) cycle
-            if (.not. allocated(s%tangential_i)) call take_contact_list(s)
+            if (.not. allocated(s%tangential_i)) call take_contact_list(s%force, s%tangential_i, s%tangential_j, &
+               s%contact_force)
             call solve_tangential_on(op, s%tangential_i, s%tangential_j, s%contact_force, request, answer, status, &
                observer)
             if (status%code /= 0) then
@@ -244,22 +245,25 @@ contains
       call distributed_shear_free(op)
    end subroutine tangential_on_ranks
 
-   !> This rank's contact pixels of `state` (force > 0; rows, columns 1 .. nj in column
-   !> order) and their forces (nN), from its force columns: all the tangential step needs
-   !> of the state, so that the columns may leave memory before it runs.
-   subroutine take_contact_list(state)
-      type(distributed_state), intent(inout) :: state
+   !> This rank's contact pixels (forces > 0, nN; rows and columns 1 .. nj in column
+   !> order) and their forces, from its force columns: all the tangential step needs of a
+   !> state (distributed_state's tangential_i, tangential_j, contact_force), so that the
+   !> columns may leave memory before it runs.
+   pure subroutine take_contact_list(forces, rows, columns, contact_forces)
+      real(dp), intent(in) :: forces(:, :)
+      integer, allocatable, intent(out) :: rows(:), columns(:)
+      real(dp), allocatable, intent(out) :: contact_forces(:)
       integer :: i, j, n
-      n = count(state%force > 0)
-      allocate(state%tangential_i(n), state%tangential_j(n), state%contact_force(n))
+      n = count(forces > 0)
+      allocate(rows(n), columns(n), contact_forces(n))
       n = 0
-      do j = 1, size(state%force, 2)
-         do i = 1, size(state%force, 1)
-            if (state%force(i, j) > 0) then
+      do j = 1, size(forces, 2)
+         do i = 1, size(forces, 1)
+            if (forces(i, j) > 0) then
                n = n + 1
-               state%tangential_i(n) = i
-               state%tangential_j(n) = j
-               state%contact_force(n) = state%force(i, j)
+               rows(n) = i
+               columns(n) = j
+               contact_forces(n) = forces(i, j)
             end if
          end do
       end do

@@ -23,7 +23,7 @@ module test_distributed
    use femcod_tangential, only: tangential_request_of
    use femcod_mpi_shear, only: tangential_on_ranks
    use femcod_mpi_observer, only: signal_observer
-   use femcod_mpi_results, only: begin_distributed_results
+   use femcod_mpi_results, only: begin_distributed_results, gather_block_maxima
    use femcod_hdf5, only: h5_file, h5_open, h5_read, h5_close
    use femcod_results, only: load_group
    use femcod_files, only: remove_file
@@ -64,6 +64,8 @@ contains
          test_friction_against_serial), &
          new_unittest("femcod-mpi's observer: each state's columns into the file as solved, then freed", &
             test_streamed_columns), &
+         new_unittest("figure blocks gathered on rank 0: the whole map's block maxima (blocks across ranks)", &
+            test_block_maxima), &
          new_unittest("--tangential (partial slip): the serial tractions and stick map on 1, 2 and 4 ranks", &
          test_tangential_against_serial), &
          new_unittest("--boundary periodic --slip: the serial tractions and stick map on 1, 2 and 4 ranks", &
@@ -523,6 +525,66 @@ contains
       call against_serial(error, options)
    end subroutine test_tangential_against_serial
 
+   !> The 64^2 self-affine deck of the tests below (2 nm pixels, seed 3).
+   subroutine rough_deck_64(deck, status)
+      type(contact_problem), intent(out) :: deck
+      type(status_type), intent(inout) :: status
+      type(scene_spec) :: spec
+      spec%kind = "self-affine"
+      spec%label = "test"
+      spec%np = 64
+      spec%pixel = 2
+      spec%seed = 3
+      call build_problem(spec, deck, status)
+   end subroutine rough_deck_64
+
+   !> gather_block_maxima (femcod-mpi's figures): on a 64^2 grid split over the ranks,
+   !> blocks of 1, 3 and 5 columns (3 and 5 do not divide a rank's 32 or 16 columns, so
+   !> blocks lie across two ranks), rank 0's blocks equal the largest value of each block
+   !> of the whole map, taken directly (every rank knows the whole map here: pseudo-random
+   !> values, frac(43758.5453 sin(12.9898 i + 78.233 j)), so that a block's largest value
+   !> lies in either rank's part of it).
+   subroutine test_block_maxima(error)
+      type(error_type), allocatable, intent(out) :: error
+      type(contact_problem) :: deck
+      type(cg_settings) :: how
+      type(status_type) :: status
+      type(distributed_grid) :: grid
+      real(dp), allocatable :: whole(:, :), blocks(:, :)
+      real(dp) :: bad(1)
+      integer :: block, i, j, f, m, k
+      integer, parameter :: widths(3) = [1, 3, 5]
+      call rough_deck_64(deck, status)
+      call distribute_problem(deck, MPI_COMM_WORLD, how, grid, block, status, .false.)
+      call check(error, status%code, 0)
+      if (allocated(error)) return
+      allocate(whole(64, 64))
+      do j = 1, 64
+         do i = 1, 64
+            whole(i, j) = modulo(43758.5453_dp*sin(12.9898_dp*i + 78.233_dp*j), 1.0_dp)
+         end do
+      end do
+      bad = 0
+      do k = 1, size(widths)
+         f = widths(k)
+         call gather_block_maxima(grid, whole(:, grid%j0 + 1:grid%j0 + grid%nj), f, blocks)
+         if (grid%rank /= 0) cycle
+         m = (64 + f - 1)/f
+         if (any(shape(blocks) /= [m, m])) then
+            bad = bad + 1
+            cycle
+         end if
+         do j = 1, m
+            do i = 1, m
+               if (blocks(i, j) /= maxval(whole((i - 1)*f + 1:min(64, i*f), (j - 1)*f + 1:min(64, j*f)))) bad = bad + 1
+            end do
+         end do
+      end do
+      call grid_free(grid)
+      call MPI_Allreduce(MPI_IN_PLACE, bad, 1, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_COMM_WORLD)
+      call check(error, nint(bad(1)), 0, "blocks unlike the whole map's block maxima")
+   end subroutine test_block_maxima
+
    !> femcod-mpi's observer (femcod_mpi_observer) writes each state's columns into the
    !> result file as soon as the state is solved, then frees them. Loads given out of order
    !> (20000, 3000, 8000 nN; the plastic cap; a tangential step after the states) on all
@@ -534,7 +596,6 @@ contains
    !> the contact lists the observer kept, with the kept columns' answer.
    subroutine test_streamed_columns(error)
       type(error_type), allocatable, intent(out) :: error
-      type(scene_spec) :: spec
       type(contact_problem) :: deck
       type(contact_options) :: options
       type(status_type) :: status
@@ -549,12 +610,7 @@ contains
       integer :: block, k, rank, ranks, stage
       call MPI_Comm_rank(MPI_COMM_WORLD, rank)
       call MPI_Comm_size(MPI_COMM_WORLD, ranks)
-      spec%kind = "self-affine"
-      spec%label = "test"
-      spec%np = 64
-      spec%pixel = 2
-      spec%seed = 3
-      call build_problem(spec, deck, status)
+      call rough_deck_64(deck, status)
       options%solver = SOLVER_CG
       options%loads = [2.0e4_dp, 3.0e3_dp, 8.0e3_dp]
       options%plastic = .true.

@@ -167,28 +167,37 @@ contains
    end function cg_storage_bytes
 
    !> femcod-mpi's distributed solver's storage on all ranks together (bytes; each rank
-   !> holds its share), from what it allocates per pixel of the NP x NP grid: the gaps (8);
-   !> the column transforms' complex half spectrum (8 on the periodic cell, 16 padded
-   !> free); on more than one node (`one_node` false) the rows' (8, or 32 free: rows of
-   !> 2 NP for NP + 1 frequencies; on one node they are freed after the set-up, as the
-   !> convolution reads its rows from the shared columns); the kernel's real spectrum for
-   !> half of one axis' frequencies (it is even) and its float32 copy (2 + 1, or 8 + 4
-   !> free); the iteration's w and t (16), the stencil's float32 copy and the float32
-   !> residual (8), the contact flags (1); the forces (8); per state held at once
-   !> (`nstates`: femcod-mpi writes each state's columns as soon as it is solved and frees
-   !> them, 1) the gap map and a copy of the forces (16). With the plastic cap, as
-   !> femcod_cg's: the deck's gaps, the capped flags, the capped rounds' force, field and
-   !> gap maps (36) and per state held the plastic map (8). Measured on one node (4096^2 text deck, 2 ranks, 1 state;
-   !> femcod-mpi's estimate adds what each rank holds and the shared Love table): free
-   !> 864 and 852 MB estimated against 892 and 845 MB peak resident memory, periodic 728
-   !> and 716 against 605 and 574.
+   !> holds its share), from what it allocates per pixel of the NP x NP grid. Throughout:
+   !> the gaps (8), the column transforms' complex half spectrum (8 on the periodic cell,
+   !> 16 padded free) and the kernel's real spectrum for half of one axis' frequencies (it
+   !> is even) with its float32 copy (2 + 1, or 8 + 4 free). The set-up: the rows' buffer
+   !> (8, or 32 free: rows of 2 NP for NP + 1 frequencies) and the reader's gaps beside the
+   !> grid's (8); on one node the rows' buffer is freed after it (the convolution reads
+   !> its rows from the shared columns), on more than one node (`one_node` false) it stays.
+   !> The iteration: the force displacements (8; the direction lives on the contacts),
+   !> the stencil's float32 copy and the float32 residual (8), the contact flags (1), the
+   !> forces (8), and per state held at once (`nstates`: femcod-mpi writes each state's
+   !> columns as soon as it is solved and frees them, 1) its gap map (8; its forces are
+   !> written from the solver's). With the plastic cap, as femcod_cg's: the deck's gaps,
+   !> the capped flags, the capped rounds' force, field and gap maps (36) and per state
+   !> held the plastic map (8). On one node the peak is the larger of the set-up and the
+   !> iteration. Measured on one node (4096^2 text deck, 2 ranks, 1 state; femcod-mpi's
+   !> estimate adds what each rank holds and the shared Love table): free 792 and 780 MB
+   !> estimated against 856 and 844 MB peak resident memory (the set-up's), periodic 600
+   !> and 588 against 561 and 536.
    pure function distributed_storage_bytes(np, nstates, periodic, plastic, one_node) result(bytes)
       integer, intent(in) :: np, nstates
       logical, intent(in) :: periodic, plastic, one_node
-      integer(i8) :: bytes, per_pixel
-      per_pixel = 8 + merge(8, 16, periodic) + merge(0, merge(8, 32, periodic), one_node) + &
-         merge(2 + 1, 8 + 4, periodic) + 16 + 8 + 1 + 8 + 16*nstates
-      if (plastic) per_pixel = per_pixel + 36 + 8*nstates
+      integer(i8) :: bytes, per_pixel, throughout, setup, iteration
+      throughout = 8 + merge(8, 16, periodic) + merge(2 + 1, 8 + 4, periodic)
+      setup = merge(8, 32, periodic) + 8
+      iteration = 8 + 8 + 1 + 8 + 8*nstates
+      if (plastic) iteration = iteration + 36 + 8*nstates
+      if (one_node) then
+         per_pixel = throughout + max(setup, iteration)
+      else
+         per_pixel = throughout + merge(8, 32, periodic) + iteration
+      end if
       bytes = int(np, i8)**2*per_pixel
    end function distributed_storage_bytes
 
