@@ -42,8 +42,8 @@ program femcod_mpi
    use femcod_about, only: FEMCOD_VERSION
    use femcod_exit, only: exit_program
    use femcod_help, only: help_requested
-   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, scatter_problem, grid_setup, &
-      distributed_rms_slope
+   use femcod_mpi_cg, only: distributed_grid, distributed_state, grid_free, solve_loads, scatter_problem, &
+      grid_setup_taking, distributed_rms_slope
    use femcod_love, only: composite_modulus
    use femcod_cg, only: distributed_storage_bytes
    use femcod_mpi_results, only: distributed_run_info, begin_distributed_results, write_distributed_results, figure_block, &
@@ -200,9 +200,9 @@ program femcod_mpi
    ! Each state's columns leave memory once written (femcod_mpi_observer): one state's at a time.
    call check_node_memory(np, 1, status)
    if (status%code /= 0) call finish(status%code, status%message)
-   call grid_setup(grid, MPI_COMM_WORLD, np, block, local, constants(2), constants(3), constants(4), &
+   ! The grid takes this rank's gaps (`local` is deallocated): the set-up holds them once.
+   call grid_setup_taking(grid, MPI_COMM_WORLD, np, block, local, constants(2), constants(3), constants(4), &
       settings%solve%cg, status, settings%solve%boundary == BOUNDARY_PERIODIC)
-   deallocate(local)
    ! kappa's slope scale: the initial gaps' rms slope, from every rank's columns.
    slope = 0
    if (status%code == 0) slope = distributed_rms_slope(grid)

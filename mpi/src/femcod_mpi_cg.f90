@@ -73,8 +73,8 @@ module femcod_mpi_cg
    use femcod_clock, only: wall_clock
    implicit none
    private
-   public :: distributed_grid, distributed_state, distributed_observer, grid_setup, grid_free, solve_loads, &
-      column_split, coarse_factor, gap_grid_setup
+   public :: distributed_grid, distributed_state, distributed_observer, grid_setup, grid_setup_taking, grid_free, &
+      solve_loads, column_split, coarse_factor, gap_grid_setup
    public :: distribute_problem, scatter_problem, distributed_convolve, problem_constants, distributed_rms_slope
 
    !> One rank's part of the problem and of the distributed convolution: an elastic
@@ -215,15 +215,31 @@ contains
       end do
    end subroutine column_split
 
-   !> The distributed grid from this rank's initial gaps (g0 of the columns `first`..)
-   !> and the global constants; makes the FFTW plans (femcod_mpi_slab_transform) and the
-   !> kernel's spectrum.
-   !> Collective over `comm`.
+   !> grid_setup_taking from a copy of g0 (the caller keeps its gaps).
    subroutine grid_setup(grid, comm, np, block, g0, pixel, c, s, how, status, periodic)
       type(distributed_grid), intent(inout) :: grid
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: np, block
       real(dp), intent(in) :: g0(:, :)
+      real(dp), intent(in) :: pixel, c, s
+      type(cg_settings), intent(in) :: how
+      type(status_type), intent(inout) :: status
+      logical, intent(in), optional :: periodic
+      real(dp), allocatable :: gaps(:, :)
+      gaps = g0
+      call grid_setup_taking(grid, comm, np, block, gaps, pixel, c, s, how, status, periodic)
+   end subroutine grid_setup
+
+   !> The distributed grid from this rank's initial gaps (g0 of the columns `first`..,
+   !> taken into the grid: g0 is deallocated, so that the set-up does not hold them twice)
+   !> and the global constants; makes the FFTW plans (femcod_mpi_slab_transform) and the
+   !> kernel's spectrum.
+   !> Collective over `comm`.
+   subroutine grid_setup_taking(grid, comm, np, block, g0, pixel, c, s, how, status, periodic)
+      type(distributed_grid), intent(inout) :: grid
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: np, block
+      real(dp), allocatable, intent(inout) :: g0(:, :)
       real(dp), intent(in) :: pixel, c, s
       type(cg_settings), intent(in) :: how
       type(status_type), intent(inout) :: status
@@ -258,12 +274,12 @@ contains
             int_str(np)//" x "//int_str(grid%nj)//" columns")
          return
       end if
-      grid%g0 = g0
+      call move_alloc(g0, grid%g0)
       grid%pixel = pixel
       grid%c = c
       grid%s = s
-      lo = minval(g0)
-      hi = maxval(g0)
+      lo = minval(grid%g0)
+      hi = maxval(grid%g0)
       call MPI_Allreduce(MPI_IN_PLACE, lo, 1, MPI_DOUBLE_PRECISION, MPI_MIN, comm)
       call MPI_Allreduce(MPI_IN_PLACE, hi, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       grid%scale = max(hi - lo, tiny(1.0_dp))
@@ -281,7 +297,7 @@ contains
       end if
       ! The convolutions need no row memory on one node.
       call slab_release_rows(grid%slab)
-   end subroutine grid_setup
+   end subroutine grid_setup_taking
 
    !> The shared window of the Love table (distributed_grid%table), allocated by rank 0
    !> and mapped by every rank, when how%direct_corrections > 0 and every rank of the
@@ -534,8 +550,8 @@ contains
       real(dp), allocatable :: local(:, :)
       real(dp) :: constants(4)
       call scatter_problem(problem, comm, how, local, constants, block)
-      call grid_setup(grid, comm, nint(constants(1)), block, local, constants(2), constants(3), constants(4), how, &
-         status, periodic)
+      call grid_setup_taking(grid, comm, nint(constants(1)), block, local, constants(2), constants(3), constants(4), &
+         how, status, periodic)
    end subroutine distribute_problem
 
    !> Rank 0 forms the composite gaps (nm) of `problem` and sends each rank of `comm` its

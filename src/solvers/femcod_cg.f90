@@ -171,9 +171,10 @@ contains
    !> the gaps (8), the column transforms' complex half spectrum (8 on the periodic cell,
    !> 16 padded free) and the kernel's real spectrum for half of one axis' frequencies (it
    !> is even) with its float32 copy (2 + 1, or 8 + 4 free). The set-up: the rows' buffer
-   !> (8, or 32 free: rows of 2 NP for NP + 1 frequencies) and the reader's gaps beside the
-   !> grid's (8); on one node the rows' buffer is freed after it (the convolution reads
-   !> its rows from the shared columns), on more than one node (`one_node` false) it stays.
+   !> (8, or 32 free: rows of 2 NP for NP + 1 frequencies; the grid takes the reader's gaps,
+   !> grid_setup_taking); on one node the rows' buffer is freed after it (the convolution
+   !> reads its rows from the shared columns), on more than one node (`one_node` false) it
+   !> stays.
    !> The iteration: the force displacements (8; the direction lives on the contacts),
    !> the stencil's float32 copy and the float32 residual (8), the contact flags (1), the
    !> forces (8), and per state held at once (`nstates`: femcod-mpi writes each state's
@@ -182,15 +183,17 @@ contains
    !> the capped flags, the capped rounds' force, field and gap maps (36) and per state
    !> held the plastic map (8). On one node the peak is the larger of the set-up and the
    !> iteration. Measured on one node (4096^2 text deck, 2 ranks, 1 state; femcod-mpi's
-   !> estimate adds what each rank holds and the shared Love table): free 792 and 780 MB
-   !> estimated against 856 and 844 MB peak resident memory (the set-up's), periodic 600
-   !> and 588 against 561 and 536.
+   !> estimate adds what each rank holds and the shared Love table): free 736 and 724 MB
+   !> estimated against 792 and 781 MB peak resident memory (the set-up's: each rank's
+   !> resident memory also counts the pages of the other ranks' columns it reads in the
+   !> node's shared window), periodic 599 and 588 against 511 to 559 and 536 to 542 (two
+   !> runs).
    pure function distributed_storage_bytes(np, nstates, periodic, plastic, one_node) result(bytes)
       integer, intent(in) :: np, nstates
       logical, intent(in) :: periodic, plastic, one_node
       integer(i8) :: bytes, per_pixel, throughout, setup, iteration
       throughout = 8 + merge(8, 16, periodic) + merge(2 + 1, 8 + 4, periodic)
-      setup = merge(8, 32, periodic) + 8
+      setup = merge(8, 32, periodic)
       iteration = 8 + 8 + 1 + 8 + 8*nstates
       if (plastic) iteration = iteration + 36 + 8*nstates
       if (one_node) then
