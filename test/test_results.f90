@@ -107,7 +107,7 @@ contains
    !> gap_solver_storage_bytes, plus what the process holds when the solve begins), in
    !> PREFIX.summary.json's memory_bytes, against the peak resident memory the system
    !> measured over the whole run (VmHWM, read as the summary is written): within 0.75 to
-   !> 1.5 of it on 512^2 and 1024^2 self-affine surfaces (measured 0.85 to 0.98), free and
+   !> 1.5 of it on 512^2 and 1024^2 self-affine surfaces (measured 0.84 to 0.98), free and
    !> periodic at fixed loads and in the gap variables with the plastic cap. The model is
    !> for the grids that can exhaust a machine; a small run is dominated by the libraries.
    subroutine test_memory_estimate(error)
